@@ -1,0 +1,16 @@
+// Each subcommand of `recruit` lives in its own file and registers itself on the app.
+// A registration adds the subcommand, its options and a callback that returns the exit code
+// through `exit_code`.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+namespace recruit::cli {
+
+void AddFilterCommand(CLI::App& app, int& exit_code);    // filter_command.cc
+void AddIdentifyCommand(CLI::App& app, int& exit_code);  // identify_command.cc
+void AddSimulateCommand(CLI::App& app, int& exit_code);  // simulate_command.cc
+void AddSweepCommand(CLI::App& app, int& exit_code);     // sweep_command.cc
+void AddRenderCommand(CLI::App& app, int& exit_code);    // render_command.cc
+
+}  // namespace recruit::cli

@@ -1,0 +1,32 @@
+// TelemetrySample: what the closed loop knows after a physics step, handed to observers (CSV
+// writer, video recorder). Shared by src/sim (producer) and src/render (consumer).
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace recruit {
+
+struct BundleTelemetry {
+  std::string actuator;        // actuator name in the model
+  int tendon_id = -1;          // tendon the bundle pulls (for colouring it in renders)
+  double force = 0;            // tension, N
+  int true_on = 0;             // units on (ground truth, the paper's debug interface)
+  double estimated_on = 0;     // the estimator's on-count (NaN when none)
+  double on_fraction = 0;      // true_on / num_units
+  double mean_temperature = 0; // deg C over all units
+  double heat = 0;             // 0 at ambient .. 1 at the on-state steady temperature
+};
+
+struct TelemetrySample {
+  double time = 0;             // s
+  double reference = 0;        // the tracked quantity's reference (N or rad, see `reference_unit`)
+  double measured = 0;         // the tracked quantity as measured
+  std::string reference_unit;  // "N" or "rad"
+  double angle = 0;            // joint angle of the limb's main joint, rad (0 on a bench)
+  double p_on = 0, p_off = 0;  // last broadcast
+  bool control_instant = false;  // true on steps where the controller broadcast
+  std::vector<BundleTelemetry> bundles;
+};
+
+}  // namespace recruit
