@@ -47,6 +47,8 @@ void SmaBundle::Reset(double* s, std::uint64_t seed, double stretch) const {
   c[kTemp] = rest.temperature;
   c[kXi] = rest.xi;
   c[kTeff] = rest.t_eff;
+  c[kHeatScale] = rest.heat_scale;
+  c[kCoolScale] = rest.cool_scale;
   // Unit index block is already 0: every unit in cohort 0.
 }
 
@@ -88,11 +90,13 @@ void SmaBundle::Advance(double* s, double stretch, double dt) const {
   const int k = NumCohorts(s);
   for (int j = 0; j < k; ++j) {
     double* c = Cohort(s, j);
-    UnitState st{c[kTemp], c[kXi], c[kTeff]};
+    UnitState st{c[kTemp], c[kXi], c[kTeff], c[kHeatScale], c[kCoolScale]};
     AdvanceUnitWithDecay(unit_, st, c[kOn] != 0, stretch, decay);
     c[kTemp] = st.temperature;
     c[kXi] = st.xi;
     c[kTeff] = st.t_eff;
+    c[kHeatScale] = st.heat_scale;
+    c[kCoolScale] = st.cool_scale;
   }
   s[kCounterSlot] += 1;
   if (k > 1 && std::fmod(s[kCounterSlot], kMergeEvery) == 0) Merge(s);
@@ -117,14 +121,17 @@ void SmaBundle::Merge(double* s) const {
     const bool same = r[kOn] == c[kOn] &&
                       std::abs(r[kTemp] - c[kTemp]) <= config_.merge_temperature &&
                       std::abs(r[kTeff] - c[kTeff]) <= config_.merge_temperature &&
-                      std::abs(r[kXi] - c[kXi]) <= config_.merge_xi;
+                      std::abs(r[kXi] - c[kXi]) <= config_.merge_xi &&
+                      std::abs(r[kHeatScale] - c[kHeatScale]) <= config_.merge_xi &&
+                      std::abs(r[kCoolScale] - c[kCoolScale]) <= config_.merge_xi;
     if (!same) {
       rep = order[j];
       continue;
     }
     // Count-weighted mean keeps the bundle's mean temperature and fraction.
     const double n = r[kCount] + c[kCount];
-    for (int f : {kTemp, kXi, kTeff}) r[f] = (r[f] * r[kCount] + c[f] * c[kCount]) / n;
+    for (int f : {kTemp, kXi, kTeff, kHeatScale, kCoolScale})
+      r[f] = (r[f] * r[kCount] + c[f] * c[kCount]) / n;
     r[kCount] = n;
     c[kCount] = 0;
     forward[order[j]] = rep;

@@ -65,9 +65,10 @@ class SmaBundle {
   // Header: magic, 4 random-stream words, cohort count, advance counter, spare.
   static constexpr int kHeader = 8;
   static constexpr int kMagicSlot = 0, kRngSlot = 1, kCohortCountSlot = 5, kCounterSlot = 6;
-  // Cohort: count, on, temperature, xi, t_eff.
-  static constexpr int kCohortStride = 5;
-  static constexpr int kCount = 0, kOn = 1, kTemp = 2, kXi = 3, kTeff = 4;
+  // Cohort: count, on, then the UnitState fields.
+  static constexpr int kCohortStride = 7;
+  static constexpr int kCount = 0, kOn = 1, kTemp = 2, kXi = 3, kTeff = 4, kHeatScale = 5,
+                       kCoolScale = 6;
   static constexpr int kMergeEvery = 8;  // steps between merge passes
 
   SmaBundle(BundleConfig c, UnitModel u, double dt);

@@ -156,33 +156,53 @@ void SolvePhase(const UnitModel& m, UnitState& s, double t_thermal, double stret
   const UnitParams& p = m.params();
   const double xi0 = s.xi;
   const double latent = p.latent_heat / p.specific_heat;  // K per unit of xi
-  auto temp = [&](double xi) { return t_thermal + latent * (xi - xi0); };
-  auto teff_h = [&](double xi) { return temp(xi) - m.Stress(m.Tension(xi, stretch)) / p.C_A; };
-  const double te0 = teff_h(xi0);
+  // Temperature after the step if xi ends at x: latent heat is absorbed by M -> A (x < xi0).
+  auto temp = [&](double x) { return t_thermal + latent * (x - xi0); };
+  auto teff_h = [&](double x) { return temp(x) - m.Stress(m.Tension(x, stretch)) / p.C_A; };
+  auto teff_c = [&](double x) { return temp(x) - m.Stress(m.Tension(x, stretch)) / p.C_M; };
+  // Both residuals have slope >= 1 in x: T_eff rises as x falls (stress rises, latent heat is
+  // released as x rises), and M+, M- are non-increasing.
+  auto g_h = [&](double x) { return x - s.heat_scale * m.MajorHeating(teff_h(x)); };
+  auto g_c = [&](double x) { return x - 1 + s.cool_scale * (1 - m.MajorCooling(teff_c(x))); };
+
   double xi = xi0;
-  if (te0 > s.t_eff) {
-    // Heating (M -> A): xi / M+(T_eff) stays constant (proportional rule).
-    const double mp = m.MajorHeating(s.t_eff);
-    const double xi_m = mp > 0 ? std::min(1.0, xi0 / mp) : 1.0;
-    auto g = [&](double x) { return x - xi_m * m.MajorHeating(teff_h(x)); };
-    const double g0 = xi0 - xi_m * m.MajorHeating(te0);
-    if (g0 > 0) xi = SolveIncreasing(g, 0.0, g(0.0), xi0, g0);
-    s.xi = xi;
-    s.temperature = temp(xi);
-    s.t_eff = teff_h(xi);
-    return;
+  double te;
+  const double te_h0 = teff_h(xi0);
+  if (te_h0 >= s.t_eff) {
+    // Heating (or steady): M -> A only, xi can only fall.
+    te = te_h0;
+    const double g0 = g_h(xi0);
+    if (g0 > 1e-12) {
+      xi = SolveIncreasing(g_h, 0.0, g_h(0.0), xi0, g0);
+      te = teff_h(xi);
+      // Transformed: a later cooling branch starts from here.
+      const double mm = m.MajorCooling(te);
+      s.cool_scale = mm < 1 ? std::clamp((1 - xi) / (1 - mm), 0.0, 1.0) : 1.0;
+    }
+  } else {
+    // Cooling: A -> M only, xi can only rise.
+    te = teff_c(xi0);
+    const double g0 = g_c(xi0);
+    if (g0 < -1e-12) {
+      xi = SolveIncreasing(g_c, xi0, g0, 1.0, g_c(1.0));
+      te = teff_c(xi);
+      const double mp = m.MajorHeating(te);
+      s.heat_scale = mp > 0 ? std::clamp(xi / mp, 0.0, 1.0) : 1.0;
+    }
   }
-  // Cooling (A -> M): (1 - xi) / (1 - M-(T_eff)) stays constant.
-  auto teff_c = [&](double xi) { return temp(xi) - m.Stress(m.Tension(xi, stretch)) / p.C_M; };
-  const double te0c = teff_c(xi0);
-  const double mm = m.MajorCooling(s.t_eff);
-  const double c = mm < 1 ? std::min(1.0, (1 - xi0) / (1 - mm)) : 1.0;
-  auto g = [&](double x) { return x - 1 + c * (1 - m.MajorCooling(teff_c(x))); };
-  const double g0 = xi0 - 1 + c * (1 - m.MajorCooling(te0c));
-  if (g0 < 0) xi = SolveIncreasing(g, xi0, g0, 1.0, g(1.0));
+  // Canonical ends of the loop, so that settled units in the same state compare equal.
+  if (xi >= 1 - 1e-12) {
+    xi = 1;
+    s.heat_scale = 1;
+    s.cool_scale = 0;
+  } else if (xi <= 1e-12) {
+    xi = 0;
+    s.heat_scale = 0;
+    s.cool_scale = 1;
+  }
   s.xi = xi;
   s.temperature = temp(xi);
-  s.t_eff = teff_c(xi);
+  s.t_eff = te;
 }
 
 }  // namespace

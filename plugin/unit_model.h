@@ -91,6 +91,12 @@ struct UnitState {
   double temperature = 20;  // C
   double xi = 1;            // martensite fraction: 1 relaxed, 0 contracted
   double t_eff = 20;        // effective temperature T - sigma / C at the last step (for reversals)
+  // Proportional-rule branch constants: heating follows xi = heat_scale * M+(T_eff), cooling
+  // follows 1 - xi = cool_scale * (1 - M-(T_eff)). Each is reset where the opposite branch last
+  // transformed, so a reversal without transformation (e.g. a short cool above Ms) does not
+  // shift the next branch.
+  double heat_scale = 1;
+  double cool_scale = 0;
 };
 
 // Cold, relaxed martensite at ambient, unloaded at `stretch`.

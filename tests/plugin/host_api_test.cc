@@ -36,7 +36,7 @@ TEST(HostApi, IsometricBenchLoadsWithOneBundleOfSixtyUnits) {
   EXPECT_EQ((*p)->actuator_id(0), mj_name2id(l.m, mjOBJ_ACTUATOR, "bundle"));
   auto need = SmaPlugin::RequiredUserdata(l.m);
   ASSERT_TRUE(need.ok());
-  EXPECT_EQ(*need, 8 + 6 * 60);
+  EXPECT_EQ(*need, 8 + 8 * 60);
 }
 
 TEST(HostApi, AllOnThenTensionRisesAndCountIsExact) {
