@@ -60,28 +60,42 @@ Status SmaBundle::Broadcast(double* s, double p_on, double p_off) const {
   }
   Rng rng = LoadRng(s + kRngSlot);
   const int k0 = NumCohorts(s);
-  int k = k0;
-  std::vector<int> split(k0, -1);  // cohort that the switching units of each cohort join
   double* idx = UnitIndex(s);
+  // Pass 1: every unit draws, in unit order.
+  std::vector<int> flips(k0, 0);
+  std::vector<char> flip(config_.units, 0);
   for (int i = 0; i < config_.units; ++i) {
     const int from = static_cast<int>(idx[i]);
-    double* c = Cohort(s, from);
     const double u = rng.Uniform();
-    if (!(u < (c[kOn] != 0 ? p_off : p_on))) continue;
-    if (split[from] < 0) {
-      split[from] = k;
-      double* n = Cohort(s, k++);
-      std::copy(c, c + kCohortStride, n);
-      n[kCount] = 0;
-      n[kOn] = c[kOn] != 0 ? 0 : 1;
+    if (u < (Cohort(s, from)[kOn] != 0 ? p_off : p_on)) {
+      flip[i] = 1;
+      ++flips[from];
     }
-    c[kCount] -= 1;
-    Cohort(s, split[from])[kCount] += 1;
-    idx[i] = split[from];
+  }
+  StoreRng(rng, s + kRngSlot);
+  // Pass 2: a cohort whose units all switch flips in place; one that splits gets a new cohort
+  // for its switching units. Non-empty cohorts never exceed N, so the N slots suffice.
+  std::vector<int> target(k0, -1);
+  int k = k0;
+  for (int j = 0; j < k0; ++j) {
+    if (flips[j] == 0) continue;
+    double* c = Cohort(s, j);
+    if (flips[j] == static_cast<int>(c[kCount])) {
+      c[kOn] = c[kOn] != 0 ? 0 : 1;
+      target[j] = j;
+      continue;
+    }
+    double* n = Cohort(s, k);
+    std::copy(c, c + kCohortStride, n);
+    n[kCount] = flips[j];
+    n[kOn] = c[kOn] != 0 ? 0 : 1;
+    c[kCount] -= flips[j];
+    target[j] = k++;
+  }
+  for (int i = 0; i < config_.units; ++i) {
+    if (flip[i]) idx[i] = target[static_cast<int>(idx[i])];
   }
   s[kCohortCountSlot] = k;
-  StoreRng(rng, s + kRngSlot);
-  if (k != k0) Compact(s, {});
   return Status::Ok();
 }
 

@@ -211,6 +211,10 @@ void AdvanceUnit(const UnitModel& m, UnitState& s, bool on, double stretch, doub
   AdvanceUnitWithDecay(m, s, on, stretch, m.DecayFactor(dt));
 }
 
+void ImposeTemperature(const UnitModel& m, UnitState& s, double t, double stretch) {
+  SolvePhase(m, s, t, stretch);
+}
+
 void AdvanceUnitWithDecay(const UnitModel& m, UnitState& s, bool on, double stretch, double decay) {
   const double t_ss = m.SteadyTemperature(on, s.xi);
   SolvePhase(m, s, t_ss + (s.temperature - t_ss) * decay, stretch);

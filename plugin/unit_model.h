@@ -107,6 +107,9 @@ UnitState RestState(const UnitModel& m, double stretch);
 // and the given extension. Heating and cooling follow the proportional rule, so a reversal starts
 // a minor loop inside the major loop.
 void AdvanceUnit(const UnitModel& m, UnitState& s, bool on, double stretch, double dt);
+// Sets the unit's temperature to t (as if imposed from outside) and solves the phase fraction
+// at extension `stretch`, with the same hysteresis rules (and latent heat) as AdvanceUnit.
+void ImposeTemperature(const UnitModel& m, UnitState& s, double t, double stretch);
 // The same with the thermal decay factor exp(-dt / tau) precomputed by the caller.
 void AdvanceUnitWithDecay(const UnitModel& m, UnitState& s, bool on, double stretch, double decay);
 
