@@ -26,7 +26,13 @@ void StoreRng(const Rng& rng, double* words) {
 }  // namespace
 
 SmaBundle::SmaBundle(BundleConfig c, UnitModel u, double dt)
-    : config_(std::move(c)), unit_(std::move(u)), dt_(dt), decay_(unit_.DecayFactor(dt)) {}
+    : config_(std::move(c)), unit_(std::move(u)), dt_(dt), decay_(unit_.DecayFactor(dt)) {
+  if (config_.update_period > 0) {
+    // The pending time reaches about a whole number of steps >= update_period.
+    period_ = dt_ * std::max(1.0, std::round(config_.update_period / dt_));
+    decay_period_ = unit_.DecayFactor(period_);
+  }
+}
 
 Result<SmaBundle> SmaBundle::Create(const BundleConfig& config, double dt) {
   auto unit = UnitModel::Create(config.unit);
@@ -54,10 +60,11 @@ void SmaBundle::Reset(double* s, std::uint64_t seed, double stretch) const {
 
 bool SmaBundle::Initialized(const double* s) { return s[kMagicSlot] == kMagic; }
 
-Status SmaBundle::Broadcast(double* s, double p_on, double p_off) const {
+Status SmaBundle::Broadcast(double* s, double p_on, double p_off, double stretch) const {
   if (!(p_on >= 0 && p_on <= 1) || !(p_off >= 0 && p_off <= 1)) {
     return Error{"actuator '" + config_.actuator + "': broadcast probabilities must be in [0, 1]"};
   }
+  Flush(s, stretch);  // time not yet integrated ran with the old on/off states
   Rng rng = LoadRng(s + kRngSlot);
   const int k0 = NumCohorts(s);
   double* idx = UnitIndex(s);
@@ -100,7 +107,29 @@ Status SmaBundle::Broadcast(double* s, double p_on, double p_off) const {
 }
 
 void SmaBundle::Advance(double* s, double stretch, double dt) const {
-  const double decay = dt == dt_ ? decay_ : unit_.DecayFactor(dt);
+  if (config_.update_period <= 0) {
+    Integrate(s, stretch, dt);
+    return;
+  }
+  s[kPendingSlot] += dt;
+  if (s[kPendingSlot] >= config_.update_period - 0.5 * dt) Flush(s, stretch);
+}
+
+void SmaBundle::Flush(double* s, double stretch) const {
+  const double t = s[kPendingSlot];
+  s[kPendingSlot] = 0;
+  if (t > 0) Integrate(s, stretch, t);
+}
+
+void SmaBundle::Integrate(double* s, double stretch, double dt) const {
+  double decay;
+  if (dt == dt_) {
+    decay = decay_;
+  } else if (std::abs(dt - period_) < 1e-9 * period_) {
+    decay = decay_period_;
+  } else {
+    decay = unit_.DecayFactor(dt);
+  }
   const int k = NumCohorts(s);
   for (int j = 0; j < k; ++j) {
     double* c = Cohort(s, j);

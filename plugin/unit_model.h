@@ -52,8 +52,14 @@ class UnitModel {
   double MajorHeating(double t_eff) const;
   double MajorCooling(double t_eff) const;
 
-  // Tension of one unit (N, >= 0) at fraction xi and extension `stretch` (m).
+  // The same with their derivatives with respect to t_eff (<= 0) in *slope.
+  double MajorHeating(double t_eff, double* slope) const;
+  double MajorCooling(double t_eff, double* slope) const;
+
+  // Tension of one unit (N, >= 0) at fraction xi and extension `stretch` (m), and its
+  // derivative with respect to xi.
   double Tension(double xi, double stretch) const;
+  double TensionSlope(double xi, double stretch) const;
   // Equivalent tensile stress (Pa) that shifts the transformation temperatures at tension f.
   double Stress(double f) const { return stress_per_newton_ * f; }
 

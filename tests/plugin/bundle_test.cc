@@ -58,7 +58,7 @@ void RunAgainstReference(int units, double merge_t, double merge_xi, double tol_
   for (int step = 0; step < 20000; ++step) {
     if (step % 500 == 0) {
       const double p_on = 0.3 * control.Uniform(), p_off = 0.3 * control.Uniform();
-      ASSERT_TRUE(b.Broadcast(state.data(), p_on, p_off).ok());
+      ASSERT_TRUE(b.Broadcast(state.data(), p_on, p_off, stretch).ok());
       ref.Broadcast(p_on, p_off);
     }
     b.Advance(state.data(), stretch, 1e-3);
@@ -102,7 +102,9 @@ TEST(SmaBundle, CohortCountGrowsSublinearlyWithBundleSize) {
     b.Reset(state.data(), 3, stretch);
     int samples = 0;
     for (int step = 0; step < 15000; ++step) {
-      if (step % 500 == 0) ASSERT_TRUE(b.Broadcast(state.data(), 0.1, 0.1).ok());
+      if (step % 500 == 0) {
+        ASSERT_TRUE(b.Broadcast(state.data(), 0.1, 0.1, stretch).ok());
+      }
       b.Advance(state.data(), stretch, 1e-3);
       if (step >= 8000) {
         mean_cohorts[k] += b.NumCohorts(state.data());
@@ -122,11 +124,12 @@ TEST(SmaBundle, SettledCohortsMergeBackToOne) {
   const double stretch = b.config().unit.prestretch;
   b.Reset(state.data(), 5, stretch);
   for (int k = 0; k < 5; ++k) {
-    ASSERT_TRUE(b.Broadcast(state.data(), 0.5, 0).ok());
+    ASSERT_TRUE(b.Broadcast(state.data(), 0.5, 0, stretch).ok());
     for (int i = 0; i < 300; ++i) b.Advance(state.data(), stretch, 1e-3);
   }
   EXPECT_GT(b.NumCohorts(state.data()), 3);
-  ASSERT_TRUE(b.Broadcast(state.data(), 0, 1).ok());  // all off: every unit cools to ambient
+  ASSERT_TRUE(
+      b.Broadcast(state.data(), 0, 1, stretch).ok());  // all off: every unit cools to ambient
   for (int i = 0; i < 30000; ++i) b.Advance(state.data(), stretch, 1e-3);
   EXPECT_EQ(b.NumCohorts(state.data()), 1);
   EXPECT_EQ(b.OnCount(state.data()), 0);
@@ -139,11 +142,11 @@ TEST(SmaBundle, BroadcastCountsFollowBinomialLaw) {
   std::vector<double> state(b.state_size());
   for (std::uint64_t seed = 1; seed <= 5; ++seed) {
     b.Reset(state.data(), seed, 0);
-    ASSERT_TRUE(b.Broadcast(state.data(), 0.3, 0.9).ok());
+    ASSERT_TRUE(b.Broadcast(state.data(), 0.3, 0.9, 0.0).ok());
     const int on = b.OnCount(state.data());
     EXPECT_NEAR(on, 1800, 5 * 35.5) << "seed " << seed;
     // Then p_off = 0.5 of the on units, p_on = 0 of the off ones: Binomial(on, 0.5).
-    ASSERT_TRUE(b.Broadcast(state.data(), 0, 0.5).ok());
+    ASSERT_TRUE(b.Broadcast(state.data(), 0, 0.5, 0.0).ok());
     EXPECT_NEAR(b.OnCount(state.data()), 0.5 * on, 5 * std::sqrt(on * 0.25));
   }
 }
@@ -154,7 +157,7 @@ TEST(SmaBundle, SameSeedSameDrawsDifferentSeedDifferentDraws) {
   b.Reset(s1.data(), 11, 0);
   b.Reset(s2.data(), 11, 0);
   b.Reset(s3.data(), 12, 0);
-  for (auto* s : {&s1, &s2, &s3}) ASSERT_TRUE(b.Broadcast(s->data(), 0.5, 0.5).ok());
+  for (auto* s : {&s1, &s2, &s3}) ASSERT_TRUE(b.Broadcast(s->data(), 0.5, 0.5, 0.0).ok());
   EXPECT_EQ(s1, s2);
   EXPECT_NE(s1, s3);
 }
@@ -163,9 +166,9 @@ TEST(SmaBundle, RejectsProbabilitiesOutsideUnitInterval) {
   const SmaBundle b = MakeBundle(10, 0.5, 0.01);
   std::vector<double> s(b.state_size());
   b.Reset(s.data(), 1, 0);
-  EXPECT_FALSE(b.Broadcast(s.data(), -0.1, 0).ok());
-  EXPECT_FALSE(b.Broadcast(s.data(), 0, 1.5).ok());
-  EXPECT_FALSE(b.Broadcast(s.data(), std::nan(""), 0).ok());
+  EXPECT_FALSE(b.Broadcast(s.data(), -0.1, 0, 0.0).ok());
+  EXPECT_FALSE(b.Broadcast(s.data(), 0, 1.5, 0.0).ok());
+  EXPECT_FALSE(b.Broadcast(s.data(), std::nan(""), 0, 0.0).ok());
   EXPECT_EQ(b.OnCount(s.data()), 0);
 }
 

@@ -133,6 +133,32 @@ TEST(IsometricBench, StepResponseMatchesPaperFigure4) {
   EXPECT_LE(s.relax, 3.0);
 }
 
+TEST(IsometricBench, CoarserUnitUpdatePeriodKeepsTheForceWithinOnePercent) {
+  // update_period=0.01: units integrated every 10 steps (exact thermal step, implicit phase).
+  ModelPtr me = MustLoad(BenchXml("units=60"));
+  ModelPtr mc = MustLoad(BenchXml("units=60 update_period=0.01"));
+  auto pe = MustCreate(me.get());
+  auto pc = MustCreate(mc.get());
+  DataPtr de = MakeData(me.get()), dc = MakeData(mc.get());
+  pe->Reset(de.get(), 8);
+  pc->Reset(dc.get(), 8);
+  double max_diff = 0, max_force = 0;
+  for (int i = 0; i < 12000; ++i) {
+    if (i % 1500 == 0) {  // broadcasts between unit updates flush the pending time first
+      ASSERT_TRUE(pe->Broadcast(de.get(), 0, 0.5, 0.3).ok());
+      ASSERT_TRUE(pc->Broadcast(dc.get(), 0, 0.5, 0.3).ok());
+    }
+    Step(me.get(), de.get(), *pe);
+    Step(mc.get(), dc.get(), *pc);
+    ASSERT_EQ(pe->OnCount(de.get(), 0), pc->OnCount(dc.get(), 0));
+    max_diff = std::max(max_diff, std::abs(pe->Force(de.get(), 0) - pc->Force(dc.get(), 0)));
+    max_force = std::max(max_force, pe->Force(de.get(), 0));
+  }
+  EXPECT_GT(max_force, 10.0);
+  EXPECT_LT(max_diff, 0.01 * max_force) << max_diff << " N of " << max_force << " N";
+  std::printf("[ info ] update_period=0.01: max |dF| = %.3g N of %.3g N\n", max_diff, max_force);
+}
+
 TEST(IsometricBench, ForceFollowsTendonLengthWithSpringStiffness) {
   ModelPtr m = MustLoad(BenchXml());
   auto p = MustCreate(m.get());
@@ -284,7 +310,9 @@ TEST_P(InvalidModel, IsRejectedWithMessageNamingTheField) {
   // The model stays usable: stepping it without a plugin applies no SMA force.
   DataPtr d = MakeData(m.get());
   mj_step(m.get(), d.get());
-  if (m->nu > 0) EXPECT_EQ(d->actuator_force[0], 0.0);
+  if (m->nu > 0) {
+    EXPECT_EQ(d->actuator_force[0], 0.0);
+  }
 }
 
 std::string Replace(std::string s, const std::string& from, const std::string& to) {
@@ -404,7 +432,9 @@ TEST(Registry, ParallelRunsMatchSerialRunsBitForBit) {
     p->Reset(d.get(), seed);
     std::vector<double> f;
     for (int i = 0; i < 4000; ++i) {
-      if (i % 250 == 0) EXPECT_TRUE(p->Broadcast(d.get(), 0, 0.3, 0.3).ok());
+      if (i % 250 == 0) {
+        EXPECT_TRUE(p->Broadcast(d.get(), 0, 0.3, 0.3).ok());
+      }
       Step(m.get(), d.get(), *p);
       f.push_back(p->Force(d.get(), 0));
     }
