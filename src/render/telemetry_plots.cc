@@ -50,6 +50,8 @@ TelemetryPlots::TelemetryPlots(double window)
   Style(tracking_.get());
   Style(recruitment_.get());
   std::snprintf(tracking_->title, sizeof(tracking_->title), "tracking");
+  std::snprintf(tracking_->yformat, sizeof(tracking_->yformat), "%%.1f");
+  std::snprintf(recruitment_->yformat, sizeof(recruitment_->yformat), "%%.0f");
   std::snprintf(recruitment_->title, sizeof(recruitment_->title), "units on: true vs estimated");
   SetLine(tracking_.get(), 0, "reference", 1.f, 1.f, 1.f);
   SetLine(tracking_.get(), 1, "measured", 1.f, 0.35f, 0.2f);
