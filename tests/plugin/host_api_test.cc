@@ -3,6 +3,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <thread>
@@ -505,6 +506,41 @@ TEST(HostApi, AgonistAndAntagonistBundlesAreIndependent) {
   EXPECT_LT(d->qpos[0], 0);              // the flexor pulled the slider towards its anchor
   EXPECT_EQ(d->actuator_force[0], 0.0);  // the motor is not ours: zero ctrl, zero force
   EXPECT_FALSE(p->Broadcast(d.get(), 2, 0.5, 0.5).ok());
+}
+
+}  // namespace
+}  // namespace recruit::sma
+
+namespace recruit::sma {
+namespace {
+
+TEST(Registry, PluginsCreatedAndDestroyedWhileOtherThreadsStep) {
+  ModelPtr stepping = MustLoad(BenchXml());
+  std::vector<ModelPtr> churn;
+  for (int k = 0; k < 4; ++k) churn.push_back(MustLoad(BenchXml()));
+  auto p = MustCreate(stepping.get());
+  std::atomic<bool> done{false};
+  std::thread creator([&] {
+    for (int round = 0; round < 40; ++round) {
+      std::vector<std::unique_ptr<SmaPlugin>> live;
+      for (auto& m : churn) live.push_back(MustCreate(m.get()));
+    }
+    done = true;
+  });
+  DataPtr d = MakeData(stepping.get()), ref = MakeData(stepping.get());
+  p->Reset(d.get(), 5);
+  p->Reset(ref.get(), 5);
+  ASSERT_TRUE(p->Broadcast(d.get(), 0, 0.7, 0).ok());
+  ASSERT_TRUE(p->Broadcast(ref.get(), 0, 0.7, 0).ok());
+  int steps = 0;
+  while (!done || steps < 2000) {
+    Step(stepping.get(), d.get(), *p);
+    ++steps;
+  }
+  creator.join();
+  for (int i = 0; i < steps; ++i) Step(stepping.get(), ref.get(), *p);
+  EXPECT_EQ(d->qpos[0], ref->qpos[0]);
+  EXPECT_EQ(p->Force(d.get(), 0), p->Force(ref.get(), 0));
 }
 
 }  // namespace
