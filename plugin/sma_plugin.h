@@ -84,7 +84,10 @@ class SmaPlugin {
   double Stretch(const mjData* d, int b) const;
 
   // Callback bodies (pure).
-  double ActDot(const mjData* d, int actuator) const { return 0; }
+  double ActDot(const mjData* d, int actuator) const {
+    const int b = bundle_of_actuator_[actuator];
+    return bundles_[b].ActDot(State(d, b));
+  }
   double Gain(const mjData* d, int actuator) const { return 0; }
   double Bias(const mjData* d, int actuator) const;
   int BundleOfActuator(int actuator) const { return bundle_of_actuator_[actuator]; }
