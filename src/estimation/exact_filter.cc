@@ -218,6 +218,18 @@ void ExactBayesFilter::Update(const Eigen::VectorXd& y) {
   for (double& p : p_) p /= sum;
 }
 
+Status ExactBayesFilter::SetProbabilities(const std::vector<double>& p) {
+  if (p.size() != p_.size()) return Error{"exact filter: belief has the wrong size"};
+  double sum = 0.0;
+  for (double v : p) {
+    if (!(v >= 0.0) || !std::isfinite(v)) return Error{"exact filter: negative or NaN belief"};
+    sum += v;
+  }
+  if (std::abs(sum - 1.0) > 1e-9) return Error{"exact filter: belief does not sum to 1"};
+  p_ = p;
+  return Status::Ok();
+}
+
 Eigen::VectorXd ExactBayesFilter::Mean() const {
   Eigen::VectorXd mean = Eigen::VectorXd::Zero(m_);
   for (size_t k = 0; k < p_.size(); ++k) {

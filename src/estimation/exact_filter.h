@@ -40,6 +40,9 @@ class ExactBayesFilter {
   Eigen::VectorXd Mean() const;
   Eigen::MatrixXd Covariance() const;
   const std::vector<double>& probabilities() const { return p_; }
+  // Replaces the belief (for example by the prior of a new run, keeping the cached tables).
+  // `p` has num_count_vectors() non-negative entries summing to 1.
+  Status SetProbabilities(const std::vector<double>& p);
   // Count vector k (m entries).
   Eigen::VectorXd State(size_t k) const;
   size_t num_count_vectors() const { return p_.size(); }
