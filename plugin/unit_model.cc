@@ -1,0 +1,219 @@
+#include "plugin/unit_model.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+namespace recruit::sma {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kStefanBoltzmann = 5.670374419e-8;  // W/(m^2 K^4)
+constexpr double kGravity = 9.81;                    // m/s^2
+
+// Root of a monotone increasing g on [lo, hi] with g(lo) <= 0 <= g(hi): Illinois (modified
+// regula falsi), falling back to bisection. g has slope >= 1 here, so |g| bounds the error.
+template <class G>
+double SolveIncreasing(const G& g, double lo, double glo, double hi, double ghi) {
+  int side = 0;
+  for (int it = 0; it < 100; ++it) {
+    double x = (ghi - glo) > 0 ? (lo * ghi - hi * glo) / (ghi - glo) : 0.5 * (lo + hi);
+    if (!(x > lo && x < hi)) x = 0.5 * (lo + hi);
+    const double gx = g(x);
+    if (std::abs(gx) < 1e-13) return x;
+    if (gx > 0) {
+      hi = x;
+      ghi = gx;
+      if (side == 1) glo *= 0.5;
+      side = 1;
+    } else {
+      lo = x;
+      glo = gx;
+      if (side == -1) ghi *= 0.5;
+      side = -1;
+    }
+    if (hi - lo < 1e-13) break;
+  }
+  return 0.5 * (lo + hi);
+}
+
+std::string Num(double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+
+}  // namespace
+
+double UnitModel::NaturalConvectionH(double d, double ambient, double dT, double emissivity) {
+  dT = std::max(dT, 1.0);
+  const double t_amb = ambient + 273.15;
+  const double t_film = t_amb + 0.5 * dT;
+  // Air at 1 atm, linear between 300 K and 350 K (Incropera & DeWitt, Table A.4).
+  const double s = (t_film - 300.0) / 50.0;
+  const double k = 0.0263 + s * (0.0300 - 0.0263);         // W/(m K)
+  const double nu = 15.89e-6 + s * (20.92e-6 - 15.89e-6);  // m^2/s
+  const double alpha = 22.5e-6 + s * (29.9e-6 - 22.5e-6);  // m^2/s
+  const double ra = kGravity * (1.0 / t_film) * dT * d * d * d / (nu * alpha);
+  // Morgan (1975), horizontal cylinder: Nu = C Ra^n by range of Ra.
+  double c = 0.675, n = 0.058;
+  if (ra >= 1e7) {
+    c = 0.125, n = 0.333;
+  } else if (ra >= 1e4) {
+    c = 0.480, n = 0.250;
+  } else if (ra >= 1e2) {
+    c = 0.850, n = 0.188;
+  } else if (ra >= 1e-2) {
+    c = 1.02, n = 0.148;
+  }
+  const double h_conv = c * std::pow(ra, n) * k / d;
+  const double t_s = t_amb + dT;
+  const double h_rad = emissivity * kStefanBoltzmann * (t_s * t_s + t_amb * t_amb) * (t_s + t_amb);
+  return h_conv + h_rad;
+}
+
+Result<UnitModel> UnitModel::Create(const UnitParams& p) {
+  if (!(p.Mf < p.Ms)) return Error{"Mf=" + Num(p.Mf) + " must be below Ms=" + Num(p.Ms)};
+  if (!(p.As < p.Af)) return Error{"As=" + Num(p.As) + " must be below Af=" + Num(p.Af)};
+  if (p.law == ForceLaw::kSpring && !(p.coil_diameter > p.wire_diameter)) {
+    return Error{"coil_diameter=" + Num(p.coil_diameter) +
+                 " must exceed wire_diameter=" + Num(p.wire_diameter)};
+  }
+  UnitModel m;
+  m.p_ = p;
+  const double d = p.wire_diameter;
+  m.area_ = kPi * d * d / 4;
+  m.h_ = p.h > 0 ? p.h
+                 : NaturalConvectionH(d, p.ambient, 0.5 * (p.As + p.Af) - p.ambient, p.emissivity);
+  m.length_ = p.law == ForceLaw::kSpring ? kPi * p.coil_diameter * p.turns : p.wire_length;
+  m.heat_capacity_ = p.density * p.specific_heat * m.area_ * m.length_;
+  m.conductance_ = m.h_ * kPi * d * m.length_;
+  m.tau_ = m.heat_capacity_ / m.conductance_;
+  if (p.law == ForceLaw::kWire) {
+    m.k_A_ = p.E_A * m.area_ / p.wire_length;
+    m.k_M_ = p.E_M * m.area_ / p.wire_length;
+    m.stretch_L_ = p.eps_L * p.wire_length;
+    m.stress_per_newton_ = 1.0 / m.area_;
+  } else {
+    const double D = p.coil_diameter;
+    const double geom = d * d * d * d / (8 * D * D * D * p.turns);
+    m.k_A_ = p.G_A * geom;
+    m.k_M_ = p.G_M * geom;
+    m.stretch_L_ = kPi * p.turns * D * D * std::sqrt(3.0) * p.eps_L / d;
+    const double index = D / d;
+    const double wahl = (4 * index - 1) / (4 * index - 4) + 0.615 / index;
+    m.stress_per_newton_ = std::sqrt(3.0) * 8 * D * wahl / (kPi * d * d * d);
+  }
+  return m;
+}
+
+double UnitModel::MajorHeating(double t_eff) const {
+  if (t_eff <= p_.As) return 1;
+  if (t_eff >= p_.Af) return 0;
+  return 0.5 * (std::cos(kPi * (t_eff - p_.As) / (p_.Af - p_.As)) + 1);
+}
+
+double UnitModel::MajorCooling(double t_eff) const {
+  if (t_eff <= p_.Mf) return 1;
+  if (t_eff >= p_.Ms) return 0;
+  return 0.5 * (std::cos(kPi * (t_eff - p_.Mf) / (p_.Ms - p_.Mf)) + 1);
+}
+
+double UnitModel::Tension(double xi, double stretch) const {
+  const double k = k_A_ + xi * (k_M_ - k_A_);
+  return std::max(0.0, k * (stretch - xi * stretch_L_));
+}
+
+double UnitModel::HeatingPower(bool on, double xi) const {
+  if (!on) return 0;
+  const double rho = p_.resistivity_A + xi * (p_.resistivity_M - p_.resistivity_A);
+  return p_.current * p_.current * rho * length_ / area_;
+}
+
+double UnitModel::SteadyTemperature(bool on, double xi) const {
+  return p_.ambient + HeatingPower(on, xi) / conductance_;
+}
+
+double UnitModel::DecayFactor(double dt) const { return std::exp(-dt / tau_); }
+
+double UnitModel::ThermalStep(double t, bool on, double xi, double dt) const {
+  const double t_ss = SteadyTemperature(on, xi);
+  return t_ss + (t - t_ss) * DecayFactor(dt);
+}
+
+UnitState RestState(const UnitModel& m, double stretch) {
+  UnitState s;
+  s.temperature = m.params().ambient;
+  s.xi = 1;
+  s.t_eff = s.temperature - m.Stress(m.Tension(1, stretch)) / m.params().C_M;
+  return s;
+}
+
+namespace {
+
+void SolvePhase(const UnitModel& m, UnitState& s, double t_thermal, double stretch) {
+  const UnitParams& p = m.params();
+  const double xi0 = s.xi;
+  const double latent = p.latent_heat / p.specific_heat;  // K per unit of xi
+  // Temperature after the step if xi ends at x: latent heat is absorbed by M -> A (x < xi0).
+  auto temp = [&](double x) { return t_thermal + latent * (x - xi0); };
+  auto teff_h = [&](double x) { return temp(x) - m.Stress(m.Tension(x, stretch)) / p.C_A; };
+  auto teff_c = [&](double x) { return temp(x) - m.Stress(m.Tension(x, stretch)) / p.C_M; };
+  // Both residuals have slope >= 1 in x: T_eff rises as x falls (stress rises, latent heat is
+  // released as x rises), and M+, M- are non-increasing.
+  auto g_h = [&](double x) { return x - s.heat_scale * m.MajorHeating(teff_h(x)); };
+  auto g_c = [&](double x) { return x - 1 + s.cool_scale * (1 - m.MajorCooling(teff_c(x))); };
+
+  double xi = xi0;
+  double te;
+  const double te_h0 = teff_h(xi0);
+  if (te_h0 >= s.t_eff) {
+    // Heating (or steady): M -> A only, xi can only fall.
+    te = te_h0;
+    const double g0 = g_h(xi0);
+    if (g0 > 1e-12) {
+      xi = SolveIncreasing(g_h, 0.0, g_h(0.0), xi0, g0);
+      te = teff_h(xi);
+      // Transformed: a later cooling branch starts from here.
+      const double mm = m.MajorCooling(te);
+      s.cool_scale = mm < 1 ? std::clamp((1 - xi) / (1 - mm), 0.0, 1.0) : 1.0;
+    }
+  } else {
+    // Cooling: A -> M only, xi can only rise.
+    te = teff_c(xi0);
+    const double g0 = g_c(xi0);
+    if (g0 < -1e-12) {
+      xi = SolveIncreasing(g_c, xi0, g0, 1.0, g_c(1.0));
+      te = teff_c(xi);
+      const double mp = m.MajorHeating(te);
+      s.heat_scale = mp > 0 ? std::clamp(xi / mp, 0.0, 1.0) : 1.0;
+    }
+  }
+  // Canonical ends of the loop, so that settled units in the same state compare equal.
+  if (xi >= 1 - 1e-12) {
+    xi = 1;
+    s.heat_scale = 1;
+    s.cool_scale = 0;
+  } else if (xi <= 1e-12) {
+    xi = 0;
+    s.heat_scale = 0;
+    s.cool_scale = 1;
+  }
+  s.xi = xi;
+  s.temperature = temp(xi);
+  s.t_eff = te;
+}
+
+}  // namespace
+
+void AdvanceUnit(const UnitModel& m, UnitState& s, bool on, double stretch, double dt) {
+  AdvanceUnitWithDecay(m, s, on, stretch, m.DecayFactor(dt));
+}
+
+void AdvanceUnitWithDecay(const UnitModel& m, UnitState& s, bool on, double stretch, double decay) {
+  const double t_ss = m.SteadyTemperature(on, s.xi);
+  SolvePhase(m, s, t_ss + (s.temperature - t_ss) * decay, stretch);
+}
+
+}  // namespace recruit::sma

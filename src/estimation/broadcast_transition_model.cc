@@ -1,0 +1,149 @@
+#include "estimation/broadcast_transition_model.h"
+
+#include <cmath>
+#include <nlohmann/json.hpp>
+
+#include "estimation/json_matrix.h"
+#include "estimation/population_chain.h"
+
+namespace recruit {
+
+Eigen::MatrixXd BroadcastTransitionModel::Matrix(double p_on, double p_off) const {
+  Eigen::MatrixXd A(num_states(), num_states());
+  FillMatrix(p_on, p_off, A);
+  return A;
+}
+
+BroadcastTransitionModel BroadcastTransitionModel::TwoState(double dt) {
+  BroadcastTransitionModel b;
+  b.state_names = {"off", "on"};
+  b.is_on = {false, true};
+  b.interior = Eigen::MatrixXd::Identity(2, 2);
+  b.on_target = {1, -1};
+  b.off_target = {-1, 0};
+  b.dt = dt;
+  return b;
+}
+
+Status BroadcastTransitionModel::Validate(const std::string& where) const {
+  const int m = num_states();
+  if (m < 1) return Error{where + ": needs at least one state"};
+  if (static_cast<int>(is_on.size()) != m) {
+    return Error{where + ".is_on: must have " + std::to_string(m) +
+                 " entries (one per state), got " + std::to_string(is_on.size())};
+  }
+  if (static_cast<int>(on_target.size()) != m || static_cast<int>(off_target.size()) != m) {
+    return Error{where + ": on_target and off_target must have " + std::to_string(m) +
+                 " entries (one per state)"};
+  }
+  if (Status s = ValidateColumnStochastic(interior, kStochasticTolerance, m, where + ".interior");
+      !s.ok()) {
+    return s;
+  }
+  for (int j = 0; j < m; ++j) {
+    const int t = is_on[j] ? off_target[j] : on_target[j];
+    const char* field = is_on[j] ? ".off_target" : ".on_target";
+    if (t < 0 || t >= m) {
+      return Error{where + field + "[" + std::to_string(j) + "] = " + std::to_string(t) +
+                   " (state '" + state_names[j] + "', " + (is_on[j] ? "on" : "off") +
+                   ") must be a state index in [0, " + std::to_string(m - 1) + "]"};
+    }
+  }
+  if (!(std::isfinite(dt) && dt > 0.0)) {
+    return Error{where + ".dt: must be a positive number of seconds, got " + std::to_string(dt)};
+  }
+  return Status::Ok();
+}
+
+Status BroadcastTransitionModel::ValidateInputs(double p_on, double p_off,
+                                                const std::string& where) {
+  if (!(std::isfinite(p_on) && p_on >= 0.0 && p_on <= 1.0)) {
+    return Error{where + ": p_on = " + std::to_string(p_on) + " must be a probability in [0, 1]"};
+  }
+  if (!(std::isfinite(p_off) && p_off >= 0.0 && p_off <= 1.0)) {
+    return Error{where + ": p_off = " + std::to_string(p_off) + " must be a probability in [0, 1]"};
+  }
+  return Status::Ok();
+}
+
+namespace {
+
+Result<std::vector<int>> ReadTargets(const nlohmann::json& j, const std::string& field, int m) {
+  std::vector<int> t(m, -1);
+  if (j.is_number_integer()) {
+    t.assign(m, j.get<int>());
+    return t;
+  }
+  if (!j.is_array() || static_cast<int>(j.size()) != m) {
+    return Error{field + ": must be a state index or an array of " + std::to_string(m) +
+                 " state indices (-1 where unused)"};
+  }
+  for (int i = 0; i < m; ++i) {
+    if (!j[i].is_number_integer()) {
+      return Error{field + "[" + std::to_string(i) + "]: must be an integer state index"};
+    }
+    t[i] = j[i].get<int>();
+  }
+  return t;
+}
+
+}  // namespace
+
+Result<BroadcastTransitionModel> BroadcastTransitionModel::FromJsonValue(
+    const nlohmann::json& j, const std::vector<std::string>& names, const std::string& where) {
+  if (!j.is_object()) return Error{where + ": must be an object"};
+  BroadcastTransitionModel b;
+  b.state_names = names;
+  const int m = static_cast<int>(names.size());
+  if (!j.contains("dt") || !j["dt"].is_number()) {
+    return Error{where + ".dt: required, the sampling period in seconds (number > 0)"};
+  }
+  b.dt = j["dt"].get<double>();
+  if (!j.contains("is_on") || !j["is_on"].is_array() || static_cast<int>(j["is_on"].size()) != m) {
+    return Error{where + ".is_on: required, an array of " + std::to_string(m) +
+                 " booleans (heater command per state)"};
+  }
+  for (int i = 0; i < m; ++i) {
+    if (!j["is_on"][i].is_boolean()) {
+      return Error{where + ".is_on[" + std::to_string(i) + "]: must be true or false"};
+    }
+    b.is_on.push_back(j["is_on"][i].get<bool>());
+  }
+  if (j.contains("interior")) {
+    auto I = json_io::ReadMatrix(j["interior"], where + ".interior", m, m);
+    if (!I.ok()) return Error{I.error()};
+    b.interior = *I;
+  } else {
+    b.interior = Eigen::MatrixXd::Identity(m, m);
+  }
+  for (const char* key : {"on_target", "off_target"}) {
+    if (!j.contains(key)) {
+      return Error{where + "." + key + ": required (state index, or array with one per state)"};
+    }
+    auto t = ReadTargets(j[key], where + "." + key, m);
+    if (!t.ok()) return Error{t.error()};
+    (std::string(key) == "on_target" ? b.on_target : b.off_target) = *t;
+  }
+  // Entries that do not apply (on_target of an on state, ...) are normalised to -1.
+  for (int i = 0; i < m; ++i) {
+    if (b.is_on[i])
+      b.on_target[i] = -1;
+    else
+      b.off_target[i] = -1;
+  }
+  if (Status s = b.Validate(where); !s.ok()) return Error{s.error()};
+  return b;
+}
+
+nlohmann::json BroadcastTransitionModel::ToJson() const {
+  nlohmann::json j;
+  j["type"] = "broadcast";
+  j["dt"] = dt;
+  j["is_on"] = is_on;
+  j["interior"] = json_io::WriteMatrix(interior);
+  j["on_target"] = on_target;
+  j["off_target"] = off_target;
+  return j;
+}
+
+}  // namespace recruit

@@ -1,0 +1,125 @@
+// Filter model files: validation messages and the JSON round trip.
+#include "estimation/filter_model.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "estimation/population_chain.h"
+
+namespace recruit {
+namespace {
+
+TEST(EstimationBroadcast, TwoStateMatrixIsTheClosedForm) {
+  const auto b = BroadcastTransitionModel::TwoState(0.5);
+  ASSERT_TRUE(b.Validate().ok()) << b.Validate().error();
+  const Eigen::MatrixXd A = b.Matrix(0.3, 0.1);
+  Eigen::Matrix2d expected;
+  expected << 0.7, 0.1, 0.3, 0.9;
+  EXPECT_LT((A - expected).cwiseAbs().maxCoeff(), 1e-15);
+}
+
+TEST(EstimationBroadcast, AugmentedModelColumns) {
+  // off0 (cold) --p_on--> on0 ; on0 --interior--> on1 ; on states --p_off--> off1 (cooling).
+  BroadcastTransitionModel b;
+  b.state_names = {"off0", "off1", "on0", "on1"};
+  b.is_on = {false, false, true, true};
+  b.interior.setZero(4, 4);
+  b.interior.col(0) << 1, 0, 0, 0;
+  b.interior.col(1) << 0.4, 0.6, 0, 0;
+  b.interior.col(2) << 0, 0, 0.5, 0.5;
+  b.interior.col(3) << 0, 0, 0, 1;
+  b.on_target = {2, 2, -1, -1};
+  b.off_target = {-1, -1, 1, 1};
+  b.dt = 0.5;
+  ASSERT_TRUE(b.Validate().ok()) << b.Validate().error();
+  const Eigen::MatrixXd A = b.Matrix(0.2, 0.3);
+  EXPECT_TRUE(ValidateColumnStochastic(A).ok());
+  // Column 1 (off1): 0.8 * (0.4, 0.6, 0, 0) + 0.2 e_2.
+  EXPECT_NEAR(A(0, 1), 0.32, 1e-15);
+  EXPECT_NEAR(A(1, 1), 0.48, 1e-15);
+  EXPECT_NEAR(A(2, 1), 0.2, 1e-15);
+  // Column 2 (on0): 0.7 * (0, 0, 0.5, 0.5) + 0.3 e_1.
+  EXPECT_NEAR(A(1, 2), 0.3, 1e-15);
+  EXPECT_NEAR(A(2, 2), 0.35, 1e-15);
+  EXPECT_NEAR(A(3, 2), 0.35, 1e-15);
+  b.off_target[3] = 7;
+  Status s = b.Validate("m.json: transition");
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.error().find("m.json: transition.off_target[3] = 7"), std::string::npos) << s.error();
+}
+
+TEST(EstimationFilterModel, SaveAndLoadRoundTrip) {
+  FilterModel f = FilterModel::TwoState(60, 0.5, 0.45, 0.3);
+  f.x0 = Eigen::Vector2d(50, 10);
+  f.P0 = Eigen::Matrix2d{{4, -4}, {-4, 4}};
+  const std::string path = testing::TempDir() + "/estimation_model_roundtrip.json";
+  ASSERT_TRUE(f.Save(path).ok());
+  auto g = FilterModel::FromJson(path);
+  ASSERT_TRUE(g.ok()) << g.error();
+  EXPECT_EQ(g->state_names, f.state_names);
+  EXPECT_EQ(g->N, 60);
+  EXPECT_EQ(g->H, f.H);
+  EXPECT_EQ(g->R, f.R);
+  EXPECT_EQ(g->x0, f.x0);
+  EXPECT_EQ(g->P0, f.P0);
+  EXPECT_EQ(g->broadcast.Matrix(0.2, 0.4), f.broadcast.Matrix(0.2, 0.4));
+  std::remove(path.c_str());
+}
+
+nlohmann::json GoodJson() {
+  return nlohmann::json::parse(R"({
+    "states": ["off", "on"], "N": 60, "H": [[0, 0.45]], "R": [[0.09]],
+    "transition": {"type": "broadcast", "dt": 0.5, "is_on": [false, true],
+                   "on_target": 1, "off_target": 0}})");
+}
+
+TEST(EstimationFilterModel, ClearErrorsForBadFields) {
+  ASSERT_TRUE(FilterModel::FromJsonValue(GoodJson(), "m.json").ok());
+  struct Case {
+    std::string pointer;
+    nlohmann::json value;
+    std::string expected;
+  };
+  const std::vector<Case> cases = {
+      {"/N", -3, "m.json: N: required, a positive integer"},
+      {"/H", nlohmann::json::parse("[[0, 0.45, 1]]"), "m.json: H: row 0 must be an array of 2"},
+      {"/R", nlohmann::json::parse("[[-1]]"), "m.json: R: must be positive definite"},
+      {"/R", nlohmann::json::parse("[[1, 0]]"), "m.json: R: row 0 must be an array of 1"},
+      {"/transition/type", "magic", "transition.type: \"magic\" is not one of"},
+      {"/transition/interior", nlohmann::json::parse("[[0.9, 0], [0.2, 1]]"),
+       "transition.interior: column 0 sums to 1.1"},
+      {"/transition/dt", 0, "transition.dt: must be a positive"},
+      {"/states", nlohmann::json::parse(R"(["off", "off"])"), "duplicate name 'off'"},
+  };
+  for (const auto& c : cases) {
+    nlohmann::json j = GoodJson();
+    j[nlohmann::json::json_pointer(c.pointer)] = c.value;
+    auto f = FilterModel::FromJsonValue(j, "m.json");
+    ASSERT_FALSE(f.ok()) << c.pointer;
+    EXPECT_NE(f.error().find(c.expected), std::string::npos) << f.error();
+  }
+  nlohmann::json j = GoodJson();
+  j["G"] = nlohmann::json::parse("[[1], [0]]");
+  j["Qw"] = nlohmann::json::parse("[[0.5]]");
+  auto f = FilterModel::FromJsonValue(j, "m.json");
+  ASSERT_FALSE(f.ok());
+  EXPECT_NE(f.error().find("zero column sums"), std::string::npos) << f.error();
+}
+
+TEST(EstimationFilterModel, MissingAndMalformedFiles) {
+  auto missing = FilterModel::FromJson("/nonexistent/dir/model.json");
+  ASSERT_FALSE(missing.ok());
+  EXPECT_NE(missing.error().find("/nonexistent/dir/model.json"), std::string::npos);
+  const std::string path = testing::TempDir() + "/estimation_malformed.json";
+  std::ofstream(path) << "{\"states\": [\"off\", ";
+  auto bad = FilterModel::FromJson(path);
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.error().find("malformed JSON"), std::string::npos) << bad.error();
+  std::remove(path.c_str());
+}
+
+}  // namespace
+}  // namespace recruit

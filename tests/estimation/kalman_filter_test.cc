@@ -1,0 +1,162 @@
+// The population Kalman filter against the paper's equations worked by hand and against a
+// textbook Kalman filter written out with explicit inverses.
+#include <gtest/gtest.h>
+
+#include "estimation/population_kalman_filter.h"
+
+namespace recruit {
+namespace {
+
+// m = 2, r = 1: X^ = (6, 4), P = 2 [1 -1; -1 1], N = 10,
+// A = [0.9 0.3; 0.1 0.7], H = [0 1], R = 0.5, y = 4.
+FilterModel HandModel() {
+  FilterModel f = FilterModel::TwoState(10, 1.0, 1.0, std::sqrt(0.5));
+  f.transition = TransitionSource::kExplicit;
+  return f;
+}
+
+struct HandCase {
+  CovarianceMode mode;
+  double qz;  // the scalar c with Qz = c [1 -1; -1 1]
+};
+
+class EstimationKalmanHandStep : public ::testing::TestWithParam<HandCase> {};
+
+TEST_P(EstimationKalmanHandStep, MatchesEquationsWorkedByHand) {
+  const HandCase c = GetParam();
+  Eigen::Matrix2d A;
+  A << 0.9, 0.3, 0.1, 0.7;
+  Eigen::Matrix2d P0;
+  P0 << 2, -2, -2, 2;
+  auto f = PopulationKalmanFilter::Create(HandModel(), c.mode, Eigen::Vector2d(6, 4), P0);
+  ASSERT_TRUE(f.ok()) << f.error();
+  f->Predict(A);
+  // (16): A X^ = (0.9*6 + 0.3*4, 0.1*6 + 0.7*4) = (6.6, 3.4).
+  EXPECT_NEAR(f->estimate()(0), 6.6, 1e-12);
+  EXPECT_NEAR(f->estimate()(1), 3.4, 1e-12);
+  // A P A^T: A (1, -1) = (0.6, -0.6), so A P A^T = 2 * 0.36 [1 -1; -1 1] = 0.72 [..].
+  const double p_pred = 0.72 + c.qz;
+  EXPECT_NEAR(f->covariance()(0, 0), p_pred, 1e-12);
+  EXPECT_NEAR(f->covariance()(0, 1), -p_pred, 1e-12);
+  EXPECT_NEAR(f->covariance()(1, 1), p_pred, 1e-12);
+  f->Update(Eigen::VectorXd::Constant(1, 4.0));
+  // (17) y^ = 3.4; S = H P H^T + R = p_pred + 0.5; K = (-p_pred, p_pred) / S (19).
+  const double S = p_pred + 0.5;
+  const double k = p_pred / S;
+  EXPECT_NEAR(f->innovation()(0), 0.6, 1e-12);
+  EXPECT_NEAR(f->gain()(0, 0), -k, 1e-12);
+  EXPECT_NEAR(f->gain()(1, 0), k, 1e-12);
+  EXPECT_NEAR(f->estimate()(0), 6.6 - k * 0.6, 1e-12);  // (15)
+  EXPECT_NEAR(f->estimate()(1), 3.4 + k * 0.6, 1e-12);
+  // (20): P = (1 - k) p_pred [1 -1; -1 1] = p_pred * 0.5 / S.
+  const double p_post = p_pred * 0.5 / S;
+  EXPECT_NEAR(f->covariance()(0, 0), p_post, 1e-12);
+  EXPECT_NEAR(f->covariance()(0, 1), -p_post, 1e-12);
+  EXPECT_NEAR(f->covariance()(1, 1), p_post, 1e-12);
+}
+
+// Qz (eq. 25) for m = 2 is sum_j x_j a_1j (1 - a_1j) [1 -1; -1 1]:
+//   extended at X^ = (6, 4):      6 * 0.9 * 0.1 + 4 * 0.3 * 0.7 = 0.54 + 0.84 = 1.38
+//   conservative at X = (10, 10): 10 * 0.09 + 10 * 0.21 = 3.0
+//   plain:                        0
+INSTANTIATE_TEST_SUITE_P(Modes, EstimationKalmanHandStep,
+                         ::testing::Values(HandCase{CovarianceMode::kExtended, 1.38},
+                                           HandCase{CovarianceMode::kConservative, 3.0},
+                                           HandCase{CovarianceMode::kPlain, 0.0}),
+                         [](const auto& info) { return std::string(ToString(info.param.mode)); });
+
+// The fixed-size path gives the same numbers as the dynamic one.
+TEST(EstimationKalman, FixedSizeMatchesDynamic) {
+  Eigen::Matrix2d A;
+  A << 0.9, 0.3, 0.1, 0.7;
+  Eigen::Matrix2d P0;
+  P0 << 2, -2, -2, 2;
+  auto d = PopulationKalmanFilter::Create(HandModel(), CovarianceMode::kExtended,
+                                          Eigen::Vector2d(6, 4), P0);
+  auto s = PopulationKalmanFilterT<2, 1>::Create(HandModel(), CovarianceMode::kExtended,
+                                                 Eigen::Vector2d(6, 4), P0);
+  ASSERT_TRUE(d.ok() && s.ok());
+  for (int t = 0; t < 50; ++t) {
+    d->Predict(A);
+    s->Predict(A);
+    if (t % 3 != 0) {
+      d->Update(Eigen::VectorXd::Constant(1, 3.0 + 0.1 * t));
+      s->Update(Eigen::Matrix<double, 1, 1>(3.0 + 0.1 * t));
+    }
+  }
+  EXPECT_LT((d->estimate() - s->estimate()).cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_LT((d->covariance() - s->covariance()).cwiseAbs().maxCoeff(), 1e-12);
+}
+
+// m = 3, r = 2, with process noise: one step against a textbook Kalman filter written with an
+// explicit inverse and the factored Joseph form.
+TEST(EstimationKalman, MatchesTextbookFilterWithTwoOutputsAndProcessNoise) {
+  FilterModel f;
+  f.state_names = {"a", "b", "c"};
+  f.N = 30;
+  f.H.resize(2, 3);
+  f.H << 1.0, 0.5, 0.0, 0.0, 0.2, 1.0;
+  f.R.resize(2, 2);
+  f.R << 0.4, 0.1, 0.1, 0.3;
+  f.G.resize(3, 1);
+  f.G << 1.0, -1.0, 0.0;  // moves agents a <-> b: column sums of G Qw G^T are zero
+  f.Qw = Eigen::MatrixXd::Constant(1, 1, 0.7);
+  f.transition = TransitionSource::kExplicit;
+  f.x0 = Eigen::Vector3d(10, 15, 5);
+  f.P0 = Eigen::MatrixXd::Zero(3, 3);
+  Eigen::Matrix3d A;
+  A << 0.8, 0.1, 0.2, 0.15, 0.7, 0.3, 0.05, 0.2, 0.5;
+  Eigen::Matrix3d P0;
+  P0 << 2, -1, -1, -1, 1.5, -0.5, -1, -0.5, 1.5;
+  const Eigen::Vector3d x0(10, 15, 5);
+  const Eigen::Vector2d y(17.0, 9.0);
+  auto kf = PopulationKalmanFilter::Create(f, CovarianceMode::kExtended, x0, P0);
+  ASSERT_TRUE(kf.ok()) << kf.error();
+  kf->Predict(A);
+  kf->Update(y);
+
+  // Reference.
+  Eigen::Matrix3d Qz = Eigen::Matrix3d::Zero();
+  for (int j = 0; j < 3; ++j) {
+    const Eigen::Vector3d a = A.col(j);
+    Qz += x0(j) * (Eigen::Matrix3d(a.asDiagonal()) - a * a.transpose());
+  }
+  const Eigen::Matrix3d Pp = A * P0 * A.transpose() + f.G * f.Qw * f.G.transpose() + Qz;
+  const Eigen::Vector3d xp = A * x0;
+  const Eigen::Matrix<double, 3, 2> K =
+      Pp * f.H.transpose() * (f.H * Pp * f.H.transpose() + f.R).inverse();
+  const Eigen::Vector3d xu = xp + K * (y - f.H * xp);
+  const Eigen::Matrix3d IKH = Eigen::Matrix3d::Identity() - K * f.H;
+  const Eigen::Matrix3d Pu = IKH * Pp * IKH.transpose() + K * f.R * K.transpose();
+  EXPECT_LT((kf->estimate() - xu).cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_LT((kf->covariance() - Pu).cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_NEAR(kf->estimate().sum(), 30.0, 1e-12);
+}
+
+TEST(EstimationKalman, RejectsBadInitialBeliefAndInputs) {
+  const FilterModel f = HandModel();
+  auto bad_sum = PopulationKalmanFilter::Create(f, CovarianceMode::kExtended, Eigen::Vector2d(6, 5),
+                                                Eigen::Matrix2d::Zero());
+  ASSERT_FALSE(bad_sum.ok());
+  EXPECT_NE(bad_sum.error().find("sum to N = 10"), std::string::npos) << bad_sum.error();
+  auto bad_size = PopulationKalmanFilter::Create(f, CovarianceMode::kExtended,
+                                                 Eigen::Vector3d(6, 4, 0), Eigen::Matrix2d::Zero());
+  EXPECT_FALSE(bad_size.ok());
+  auto fixed_wrong = PopulationKalmanFilterT<3, 1>::Create(f, CovarianceMode::kExtended);
+  ASSERT_FALSE(fixed_wrong.ok());
+  EXPECT_NE(fixed_wrong.error().find("m = 3"), std::string::npos);
+
+  auto kf = PopulationKalmanFilter::Create(f, CovarianceMode::kExtended);
+  ASSERT_TRUE(kf.ok());
+  Eigen::Matrix2d A;
+  A << 0.9, 0.3, 0.2, 0.7;  // column 0 sums to 1.1
+  Status s = kf->PredictChecked(A);
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.error().find("column 0 sums to 1.1"), std::string::npos) << s.error();
+  EXPECT_FALSE(kf->UpdateChecked(Eigen::VectorXd::Constant(1, NAN)).ok());
+  EXPECT_FALSE(kf->UpdateChecked(Eigen::VectorXd::Zero(2)).ok());
+  EXPECT_EQ(kf->estimate(), Eigen::Vector2d(10, 0));  // untouched by the rejected inputs
+}
+
+}  // namespace
+}  // namespace recruit
