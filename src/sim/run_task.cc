@@ -240,6 +240,7 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
   double next_control = 0;
   const bool show_progress = options.progress;
   long next_progress = 0;
+  double next_progress_wall = 0;
   for (long step = 0; step < num_steps; ++step) {
     const double t = d->time;
     apply_payloads(t);
@@ -326,9 +327,15 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
       }
     }
     if (show_progress && step >= next_progress) {
-      std::fprintf(stderr, "\r  %.1f / %.1f s simulated (%3.0f %%)", d->time, duration,
-                   100.0 * step / num_steps);
-      next_progress = step + std::max(1L, num_steps / 100);
+      // At most about 5 updates per second of wall time.
+      const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() -
+                                                        wall_start).count();
+      if (wall >= next_progress_wall) {
+        std::fprintf(stderr, "\r  %.1f / %.1f s simulated (%3.0f %%)", d->time, duration,
+                     100.0 * step / num_steps);
+        next_progress_wall = wall + 0.2;
+      }
+      next_progress = step + std::max(1L, num_steps / 1000);
     }
   }
   if (show_progress)
