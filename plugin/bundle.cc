@@ -245,8 +245,9 @@ double SmaBundle::MeanXi(const double* s) const {
 
 double SmaBundle::Heat(const double* s) const {
   const double amb = config_.unit.ambient;
-  const double h = (MeanTemperature(s) - amb) / (unit_.on_temperature() - amb);
-  return std::clamp(h, 0.0, 1.0);
+  const double span = unit_.on_temperature() - amb;
+  if (!(span > 0)) return 0;  // current=0: on units do not heat
+  return std::clamp((MeanTemperature(s) - amb) / span, 0.0, 1.0);
 }
 
 int SmaBundle::UnitCohort(const double* s, int i) const {

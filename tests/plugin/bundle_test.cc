@@ -181,6 +181,22 @@ TEST(SmaBundle, SameSeedSameDrawsDifferentSeedDifferentDraws) {
   EXPECT_NE(s1, s3);
 }
 
+TEST(SmaBundle, ZeroCurrentAndSingleUnitAreWellDefined) {
+  auto c = BundleConfig::FromText("b", "units=1 current=0");
+  ASSERT_TRUE(c.ok()) << c.error();
+  auto b = SmaBundle::Create(*c, 1e-3);
+  ASSERT_TRUE(b.ok()) << b.error();
+  std::vector<double> s(b->state_size());
+  b->Reset(s.data(), 1, 3e-3);
+  ASSERT_TRUE(b->Broadcast(s.data(), 1, 0, 3e-3).ok());
+  for (int i = 0; i < 100; ++i) b->Advance(s.data(), 3e-3, 1e-3);
+  EXPECT_EQ(b->OnCount(s.data()), 1);
+  EXPECT_EQ(b->Heat(s.data()), 0.0);
+  EXPECT_EQ(b->MeanTemperature(s.data()), 20.0);
+  EXPECT_EQ(b->Tension(s.data(), 3e-3), 0.0);
+  EXPECT_EQ(b->SettledOnTension(3e-3), 0.0);
+}
+
 TEST(SmaBundle, RejectsProbabilitiesOutsideUnitInterval) {
   const SmaBundle b = MakeBundle(10, 0.5, 0.01);
   std::vector<double> s(b.state_size());
