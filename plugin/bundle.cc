@@ -163,7 +163,6 @@ void SmaBundle::Merge(double* s) const {
     double* c = Cohort(s, order[j]);
     const bool same = r[kOn] == c[kOn] &&
                       std::abs(r[kTemp] - c[kTemp]) <= config_.merge_temperature &&
-                      std::abs(r[kTeff] - c[kTeff]) <= config_.merge_temperature &&
                       std::abs(r[kXi] - c[kXi]) <= config_.merge_xi &&
                       std::abs(r[kHeatScale] - c[kHeatScale]) <= config_.merge_xi &&
                       std::abs(r[kCoolScale] - c[kCoolScale]) <= config_.merge_xi;
