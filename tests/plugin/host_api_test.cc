@@ -545,3 +545,41 @@ TEST(Registry, PluginsCreatedAndDestroyedWhileOtherThreadsStep) {
 
 }  // namespace
 }  // namespace recruit::sma
+
+namespace recruit::sma {
+namespace {
+
+TEST(HostApi, UserdataAddressLeavesTheHostsOwnEntriesAlone) {
+  const std::string xml = Replace(BenchXml("units=60", 498), "<custom>",
+                                  "<custom><numeric name=\"recruit.sma.userdata_address\" "
+                                  "data=\"10\"/>");
+  ModelPtr m = MustLoad(xml);
+  auto need = SmaPlugin::RequiredUserdata(m.get());
+  ASSERT_TRUE(need.ok()) << need.error();
+  EXPECT_EQ(*need, 10 + 8 + 8 * 60);
+  auto p = MustCreate(m.get());
+  DataPtr d = MakeData(m.get());
+  for (int i = 0; i < 10; ++i) d->userdata[i] = 100 + i;
+  p->Reset(d.get(), 1);
+  ASSERT_TRUE(p->Broadcast(d.get(), 0, 1, 0).ok());
+  for (int i = 0; i < 2000; ++i) Step(m.get(), d.get(), *p);
+  for (int i = 0; i < 10; ++i) EXPECT_EQ(d->userdata[i], 100 + i);
+  EXPECT_GT(p->Force(d.get(), 0), 5.0);
+}
+
+TEST(HostApi, UserdataAddressMustBeAWholeNonNegativeNumber) {
+  for (const char* bad : {"-1", "2.5"}) {
+    const std::string xml =
+        Replace(BenchXml("units=60", 600), "<custom>",
+                std::string("<custom><numeric name=\"recruit.sma.userdata_address\" data=\"") +
+                    bad + "\"/>");
+    ModelPtr m = MustLoad(xml);
+    auto p = SmaPlugin::Create(m.get());
+    ASSERT_FALSE(p.ok()) << bad;
+    EXPECT_THAT(p.error(), HasSubstr("recruit.sma.userdata_address"));
+    EXPECT_THAT(p.error(), HasSubstr("whole number >= 0"));
+  }
+}
+
+}  // namespace
+}  // namespace recruit::sma
