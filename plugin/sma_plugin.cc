@@ -260,9 +260,14 @@ void SmaPlugin::Reset(mjData* d, std::uint64_t seed) const {
   mj_forward(m_, d);  // forces and sensors from the reset units
 }
 
-void SmaPlugin::ResetKeyframe(mjData* d, int key, std::uint64_t seed) const {
+Status SmaPlugin::ResetKeyframe(mjData* d, int key, std::uint64_t seed) const {
+  if (key < 0 || key >= m_->nkey) {
+    return Error{"ResetKeyframe: keyframe " + std::to_string(key) + " does not exist (model has " +
+                 std::to_string(m_->nkey) + ")"};
+  }
   mj_resetDataKeyframe(m_, d, key);
   Reset(d, seed);
+  return Status::Ok();
 }
 
 void SmaPlugin::EnsureInitialised(mjData* d) const {

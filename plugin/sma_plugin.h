@@ -58,8 +58,9 @@ class SmaPlugin {
   // Rng::DeriveSeed(seed, b). Call after mj_resetData / mj_resetDataKeyframe (they do not
   // restore userdata).
   void Reset(mjData* d, std::uint64_t seed) const;
-  // mj_resetDataKeyframe(m, d, key), then Reset(d, seed).
-  void ResetKeyframe(mjData* d, int key, std::uint64_t seed) const;
+  // mj_resetDataKeyframe(m, d, key), then Reset(d, seed). Error (and d untouched) if the model
+  // has no keyframe `key`.
+  Status ResetKeyframe(mjData* d, int key, std::uint64_t seed) const;
 
   // Each unit of bundle b draws its transition (off->on with p_on, on->off with p_off).
   Status Broadcast(mjData* d, int b, double p_on, double p_off) const;

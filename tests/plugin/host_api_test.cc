@@ -262,7 +262,8 @@ TEST(HostApi, ResetKeyframeRestoresPoseAndColdUnits) {
   ASSERT_TRUE(p->Broadcast(d.get(), 0, 1, 0).ok());
   for (int i = 0; i < 2000; ++i) Step(m.get(), d.get(), *p);
   ASSERT_GT(p->MeanTemperature(d.get(), 0), 60);
-  p->ResetKeyframe(d.get(), 0, 1);
+  EXPECT_FALSE(p->ResetKeyframe(d.get(), 1, 1).ok());  // the model has one keyframe
+  ASSERT_TRUE(p->ResetKeyframe(d.get(), 0, 1).ok());
   EXPECT_EQ(d->qpos[0], 0.0005);
   EXPECT_EQ(d->time, 0.0);
   EXPECT_EQ(p->OnCount(d.get(), 0), 0);
@@ -271,7 +272,7 @@ TEST(HostApi, ResetKeyframeRestoresPoseAndColdUnits) {
   EXPECT_EQ(p->UnitXi(d.get(), 0, 0), 1.0);
   // Same seed after the same reset: the same draws as a fresh run.
   DataPtr fresh = MakeData(m.get());
-  p->ResetKeyframe(fresh.get(), 0, 1);
+  ASSERT_TRUE(p->ResetKeyframe(fresh.get(), 0, 1).ok());
   ASSERT_TRUE(p->Broadcast(d.get(), 0, 0.5, 0).ok());
   ASSERT_TRUE(p->Broadcast(fresh.get(), 0, 0.5, 0).ok());
   for (int i = 0; i < 60; ++i) {
