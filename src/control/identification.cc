@@ -21,16 +21,18 @@ Eigen::MatrixXd MeanTrajectory(const TransientChain& chain, const SwitchingLog& 
   return X;
 }
 
-// Neighbour differences along the heating path (cold, heat1..heatK, hot) and the cooling path
-// (hot, cool1..coolK, cold).
+// Neighbour differences along the heating chain (heat1..heatK, hot) and the cooling chain
+// (cool1..coolK, cold). The entry edges (cold -> heat1, hot -> cool1) are left out: the force
+// may jump there within one period (at long dT especially), and tying hot to cool1 would drag
+// the settled force down.
 Eigen::MatrixXd ChainDifferences(const TransientChain& c) {
   const int K = c.chain_length, m = c.num_states();
-  std::vector<int> heat_path{c.cold()}, cool_path{c.hot()};
+  std::vector<int> heat_path, cool_path;
   for (int i = 1; i <= K; ++i) heat_path.push_back(c.heat(i));
   for (int i = 1; i <= K; ++i) cool_path.push_back(c.cool(i));
   heat_path.push_back(c.hot());
   cool_path.push_back(c.cold());
-  Eigen::MatrixXd d = Eigen::MatrixXd::Zero(2 * (K + 1), m);
+  Eigen::MatrixXd d = Eigen::MatrixXd::Zero(2 * K, m);
   int r = 0;
   for (const auto* path : {&heat_path, &cool_path}) {
     for (size_t i = 0; i + 1 < path->size(); ++i, ++r) {
@@ -47,6 +49,7 @@ class Problem {
       : log_(log), train_(train), opt_(opt), shape_(std::move(shape)) {
     D_ = ChainDifferences(shape_);
     y_ = Eigen::Map<const Eigen::VectorXd>(log.force.data(), train_);
+    advance_weight_ = std::sqrt(opt.advance_prior * y_.squaredNorm() / train_);
   }
   int num_params() const { return 2 * shape_.chain_length; }
 
@@ -75,9 +78,14 @@ class Problem {
     // well-defined.
     normal.diagonal().array() += 1e-12 * std::max(normal.trace() / normal.rows(), 1e-300);
     const Eigen::VectorXd h = normal.ldlt().solve(X.transpose() * y_);
-    Eigen::VectorXd r(train_ + D_.rows());
+    const int K = c.chain_length;
+    Eigen::VectorXd r(train_ + D_.rows() + 2 * K);
     r.head(train_) = y_ - X * h;
-    r.tail(D_.rows()) = std::sqrt(mu) * (D_ * h);
+    r.segment(train_, D_.rows()) = std::sqrt(mu) * (D_ * h);
+    // Prior towards progress (a = 1): an edge the data do not constrain lets units move on to
+    // the settled state instead of stalling in a state whose force nothing pins down.
+    r.segment(train_ + D_.rows(), K) = advance_weight_ * (1.0 - c.heat_advance.array()).matrix();
+    r.tail(K) = advance_weight_ * (1.0 - c.cool_advance.array()).matrix();
     if (h_out) *h_out = h;
     return r;
   }
@@ -89,6 +97,7 @@ class Problem {
   TransientChain shape_;
   Eigen::MatrixXd D_;
   Eigen::VectorXd y_;
+  double advance_weight_ = 0;
 };
 
 // Bounded Levenberg-Marquardt with forward-difference Jacobian. Returns the final parameters;
