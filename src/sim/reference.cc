@@ -79,24 +79,26 @@ Result<Reference> Reference::Piecewise(std::vector<Knot> knots) {
 
 Reference Reference::PaperFig5() {
   // Steps up through the range, a slow ramp down, then steps up and down again: the kind of
-  // profile of the paper's Fig. 5 (0-30 N over about 200 s). Holds last 20-25 s, several times
-  // the units' settling time (about 5 s, Fig. 4), so each step can be scored.
+  // profile of the paper's Fig. 5 (0-30 N over about 200 s), with its peak at 25 N because the
+  // calibrated 60-unit bench saturates at about 27 N (all units on): a reference above that
+  // cannot settle and would only measure saturation. Holds last 25 s, several times the units'
+  // settling time (about 5 s, Fig. 4), so each step can be scored.
   auto r = Piecewise({{0, 0},
                       {5, 0},
-                      {5, 10},
-                      {30, 10},
-                      {30, 20},
-                      {55, 20},
-                      {55, 30},
-                      {80, 30},
-                      {110, 10},
-                      {130, 10},
-                      {130, 25},
-                      {155, 25},
-                      {155, 15},
-                      {180, 15},
-                      {180, 5},
-                      {200, 5}});
+                      {5, 8},
+                      {30, 8},
+                      {30, 16},
+                      {55, 16},
+                      {55, 25},
+                      {80, 25},
+                      {110, 8},
+                      {130, 8},
+                      {130, 20},
+                      {155, 20},
+                      {155, 12},
+                      {180, 12},
+                      {180, 4},
+                      {200, 4}});
   return std::move(r).value();
 }
 

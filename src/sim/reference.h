@@ -32,7 +32,7 @@ class Reference {
                                  const std::vector<double>& values);
   // Knots in non-decreasing time; equal times make a jump.
   static Result<Reference> Piecewise(std::vector<Knot> knots);
-  // The paper's kind of force profile (Fig. 5): 0-30 N over 200 s, six steps and a ramp.
+  // The paper's kind of force profile (Fig. 5): 0-25 N over 200 s, six steps and a ramp.
   static Reference PaperFig5();
 
   // From a task file's "reference" object. `where` names the file and field for errors,

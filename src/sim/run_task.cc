@@ -33,12 +33,12 @@ struct AngleLoop {
   // Net tendon force (N): positive pulls the agonist (flexor), negative the antagonist.
   double Step(double reference, double angle, double velocity, double dT, double limit) {
     const double e = reference - angle;
-    const double unsat = gains.kp * e + gains.ki * (integral + e * dT) - gains.kd * velocity +
-                         gains.feedforward * std::sin(angle);
+    // Gravity compensation at the reference pose: the force that holds the arm there.
+    const double ff = gains.feedforward * std::sin(reference);
+    const double unsat = gains.kp * e + gains.ki * (integral + e * dT) - gains.kd * velocity + ff;
     // Integrate only while the command is not saturated the same way (anti-windup).
     if (std::abs(unsat) < limit || unsat * e < 0) integral += e * dT;
-    return gains.kp * e + gains.ki * integral - gains.kd * velocity +
-           gains.feedforward * std::sin(angle);
+    return gains.kp * e + gains.ki * integral - gains.kd * velocity + ff;
   }
 };
 
@@ -227,7 +227,7 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
   ys.reserve(num_steps);
   std::vector<std::vector<int> > on_counts(nb);
   for (int i = 0; i < nb; ++i) {
-    on_counts[i].reserve(num_steps + 1);
+    on_counts[i].reserve(static_cast<size_t>(duration / settings.dT) + 2);
     on_counts[i].push_back(plugin.OnCount(d, bundles[i]));
   }
   std::vector<double> est_on, true_on, est_var;  // agonist, at control instants
@@ -240,6 +240,7 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
   double next_control = 0;
   const bool show_progress = options.progress;
   long next_progress = 0;
+  double next_progress_wall = 0;
   for (long step = 0; step < num_steps; ++step) {
     const double t = d->time;
     apply_payloads(t);
@@ -299,7 +300,11 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
     ts.push_back(d->time);
     rs.push_back(r);
     ys.push_back(y);
-    for (int i = 0; i < nb; ++i) on_counts[i].push_back(plugin.OnCount(d, bundles[i]));
+    // Units switch only when a broadcast reaches them, so the on-counts change only at
+    // control instants: sample them there (after the broadcast took effect) for the metrics.
+    if (sample.control_instant) {
+      for (int i = 0; i < nb; ++i) on_counts[i].push_back(plugin.OnCount(d, bundles[i]));
+    }
     if (!observers.empty()) {
       sample.time = d->time;
       sample.reference = r;
@@ -326,9 +331,15 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
       }
     }
     if (show_progress && step >= next_progress) {
-      std::fprintf(stderr, "\r  %.1f / %.1f s simulated (%3.0f %%)", d->time, duration,
-                   100.0 * step / num_steps);
-      next_progress = step + std::max(1L, num_steps / 100);
+      // At most about 5 updates per second of wall time.
+      const double wall =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+      if (wall >= next_progress_wall) {
+        std::fprintf(stderr, "\r  %.1f / %.1f s simulated (%3.0f %%)", d->time, duration,
+                     100.0 * step / num_steps);
+        next_progress_wall = wall + 0.2;
+      }
+      next_progress = step + std::max(1L, num_steps / 1000);
     }
   }
   if (show_progress)

@@ -287,9 +287,11 @@ Status WriteSweepReport(const std::vector<CellStats>& cells, const TrackingCrite
       if (c.estimator == est && c.lambda == lambda) col.push_back(&c);
     }
     std::sort(col.begin(), col.end(), [](auto* a, auto* b) { return a->dT < b->dT; });
-    // The shortest dT from which every longer dT tried also meets it.
+    // The shortest dT tried that meets it (a long dT can fail too: too slow to settle).
     int best = -1;
-    for (int i = static_cast<int>(col.size()) - 1; i >= 0 && col[i]->meets; --i) best = i;
+    for (int i = 0; i < static_cast<int>(col.size()) && best < 0; ++i) {
+      if (col[i]->meets) best = i;
+    }
     if (best < 0) {
       shortest += fmt::format("| {} | {:g} | none of the dT tried | - | - |\n", est, lambda);
     } else {
@@ -330,7 +332,7 @@ Status WriteSweepReport(const std::vector<CellStats>& cells, const TrackingCrite
   const std::string tmp_png = png + ".tmp.png";
   std::string gp = fmt::format(
       "# Stability map of a recruit sweep (made by `recruit sweep`).\n"
-      "set terminal png size {},420 font ',10'\nset output '{}'\n"
+      "set terminal png size {},420 font ',10' noenhanced\nset output '{}'\n"
       "set multiplot layout 1,{} title '{}: mean step overshoot (%), ring = meets criterion'\n"
       "set logscale x 2\nset xlabel 'dT (s)'\nset ylabel 'lambda'\n"
       "set cbrange [0:50]\nset palette defined (0 'forest-green', 10 'yellow', 50 'red')\n"

@@ -30,7 +30,7 @@ struct OuterLoop {
   double kp = 0;           // N/rad
   double ki = 0;           // N/(rad s)
   double kd = 0;           // N s/rad
-  double feedforward = 0;  // N per unit sin(angle): gravity compensation of the forearm
+  double feedforward = 0;  // N: gravity compensation, feedforward * sin(reference angle)
   double tone = 0;         // N, baseline force of both bundles (co-contraction)
   double max_force = 30;   // N, clamp of each bundle's force reference
 };

@@ -42,13 +42,13 @@ TEST(Reference, HoldEndsWhereARampBegins) {
   EXPECT_DOUBLE_EQ(steps[0].end, 4.0);
 }
 
-TEST(Reference, PaperProfileSpansZeroToThirtyNewtonsOver200Seconds) {
+TEST(Reference, PaperProfileSpansZeroToTwentyFiveNewtonsOver200Seconds) {
   const Reference r = Reference::PaperFig5();
   EXPECT_DOUBLE_EQ(r.MinValue(), 0.0);
-  EXPECT_DOUBLE_EQ(r.MaxValue(), 30.0);
+  EXPECT_DOUBLE_EQ(r.MaxValue(), 25.0);
   EXPECT_DOUBLE_EQ(r.knots().back().t, 200.0);
   EXPECT_EQ(r.Steps(200).size(), 6u);
-  EXPECT_DOUBLE_EQ(r(95.0), 20.0);  // halfway down the 30 -> 10 ramp over 80..110 s
+  EXPECT_DOUBLE_EQ(r(95.0), 16.5);  // halfway down the 25 -> 8 ramp over 80..110 s
 }
 
 TEST(Reference, DegreesScaleToRadians) {

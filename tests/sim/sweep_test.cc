@@ -174,7 +174,7 @@ TEST(Sweep, ARecordOfAnotherSeedIsNotReused) {
   fs::remove_all(dir);
 }
 
-TEST(Sweep, ShortestDtIsTheShortestFromWhichAllLongerMeetTheCriterion) {
+TEST(Sweep, ShortestDtIsTheShortestThatMeetsTheCriterion) {
   // Fake overshoot = 0.3 / dT * lambda / 0.2 + U(0, 0.01) for output: at lambda 0.1,
   // 0.15 / dT <= 0.10 needs dT >= 1.5 -> 2.0 meets, 1.0 does not (0.15).
   auto grid = ExpandGrid(Spec());
