@@ -35,6 +35,10 @@ struct IdentifyArgs {
 
 int RunIdentify(const IdentifyArgs& a, const std::string& command_line) {
   using namespace recruit::control;
+  if (a.states < 4 || a.states % 2 != 0) {
+    std::cerr << "recruit identify: --states " << a.states << ": must be even and >= 4\n";
+    return 1;
+  }
   SwitchingLog log;
   double unit_force = 0;
   std::string source;
