@@ -37,7 +37,7 @@ struct RunMetrics {
   double oscillation = 0;        // excess total variation, see metrics.h
   double switching_rate = 0;     // unit transitions per unit per second (all bundles)
   double estimator_rmse = 0;     // units, at control instants (agonist)
-  double mean_nees = 0;          // on-count NEES at control instants (agonist)
+  double mean_nees = 0;          // on-count NEES at control instants (agonist); NaN: no variance
   double estimator_within3 = 0;  // fraction of control instants with |n^ - n| <= 3
   int num_steps = 0;
 };
