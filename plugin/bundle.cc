@@ -26,7 +26,13 @@ void StoreRng(const Rng& rng, double* words) {
 }  // namespace
 
 SmaBundle::SmaBundle(BundleConfig c, UnitModel u, double dt)
-    : config_(std::move(c)), unit_(std::move(u)), dt_(dt), decay_(unit_.DecayFactor(dt)) {}
+    : config_(std::move(c)), unit_(std::move(u)), dt_(dt), decay_(unit_.DecayFactor(dt)) {
+  if (config_.update_period > 0) {
+    // The pending time reaches about a whole number of steps >= update_period.
+    period_ = dt_ * std::max(1.0, std::round(config_.update_period / dt_));
+    decay_period_ = unit_.DecayFactor(period_);
+  }
+}
 
 Result<SmaBundle> SmaBundle::Create(const BundleConfig& config, double dt) {
   auto unit = UnitModel::Create(config.unit);
@@ -54,39 +60,76 @@ void SmaBundle::Reset(double* s, std::uint64_t seed, double stretch) const {
 
 bool SmaBundle::Initialized(const double* s) { return s[kMagicSlot] == kMagic; }
 
-Status SmaBundle::Broadcast(double* s, double p_on, double p_off) const {
+Status SmaBundle::Broadcast(double* s, double p_on, double p_off, double stretch) const {
   if (!(p_on >= 0 && p_on <= 1) || !(p_off >= 0 && p_off <= 1)) {
     return Error{"actuator '" + config_.actuator + "': broadcast probabilities must be in [0, 1]"};
   }
+  Flush(s, stretch);  // time not yet integrated ran with the old on/off states
   Rng rng = LoadRng(s + kRngSlot);
   const int k0 = NumCohorts(s);
-  int k = k0;
-  std::vector<int> split(k0, -1);  // cohort that the switching units of each cohort join
   double* idx = UnitIndex(s);
+  // Pass 1: every unit draws, in unit order.
+  std::vector<int> flips(k0, 0);
+  std::vector<char> flip(config_.units, 0);
   for (int i = 0; i < config_.units; ++i) {
     const int from = static_cast<int>(idx[i]);
-    double* c = Cohort(s, from);
     const double u = rng.Uniform();
-    if (!(u < (c[kOn] != 0 ? p_off : p_on))) continue;
-    if (split[from] < 0) {
-      split[from] = k;
-      double* n = Cohort(s, k++);
-      std::copy(c, c + kCohortStride, n);
-      n[kCount] = 0;
-      n[kOn] = c[kOn] != 0 ? 0 : 1;
+    if (u < (Cohort(s, from)[kOn] != 0 ? p_off : p_on)) {
+      flip[i] = 1;
+      ++flips[from];
     }
-    c[kCount] -= 1;
-    Cohort(s, split[from])[kCount] += 1;
-    idx[i] = split[from];
+  }
+  StoreRng(rng, s + kRngSlot);
+  // Pass 2: a cohort whose units all switch flips in place; one that splits gets a new cohort
+  // for its switching units. Non-empty cohorts never exceed N, so the N slots suffice.
+  std::vector<int> target(k0, -1);
+  int k = k0;
+  for (int j = 0; j < k0; ++j) {
+    if (flips[j] == 0) continue;
+    double* c = Cohort(s, j);
+    if (flips[j] == static_cast<int>(c[kCount])) {
+      c[kOn] = c[kOn] != 0 ? 0 : 1;
+      target[j] = j;
+      continue;
+    }
+    double* n = Cohort(s, k);
+    std::copy(c, c + kCohortStride, n);
+    n[kCount] = flips[j];
+    n[kOn] = c[kOn] != 0 ? 0 : 1;
+    c[kCount] -= flips[j];
+    target[j] = k++;
+  }
+  for (int i = 0; i < config_.units; ++i) {
+    if (flip[i]) idx[i] = target[static_cast<int>(idx[i])];
   }
   s[kCohortCountSlot] = k;
-  StoreRng(rng, s + kRngSlot);
-  if (k != k0) Compact(s, {});
   return Status::Ok();
 }
 
 void SmaBundle::Advance(double* s, double stretch, double dt) const {
-  const double decay = dt == dt_ ? decay_ : unit_.DecayFactor(dt);
+  if (config_.update_period <= 0) {
+    Integrate(s, stretch, dt);
+    return;
+  }
+  s[kPendingSlot] += dt;
+  if (s[kPendingSlot] >= config_.update_period - 0.5 * dt) Flush(s, stretch);
+}
+
+void SmaBundle::Flush(double* s, double stretch) const {
+  const double t = s[kPendingSlot];
+  s[kPendingSlot] = 0;
+  if (t > 0) Integrate(s, stretch, t);
+}
+
+void SmaBundle::Integrate(double* s, double stretch, double dt) const {
+  double decay;
+  if (dt == dt_) {
+    decay = decay_;
+  } else if (std::abs(dt - period_) < 1e-9 * period_) {
+    decay = decay_period_;
+  } else {
+    decay = unit_.DecayFactor(dt);
+  }
   const int k = NumCohorts(s);
   for (int j = 0; j < k; ++j) {
     double* c = Cohort(s, j);

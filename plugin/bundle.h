@@ -36,9 +36,13 @@ class SmaBundle {
 
   // Every unit draws once from the bundle's stream: an off unit turns on with probability p_on,
   // an on unit turns off with probability p_off. Probabilities must be in [0, 1].
-  Status Broadcast(double* s, double p_on, double p_off) const;
+  // Time accumulated since the last unit update (update_period > 0) is integrated first, with
+  // the units' old on/off states, at extension `stretch` (m).
+  Status Broadcast(double* s, double p_on, double p_off, double stretch) const;
 
-  // Advances every cohort by dt at unit extension `stretch` (m).
+  // Advances every cohort by dt at unit extension `stretch` (m); with update_period > 0 the
+  // units are integrated once the accumulated time reaches it (exact thermal step, implicit
+  // phase solve: both stay accurate for long steps).
   void Advance(double* s, double stretch, double dt) const;
 
   // Total tension of the bundle (N, >= 0) at unit extension `stretch`: pure, reads s only.
@@ -62,9 +66,10 @@ class SmaBundle {
   double SettledOnTension(double stretch) const;
 
  private:
-  // Header: magic, 4 random-stream words, cohort count, advance counter, spare.
+  // Header: magic, 4 random-stream words, cohort count, update counter, pending time (s).
   static constexpr int kHeader = 8;
-  static constexpr int kMagicSlot = 0, kRngSlot = 1, kCohortCountSlot = 5, kCounterSlot = 6;
+  static constexpr int kMagicSlot = 0, kRngSlot = 1, kCohortCountSlot = 5, kCounterSlot = 6,
+                       kPendingSlot = 7;
   // Cohort: count, on, then the UnitState fields.
   static constexpr int kCohortStride = 7;
   static constexpr int kCount = 0, kOn = 1, kTemp = 2, kXi = 3, kTeff = 4, kHeatScale = 5,
@@ -79,13 +84,15 @@ class SmaBundle {
     return s + kHeader + kCohortStride * config_.units;
   }
   void Merge(double* s) const;
+  void Flush(double* s, double stretch) const;
+  void Integrate(double* s, double stretch, double dt) const;
   // Drops cohorts with count 0 and relabels units; forward[j] >= 0 sends the units of an
   // emptied cohort j to cohort forward[j].
   void Compact(double* s, const std::vector<int>& forward) const;
 
   BundleConfig config_;
   UnitModel unit_;
-  double dt_ = 0, decay_ = 1;
+  double dt_ = 0, decay_ = 1, period_ = 0, decay_period_ = 1;
 };
 
 }  // namespace recruit::sma

@@ -60,6 +60,7 @@ const std::vector<Key>& NumericKeys() {
       {"merge_temperature", 0, 10, false, "C",
        [](BundleConfig& c, double v) { c.merge_temperature = v; }},
       {"merge_xi", 0, 0.1, false, "", [](BundleConfig& c, double v) { c.merge_xi = v; }},
+      {"update_period", 0, 1, false, "s", [](BundleConfig& c, double v) { c.update_period = v; }},
   };
   return keys;
 }

@@ -21,9 +21,17 @@ struct BundleConfig {
   // Tendon length (m) at which each unit's extension equals unit.prestretch; NaN = the
   // actuator's length at qpos0 (mjModel.actuator_length0).
   double ref_length = std::nan("");
-  // Cohorts of units whose states differ by less than these are merged (deg C, fraction).
-  double merge_temperature = 1e-3;
-  double merge_xi = 1e-5;
+  // Cohorts of units in the same on/off state whose temperatures (and effective temperatures)
+  // differ by at most merge_temperature (C) and whose xi (and branch constants) differ by at
+  // most merge_xi are merged into one with the count-weighted mean state. The mean temperature
+  // and xi are kept, so the bundle's tension moves by ~1e-4 of one unit's force; per-unit debug
+  // values are exact only with both set to 0 (then only identical states merge).
+  double merge_temperature = 0.5;
+  double merge_xi = 0.01;
+  // Units are integrated every update_period seconds (rounded to whole timesteps) instead of
+  // every step; 0 = every step. For long sweeps: the thermal time constant is about 1 s, so a
+  // few ms keeps the force within a fraction of a percent at a fraction of the cost.
+  double update_period = 0;
 
   // Parses `text` (whitespace-separated key=value). Errors name the actuator and the key.
   static Result<BundleConfig> FromText(const std::string& actuator, const std::string& text);

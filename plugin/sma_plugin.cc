@@ -262,7 +262,7 @@ Status SmaPlugin::Broadcast(mjData* d, int b, double p_on, double p_off) const {
                  std::to_string(num_bundles()) + ")"};
   }
   EnsureInitialised(d);
-  Status s = bundles_[b].Broadcast(State(d, b), p_on, p_off);
+  Status s = bundles_[b].Broadcast(State(d, b), p_on, p_off, Stretch(d, b));
   WriteAct(d, b);
   return s;
 }

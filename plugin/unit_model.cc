@@ -12,30 +12,28 @@ constexpr double kPi = 3.14159265358979323846;
 constexpr double kStefanBoltzmann = 5.670374419e-8;  // W/(m^2 K^4)
 constexpr double kGravity = 9.81;                    // m/s^2
 
-// Root of a monotone increasing g on [lo, hi] with g(lo) <= 0 <= g(hi): Illinois (modified
-// regula falsi), falling back to bisection. g has slope >= 1 here, so |g| bounds the error.
-template <class G>
-double SolveIncreasing(const G& g, double lo, double glo, double hi, double ghi) {
-  int side = 0;
-  for (int it = 0; it < 100; ++it) {
-    double x = (ghi - glo) > 0 ? (lo * ghi - hi * glo) / (ghi - glo) : 0.5 * (lo + hi);
-    if (!(x > lo && x < hi)) x = 0.5 * (lo + hi);
-    const double gx = g(x);
-    if (std::abs(gx) < 1e-13) return x;
-    if (gx > 0) {
+// Root of a monotone increasing g on [lo, hi] by Newton's method from x (g and slope given),
+// safeguarded by the bracket: a step that leaves it bisects instead. The step-to-step change of
+// xi is small, so 2-3 iterations usually suffice. gd(x, &g, &dg) evaluates g and its slope.
+template <class GD>
+double SolveNewton(const GD& gd, double lo, double hi, double x, double g, double dg) {
+  for (int it = 0; it < 60; ++it) {
+    if (g > 0) {
       hi = x;
-      ghi = gx;
-      if (side == 1) glo *= 0.5;
-      side = 1;
     } else {
       lo = x;
-      glo = gx;
-      if (side == -1) ghi *= 0.5;
-      side = -1;
     }
-    if (hi - lo < 1e-13) break;
+    double next = dg > 0 ? x - g / dg : 0.5 * (lo + hi);
+    if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
+    const double step = next - x;
+    x = next;
+    // Newton converges quadratically: after a step below 1e-10 the remaining error is far
+    // smaller (and at most the step where g has a kink), so x is accepted unevaluated.
+    if (std::abs(step) < 1e-10 || hi - lo < 1e-15) break;
+    gd(x, &g, &dg);
+    if (std::abs(g) < 1e-13) break;
   }
-  return 0.5 * (lo + hi);
+  return x;
 }
 
 std::string Num(double v) {
@@ -120,6 +118,34 @@ double UnitModel::MajorCooling(double t_eff) const {
   return 0.5 * (std::cos(kPi * (t_eff - p_.Mf) / (p_.Ms - p_.Mf)) + 1);
 }
 
+double UnitModel::MajorHeating(double t_eff, double* slope) const {
+  if (t_eff <= p_.As || t_eff >= p_.Af) {
+    *slope = 0;
+    return t_eff <= p_.As ? 1 : 0;
+  }
+  const double w = kPi / (p_.Af - p_.As);
+  const double a = w * (t_eff - p_.As);
+  *slope = -0.5 * w * std::sin(a);  // sin and cos of one angle: one sincos call
+  return 0.5 * (std::cos(a) + 1);
+}
+
+double UnitModel::MajorCooling(double t_eff, double* slope) const {
+  if (t_eff <= p_.Mf || t_eff >= p_.Ms) {
+    *slope = 0;
+    return t_eff <= p_.Mf ? 1 : 0;
+  }
+  const double w = kPi / (p_.Ms - p_.Mf);
+  const double a = w * (t_eff - p_.Mf);
+  *slope = -0.5 * w * std::sin(a);
+  return 0.5 * (std::cos(a) + 1);
+}
+
+double UnitModel::TensionSlope(double xi, double stretch) const {
+  const double k = k_A_ + xi * (k_M_ - k_A_);
+  if (k * (stretch - xi * stretch_L_) <= 0) return 0;
+  return (k_M_ - k_A_) * (stretch - xi * stretch_L_) - k * stretch_L_;
+}
+
 double UnitModel::Tension(double xi, double stretch) const {
   const double k = k_A_ + xi * (k_M_ - k_A_);
   return std::max(0.0, k * (stretch - xi * stretch_L_));
@@ -162,8 +188,20 @@ void SolvePhase(const UnitModel& m, UnitState& s, double t_thermal, double stret
   auto teff_c = [&](double x) { return temp(x) - m.Stress(m.Tension(x, stretch)) / p.C_M; };
   // Both residuals have slope >= 1 in x: T_eff rises as x falls (stress rises, latent heat is
   // released as x rises), and M+, M- are non-increasing.
-  auto g_h = [&](double x) { return x - s.heat_scale * m.MajorHeating(teff_h(x)); };
-  auto g_c = [&](double x) { return x - 1 + s.cool_scale * (1 - m.MajorCooling(teff_c(x))); };
+  // With slopes, for Newton: dT_eff/dx = L/c - (dsigma/dF) (dF/dx) / C >= 0.
+  const double stress_slope = m.Stress(1.0);
+  auto gd_h = [&](double x, double* g, double* dg) {
+    double slope;
+    *g = x - s.heat_scale * m.MajorHeating(teff_h(x), &slope);
+    const double dte = latent - stress_slope * m.TensionSlope(x, stretch) / p.C_A;
+    *dg = 1 - s.heat_scale * slope * dte;
+  };
+  auto gd_c = [&](double x, double* g, double* dg) {
+    double slope;
+    *g = x - 1 + s.cool_scale * (1 - m.MajorCooling(teff_c(x), &slope));
+    const double dte = latent - stress_slope * m.TensionSlope(x, stretch) / p.C_M;
+    *dg = 1 - s.cool_scale * slope * dte;
+  };
 
   double xi = xi0;
   double te;
@@ -171,9 +209,10 @@ void SolvePhase(const UnitModel& m, UnitState& s, double t_thermal, double stret
   if (te_h0 >= s.t_eff) {
     // Heating (or steady): M -> A only, xi can only fall.
     te = te_h0;
-    const double g0 = g_h(xi0);
+    double g0, dg0;
+    gd_h(xi0, &g0, &dg0);
     if (g0 > 1e-12) {
-      xi = SolveIncreasing(g_h, 0.0, g_h(0.0), xi0, g0);
+      xi = SolveNewton(gd_h, 0.0, xi0, xi0, g0, dg0);
       te = teff_h(xi);
       // Transformed: a later cooling branch starts from here.
       const double mm = m.MajorCooling(te);
@@ -182,9 +221,10 @@ void SolvePhase(const UnitModel& m, UnitState& s, double t_thermal, double stret
   } else {
     // Cooling: A -> M only, xi can only rise.
     te = teff_c(xi0);
-    const double g0 = g_c(xi0);
+    double g0, dg0;
+    gd_c(xi0, &g0, &dg0);
     if (g0 < -1e-12) {
-      xi = SolveIncreasing(g_c, xi0, g0, 1.0, g_c(1.0));
+      xi = SolveNewton(gd_c, xi0, 1.0, xi0, g0, dg0);
       te = teff_c(xi);
       const double mp = m.MajorHeating(te);
       s.heat_scale = mp > 0 ? std::clamp(xi / mp, 0.0, 1.0) : 1.0;
@@ -209,6 +249,10 @@ void SolvePhase(const UnitModel& m, UnitState& s, double t_thermal, double stret
 
 void AdvanceUnit(const UnitModel& m, UnitState& s, bool on, double stretch, double dt) {
   AdvanceUnitWithDecay(m, s, on, stretch, m.DecayFactor(dt));
+}
+
+void ImposeTemperature(const UnitModel& m, UnitState& s, double t, double stretch) {
+  SolvePhase(m, s, t, stretch);
 }
 
 void AdvanceUnitWithDecay(const UnitModel& m, UnitState& s, bool on, double stretch, double decay) {

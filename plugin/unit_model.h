@@ -52,8 +52,14 @@ class UnitModel {
   double MajorHeating(double t_eff) const;
   double MajorCooling(double t_eff) const;
 
-  // Tension of one unit (N, >= 0) at fraction xi and extension `stretch` (m).
+  // The same with their derivatives with respect to t_eff (<= 0) in *slope.
+  double MajorHeating(double t_eff, double* slope) const;
+  double MajorCooling(double t_eff, double* slope) const;
+
+  // Tension of one unit (N, >= 0) at fraction xi and extension `stretch` (m), and its
+  // derivative with respect to xi.
   double Tension(double xi, double stretch) const;
+  double TensionSlope(double xi, double stretch) const;
   // Equivalent tensile stress (Pa) that shifts the transformation temperatures at tension f.
   double Stress(double f) const { return stress_per_newton_ * f; }
 
@@ -107,6 +113,9 @@ UnitState RestState(const UnitModel& m, double stretch);
 // and the given extension. Heating and cooling follow the proportional rule, so a reversal starts
 // a minor loop inside the major loop.
 void AdvanceUnit(const UnitModel& m, UnitState& s, bool on, double stretch, double dt);
+// Sets the unit's temperature to t (as if imposed from outside) and solves the phase fraction
+// at extension `stretch`, with the same hysteresis rules (and latent heat) as AdvanceUnit.
+void ImposeTemperature(const UnitModel& m, UnitState& s, double t, double stretch);
 // The same with the thermal decay factor exp(-dt / tau) precomputed by the caller.
 void AdvanceUnitWithDecay(const UnitModel& m, UnitState& s, bool on, double stretch, double decay);
 

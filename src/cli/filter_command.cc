@@ -1,16 +1,75 @@
+// `recruit filter`: runs one estimator offline over a recorded log (docs/formats/filter.md).
 #include <iostream>
+#include <string>
 
 #include "cli/commands.h"
+#include "common/atomic_file.h"
+#include "estimation/count_filter.h"
+#include "estimation/filter_log.h"
+#include "estimation/filter_model.h"
 
 namespace recruit::cli {
+namespace {
 
-// Placeholder until issue 2 lands: the subcommand exists so that --help lists it.
+struct FilterArgs {
+  std::string model, log, out;
+  CountFilterOptions options;
+};
+
+int RunFilter(const FilterArgs& a) {
+  auto fail = [](const std::string& msg) {
+    std::cerr << "recruit filter: " << msg << "\n";
+    return 1;
+  };
+  auto model = FilterModel::FromJson(a.model);
+  if (!model.ok()) return fail(model.error());
+  auto log = ReadFilterLog(a.log, *model);
+  if (!log.ok()) return fail(log.error());
+  auto filter = MakeCountFilter(*model, a.options);
+  if (!filter.ok()) return fail(filter.error());
+  auto csv = RunFilterOverLog(*model, *log, **filter);
+  if (!csv.ok()) return fail(a.log + ": " + csv.error());
+  if (Status s = WriteFileAtomically(a.out, *csv); !s.ok()) return fail(s.error());
+  return 0;
+}
+
+}  // namespace
+
 void AddFilterCommand(CLI::App& app, int& exit_code) {
-  auto* cmd = app.add_subcommand("filter", "(not built yet: issue 2)");
-  cmd->callback([&exit_code] {
-    std::cerr << "recruit filter: not implemented yet (issue 2)\n";
-    exit_code = 2;
-  });
+  auto args = std::make_shared<FilterArgs>();
+  auto* cmd = app.add_subcommand(
+      "filter",
+      "Run a population estimator offline over a recorded log: the Kalman filter for population "
+      "Markov chains (extended, conservative or plain covariance), the exact Bayesian filter or "
+      "a particle filter. Formats: docs/formats/filter.md.");
+  cmd->add_option("--model", args->model,
+                  "Filter model file (JSON): states, N, H, R, optional G and Qw, the transition "
+                  "(broadcast, explicit or constant) and the initial belief")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--log", args->log,
+                  "Log (CSV): optional t, the inputs of each step (p_on,p_off or A_i_j) and the "
+                  "measurement (y, or y_0..y_{r-1}; empty cells = no measurement that step)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--out", args->out,
+                  "Output CSV: step[,t],updated,x_<state>...,var_<state>... (estimate and "
+                  "diagonal of its covariance per step), written atomically")
+      ->required();
+  cmd->add_option("--estimator", args->options.estimator,
+                  std::string("Estimator: ") + kEstimatorNames)
+      ->check(CLI::IsMember({"extended", "conservative", "plain", "exact", "particle"}))
+      ->capture_default_str();
+  cmd->add_option("--particles", args->options.particles, "Particle filter: number of particles")
+      ->check(CLI::Range(1, 100000000))
+      ->capture_default_str();
+  cmd->add_option("--seed", args->options.seed, "Particle filter: random seed")
+      ->capture_default_str();
+  cmd->add_option("--max-states", args->options.max_states,
+                  "Exact filter: refuse models with more count vectors C(N+m-1, m-1) than this")
+      ->check(CLI::Range(uint64_t{1}, uint64_t{200000000}))
+      ->capture_default_str();
+  cmd->callback([args, &exit_code] { exit_code = RunFilter(*args); });
 }
 
 }  // namespace recruit::cli

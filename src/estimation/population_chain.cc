@@ -11,7 +11,7 @@ namespace {
 
 std::string Num(double v) {
   std::ostringstream s;
-  s.precision(17);
+  s.precision(6);  // enough to name the value; 1.0499999999999998 reads as 1.05
   s << v;
   return s.str();
 }
@@ -159,15 +159,14 @@ Eigen::MatrixXd ProcessCovarianceQz(const Eigen::MatrixXd& A, const Eigen::Vecto
   return Q;
 }
 
+Eigen::MatrixXd ConservativeQz(const Eigen::MatrixXd& A, double N) {
+  return ProcessCovarianceQz(A, Eigen::VectorXd::Constant(A.cols(), N));
+}
+
 Eigen::VectorXd ProjectOntoSimplex(const Eigen::VectorXd& x, double N) {
   const Eigen::Index m = x.size();
-  // Fast path: already feasible (up to the sum, which the filters keep exact).
-  if ((x.array() >= 0.0).all()) {
-    Eigen::VectorXd y = x;
-    const double s = y.sum();
-    if (s > 0) y *= N / s;
-    return y;
-  }
+  // Fast path: already feasible.
+  if ((x.array() >= 0.0).all() && std::abs(x.sum() - N) <= 1e-12 * std::abs(N)) return x;
   std::vector<double> u(x.data(), x.data() + m);
   std::sort(u.begin(), u.end(), std::greater<double>());
   double cumsum = 0.0, theta = 0.0;
@@ -203,7 +202,7 @@ Eigen::MatrixXd EquilibriumCovariance(const Eigen::VectorXd& pi, double N) {
   return C;
 }
 
-Result<GammaBound> ComputeGammaBound(const Eigen::MatrixXd& A, const Eigen::MatrixXd& Q) {
+Result<GammaBound> ComputeGammaBound(const Eigen::MatrixXd& A, const Eigen::MatrixXd& Qmax) {
   if (Status s = ValidateColumnStochastic(A); !s.ok()) return Error{s.error()};
   const Eigen::Index m = A.rows();
   Eigen::EigenSolver<Eigen::MatrixXd> es(A.transpose());
@@ -236,13 +235,13 @@ Result<GammaBound> ComputeGammaBound(const Eigen::MatrixXd& A, const Eigen::Matr
       return Error{"Gamma bound: a second eigenvalue has modulus 1 (periodic or reducible chain)"};
     }
   }
-  const Eigen::MatrixXd VQV = g.V.transpose() * Q * g.V;
+  const Eigen::MatrixXd VQV = g.V.transpose() * Qmax * g.V;
   g.bound.resize(m, m);
   for (Eigen::Index i = 0; i < m; ++i) {
     for (Eigen::Index j = 0; j < m; ++j) {
-      g.bound(i, j) = (i == 0 && j == 0)
-                          ? 0.0
-                          : std::abs(VQV(i, j)) / (1.0 - std::abs(g.lambda(i) * g.lambda(j)));
+      g.bound(i, j) = (i == 0 && j == 0) ? 0.0
+                                         : std::sqrt(std::max(0.0, VQV(i, i) * VQV(j, j))) /
+                                               (1.0 - std::abs(g.lambda(i) * g.lambda(j)));
     }
   }
   return g;

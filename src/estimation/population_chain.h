@@ -48,6 +48,11 @@ Eigen::VectorXd CountStates(const std::vector<int>& states, int m);
 // Qz(X, A) = E[z z^T | X] = diag(A X) - A diag(X) A^T (eq. 25). PSD when X >= 0.
 Eigen::MatrixXd ProcessCovarianceQz(const Eigen::MatrixXd& A, const Eigen::VectorXd& x);
 
+// The conservative bound Qz(N 1) = N (diag(A 1) - A A^T). Qz(X) = sum_j X_j S_j with
+// S_j = diag(a_j) - a_j a_j^T PSD, so Qz(N 1) - Qz(X) = sum_j (N - X_j) S_j is PSD for every X
+// with 0 <= X_j <= N: it dominates Qz(X) in the PSD order over the paper's box (eq. 35).
+Eigen::MatrixXd ConservativeQz(const Eigen::MatrixXd& A, double N);
+
 // Euclidean projection of x onto the scaled simplex {n_i >= 0, sum_i n_i = N} (sort-based,
 // O(m log m)). Used to keep the extended filter's Qz PSD.
 Eigen::VectorXd ProjectOntoSimplex(const Eigen::VectorXd& x, double N);
@@ -60,19 +65,24 @@ Result<Eigen::VectorXd> StationaryDistribution(const Eigen::MatrixXd& A);
 // N (diag pi - pi pi^T): the limit of Cov[X] with no data (eq. 30).
 Eigen::MatrixXd EquilibriumCovariance(const Eigen::VectorXd& pi, double N);
 
-// The eq. 34/36 picture of the no-data covariance recursion P(t+1) = A P A^T + Q.
+// The eq. 34/36 picture of the no-data covariance recursion P(t+1) = A P A^T + Q(t).
 // V holds the left eigenvectors of A (right eigenvectors of A^T) as columns, sorted by
-// decreasing |lambda|, lambda_1 = 1 first with e_1 = 1 (all ones). Gamma = V^T P V.
-// bound_ij = Qbar_ij / (1 - |lambda_i lambda_j|) (eq. 36) with Qbar_ij = |e_i^T Q e_j|, for
-// (i, j) != (1, 1); bound_11 = 0. Requires A with real, distinct eigenvalues |lambda_i| < 1
-// for i > 1 (true for the positive two-state and birth-death chains); complex spectra error.
+// decreasing |lambda|, lambda_1 = 1 first with e_1 = 1 (all ones). Gamma = V^T P V evolves as
+// Gamma_ij(t+1) = lambda_i lambda_j Gamma_ij(t) + e_i^T Q(t) e_j (eq. 34).
+// `Qmax` is a PSD upper bound of every Q(t) (for example the conservative Qz(N 1) plus
+// G Qw G^T). Then |e_i^T Q(t) e_j| <= Qbar_ij = sqrt(e_i^T Qmax e_i * e_j^T Qmax e_j)
+// (Cauchy-Schwarz on the PSD Q(t), and Q(t) <= Qmax), and by induction from Gamma(0) = 0
+// |Gamma_ij(t)| <= bound_ij = Qbar_ij / (1 - |lambda_i lambda_j|) for every t (eq. 36), with
+// bound_11 = 0 (1^T P = 0). Requires a real spectrum with |lambda_i| < 1 for i > 1 (true for
+// the two-state and birth-death chains, whose A is similar to a symmetric matrix); a complex
+// spectrum is an error.
 struct GammaBound {
   Eigen::VectorXd lambda;  // eigenvalues of A, lambda(0) = 1
   Eigen::MatrixXd V;       // columns e_i
   Eigen::MatrixXd bound;   // m x m, the eq. 36 limit of |Gamma_ij|
   Eigen::MatrixXd Gamma(const Eigen::MatrixXd& P) const { return V.transpose() * P * V; }
 };
-Result<GammaBound> ComputeGammaBound(const Eigen::MatrixXd& A, const Eigen::MatrixXd& Q);
+Result<GammaBound> ComputeGammaBound(const Eigen::MatrixXd& A, const Eigen::MatrixXd& Qmax);
 
 // Number of count vectors of N agents over m states: C(N + m - 1, m - 1), saturating at
 // `cap` + 1 so huge spaces do not overflow.

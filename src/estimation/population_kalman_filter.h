@@ -122,7 +122,7 @@ namespace kf_detail {
 // same size (no allocation for fixed sizes).
 template <class V>
 void ProjectOntoSimplexInto(const V& x, double N, V& out, V& work) {
-  if ((x.array() >= 0.0).all()) {
+  if ((x.array() >= 0.0).all()) {  // feasible: the filter keeps sum x = N exactly
     out = x;
     return;
   }

@@ -99,6 +99,11 @@ void EncodePipeline::Run() {
   }
 }
 
+void EncodePipeline::WaitIdle() {
+  std::unique_lock<std::mutex> lock(mu_);
+  cv_.wait(lock, [this] { return free_.size() == storage_.size(); });
+}
+
 Status EncodePipeline::Finish() {
   if (finished_) return error_;
   finished_ = true;

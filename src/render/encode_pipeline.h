@@ -34,6 +34,9 @@ class EncodePipeline {
   Result<Frame*> Acquire();
   // Queues the frame (from Acquire) for writing; returns an earlier encoder error, if any.
   Status Submit(Frame* frame);
+  // Blocks until every submitted frame has been handed to the writers (benchmarks use it to
+  // keep the encoder from running into a render-only measurement).
+  void WaitIdle();
   // Writes what is queued, finishes every file (rename into place) and reports the first error.
   Status Finish();
 

@@ -27,6 +27,12 @@ LibavOutput::~LibavOutput() {
 }
 
 Result<std::unique_ptr<LibavOutput>> LibavOutput::Open(const std::string& path, const char* muxer) {
+  // libav's default (info) level prints x264's statistics for every file; keep warnings and
+  // errors unless the host program chose a level itself.
+  static std::once_flag quiet;
+  std::call_once(quiet, [] {
+    if (av_log_get_level() == AV_LOG_INFO) av_log_set_level(AV_LOG_WARNING);
+  });
   std::unique_ptr<LibavOutput> out(new LibavOutput());
   // Creating the AtomicFile checks the directory is writable and reserves the temporary name.
   out->file_ = std::make_unique<AtomicFile>(path, std::ios::binary);

@@ -29,6 +29,10 @@ Status RenderOptions::Validate() const {
   if (!(figure_window > 0) || !std::isfinite(figure_window)) {
     return Error{"figure window must be a positive number of seconds"};
   }
+  if (!std::isfinite(min_tendon_width) || min_tendon_width < 0 || min_tendon_width > 1) {
+    return Error{"minimum tendon width must be in [0, 1] m (0 = the model's), got " +
+                 std::to_string(min_tendon_width)};
+  }
   if (multisamples != -1 && (multisamples < 0 || multisamples > 16)) {
     return Error{"multisamples must be -1 (the model's value) or in [0, 16], got " +
                  std::to_string(multisamples)};
@@ -150,15 +154,22 @@ Status SceneRenderer::Render(const mjModel* m, const mjData* d, const TelemetryS
   if (sample && options_.heat_colours) {
     last_recoloured_ = ColourTendonsByHeat(m, *sample, &scene_);
   }
+  if (sample && options_.min_tendon_width > 0) {
+    WidenTendons(m, *sample, options_.min_tendon_width, &scene_);
+  }
   mjr_setBuffer(mjFB_OFFSCREEN, &context_);
   const mjrRect viewport = {0, 0, options_.width, options_.height};
-  mjr_render(viewport, &scene_, &context_);
+  // With plots, the scene takes the left three fifths and the plots the right two, so neither
+  // hides the other.
+  const int plot_width = plots_ ? options_.width * 2 / 5 : 0;
+  const mjrRect scene_viewport = {0, 0, options_.width - plot_width, options_.height};
+  mjr_render(scene_viewport, &scene_, &context_);
   if (plots_) {
-    // Right-hand column, both figures stacked, over the scene.
-    const int w = options_.width * 2 / 5;
-    plots_->Draw({options_.width - w, 0, w, options_.height}, &context_);
+    const mjrRect plot_area = {options_.width - plot_width, 0, plot_width, options_.height};
+    mjr_rectangle(plot_area, 0.f, 0.f, 0.f, 1.f);
+    plots_->Draw(plot_area, &context_);
   }
-  if (options_.text_panel) DrawPanel(sample, viewport);
+  if (options_.text_panel) DrawPanel(sample, scene_viewport);
   mjr_readPixels(rgb, nullptr, viewport, &context_);
   if (const int err = mjr_getError(); err != 0) {
     char code[16];

@@ -38,7 +38,10 @@ struct RenderOptions {
   bool text_panel = true;     // the mjr_overlay panel
   bool heat_colours = true;   // colour each bundle's tendon by its heat
   double figure_window = 20;  // s of history in the plots
-  int multisamples = -1;      // offscreen MSAA samples; -1 = the model's <quality offsamples>
+  // Draw each bundle's tendon at least this thick (m, radius); 0 = as the model says. Real SMA
+  // bundles are a few mm thick, a pixel or two in a whole-arm shot.
+  double min_tendon_width = 0;
+  int multisamples = -1;  // offscreen MSAA samples; -1 = the model's <quality offsamples>
 
   static constexpr int kMinSide = 16;
   static constexpr int kMaxSide = 8192;

@@ -29,4 +29,23 @@ int ColourTendonsByHeat(const mjModel* m, const TelemetrySample& sample, mjvScen
   return count;
 }
 
+int WidenTendons(const mjModel* m, const TelemetrySample& sample, double min_width,
+                 mjvScene* scene) {
+  int count = 0;
+  const float w = static_cast<float>(min_width);
+  for (const BundleTelemetry& b : sample.bundles) {
+    if (b.tendon_id < 0 || b.tendon_id >= m->ntendon) continue;
+    for (int g = 0; g < scene->ngeom; ++g) {
+      mjvGeom& geom = scene->geoms[g];
+      if (geom.objtype != mjOBJ_TENDON || geom.objid != b.tendon_id) continue;
+      // Connectors (capsule/cylinder segments) carry the radius in size[0] and size[1]; the
+      // spheres at wrap points in all three.
+      const int n = geom.type == mjGEOM_SPHERE ? 3 : 2;
+      for (int k = 0; k < n; ++k) geom.size[k] = std::max(geom.size[k], w);
+      ++count;
+    }
+  }
+  return count;
+}
+
 }  // namespace recruit::render

@@ -19,4 +19,9 @@ std::array<float, 4> HeatColour(double heat);
 // tendon_id outside [0, ntendon) are skipped. Returns the number of geoms recoloured.
 int ColourTendonsByHeat(const mjModel* m, const TelemetrySample& sample, mjvScene* scene);
 
+// Draws each bundle's tendon geoms at least `min_width` (m) thick in the scene only (the model's
+// tendon width is for display too, but real bundles are thin). Returns the geoms widened.
+int WidenTendons(const mjModel* m, const TelemetrySample& sample, double min_width,
+                 mjvScene* scene);
+
 }  // namespace recruit::render

@@ -1,0 +1,225 @@
+// `recruit filter` run as a separate process: the documented worked example, every estimator,
+// and bad input (clear message, non-zero exit, no output file).
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "common/atomic_file.h"
+#include "estimation/count_filter.h"
+#include "estimation/filter_log.h"
+#include "estimation/filter_model.h"
+
+namespace recruit {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct RunResult {
+  int exit_code;
+  std::string err;
+};
+
+// Runs `recruit ARGS` with stderr captured to a file.
+RunResult RunRecruit(const std::string& args) {
+  const std::string err_path = ::testing::TempDir() + "/estimation_cli_stderr.txt";
+  const std::string cmd = std::string(RECRUIT_BINARY) + " " + args + " > /dev/null 2> " + err_path;
+  const int status = std::system(cmd.c_str());
+  RunResult r{WIFEXITED(status) ? WEXITSTATUS(status) : -1, ""};
+  auto text = ReadFile(err_path);
+  if (text.ok()) r.err = *text;
+  return r;
+}
+
+std::string Src(const std::string& rel) { return std::string(RECRUIT_SOURCE_DIR) + "/" + rel; }
+
+class EstimationCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::path(::testing::TempDir()) /
+           ("estimation_cli_" +
+            std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  std::string Write(const std::string& name, const std::string& text) {
+    const std::string p = (dir_ / name).string();
+    std::ofstream(p) << text;
+    return p;
+  }
+  std::string Out() const { return (dir_ / "out.csv").string(); }
+  // Nothing named out.csv* (neither the output nor a leftover temporary file).
+  bool NoOutput() const {
+    for (const auto& e : fs::directory_iterator(dir_)) {
+      if (e.path().filename().string().rfind("out.csv", 0) == 0) return false;
+    }
+    return true;
+  }
+  fs::path dir_;
+};
+
+std::vector<std::vector<double>> ReadCsvNumbers(const std::string& path, std::string* header) {
+  std::ifstream in(path);
+  std::string line;
+  std::getline(in, *header);
+  std::vector<std::vector<double>> rows;
+  while (std::getline(in, line)) {
+    std::vector<double> row;
+    std::stringstream ss(line);
+    std::string cell;
+    while (std::getline(ss, cell, ',')) row.push_back(std::stod(cell));
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+// The command of docs/formats/filter.md, on the committed worked example.
+TEST_F(EstimationCli, DocumentedExampleRunsAndTracksTheTruth) {
+  const std::string model = Src("models/filter/three_state_model.json");
+  const std::string log = Src("models/filter/three_state_log.csv");
+  const RunResult r = RunRecruit("filter --model " + model + " --log " + log +
+                                 " --estimator extended --out " + Out());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::string header;
+  const auto rows = ReadCsvNumbers(Out(), &header);
+  EXPECT_EQ(header, "step,t,updated,x_off,x_warming,x_on,var_off,var_warming,var_on");
+  std::string truth_header;
+  const auto truth = ReadCsvNumbers(Src("models/filter/three_state_truth.csv"), &truth_header);
+  ASSERT_EQ(rows.size(), 80u);
+  ASSERT_EQ(truth.size(), 80u);
+  double se = 0;
+  for (size_t k = 0; k < rows.size(); ++k) {
+    EXPECT_NEAR(rows[k][3] + rows[k][4] + rows[k][5], 60.0, 1e-6);
+    EXPECT_EQ(rows[k][2], k % 5 == 4 ? 0.0 : 1.0);  // every fifth measurement is missing
+    for (int i = 0; i < 3; ++i) se += std::pow(rows[k][3 + i] - truth[k][2 + i], 2);
+  }
+  const double rmse = std::sqrt(se / rows.size());
+  EXPECT_LT(rmse, 3.0) << "count RMSE against the simulated truth";
+  // Same numbers as the library run in process.
+  auto m = FilterModel::FromJson(model);
+  ASSERT_TRUE(m.ok());
+  auto l = ReadFilterLog(log, *m);
+  ASSERT_TRUE(l.ok());
+  auto f = MakeCountFilter(*m, {});
+  ASSERT_TRUE(f.ok());
+  auto csv = RunFilterOverLog(*m, *l, **f);
+  ASSERT_TRUE(csv.ok());
+  EXPECT_EQ(*ReadFile(Out()), *csv);
+}
+
+TEST_F(EstimationCli, EveryEstimatorRunsAndParticleSeedIsReproducible) {
+  const std::string args = "filter --model " + Src("models/filter/three_state_model.json") +
+                           " --log " + Src("models/filter/three_state_log.csv");
+  for (const char* e : {"conservative", "plain", "exact"}) {
+    const RunResult r = RunRecruit(args + " --estimator " + e + " --out " + Out());
+    EXPECT_EQ(r.exit_code, 0) << e << ": " << r.err;
+    EXPECT_TRUE(fs::exists(Out())) << e;
+    fs::remove(Out());
+  }
+  const std::string a = (dir_ / "a.csv").string(), b = (dir_ / "b.csv").string(),
+                    c = (dir_ / "c.csv").string();
+  const std::string pf = args + " --estimator particle --particles 300 ";
+  ASSERT_EQ(RunRecruit(pf + "--seed 5 --out " + a).exit_code, 0);
+  ASSERT_EQ(RunRecruit(pf + "--seed 5 --out " + b).exit_code, 0);
+  ASSERT_EQ(RunRecruit(pf + "--seed 6 --out " + c).exit_code, 0);
+  EXPECT_EQ(*ReadFile(a), *ReadFile(b));
+  EXPECT_NE(*ReadFile(a), *ReadFile(c));
+}
+
+TEST_F(EstimationCli, HelpListsEveryOption) {
+  const std::string help_path = (dir_ / "help.txt").string();
+  const int status =
+      std::system((std::string(RECRUIT_BINARY) + " filter --help > " + help_path).c_str());
+  ASSERT_EQ(WEXITSTATUS(status), 0);
+  const std::string help = *ReadFile(help_path);
+  for (const char* opt :
+       {"--model", "--log", "--out", "--estimator", "--particles", "--seed", "--max-states"}) {
+    EXPECT_NE(help.find(opt), std::string::npos) << opt;
+  }
+}
+
+const char* kTwoStateModel = R"({
+  "states": ["off", "on"], "N": 60, "H": [[0, 0.45]], "R": [[0.09]],
+  "transition": {"type": "broadcast", "dt": 0.5, "is_on": [false, true],
+                 "on_target": 1, "off_target": 0}})";
+
+const char* kExplicitModel = R"({
+  "states": ["off", "on"], "N": 60, "H": [[0, 0.45]], "R": [[0.09]],
+  "transition": {"type": "explicit"}})";
+
+const char* kGoodLog = "t,p_on,p_off,y\n0,0.2,0,0.1\n0.5,0.2,0,\n1,,,4.0\n";
+
+struct BadCase {
+  std::string name;
+  std::string model;  // JSON text, or "" for a missing file
+  std::string log;
+  std::string extra;
+  std::string expected;  // in stderr
+};
+
+TEST_F(EstimationCli, BadInputGivesClearMessageNonZeroExitAndNoOutput) {
+  const std::vector<BadCase> cases = {
+      {"non-stochastic A", kExplicitModel,
+       "A_0_0,A_0_1,A_1_0,A_1_1,y\n0.9,0.1,0.1,0.8,1.0\n0.9,0.1,0.1,0.9,2.0\n", "",
+       ":2: A: column 1 sums to 0.9, not 1 (tolerance 1e-09)"},
+      {"negative counts",
+       R"({"states": ["off", "on"], "N": 60, "H": [[0, 0.45]], "R": [[0.09]],
+           "transition": {"type": "explicit"}, "initial": {"x0": [70, -10]}})",
+       "A_0_0,A_0_1,A_1_0,A_1_1,y\n1,0,0,1,1.0\n", "",
+       "initial.x0: entries must be finite and >= 0"},
+      {"NaN measurement", kTwoStateModel, "t,p_on,p_off,y\n0,0.2,0,nan\n", "",
+       ":2: column 'y': 'nan' is not a finite number"},
+      {"probability above 1", kTwoStateModel, "t,p_on,p_off,y\n0,1.5,0,1\n", "",
+       "p_on = 1.500000 must be a probability in [0, 1]"},
+      {"wrong H dimensions",
+       R"({"states": ["off", "on"], "N": 60, "H": [[0, 0.45, 1]], "R": [[0.09]],
+           "transition": {"type": "explicit"}})",
+       kGoodLog, "", "H: row 0 must be an array of 2 numbers"},
+      {"malformed JSON", "{\"states\": [\"off\", \"on\"], \"N\": 60,", kGoodLog, "",
+       "malformed JSON"},
+      {"malformed CSV row", kTwoStateModel, "t,p_on,p_off,y\n0,0.2,0\n", "",
+       ":2: has 3 cells, the header 4"},
+      {"unknown CSV column", kTwoStateModel, "t,p_on,p_off,force\n0,0.2,0,1\n", "",
+       "unknown column 'force'; this model's log has columns: t (optional), p_on, p_off, y"},
+      {"inputs missing mid-log", kTwoStateModel, "p_on,p_off,y\n0.2,0,1\n,,2\n0.1,0.1,3\n", "",
+       ":3: inputs are empty; only the last row may omit them"},
+      {"empty log", kTwoStateModel, "", "", "empty log"},
+      {"missing model file", "", kGoodLog, "", "model.json"},
+      {"exact filter too large",
+       R"({"states": ["a", "b", "c"], "N": 1000, "H": [[0, 0.2, 0.45]], "R": [[0.09]],
+           "transition": {"type": "constant", "A": [[0.9, 0, 0.1], [0.1, 0.9, 0], [0, 0.1, 0.9]]}})",
+       "y\n1.0\n", "--estimator exact", "more than 200000 count vectors"},
+      {"unknown estimator", kTwoStateModel, kGoodLog, "--estimator magic", "magic"},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.name);
+    const std::string model = (dir_ / "model.json").string();
+    fs::remove(model);
+    if (!c.model.empty()) Write("model.json", c.model);
+    const std::string log = Write("log.csv", c.log);
+    const RunResult r =
+        RunRecruit("filter --model " + model + " --log " + log + " --out " + Out() + " " + c.extra);
+    EXPECT_NE(r.exit_code, 0);
+    EXPECT_NE(r.err.find(c.expected), std::string::npos) << r.err;
+    EXPECT_TRUE(NoOutput());
+  }
+}
+
+TEST_F(EstimationCli, UnwritableOutputFails) {
+  const RunResult r =
+      RunRecruit("filter --model " + Write("model.json", kTwoStateModel) + " --log " +
+                 Write("log.csv", kGoodLog) + " --out /nonexistent_dir/out.csv");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.err.find("cannot write '/nonexistent_dir/out.csv'"), std::string::npos) << r.err;
+}
+
+}  // namespace
+}  // namespace recruit
