@@ -30,7 +30,8 @@ TEST(TransientChain, SwitchingEdgesFollowTheHeatLevel) {
   TransientChain c = TransientChain::Uniform(8, 1.0);  // K = 3
   EXPECT_EQ(c.StateNames()[4], "hot");
   EXPECT_EQ(c.StateNames()[5], "cool1");
-  const auto on = c.OnTarget(), off = c.OffTarget();
+  const auto& on = c.switch_on;
+  const auto& off = c.switch_off;
   // Switch on: cold -> heat1; cool1 (level 3) -> hot; cool2 (level 2) -> heat3;
   // cool3 (level 1) -> heat2.
   EXPECT_EQ(on[0], 1);
@@ -42,6 +43,10 @@ TEST(TransientChain, SwitchingEdgesFollowTheHeatLevel) {
   EXPECT_EQ(off[3], 6);
   EXPECT_EQ(off[2], 7);
   EXPECT_EQ(off[1], 0);
+  // A switch does not apply to the other kind of state.
+  EXPECT_EQ(on[4], -1);
+  EXPECT_EQ(off[0], -1);
+  EXPECT_EQ(off[7], -1);
 }
 
 TEST(TransientChain, MatrixIsColumnStochasticAndMatchesPropagateMean) {
