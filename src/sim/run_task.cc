@@ -50,6 +50,7 @@ ControllerSettings EffectiveSettings(const Task& task, const RunOptions& options
   if (options.filter_model) s.filter_model = *options.filter_model;
   if (options.dT) s.dT = *options.dT;
   if (options.lambda) s.lambda = *options.lambda;
+  if (options.force_noise_std) s.force_noise_std = *options.force_noise_std;
   return s;
 }
 
@@ -192,7 +193,8 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
   mj_forward(m, d);
 
   // One recruitment controller per bundle.
-  auto spec = control::EstimatorSpec::Parse(settings.estimator, "extended", settings.filter_model);
+  auto spec = control::EstimatorSpec::Parse(settings.estimator, "extended", settings.filter_model,
+                                            20, settings.force_noise_std);
   if (!spec.ok()) return Error{where + ".controller.estimator: " + spec.error()};
   std::vector<control::RecruitmentController> controllers;
   for (int b : bundles) {

@@ -22,7 +22,8 @@ struct RunOptions {
   std::optional<std::string> filter_model;  // filter model file for "kalman"
   std::optional<double> dT;                 // s
   std::optional<double> lambda;
-  std::optional<double> duration;  // s
+  std::optional<double> force_noise_std;  // N, Kalman estimators' measurement noise
+  std::optional<double> duration;         // s
   std::uint64_t seed = 1;
   bool progress = false;  // progress on stderr
 };
