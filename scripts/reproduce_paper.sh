@@ -3,7 +3,8 @@
 #   1. one run each (seed 1) of the isometric paper task: output only at dT = 2.0 s and 0.5 s,
 #      the Kalman filter on the augmented model at dT = 0.5 s; plots in docs/img/repro_*.png;
 #   2. 20 seeds of each at lambda = 0.2 (recruit sweep), and the claims checked on them;
-#   3. a dT x lambda sweep of output only and of the filter: stability map docs/img/sweep_*.png.
+#   3. a dT x lambda sweep of output only and of the filter: stability map docs/img/sweep_*.png;
+#   4. the three arm tasks (seed 1): docs/img/repro_arm_*.png.
 # Usage: scripts/reproduce_paper.sh [OUT_DIR]   (default renders/out/repro; resumable)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -70,4 +71,10 @@ cp "$OUT/map_output/stability.png" docs/img/sweep_stability_output.png
 "$RECRUIT" sweep --task "$TASK" --out "$OUT/map_kalman" --dT 0.5 \
   --lambda 0.1,0.2,0.35,0.5 --estimator kalman-augmented --seeds "${MAP_SEEDS:-5}" "${FM[@]}"
 cp "$OUT/map_kalman/stability.png" docs/img/sweep_stability_kalman.png
+echo "== arm tasks (seed 1, output only)"
+for t in arm_reach_hold arm_lift arm_push; do
+  "$RECRUIT" simulate --task "models/tasks/$t.json" --seed 1 --out "$OUT" --csv-every 5
+  gnuplot -e "csv='$OUT/${t}_steps.csv'; out='docs/img/repro_$t.png'; title='$t (seed 1)'" \
+    scripts/plot_arm.gp
+done
 echo "done: $OUT, docs/img/repro_*.png, docs/img/sweep_*.png"
