@@ -88,6 +88,8 @@ Result<UnitModel> UnitModel::Create(const UnitParams& p) {
   m.heat_capacity_ = p.density * p.specific_heat * m.area_ * m.length_;
   m.conductance_ = m.h_ * kPi * d * m.length_;
   m.tau_ = m.heat_capacity_ / m.conductance_;
+  m.heat_rate_ = kPi / (p.Af - p.As);
+  m.cool_rate_ = kPi / (p.Ms - p.Mf);
   if (p.law == ForceLaw::kWire) {
     m.k_A_ = p.E_A * m.area_ / p.wire_length;
     m.k_M_ = p.E_M * m.area_ / p.wire_length;
@@ -123,7 +125,7 @@ double UnitModel::MajorHeating(double t_eff, double* slope) const {
     *slope = 0;
     return t_eff <= p_.As ? 1 : 0;
   }
-  const double w = kPi / (p_.Af - p_.As);
+  const double w = heat_rate_;
   const double a = w * (t_eff - p_.As);
   *slope = -0.5 * w * std::sin(a);  // sin and cos of one angle: one sincos call
   return 0.5 * (std::cos(a) + 1);
@@ -134,16 +136,27 @@ double UnitModel::MajorCooling(double t_eff, double* slope) const {
     *slope = 0;
     return t_eff <= p_.Mf ? 1 : 0;
   }
-  const double w = kPi / (p_.Ms - p_.Mf);
+  const double w = cool_rate_;
   const double a = w * (t_eff - p_.Mf);
   *slope = -0.5 * w * std::sin(a);
   return 0.5 * (std::cos(a) + 1);
 }
 
 double UnitModel::TensionSlope(double xi, double stretch) const {
+  double slope;
+  Tension(xi, stretch, &slope);
+  return slope;
+}
+
+double UnitModel::Tension(double xi, double stretch, double* slope) const {
   const double k = k_A_ + xi * (k_M_ - k_A_);
-  if (k * (stretch - xi * stretch_L_) <= 0) return 0;
-  return (k_M_ - k_A_) * (stretch - xi * stretch_L_) - k * stretch_L_;
+  const double e = stretch - xi * stretch_L_;
+  if (k * e <= 0) {
+    *slope = 0;
+    return 0;
+  }
+  *slope = (k_M_ - k_A_) * e - k * stretch_L_;
+  return k * e;
 }
 
 double UnitModel::Tension(double xi, double stretch) const {
@@ -184,23 +197,24 @@ void SolvePhase(const UnitModel& m, UnitState& s, double t_thermal, double stret
   const double latent = p.latent_heat / p.specific_heat;  // K per unit of xi
   // Temperature after the step if xi ends at x: latent heat is absorbed by M -> A (x < xi0).
   auto temp = [&](double x) { return t_thermal + latent * (x - xi0); };
-  auto teff_h = [&](double x) { return temp(x) - m.Stress(m.Tension(x, stretch)) / p.C_A; };
-  auto teff_c = [&](double x) { return temp(x) - m.Stress(m.Tension(x, stretch)) / p.C_M; };
+  const double per_newton_h = m.Stress(1.0) / p.C_A;  // K of T_eff shift per N of tension
+  const double per_newton_c = m.Stress(1.0) / p.C_M;
+  auto teff_h = [&](double x) { return temp(x) - per_newton_h * m.Tension(x, stretch); };
+  auto teff_c = [&](double x) { return temp(x) - per_newton_c * m.Tension(x, stretch); };
   // Both residuals have slope >= 1 in x: T_eff rises as x falls (stress rises, latent heat is
   // released as x rises), and M+, M- are non-increasing.
   // With slopes, for Newton: dT_eff/dx = L/c - (dsigma/dF) (dF/dx) / C >= 0.
-  const double stress_slope = m.Stress(1.0);
   auto gd_h = [&](double x, double* g, double* dg) {
-    double slope;
-    *g = x - s.heat_scale * m.MajorHeating(teff_h(x), &slope);
-    const double dte = latent - stress_slope * m.TensionSlope(x, stretch) / p.C_A;
-    *dg = 1 - s.heat_scale * slope * dte;
+    double slope, dfdx;
+    const double te = temp(x) - per_newton_h * m.Tension(x, stretch, &dfdx);
+    *g = x - s.heat_scale * m.MajorHeating(te, &slope);
+    *dg = 1 - s.heat_scale * slope * (latent - per_newton_h * dfdx);
   };
   auto gd_c = [&](double x, double* g, double* dg) {
-    double slope;
-    *g = x - 1 + s.cool_scale * (1 - m.MajorCooling(teff_c(x), &slope));
-    const double dte = latent - stress_slope * m.TensionSlope(x, stretch) / p.C_M;
-    *dg = 1 - s.cool_scale * slope * dte;
+    double slope, dfdx;
+    const double te = temp(x) - per_newton_c * m.Tension(x, stretch, &dfdx);
+    *g = x - 1 + s.cool_scale * (1 - m.MajorCooling(te, &slope));
+    *dg = 1 - s.cool_scale * slope * (latent - per_newton_c * dfdx);
   };
 
   double xi = xi0;

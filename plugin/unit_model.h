@@ -60,6 +60,7 @@ class UnitModel {
   // derivative with respect to xi.
   double Tension(double xi, double stretch) const;
   double TensionSlope(double xi, double stretch) const;
+  double Tension(double xi, double stretch, double* slope) const;  // both at once
   // Equivalent tensile stress (Pa) that shifts the transformation temperatures at tension f.
   double Stress(double f) const { return stress_per_newton_ * f; }
 
@@ -90,6 +91,7 @@ class UnitModel {
   double area_ = 0, length_ = 0, h_ = 0, heat_capacity_ = 0, conductance_ = 0, tau_ = 0;
   double k_A_ = 0, k_M_ = 0, stretch_L_ = 0;  // unit stiffness (N/m) and recoverable stretch (m)
   double stress_per_newton_ = 0;
+  double heat_rate_ = 0, cool_rate_ = 0;  // pi / (Af - As), pi / (Ms - Mf)
 };
 
 // State of one unit (or of a cohort of identical units).

@@ -62,6 +62,23 @@ TEST(UnitThermal, HeatingStepMatchesClosedForm) {
   EXPECT_NEAR(m.time_constant(), tau, 1e-12);
 }
 
+TEST(UnitThermal, HotUnloadedUnitSettlesAtJouleOverConvectionTemperature) {
+  // Unloaded, so fully austenite once hot: T_ss = T_amb + I^2 rho_A L / A / (h pi d L).
+  UnitParams p = Unloaded();
+  p.law = ForceLaw::kWire;
+  p.h = 120;
+  p.current = 0.2;
+  const UnitModel m = MakeModel(p);
+  const double d = p.wire_diameter;
+  const double t_ss = 20 + 0.2 * 0.2 * 100e-8 * 4 / (kPi * d * d) / (120.0 * kPi * d);
+  ASSERT_GT(t_ss, 90);
+  UnitState s = RestState(m, 0);
+  for (int i = 0; i < 40000; ++i) AdvanceUnit(m, s, true, 0, 1e-3);  // 36 tau
+  EXPECT_EQ(s.xi, 0.0);
+  EXPECT_NEAR(s.temperature, t_ss, 1e-6);
+  EXPECT_NEAR(m.on_temperature(), t_ss, 1e-9);
+}
+
 TEST(UnitThermal, CoolingStepMatchesClosedFormAndIsStableForLargeSteps) {
   UnitParams p = Unloaded();
   p.h = 120;
