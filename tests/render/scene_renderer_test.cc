@@ -122,6 +122,26 @@ TEST_F(SceneRendererTest, TendonTurnsFromBlueToRedWhereThePinholeModelPutsIt) {
   EXPECT_NEAR(row_sum / count, row, 8.0);
 }
 
+TEST_F(SceneRendererTest, MinimumTendonWidthThickensOnlyTheTendon) {
+  RenderOptions o = Front();
+  o.figures = false;
+  o.text_panel = false;
+  const TelemetrySample hot = Sample(1.0, 1.0);
+  auto red_pixels = [&](const std::vector<unsigned char>& rgb) {
+    long n = 0;
+    for (size_t i = 0; i < rgb.size(); i += 3)
+      n += rgb[i] > 120 && rgb[i + 1] < 90 && rgb[i + 2] < 90;
+    return n;
+  };
+  const long thin = red_pixels(Render(o, &hot));  // model width 0.02 m (radius)
+  o.min_tendon_width = 0.04;
+  const long thick = red_pixels(Render(o, &hot));
+  ASSERT_GT(thin, 300);
+  // Reference: the drawn area of a capsule seen side on scales about with its radius.
+  EXPECT_GT(thick, 1.6 * thin);
+  EXPECT_LT(thick, 2.6 * thin);
+}
+
 TEST_F(SceneRendererTest, SameStateGivesIdenticalFrames) {
   const TelemetrySample s = Sample(2.0, 0.3);
   const std::vector<unsigned char> a = Render(Front(), &s);
