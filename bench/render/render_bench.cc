@@ -3,7 +3,7 @@
 // into memory (render_fps), then renders the same number again through the encoder pipeline
 // into one MP4 that stays open for the whole run (pipeline_fps); ratio = pipeline_fps /
 // render_fps. Arguments: width, height, encoder queue frames (0 = encode inline on the render
-// thread), x264 preset (0 ultrafast, 1 veryfast, 2 medium).
+// thread), x264 preset (0 ultrafast, 1 veryfast, 2 medium), x264 threads (0 = automatic).
 #include <benchmark/benchmark.h>
 #include <unistd.h>
 
@@ -53,6 +53,7 @@ void BM_RenderVsRenderEncode(benchmark::State& state) {
   const int queue = static_cast<int>(state.range(2));
   H264Options h264;
   h264.preset = kPresets[state.range(3)];
+  h264.threads = static_cast<int>(state.range(4));
   Scene scene;
   RenderOptions options;
   options.width = width;
@@ -129,18 +130,22 @@ void BM_RenderVsRenderEncode(benchmark::State& state) {
   state.SetLabel(std::string(kPresets[state.range(3)]) + (queue ? ", encoder thread" : ", inline"));
 }
 
-// 640x480 and 1280x720; encoder thread (queue 4) against inline encoding; three presets.
+// 640x480 and 1280x720; encoder thread (queue 4) against inline encoding (queue 0); x264's own
+// threads (automatic) against one; three presets.
 BENCHMARK(BM_RenderVsRenderEncode)
-    ->ArgNames({"w", "h", "queue", "preset"})
-    ->Args({640, 480, 4, 1})
-    ->Args({640, 480, 0, 1})
-    ->Args({640, 480, 4, 0})
-    ->Args({640, 480, 4, 2})
-    ->Args({1280, 720, 4, 1})
-    ->Args({1280, 720, 0, 1})
-    ->Args({1280, 720, 4, 0})
+    ->ArgNames({"w", "h", "queue", "preset", "x264threads"})
+    ->Args({640, 480, 4, 1, 0})
+    ->Args({640, 480, 0, 1, 0})
+    ->Args({640, 480, 4, 1, 1})
+    ->Args({640, 480, 0, 1, 1})
+    ->Args({640, 480, 4, 0, 0})
+    ->Args({640, 480, 4, 2, 0})
+    ->Args({1280, 720, 4, 1, 0})
+    ->Args({1280, 720, 0, 1, 0})
+    ->Args({1280, 720, 4, 1, 1})
+    ->Args({1280, 720, 0, 1, 1})
     ->Unit(benchmark::kMillisecond)
-    ->MinTime(3.0);
+    ->MinTime(5.0);
 
 }  // namespace
 }  // namespace recruit::render

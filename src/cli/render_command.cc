@@ -170,6 +170,10 @@ void AddRenderCommand(CLI::App& app, int& exit_code) {
   cmd->add_option("--tendon-width", a->video.render.min_tendon_width,
                   "Draw bundle tendons at least this thick (radius, m; 0 = the model's width)")
       ->capture_default_str();
+  cmd->add_flag(
+      "--transparent", a->video.render.transparent,
+      "Draw bodies translucent (35 % opacity, floor and tendons opaque) so tendons inside "
+      "bones show");
   cmd->add_flag("--no-figures", a->no_figures, "Leave out the two plots");
   cmd->add_flag("--no-panel", a->no_panel, "Leave out the text panel");
   cmd->callback([a, &exit_code] { exit_code = Run(*a); });

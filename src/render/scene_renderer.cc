@@ -10,6 +10,13 @@ namespace {
 
 std::string Size(int w, int h) { return std::to_string(w) + "x" + std::to_string(h); }
 
+// 0.12 -> ".12", 1 -> "1.00": the panel column is narrow.
+std::string Fraction(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%.2f", x);
+  return buf[0] == '0' && buf[1] == '.' ? std::string(buf + 1) : std::string(buf);
+}
+
 struct ModelCopy {
   mjModel* m = nullptr;
   ~ModelCopy() {
@@ -109,6 +116,10 @@ void SceneRenderer::AddPlotPoint(const TelemetrySample& sample) {
   if (plots_) plots_->Add(sample);
 }
 
+int SceneRenderer::PanelRows(const TelemetrySample* s) const {
+  return (ShowTaskRow() ? 1 : 0) + 3 + (s ? 1 + static_cast<int>(s->bundles.size()) : 0);
+}
+
 void SceneRenderer::DrawPanel(const TelemetrySample* s, mjrRect viewport) {
   std::string titles, values;
   auto row = [&](const std::string& title, const std::string& value) {
@@ -120,24 +131,28 @@ void SceneRenderer::DrawPanel(const TelemetrySample* s, mjrRect viewport) {
     values += value;
   };
   char buf[160];
-  if (!label_.task.empty()) row("task", label_.task);
+  if (ShowTaskRow()) row("task", label_.task);
   std::snprintf(buf, sizeof(buf), "%.2f s", s ? s->time : 0.0);
   row("time", buf);
-  std::snprintf(buf, sizeof(buf), "%.3g s", label_.dT);
-  row("dT", buf);
-  std::snprintf(buf, sizeof(buf), "%.3g", label_.lambda);
-  row("lambda", buf);
+  std::snprintf(buf, sizeof(buf), "%.3g s / %.3g", label_.dT, label_.lambda);
+  row("dT / lambda", buf);
   row("estimator", label_.estimator.empty() ? "none" : label_.estimator);
   if (s) {
-    std::snprintf(buf, sizeof(buf), "%.3g / %.3g %s", s->measured, s->reference,
-                  s->reference_unit.c_str());
-    row("measured / ref", buf);
+    if (s->reference_unit == "rad") {
+      std::snprintf(buf, sizeof(buf), "%.1f deg (ref %.1f)", s->measured * 180 / M_PI,
+                    s->reference * 180 / M_PI);
+      row("angle", buf);
+    } else {
+      std::snprintf(buf, sizeof(buf), "%.3g %s (ref %.3g)", s->measured, s->reference_unit.c_str(),
+                    s->reference);
+      row("force", buf);
+    }
     for (const BundleTelemetry& b : s->bundles) {
       if (std::isfinite(b.estimated_on)) {
-        std::snprintf(buf, sizeof(buf), "on %d (est %.1f), heat %.2f", b.true_on, b.estimated_on,
-                      b.heat);
+        std::snprintf(buf, sizeof(buf), "%d on, est %.1f, heat %s", b.true_on, b.estimated_on,
+                      Fraction(b.heat).c_str());
       } else {
-        std::snprintf(buf, sizeof(buf), "on %d, heat %.2f", b.true_on, b.heat);
+        std::snprintf(buf, sizeof(buf), "%d on, heat %s", b.true_on, Fraction(b.heat).c_str());
       }
       row(b.actuator, buf);
     }
@@ -154,22 +169,38 @@ Status SceneRenderer::Render(const mjModel* m, const mjData* d, const TelemetryS
   if (sample && options_.heat_colours) {
     last_recoloured_ = ColourTendonsByHeat(m, *sample, &scene_);
   }
+  if (options_.transparent) {
+    // Every geom but planes (the floor) at 35 % opacity; tendons stay opaque.
+    for (int g = 0; g < scene_.ngeom; ++g) {
+      mjvGeom& geom = scene_.geoms[g];
+      if (geom.objtype == mjOBJ_GEOM && geom.type != mjGEOM_PLANE) geom.rgba[3] *= 0.35f;
+    }
+  }
   if (sample && options_.min_tendon_width > 0) {
     WidenTendons(m, *sample, options_.min_tendon_width, &scene_);
   }
   mjr_setBuffer(mjFB_OFFSCREEN, &context_);
   const mjrRect viewport = {0, 0, options_.width, options_.height};
-  // With plots, the scene takes the left three fifths and the plots the right two, so neither
-  // hides the other.
-  const int plot_width = plots_ ? options_.width * 2 / 5 : 0;
-  const mjrRect scene_viewport = {0, 0, options_.width - plot_width, options_.height};
+  // With plots, the scene takes the left 55 % of the frame and the right 45 % hold the text
+  // panel on top and the plots below it, so nothing covers the model.
+  const int side = plots_ ? options_.width * 9 / 20 : 0;
+  const mjrRect scene_viewport = {0, 0, options_.width - side, options_.height};
   mjr_render(scene_viewport, &scene_, &context_);
   if (plots_) {
-    const mjrRect plot_area = {options_.width - plot_width, 0, plot_width, options_.height};
-    mjr_rectangle(plot_area, 0.f, 0.f, 0.f, 1.f);
-    plots_->Draw(plot_area, &context_);
+    const mjrRect column = {options_.width - side, 0, side, options_.height};
+    mjr_rectangle(column, 0.f, 0.f, 0.f, 1.f);
+    // mjr_overlay's box is rows * (charHeight + 5) + 5 pixels tall, 5 pixels from the edge.
+    const int panel =
+        options_.text_panel
+            ? std::min(options_.height / 2, PanelRows(sample) * (context_.charHeight + 5) + 12)
+            : 0;
+    if (options_.text_panel) {
+      DrawPanel(sample, {column.left, options_.height - panel, side, panel});
+    }
+    plots_->Draw({column.left, 0, side, options_.height - panel}, &context_);
+  } else if (options_.text_panel) {
+    DrawPanel(sample, scene_viewport);
   }
-  if (options_.text_panel) DrawPanel(sample, scene_viewport);
   mjr_readPixels(rgb, nullptr, viewport, &context_);
   if (const int err = mjr_getError(); err != 0) {
     char code[16];

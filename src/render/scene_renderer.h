@@ -41,6 +41,9 @@ struct RenderOptions {
   // Draw each bundle's tendon at least this thick (m, radius); 0 = as the model says. Real SMA
   // bundles are a few mm thick, a pixel or two in a whole-arm shot.
   double min_tendon_width = 0;
+  // Draw every geom but planes at 35 % opacity (tendons stay opaque), so tendons routed inside
+  // a bone's capsule show through it. MuJoCo's own mjVIS_TRANSPARENT only affects moving bodies.
+  bool transparent = false;
   int multisamples = -1;  // offscreen MSAA samples; -1 = the model's <quality offsamples>
 
   static constexpr int kMinSide = 16;
@@ -80,6 +83,9 @@ class SceneRenderer {
  private:
   SceneRenderer(const RenderOptions& options, const RunLabel& label);
   void DrawPanel(const TelemetrySample* sample, mjrRect viewport);
+  int PanelRows(const TelemetrySample* sample) const;
+  // The task's name gets a row only when the panel is over the scene (no plot column).
+  bool ShowTaskRow() const { return !label_.task.empty() && !plots_; }
 
   RenderOptions options_;
   RunLabel label_;

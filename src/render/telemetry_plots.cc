@@ -52,7 +52,7 @@ TelemetryPlots::TelemetryPlots(double window)
   std::snprintf(tracking_->title, sizeof(tracking_->title), "tracking");
   std::snprintf(tracking_->yformat, sizeof(tracking_->yformat), "%%.1f");
   std::snprintf(recruitment_->yformat, sizeof(recruitment_->yformat), "%%.0f");
-  std::snprintf(recruitment_->title, sizeof(recruitment_->title), "units on: true vs estimated");
+  std::snprintf(recruitment_->title, sizeof(recruitment_->title), "units on (pale: estimated)");
   SetLine(tracking_.get(), 0, "reference", 1.f, 1.f, 1.f);
   SetLine(tracking_.get(), 1, "measured", 1.f, 0.35f, 0.2f);
 }
@@ -90,21 +90,24 @@ void TelemetryPlots::Scroll(mjvFigure* fig, double now) {
 void TelemetryPlots::Add(const TelemetrySample& s) {
   if (!configured_) {
     configured_ = true;
-    const bool angle = s.reference_unit == "rad";
-    std::snprintf(
-        tracking_->title, sizeof(tracking_->title), "%s",
-        angle ? "joint angle (rad): reference vs measured" : "force (N): reference vs measured");
+    angle_ = s.reference_unit == "rad";
+    std::snprintf(tracking_->title, sizeof(tracking_->title), "%s",
+                  angle_ ? "joint angle (deg)" : "force (N)");
     const int nb = std::min<int>(s.bundles.size(), kMaxBundles);
     for (int b = 0; b < nb; ++b) {
       const float* c = kBundleRgb[b];
-      const std::string prefix = nb > 1 ? s.bundles[b].actuator + " " : std::string();
-      SetLine(recruitment_.get(), 2 * b, (prefix + "true").c_str(), c[0], c[1], c[2]);
-      SetLine(recruitment_.get(), 2 * b + 1, (prefix + "estimated").c_str(), 0.5f + 0.5f * c[0],
-              0.5f + 0.5f * c[1], 0.5f + 0.5f * c[2]);
+      // The legend names the bundles (true counts); estimates are the paler, unnamed lines
+      // (mjr_figure leaves unnamed lines out of the legend).
+      SetLine(recruitment_.get(), 2 * b, nb > 1 ? s.bundles[b].actuator.c_str() : "true", c[0],
+              c[1], c[2]);
+      SetLine(recruitment_.get(), 2 * b + 1, nb > 1 ? "" : "estimated", 0.55f + 0.45f * c[0],
+              0.55f + 0.45f * c[1], 0.55f + 0.45f * c[2]);
     }
   }
-  Push(tracking_.get(), 0, s.time, s.reference);
-  Push(tracking_.get(), 1, s.time, s.measured);
+  // Angles are plotted in degrees, the unit task files use.
+  const double scale = angle_ ? 180.0 / M_PI : 1.0;
+  Push(tracking_.get(), 0, s.time, scale * s.reference);
+  Push(tracking_.get(), 1, s.time, scale * s.measured);
   const int nb = std::min<int>(s.bundles.size(), kMaxBundles);
   for (int b = 0; b < nb; ++b) {
     Push(recruitment_.get(), 2 * b, s.time, s.bundles[b].true_on);

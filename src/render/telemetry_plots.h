@@ -1,5 +1,5 @@
-// TelemetryPlots: two scrolling MuJoCo figures drawn over the scene, (1) the tracked quantity
-// against its reference (force in N, or the joint angle in rad) and (2) each bundle's true
+// TelemetryPlots: two scrolling MuJoCo figures drawn beside the scene, (1) the tracked quantity
+// against its reference (force in N, or the joint angle in deg) and (2) each bundle's true
 // against estimated on-count. mjvFigure is about 800 KB (100 lines x 1000 points), so both live
 // on the heap.
 #pragma once
@@ -36,6 +36,7 @@ class TelemetryPlots {
 
   double window_;
   bool configured_ = false;
+  bool angle_ = false;  // the tracked quantity is a joint angle (plotted in deg)
   std::unique_ptr<mjvFigure> tracking_;
   std::unique_ptr<mjvFigure> recruitment_;
 };

@@ -122,6 +122,26 @@ TEST_F(SceneRendererTest, TendonTurnsFromBlueToRedWhereThePinholeModelPutsIt) {
   EXPECT_NEAR(row_sum / count, row, 8.0);
 }
 
+TEST_F(SceneRendererTest, MinimumTendonWidthThickensOnlyTheTendon) {
+  RenderOptions o = Front();
+  o.figures = false;
+  o.text_panel = false;
+  const TelemetrySample hot = Sample(1.0, 1.0);
+  auto red_pixels = [&](const std::vector<unsigned char>& rgb) {
+    long n = 0;
+    for (size_t i = 0; i < rgb.size(); i += 3)
+      n += rgb[i] > 120 && rgb[i + 1] < 90 && rgb[i + 2] < 90;
+    return n;
+  };
+  const long thin = red_pixels(Render(o, &hot));  // model width 0.02 m (radius)
+  o.min_tendon_width = 0.04;
+  const long thick = red_pixels(Render(o, &hot));
+  ASSERT_GT(thin, 300);
+  // Reference: the drawn area of a capsule seen side on scales about with its radius.
+  EXPECT_GT(thick, 1.6 * thin);
+  EXPECT_LT(thick, 2.6 * thin);
+}
+
 TEST_F(SceneRendererTest, SameStateGivesIdenticalFrames) {
   const TelemetrySample s = Sample(2.0, 0.3);
   const std::vector<unsigned char> a = Render(Front(), &s);
@@ -135,15 +155,27 @@ TEST_F(SceneRendererTest, FrameLargerThanTheModelsOffscreenBufferIsEnlarged) {
   RenderOptions o = Front(800, 600);
   const std::vector<unsigned char> rgb = Render(o, &s);
   ASSERT_EQ(rgb.size(), 800u * 600 * 3);
-  // The top-right corner (outside the default 640x480) is drawn: it holds the plots.
-  std::set<int> colours;
-  for (int row = 500; row < 600; ++row) {
-    for (int col = 700; col < 800; ++col) {
+  // The strips outside the default 640x480 are drawn: the columns right of x = 640 hold the
+  // plots, the rows above y = 480 the text panel.
+  auto colours_in = [&](int col0, int col1, int row0, int row1) {
+    std::set<int> colours;
+    for (int row = row0; row < row1; ++row) {
+      for (int col = col0; col < col1; ++col) {
+        const size_t i = 3 * (static_cast<size_t>(row) * 800 + col);
+        colours.insert(rgb[i] << 16 | rgb[i + 1] << 8 | rgb[i + 2]);
+      }
+    }
+    return colours.size();
+  };
+  EXPECT_GT(colours_in(650, 800, 0, 600), 5u);
+  long bright = 0;  // panel text (light grey and white) in the top strip
+  for (int row = 490; row < 600; ++row) {
+    for (int col = 0; col < 800; ++col) {
       const size_t i = 3 * (static_cast<size_t>(row) * 800 + col);
-      colours.insert(rgb[i] << 16 | rgb[i + 1] << 8 | rgb[i + 2]);
+      bright += rgb[i] > 150 && rgb[i + 1] > 150 && rgb[i + 2] > 150;
     }
   }
-  EXPECT_GT(colours.size(), 5u);
+  EXPECT_GT(bright, 200);
 }
 
 TEST_F(SceneRendererTest, UnknownCameraListsTheModelsCameras) {
