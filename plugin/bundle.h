@@ -45,8 +45,11 @@ class SmaBundle {
   // phase solve: both stay accurate for long steps).
   void Advance(double* s, double stretch, double dt) const;
 
-  // Total tension of the bundle (N, >= 0) at unit extension `stretch`: pure, reads s only.
+  // Total tension of the bundle (N, >= 0) at unit extension `stretch`: pure, reads s only
+  // (the "compute" step of a MuJoCo 3.x actuator plugin).
   double Tension(const double* s, double stretch) const;
+  // Rate of the actuator's MuJoCo-integrated state: none, all state advances in Advance.
+  double ActDot(const double* s) const { return 0; }
 
   int OnCount(const double* s) const;
   int NumCohorts(const double* s) const { return static_cast<int>(s[kCohortCountSlot]); }

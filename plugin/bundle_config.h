@@ -21,11 +21,12 @@ struct BundleConfig {
   // Tendon length (m) at which each unit's extension equals unit.prestretch; NaN = the
   // actuator's length at qpos0 (mjModel.actuator_length0).
   double ref_length = std::nan("");
-  // Cohorts of units in the same on/off state whose temperatures (and effective temperatures)
-  // differ by at most merge_temperature (C) and whose xi (and branch constants) differ by at
-  // most merge_xi are merged into one with the count-weighted mean state. The mean temperature
-  // and xi are kept, so the bundle's tension moves by ~1e-4 of one unit's force; per-unit debug
-  // values are exact only with both set to 0 (then only identical states merge).
+  // Cohorts of units in the same on/off state whose temperatures differ by at most
+  // merge_temperature (C) and whose xi (and branch constants) differ by at most merge_xi are
+  // merged (the effective temperature follows from T and xi at the bundle's common length) into one
+  // with the count-weighted mean state. The mean temperature and xi are kept, so the bundle's
+  // tension moves by ~1e-4 of one unit's force; per-unit debug values are exact only with both set
+  // to 0 (then only identical states merge).
   double merge_temperature = 0.5;
   double merge_xi = 0.01;
   // Units are integrated every update_period seconds (rounded to whole timesteps) instead of

@@ -11,15 +11,21 @@
 namespace recruit::sma {
 namespace {
 
-// Registry of live plugins keyed by model pointer. Callbacks read an immutable snapshot without
-// locking; writers publish a new snapshot under a mutex and keep the old ones alive (a callback
-// on another thread may still be scanning one), so lookups are wait-free.
-using Snapshot = std::vector<std::pair<const mjModel*, const SmaPlugin*>>;
+// Registry of live plugins keyed by model pointer: a fixed table of slots that callbacks scan
+// with atomic loads (no lock, no allocation: sweeps create and destroy plugins on many threads
+// while others step). Writers hold a mutex. A slot's plugin is stored before its model, so a
+// reader that sees the model sees the plugin.
+constexpr int kMaxLivePlugins = 4096;
+
+struct Slot {
+  std::atomic<const mjModel*> model{nullptr};
+  std::atomic<const SmaPlugin*> plugin{nullptr};
+};
 
 struct Registry {
   std::mutex mu;
-  std::atomic<const Snapshot*> current{nullptr};
-  std::vector<std::unique_ptr<Snapshot>> all;  // every snapshot ever published
+  Slot slots[kMaxLivePlugins];
+  std::atomic<int> used{0};  // slots [0, used) may be occupied
   mjfAct prev_dyn = nullptr, prev_gain = nullptr, prev_bias = nullptr;
 };
 
@@ -29,42 +35,50 @@ Registry& GetRegistry() {
 }
 
 const SmaPlugin* Lookup(const mjModel* m) {
-  const Snapshot* s = GetRegistry().current.load(std::memory_order_acquire);
-  if (s == nullptr) return nullptr;
-  for (const auto& [model, plugin] : *s) {
-    if (model == m) return plugin;
+  Registry& r = GetRegistry();
+  const int n = r.used.load(std::memory_order_acquire);
+  for (int i = 0; i < n; ++i) {
+    if (r.slots[i].model.load(std::memory_order_acquire) == m) {
+      return r.slots[i].plugin.load(std::memory_order_acquire);
+    }
   }
   return nullptr;
 }
 
-void Publish(Registry& r, Snapshot next) {
-  r.all.push_back(std::make_unique<Snapshot>(std::move(next)));
-  r.current.store(r.all.back().get(), std::memory_order_release);
-}
-
-void Register(const mjModel* m, const SmaPlugin* p) {
+// The newest plugin of a model wins.
+bool Register(const mjModel* m, const SmaPlugin* p) {
   Registry& r = GetRegistry();
   std::lock_guard<std::mutex> lock(r.mu);
-  Snapshot next;
-  if (const Snapshot* cur = r.current.load(std::memory_order_relaxed)) {
-    for (const auto& e : *cur) {
-      if (e.first != m) next.push_back(e);  // the newest plugin of a model wins
+  const int n = r.used.load(std::memory_order_relaxed);
+  int free_slot = -1;
+  for (int i = 0; i < n; ++i) {
+    const mjModel* mi = r.slots[i].model.load(std::memory_order_relaxed);
+    if (mi == m) {
+      r.slots[i].plugin.store(p, std::memory_order_release);
+      return true;
     }
+    if (mi == nullptr && free_slot < 0) free_slot = i;
   }
-  next.emplace_back(m, p);
-  Publish(r, std::move(next));
+  if (free_slot < 0) {
+    if (n == kMaxLivePlugins) return false;
+    free_slot = n;
+  }
+  r.slots[free_slot].plugin.store(p, std::memory_order_release);
+  r.slots[free_slot].model.store(m, std::memory_order_release);
+  if (free_slot == n) r.used.store(n + 1, std::memory_order_release);
+  return true;
 }
 
 void Unregister(const SmaPlugin* p) {
   Registry& r = GetRegistry();
   std::lock_guard<std::mutex> lock(r.mu);
-  const Snapshot* cur = r.current.load(std::memory_order_relaxed);
-  if (cur == nullptr) return;
-  Snapshot next;
-  for (const auto& e : *cur) {
-    if (e.second != p) next.push_back(e);
+  const int n = r.used.load(std::memory_order_relaxed);
+  for (int i = 0; i < n; ++i) {
+    if (r.slots[i].plugin.load(std::memory_order_relaxed) == p) {
+      r.slots[i].model.store(nullptr, std::memory_order_release);
+      r.slots[i].plugin.store(nullptr, std::memory_order_release);
+    }
   }
-  if (next.size() != cur->size()) Publish(r, std::move(next));
 }
 
 mjtNum DynCallback(const mjModel* m, const mjData* d, int id) {
@@ -136,7 +150,10 @@ Result<std::unique_ptr<SmaPlugin>> SmaPlugin::Create(const mjModel* m) {
                  "\"/> or more (it has nuserdata=" + std::to_string(m->nuserdata) + ")"};
   }
   RegisterSmaCallbacks();
-  Register(m, p->get());
+  if (!Register(m, p->get())) {
+    return Error{"SmaPlugin::Create: more than " + std::to_string(kMaxLivePlugins) +
+                 " plugins alive at once; destroy plugins of finished runs"};
+  }
   (*p)->registered_ = true;
   return p;
 }
@@ -243,9 +260,14 @@ void SmaPlugin::Reset(mjData* d, std::uint64_t seed) const {
   mj_forward(m_, d);  // forces and sensors from the reset units
 }
 
-void SmaPlugin::ResetKeyframe(mjData* d, int key, std::uint64_t seed) const {
+Status SmaPlugin::ResetKeyframe(mjData* d, int key, std::uint64_t seed) const {
+  if (key < 0 || key >= m_->nkey) {
+    return Error{"ResetKeyframe: keyframe " + std::to_string(key) + " does not exist (model has " +
+                 std::to_string(m_->nkey) + ")"};
+  }
   mj_resetDataKeyframe(m_, d, key);
   Reset(d, seed);
+  return Status::Ok();
 }
 
 void SmaPlugin::EnsureInitialised(mjData* d) const {

@@ -58,8 +58,9 @@ class SmaPlugin {
   // Rng::DeriveSeed(seed, b). Call after mj_resetData / mj_resetDataKeyframe (they do not
   // restore userdata).
   void Reset(mjData* d, std::uint64_t seed) const;
-  // mj_resetDataKeyframe(m, d, key), then Reset(d, seed).
-  void ResetKeyframe(mjData* d, int key, std::uint64_t seed) const;
+  // mj_resetDataKeyframe(m, d, key), then Reset(d, seed). Error (and d untouched) if the model
+  // has no keyframe `key`.
+  Status ResetKeyframe(mjData* d, int key, std::uint64_t seed) const;
 
   // Each unit of bundle b draws its transition (off->on with p_on, on->off with p_off).
   Status Broadcast(mjData* d, int b, double p_on, double p_off) const;
@@ -84,7 +85,10 @@ class SmaPlugin {
   double Stretch(const mjData* d, int b) const;
 
   // Callback bodies (pure).
-  double ActDot(const mjData* d, int actuator) const { return 0; }
+  double ActDot(const mjData* d, int actuator) const {
+    const int b = bundle_of_actuator_[actuator];
+    return bundles_[b].ActDot(State(d, b));
+  }
   double Gain(const mjData* d, int actuator) const { return 0; }
   double Bias(const mjData* d, int actuator) const;
   int BundleOfActuator(int actuator) const { return bundle_of_actuator_[actuator]; }

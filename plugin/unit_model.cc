@@ -44,6 +44,26 @@ std::string Num(double v) {
 
 }  // namespace
 
+void SinCosHalfTurn(double a, double* sin_a, double* cos_a) {
+  const double b = a - 0.5 * kPi;
+  const double z = b * b, z2 = z * z, z4 = z2 * z2, z8 = z4 * z4;
+  // Taylor coefficients (-1)^k / (2k)! (cosine) and (-1)^k / (2k+1)! (sine) of z^k, k = 0..10
+  // and 0..9, summed by Estrin's scheme (shorter dependency chains than Horner's).
+  constexpr double c0 = 1, c1 = -1.0 / 2, c2 = 1.0 / 24, c3 = -1.0 / 720, c4 = 1.0 / 40320,
+                   c5 = -1.0 / 3628800, c6 = 1.0 / 479001600, c7 = -1.0 / 87178291200,
+                   c8 = 1.0 / 20922789888000, c9 = -1.0 / 6402373705728000,
+                   c10 = 1.0 / 2432902008176640000;
+  constexpr double s0 = 1, s1 = -1.0 / 6, s2 = 1.0 / 120, s3 = -1.0 / 5040, s4 = 1.0 / 362880,
+                   s5 = -1.0 / 39916800, s6 = 1.0 / 6227020800, s7 = -1.0 / 1307674368000,
+                   s8 = 1.0 / 355687428096000, s9 = -1.0 / 121645100408832000;
+  const double cos_b = ((c0 + c1 * z) + (c2 + c3 * z) * z2) +
+                       ((c4 + c5 * z) + (c6 + c7 * z) * z2) * z4 + ((c8 + c9 * z) + c10 * z2) * z8;
+  const double sin_b = b * (((s0 + s1 * z) + (s2 + s3 * z) * z2) +
+                            ((s4 + s5 * z) + (s6 + s7 * z) * z2) * z4 + (s8 + s9 * z) * z8);
+  *sin_a = cos_b;
+  *cos_a = -sin_b;
+}
+
 double UnitModel::NaturalConvectionH(double d, double ambient, double dT, double emissivity) {
   dT = std::max(dT, 1.0);
   const double t_amb = ambient + 273.15;
@@ -88,6 +108,9 @@ Result<UnitModel> UnitModel::Create(const UnitParams& p) {
   m.heat_capacity_ = p.density * p.specific_heat * m.area_ * m.length_;
   m.conductance_ = m.h_ * kPi * d * m.length_;
   m.tau_ = m.heat_capacity_ / m.conductance_;
+  m.latent_rise_ = p.latent_heat / p.specific_heat;
+  m.heat_rate_ = kPi / (p.Af - p.As);
+  m.cool_rate_ = kPi / (p.Ms - p.Mf);
   if (p.law == ForceLaw::kWire) {
     m.k_A_ = p.E_A * m.area_ / p.wire_length;
     m.k_M_ = p.E_M * m.area_ / p.wire_length;
@@ -103,19 +126,30 @@ Result<UnitModel> UnitModel::Create(const UnitParams& p) {
     const double wahl = (4 * index - 1) / (4 * index - 4) + 0.615 / index;
     m.stress_per_newton_ = std::sqrt(3.0) * 8 * D * wahl / (kPi * d * d * d);
   }
+  m.heat_shift_per_newton_ = m.stress_per_newton_ / p.C_A;
+  m.cool_shift_per_newton_ = m.stress_per_newton_ / p.C_M;
+  const double joule = p.current * p.current * m.length_ / m.area_;  // W per (ohm m)
+  m.on_power_A_ = joule * p.resistivity_A;
+  m.on_power_dM_ = joule * (p.resistivity_M - p.resistivity_A);
+  m.on_rise_A_ = m.on_power_A_ / m.conductance_;
+  m.on_rise_dM_ = m.on_power_dM_ / m.conductance_;
   return m;
 }
 
 double UnitModel::MajorHeating(double t_eff) const {
   if (t_eff <= p_.As) return 1;
   if (t_eff >= p_.Af) return 0;
-  return 0.5 * (std::cos(kPi * (t_eff - p_.As) / (p_.Af - p_.As)) + 1);
+  double sn, cs;
+  SinCosHalfTurn(heat_rate_ * (t_eff - p_.As), &sn, &cs);
+  return 0.5 * (cs + 1);
 }
 
 double UnitModel::MajorCooling(double t_eff) const {
   if (t_eff <= p_.Mf) return 1;
   if (t_eff >= p_.Ms) return 0;
-  return 0.5 * (std::cos(kPi * (t_eff - p_.Mf) / (p_.Ms - p_.Mf)) + 1);
+  double sn, cs;
+  SinCosHalfTurn(cool_rate_ * (t_eff - p_.Mf), &sn, &cs);
+  return 0.5 * (cs + 1);
 }
 
 double UnitModel::MajorHeating(double t_eff, double* slope) const {
@@ -123,10 +157,11 @@ double UnitModel::MajorHeating(double t_eff, double* slope) const {
     *slope = 0;
     return t_eff <= p_.As ? 1 : 0;
   }
-  const double w = kPi / (p_.Af - p_.As);
-  const double a = w * (t_eff - p_.As);
-  *slope = -0.5 * w * std::sin(a);  // sin and cos of one angle: one sincos call
-  return 0.5 * (std::cos(a) + 1);
+  const double w = heat_rate_;
+  double sn, cs;
+  SinCosHalfTurn(w * (t_eff - p_.As), &sn, &cs);
+  *slope = -0.5 * w * sn;
+  return 0.5 * (cs + 1);
 }
 
 double UnitModel::MajorCooling(double t_eff, double* slope) const {
@@ -134,16 +169,28 @@ double UnitModel::MajorCooling(double t_eff, double* slope) const {
     *slope = 0;
     return t_eff <= p_.Mf ? 1 : 0;
   }
-  const double w = kPi / (p_.Ms - p_.Mf);
-  const double a = w * (t_eff - p_.Mf);
-  *slope = -0.5 * w * std::sin(a);
-  return 0.5 * (std::cos(a) + 1);
+  const double w = cool_rate_;
+  double sn, cs;
+  SinCosHalfTurn(w * (t_eff - p_.Mf), &sn, &cs);
+  *slope = -0.5 * w * sn;
+  return 0.5 * (cs + 1);
 }
 
 double UnitModel::TensionSlope(double xi, double stretch) const {
+  double slope;
+  Tension(xi, stretch, &slope);
+  return slope;
+}
+
+double UnitModel::Tension(double xi, double stretch, double* slope) const {
   const double k = k_A_ + xi * (k_M_ - k_A_);
-  if (k * (stretch - xi * stretch_L_) <= 0) return 0;
-  return (k_M_ - k_A_) * (stretch - xi * stretch_L_) - k * stretch_L_;
+  const double e = stretch - xi * stretch_L_;
+  if (k * e <= 0) {
+    *slope = 0;
+    return 0;
+  }
+  *slope = (k_M_ - k_A_) * e - k * stretch_L_;
+  return k * e;
 }
 
 double UnitModel::Tension(double xi, double stretch) const {
@@ -153,12 +200,11 @@ double UnitModel::Tension(double xi, double stretch) const {
 
 double UnitModel::HeatingPower(bool on, double xi) const {
   if (!on) return 0;
-  const double rho = p_.resistivity_A + xi * (p_.resistivity_M - p_.resistivity_A);
-  return p_.current * p_.current * rho * length_ / area_;
+  return on_power_A_ + xi * on_power_dM_;  // I^2 rho(xi) l / A, rho linear in xi
 }
 
 double UnitModel::SteadyTemperature(bool on, double xi) const {
-  return p_.ambient + HeatingPower(on, xi) / conductance_;
+  return on ? p_.ambient + (on_rise_A_ + xi * on_rise_dM_) : p_.ambient;
 }
 
 double UnitModel::DecayFactor(double dt) const { return std::exp(-dt / tau_); }
@@ -179,28 +225,28 @@ UnitState RestState(const UnitModel& m, double stretch) {
 namespace {
 
 void SolvePhase(const UnitModel& m, UnitState& s, double t_thermal, double stretch) {
-  const UnitParams& p = m.params();
   const double xi0 = s.xi;
-  const double latent = p.latent_heat / p.specific_heat;  // K per unit of xi
+  const double latent = m.latent_rise();  // K per unit of xi
   // Temperature after the step if xi ends at x: latent heat is absorbed by M -> A (x < xi0).
   auto temp = [&](double x) { return t_thermal + latent * (x - xi0); };
-  auto teff_h = [&](double x) { return temp(x) - m.Stress(m.Tension(x, stretch)) / p.C_A; };
-  auto teff_c = [&](double x) { return temp(x) - m.Stress(m.Tension(x, stretch)) / p.C_M; };
+  const double per_newton_h = m.heat_shift_per_newton();  // K of T_eff shift per N of tension
+  const double per_newton_c = m.cool_shift_per_newton();
+  auto teff_h = [&](double x) { return temp(x) - per_newton_h * m.Tension(x, stretch); };
+  auto teff_c = [&](double x) { return temp(x) - per_newton_c * m.Tension(x, stretch); };
   // Both residuals have slope >= 1 in x: T_eff rises as x falls (stress rises, latent heat is
   // released as x rises), and M+, M- are non-increasing.
   // With slopes, for Newton: dT_eff/dx = L/c - (dsigma/dF) (dF/dx) / C >= 0.
-  const double stress_slope = m.Stress(1.0);
   auto gd_h = [&](double x, double* g, double* dg) {
-    double slope;
-    *g = x - s.heat_scale * m.MajorHeating(teff_h(x), &slope);
-    const double dte = latent - stress_slope * m.TensionSlope(x, stretch) / p.C_A;
-    *dg = 1 - s.heat_scale * slope * dte;
+    double slope, dfdx;
+    const double te = temp(x) - per_newton_h * m.Tension(x, stretch, &dfdx);
+    *g = x - s.heat_scale * m.MajorHeating(te, &slope);
+    *dg = 1 - s.heat_scale * slope * (latent - per_newton_h * dfdx);
   };
   auto gd_c = [&](double x, double* g, double* dg) {
-    double slope;
-    *g = x - 1 + s.cool_scale * (1 - m.MajorCooling(teff_c(x), &slope));
-    const double dte = latent - stress_slope * m.TensionSlope(x, stretch) / p.C_M;
-    *dg = 1 - s.cool_scale * slope * dte;
+    double slope, dfdx;
+    const double te = temp(x) - per_newton_c * m.Tension(x, stretch, &dfdx);
+    *g = x - 1 + s.cool_scale * (1 - m.MajorCooling(te, &slope));
+    *dg = 1 - s.cool_scale * slope * (latent - per_newton_c * dfdx);
   };
 
   double xi = xi0;

@@ -4,7 +4,7 @@
 if (!exists("csv")) csv = 'steps.csv'
 if (!exists("out")) out = 'plot.png'
 if (!exists("title")) title = ''
-set terminal png size 900,800 font ',10'
+set terminal png size 900,800 font ',10' noenhanced
 set output out
 set datafile separator ','
 set datafile columnheaders

@@ -6,7 +6,7 @@ if (!exists("csv")) csv = 'steps.csv'
 if (!exists("out")) out = 'plot.png'
 if (!exists("title")) title = ''
 if (!exists("bundle")) bundle = 'bundle'
-set terminal png size 900,640 font ',10'
+set terminal png size 900,640 font ',10' noenhanced
 set output out
 set datafile separator ','
 set datafile columnheaders

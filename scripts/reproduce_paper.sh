@@ -3,7 +3,8 @@
 #   1. one run each (seed 1) of the isometric paper task: output only at dT = 2.0 s and 0.5 s,
 #      the Kalman filter on the augmented model at dT = 0.5 s; plots in docs/img/repro_*.png;
 #   2. 20 seeds of each at lambda = 0.2 (recruit sweep), and the claims checked on them;
-#   3. a dT x lambda sweep of output only and of the filter: stability map docs/img/sweep_*.png.
+#   3. a dT x lambda sweep of output only and of the filter: stability map docs/img/sweep_*.png;
+#   4. the three arm tasks (seed 1): docs/img/repro_arm_*.png.
 # Usage: scripts/reproduce_paper.sh [OUT_DIR]   (default renders/out/repro; resumable)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -11,12 +12,17 @@ RECRUIT=${RECRUIT:-./build/src/cli/recruit}
 OUT=${1:-renders/out/repro}
 TASK=models/tasks/isometric_paper.json
 SEEDS=${SEEDS:-20}
+# FILTER_MODEL=FILE uses that filter model for kalman-augmented instead of models/identified/'s.
+FM=()
+[ -n "${FILTER_MODEL:-}" ] && FM=(--filter-model "$FILTER_MODEL")
 mkdir -p "$OUT" docs/img
 [ -x "$RECRUIT" ] || { echo "build first: bash scripts/build.sh" >&2; exit 1; }
 
 run() {  # run NAME ESTIMATOR DT
+  local fm=()
+  [ "$2" = kalman-augmented ] && fm=("${FM[@]}")
   "$RECRUIT" simulate --task "$TASK" --estimator "$2" --dT "$3" --lambda 0.2 --seed 1 \
-    --out "$OUT" --csv "$OUT/$1.csv" --summary "$OUT/$1.json" --csv-every 5
+    --out "$OUT" --csv "$OUT/$1.csv" --summary "$OUT/$1.json" --csv-every 5 "${fm[@]}"
 }
 echo "== single runs (seed 1)"
 run fig5_top output 2.0
@@ -34,7 +40,7 @@ echo "== $SEEDS seeds at lambda = 0.2"
 "$RECRUIT" sweep --task "$TASK" --out "$OUT/seeds_output" --dT 0.5,2.0 --lambda 0.2 \
   --estimator output --seeds "$SEEDS"
 "$RECRUIT" sweep --task "$TASK" --out "$OUT/seeds_kalman" --dT 0.5 --lambda 0.2 \
-  --estimator kalman-augmented --seeds "$SEEDS"
+  --estimator kalman-augmented --seeds "$SEEDS" "${FM[@]}"
 
 # The claims, from the sweeps' table.csv (columns: dT,lambda,estimator,seeds,overshoot_mean,
 # overshoot_sd,settling_time_mean,settled_fraction,...,estimator_within3_mean = 15).
@@ -63,6 +69,12 @@ echo "== dT x lambda sweeps (stability maps)"
   --lambda 0.1,0.2,0.35,0.5 --estimator output --seeds "${MAP_SEEDS:-5}"
 cp "$OUT/map_output/stability.png" docs/img/sweep_stability_output.png
 "$RECRUIT" sweep --task "$TASK" --out "$OUT/map_kalman" --dT 0.5 \
-  --lambda 0.1,0.2,0.35,0.5 --estimator kalman-augmented --seeds "${MAP_SEEDS:-5}"
+  --lambda 0.1,0.2,0.35,0.5 --estimator kalman-augmented --seeds "${MAP_SEEDS:-5}" "${FM[@]}"
 cp "$OUT/map_kalman/stability.png" docs/img/sweep_stability_kalman.png
+echo "== arm tasks (seed 1, output only)"
+for t in arm_reach_hold arm_lift arm_push; do
+  "$RECRUIT" simulate --task "models/tasks/$t.json" --seed 1 --out "$OUT" --csv-every 5
+  gnuplot -e "csv='$OUT/${t}_steps.csv'; out='docs/img/repro_$t.png'; title='$t (seed 1)'" \
+    scripts/plot_arm.gp
+done
 echo "done: $OUT, docs/img/repro_*.png, docs/img/sweep_*.png"

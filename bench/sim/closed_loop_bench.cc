@@ -3,6 +3,7 @@
 // same models (mj_step + plugin Advance, no controller) side by side as the reference.
 #include <benchmark/benchmark.h>
 
+#include <cstdlib>
 #include <memory>
 
 #include "plugin/sma_plugin.h"
@@ -25,6 +26,10 @@ void RunClosedLoop(benchmark::State& state, const std::string& task_file,
   o.estimator = estimator;
   o.dT = dT;
   o.duration = duration;
+  // RECRUIT_FILTER_MODEL overrides the filter model (default: models/identified/ for dT).
+  if (const char* fm = std::getenv("RECRUIT_FILTER_MODEL"); fm && estimator != "output") {
+    o.filter_model = fm;
+  }
   double simulated = 0;
   for (auto _ : state) {
     auto r = RunTask(*task, o);

@@ -24,6 +24,12 @@ void AddRunOptions(CLI::App* cmd, sim::RunOptions* options) {
          "Gain of the expectation law, in (0, 1] [default: the task file's]")
       ->type_name("GAIN")
       ->check(CLI::Range(1e-9, 1.0));
+  cmd->add_option_function<double>(
+         "--force-noise-std", [options](double v) { options->force_noise_std = v; },
+         "Kalman estimators: force measurement noise std, N (0 = the estimator's default) "
+         "[default: the task file's]")
+      ->type_name("N")
+      ->check(CLI::NonNegativeNumber);
   cmd->add_option("--seed", options->seed, "Seed of the units' random draws")
       ->capture_default_str();
   cmd->add_option_function<double>(

@@ -5,8 +5,11 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "control/kalman_estimator.h"
 #include "control/on_count_estimator.h"
 #include "control/output_estimator.h"
+#include "estimation/filter_model.h"
+#include "estimation/population_kalman_filter.h"
 
 namespace recruit::control {
 namespace {
@@ -16,6 +19,19 @@ bool IsKind(const std::string& k) {
 }
 bool IsCovariance(const std::string& c) {
   return c == "extended" || c == "conservative" || c == "plain";
+}
+
+// A relative path is tried from the working directory, then from the source tree (so that the
+// shipped models/identified/ files are found from a build directory too).
+std::string ResolveModelPath(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (path.empty() || fs::path(path).is_absolute() || fs::exists(path, ec)) return path;
+#ifdef RECRUIT_SOURCE_DIR
+  const fs::path alt = fs::path(RECRUIT_SOURCE_DIR) / path;
+  if (fs::exists(alt, ec)) return alt.string();
+#endif
+  return path;
 }
 
 }  // namespace
@@ -107,7 +123,50 @@ Result<std::unique_ptr<OnCountEstimator>> MakeEstimator(const EstimatorSpec& spe
   if (spec.kind == "output") {
     return std::unique_ptr<OnCountEstimator>(new OutputOnlyEstimator(num_units, unit_force));
   }
-  return Error{"estimator: kind \"" + spec.kind + "\" needs recruit_estimation (not merged yet)"};
+  auto mode = ParseCovarianceMode(spec.covariance);
+  if (!mode) return Error{"estimator: " + mode.error()};
+  FilterModel model;
+  if (spec.kind == "kalman2") {
+    const double sd = spec.force_noise_std > 0 ? spec.force_noise_std : unit_force;
+    model = FilterModel::TwoState(num_units, dT, unit_force, sd);
+  } else {
+    const std::string file = ResolveModelPath(
+        spec.model_file.empty() ? DefaultModelFile(dT, spec.num_states) : spec.model_file);
+    auto loaded = FilterModel::FromJson(file);
+    if (!loaded) {
+      return Error{"estimator: " + loaded.error() +
+                   (spec.model_file.empty()
+                        ? " (no identified model for this dT and number of states: make one "
+                          "with `recruit identify --dt DT --states M -o FILE` and pass it as "
+                          "the model file)"
+                        : "")};
+    }
+    model = std::move(loaded).value();
+    if (model.transition != TransitionSource::kBroadcast) {
+      return Error{"estimator: " + file + ": transition.type must be \"broadcast\""};
+    }
+    if (model.num_states() != spec.num_states) {
+      return Error{
+          "estimator: " + file + " has " + std::to_string(model.num_states()) +
+          " states, the estimator asks for num_states = " + std::to_string(spec.num_states)};
+    }
+    if (std::abs(model.broadcast.dt - dT) > 1e-9 * std::max(1.0, dT)) {
+      return Error{"estimator: " + file +
+                   " was identified for dt = " + std::to_string(model.broadcast.dt) +
+                   " s, the controller samples every dT = " + std::to_string(dT) +
+                   " s (identify a model for this dT)"};
+    }
+    if (model.num_outputs() != 1) {
+      return Error{"estimator: " + file + ": H must have one row (the bundle's force)"};
+    }
+    if (model.N != num_units) model = model.WithPopulation(num_units);
+    if (spec.force_noise_std > 0) {
+      model.R = Eigen::MatrixXd::Constant(1, 1, spec.force_noise_std * spec.force_noise_std);
+    }
+  }
+  auto est = KalmanOnCountEstimator::Create(model, *mode);
+  if (!est) return Error{"estimator: " + est.error()};
+  return std::unique_ptr<OnCountEstimator>(std::move(est).value());
 }
 
 }  // namespace recruit::control

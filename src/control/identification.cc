@@ -16,21 +16,23 @@ Eigen::MatrixXd MeanTrajectory(const TransientChain& chain, const SwitchingLog& 
   x[chain.cold()] = log.num_units;
   for (int k = 0; k < rows; ++k) {
     X.row(k) = x.transpose();
-    chain.PropagateMean(log.p_on[k], log.p_off[k], x);
+    chain.PropagateMean(log.InputOn(k), log.InputOff(k), x);
   }
   return X;
 }
 
-// Neighbour differences along the heating path (cold, heat1..heatK, hot) and the cooling path
-// (hot, cool1..coolK, cold).
+// Neighbour differences along the heating chain (heat1..heatK, hot) and the cooling chain
+// (cool1..coolK, cold). The entry edges (cold -> heat1, hot -> cool1) are left out: the force
+// may jump there within one period (at long dT especially), and tying hot to cool1 would drag
+// the settled force down.
 Eigen::MatrixXd ChainDifferences(const TransientChain& c) {
   const int K = c.chain_length, m = c.num_states();
-  std::vector<int> heat_path{c.cold()}, cool_path{c.hot()};
+  std::vector<int> heat_path, cool_path;
   for (int i = 1; i <= K; ++i) heat_path.push_back(c.heat(i));
   for (int i = 1; i <= K; ++i) cool_path.push_back(c.cool(i));
   heat_path.push_back(c.hot());
   cool_path.push_back(c.cold());
-  Eigen::MatrixXd d = Eigen::MatrixXd::Zero(2 * (K + 1), m);
+  Eigen::MatrixXd d = Eigen::MatrixXd::Zero(2 * K, m);
   int r = 0;
   for (const auto* path : {&heat_path, &cool_path}) {
     for (size_t i = 0; i + 1 < path->size(); ++i, ++r) {
@@ -47,6 +49,7 @@ class Problem {
       : log_(log), train_(train), opt_(opt), shape_(std::move(shape)) {
     D_ = ChainDifferences(shape_);
     y_ = Eigen::Map<const Eigen::VectorXd>(log.force.data(), train_);
+    advance_weight_ = std::sqrt(opt.advance_prior * y_.squaredNorm() / train_);
   }
   int num_params() const { return 2 * shape_.chain_length; }
 
@@ -58,10 +61,15 @@ class Problem {
     return c;
   }
 
+  const TransientChain& shape() const { return shape_; }
+  void set_shape(const TransientChain& c) { shape_ = c; }
+
   // Solves for H given the advance probabilities; returns the stacked residual
   // [y - X H; sqrt(mu) D H] and H.
   Eigen::VectorXd Residual(const Eigen::VectorXd& a, Eigen::VectorXd* h_out = nullptr) const {
-    const TransientChain c = WithParams(a);
+    return ResidualOf(WithParams(a), h_out);
+  }
+  Eigen::VectorXd ResidualOf(const TransientChain& c, Eigen::VectorXd* h_out = nullptr) const {
     const Eigen::MatrixXd X = MeanTrajectory(c, log_, train_);
     Eigen::MatrixXd normal = X.transpose() * X;
     const double mu = opt_.smoothness * std::max(normal.trace() / normal.rows(), 1e-300);
@@ -70,9 +78,14 @@ class Problem {
     // well-defined.
     normal.diagonal().array() += 1e-12 * std::max(normal.trace() / normal.rows(), 1e-300);
     const Eigen::VectorXd h = normal.ldlt().solve(X.transpose() * y_);
-    Eigen::VectorXd r(train_ + D_.rows());
+    const int K = c.chain_length;
+    Eigen::VectorXd r(train_ + D_.rows() + 2 * K);
     r.head(train_) = y_ - X * h;
-    r.tail(D_.rows()) = std::sqrt(mu) * (D_ * h);
+    r.segment(train_, D_.rows()) = std::sqrt(mu) * (D_ * h);
+    // Prior towards progress (a = 1): an edge the data do not constrain lets units move on to
+    // the settled state instead of stalling in a state whose force nothing pins down.
+    r.segment(train_ + D_.rows(), K) = advance_weight_ * (1.0 - c.heat_advance.array()).matrix();
+    r.tail(K) = advance_weight_ * (1.0 - c.cool_advance.array()).matrix();
     if (h_out) *h_out = h;
     return r;
   }
@@ -84,6 +97,7 @@ class Problem {
   TransientChain shape_;
   Eigen::MatrixXd D_;
   Eigen::VectorXd y_;
+  double advance_weight_ = 0;
 };
 
 // Bounded Levenberg-Marquardt with forward-difference Jacobian. Returns the final parameters;
@@ -151,6 +165,45 @@ Eigen::VectorXd FitAdvance(const Problem& p, Eigen::VectorXd a, double lo, int m
   *cost = f;
   *iterations = it;
   return a;
+}
+
+// Greedy least-squares choice of the mid-transient switching targets: for every source state
+// (heat<i>, cool<i>), try each state of the other chain as its target, keep the one with the
+// smallest cost (H re-solved each time, advance probabilities fixed). Returns true if any
+// target changed.
+bool RefineTargets(Problem& p, const Eigen::VectorXd& a) {
+  TransientChain c = p.WithParams(a);
+  double best = p.ResidualOf(c).squaredNorm();
+  bool changed = false;
+  const int K = c.chain_length;
+  for (int s = 1; s < c.num_states(); ++s) {
+    if (s == c.hot()) continue;
+    const bool on = s < c.hot();
+    std::vector<int> candidates;
+    if (on) {
+      candidates.push_back(c.cold());
+      for (int i = 1; i <= K; ++i) candidates.push_back(c.cool(i));
+    } else {
+      for (int i = 1; i <= K; ++i) candidates.push_back(c.heat(i));
+      candidates.push_back(c.hot());
+    }
+    std::vector<int>& target = on ? c.switch_off : c.switch_on;
+    const int original = target[s];
+    int chosen = original;
+    for (int t : candidates) {
+      if (t == original) continue;
+      target[s] = t;
+      const double f = p.ResidualOf(c).squaredNorm();
+      if (f < best * (1 - 1e-9)) {
+        best = f;
+        chosen = t;
+      }
+    }
+    target[s] = chosen;
+    changed |= chosen != original;
+  }
+  p.set_shape(c);
+  return changed;
 }
 
 // Negative log-likelihood (up to constants) of the force samples [0, rows) under the population
@@ -221,7 +274,7 @@ Eigen::VectorXd TwoStatePrediction(const SwitchingLog& log, int train) {
   for (int k = 0; k < n; ++k) {
     X(k, 0) = log.num_units - on;
     X(k, 1) = on;
-    on = on + log.p_on[k] * (log.num_units - on) - log.p_off[k] * on;
+    on = on + log.InputOn(k) * (log.num_units - on) - log.InputOff(k) * on;
   }
   const Eigen::MatrixXd Xt = X.topRows(train);
   const Eigen::VectorXd y = Eigen::Map<const Eigen::VectorXd>(log.force.data(), train);
@@ -274,26 +327,28 @@ Result<IdentificationResult> IdentifyTransientModel(const SwitchingLog& log,
     return Error{"identify: " + std::to_string(train) + " training samples are too few for " +
                  std::to_string(opt.num_states) + " states (need at least 3 per state)"};
   }
-  const TransientChain shape = TransientChain::Uniform(opt.num_states, 1.0);
-  const Problem problem(log, train, opt, shape);
-
-  // Two starts: the deterministic chain (each state = k periods since the switch) and a
-  // spread-out one; keep the better.
+  // Start from the deterministic chain (each state = k periods since the switch) with the
+  // heat-level targets; alternate the switching targets (greedy) and the advance probabilities
+  // (Levenberg-Marquardt) until the targets settle.
+  Problem problem(log, train, opt, TransientChain::Uniform(opt.num_states, 1.0));
   IdentificationResult best;
-  best.cost = std::numeric_limits<double>::infinity();
-  for (double start : {1.0, 0.5}) {
+  Eigen::VectorXd a = Eigen::VectorXd::Ones(problem.num_params());
+  for (int round = 0; round < opt.max_rounds; ++round) {
+    // Targets first: with the heat-level targets the mid-transient switches can be far off, and
+    // fitting the advance probabilities to them would bend the chains.
+    bool changed = false;
+    for (int sweep = 0; sweep < 3 && RefineTargets(problem, a); ++sweep) changed = true;
+    if (round > 0 && !changed) break;
     double cost = 0;
     int iters = 0;
-    Eigen::VectorXd a0 = Eigen::VectorXd::Constant(problem.num_params(), start);
-    Eigen::VectorXd a = FitAdvance(problem, a0, opt.min_advance, opt.max_iterations, &cost, &iters);
-    if (cost < best.cost) {
-      best.cost = cost;
-      best.iterations = iters;
-      best.chain = problem.WithParams(a);
-      Eigen::VectorXd h;
-      (void)problem.Residual(a, &h);
-      best.chain.force = h;
-    }
+    a = FitAdvance(problem, a, opt.min_advance, opt.max_iterations, &cost, &iters);
+    best.iterations += iters;
+  }
+  best.chain = problem.WithParams(a);
+  {
+    Eigen::VectorXd h;
+    best.cost = problem.Residual(a, &h).squaredNorm();
+    best.chain.force = h;
   }
 
   const Eigen::VectorXd pred = PredictMeanForce(best.chain, log);

@@ -31,17 +31,22 @@ Result<SwitchingLog> SwitchingLog::FromCsv(const std::string& path, int num_unit
   std::string line;
   if (!std::getline(in, line)) return Error{path + ": empty file (expected a CSV header)"};
   const auto header = SplitCsv(line);
-  int col_t = -1, col_on = -1, col_off = -1, col_f = -1, col_true = -1;
+  int col_t = -1, col_on = -1, col_off = -1, col_f = -1, col_true = -1, col_ron = -1, col_roff = -1;
   for (int i = 0; i < static_cast<int>(header.size()); ++i) {
     if (header[i] == "time") col_t = i;
     if (header[i] == "p_on") col_on = i;
     if (header[i] == "p_off") col_off = i;
     if (header[i] == "force") col_f = i;
     if (header[i] == "true_on") col_true = i;
+    if (header[i] == "realized_on") col_ron = i;
+    if (header[i] == "realized_off") col_roff = i;
   }
   if (col_t < 0 || col_on < 0 || col_off < 0 || col_f < 0) {
     return Error{path + ": header must name the columns time, p_on, p_off, force (got \"" + line +
                  "\")"};
+  }
+  if ((col_ron < 0) != (col_roff < 0)) {
+    return Error{path + ": realized_on and realized_off must be given together"};
   }
   SwitchingLog log;
   log.num_units = num_units;
@@ -71,6 +76,13 @@ Result<SwitchingLog> SwitchingLog::FromCsv(const std::string& path, int num_unit
       if (Status s = get(col_true, "true_on", tr); !s) return Error{s.error()};
       log.true_on.push_back(tr);
     }
+    if (col_ron >= 0) {
+      double ron, roff;
+      if (Status s = get(col_ron, "realized_on", ron); !s) return Error{s.error()};
+      if (Status s = get(col_roff, "realized_off", roff); !s) return Error{s.error()};
+      log.realized_on.push_back(ron);
+      log.realized_off.push_back(roff);
+    }
     log.time.push_back(t);
     log.p_on.push_back(on);
     log.p_off.push_back(off);
@@ -94,13 +106,18 @@ Status SwitchingLog::Validate(const std::string& where) const {
   const size_t n = force.size();
   if (n < 2) return Error{where + ": a switching log needs at least 2 samples"};
   if (time.size() != n || p_on.size() != n || p_off.size() != n ||
-      (!true_on.empty() && true_on.size() != n)) {
-    return Error{where + ": columns time, p_on, p_off, force (and true_on) differ in length"};
+      (!true_on.empty() && true_on.size() != n) ||
+      (has_realized() && (realized_on.size() != n || realized_off.size() != n))) {
+    return Error{where +
+                 ": columns time, p_on, p_off, force (and true_on, realized_on, realized_off) "
+                 "differ in length"};
   }
   if (num_units < 1) return Error{where + ": num_units must be >= 1"};
   if (!(dT > 0) || !std::isfinite(dT)) return Error{where + ": dT must be > 0 s"};
   for (size_t k = 0; k < n; ++k) {
-    for (auto [v, name] : {std::pair{p_on[k], "p_on"}, std::pair{p_off[k], "p_off"}}) {
+    for (auto [v, name] : {std::pair{p_on[k], "p_on"}, std::pair{p_off[k], "p_off"},
+                           std::pair{has_realized() ? realized_on[k] : 0.0, "realized_on"},
+                           std::pair{has_realized() ? realized_off[k] : 0.0, "realized_off"}}) {
       if (!(v >= 0 && v <= 1)) {
         return Error{where + ": sample " + std::to_string(k) + ": " + name + " = " +
                      std::to_string(v) + " is not in [0, 1]"};
@@ -117,11 +134,13 @@ Status SwitchingLog::SaveCsv(const std::string& path) const {
   AtomicFile f(path);
   if (!f.ok()) return Error{f.error()};
   auto& o = f.stream();
-  o << "time,p_on,p_off,force" << (true_on.empty() ? "" : ",true_on") << "\n";
+  o << "time,p_on,p_off,force" << (true_on.empty() ? "" : ",true_on")
+    << (has_realized() ? ",realized_on,realized_off" : "") << "\n";
   o << std::setprecision(10);
   for (int k = 0; k < size(); ++k) {
     o << time[k] << ',' << p_on[k] << ',' << p_off[k] << ',' << force[k];
     if (!true_on.empty()) o << ',' << true_on[k];
+    if (has_realized()) o << ',' << realized_on[k] << ',' << realized_off[k];
     o << '\n';
   }
   return f.Commit();

@@ -10,6 +10,8 @@ TransientChain TransientChain::Uniform(int num_states, double advance) {
   c.heat_advance = Eigen::VectorXd::Constant(c.chain_length, advance);
   c.cool_advance = Eigen::VectorXd::Constant(c.chain_length, advance);
   c.force = Eigen::VectorXd::Zero(c.num_states());
+  c.switch_on = c.LevelOnTarget();
+  c.switch_off = c.LevelOffTarget();
   return c;
 }
 
@@ -36,30 +38,30 @@ int TransientChain::Level(int s) const {
   return chain_length + 1 - (s - hot());
 }
 
-std::vector<int> TransientChain::OnTarget() const {
+int TransientChain::Next(int s) const {
+  if (s == cold() || s == hot()) return -1;
+  if (s < hot()) return s == heat(chain_length) ? hot() : s + 1;
+  return s == cool(chain_length) ? cold() : s + 1;
+}
+
+std::vector<int> TransientChain::LevelOnTarget() const {
   const int m = num_states();
   const auto on = IsOn();
-  std::vector<int> t(m);
+  std::vector<int> t(m, -1);
   for (int s = 0; s < m; ++s) {
-    if (on[s]) {
-      t[s] = s;
-      continue;
-    }
+    if (on[s]) continue;
     const int level = std::min(Level(s) + 1, chain_length + 1);
     t[s] = level == chain_length + 1 ? hot() : heat(level);
   }
   return t;
 }
 
-std::vector<int> TransientChain::OffTarget() const {
+std::vector<int> TransientChain::LevelOffTarget() const {
   const int m = num_states();
   const auto on = IsOn();
-  std::vector<int> t(m);
+  std::vector<int> t(m, -1);
   for (int s = 0; s < m; ++s) {
-    if (!on[s]) {
-      t[s] = s;
-      continue;
-    }
+    if (!on[s]) continue;
     const int level = std::max(Level(s) - 1, 0);
     t[s] = level == 0 ? cold() : cool(chain_length + 1 - level);
   }
@@ -83,43 +85,30 @@ Eigen::MatrixXd TransientChain::Interior() const {
 Eigen::MatrixXd TransientChain::Matrix(double p_on, double p_off) const {
   Eigen::MatrixXd a = Interior();
   const auto on = IsOn();
-  const auto ton = OnTarget(), toff = OffTarget();
   for (int j = 0; j < num_states(); ++j) {
     const double p = on[j] ? p_off : p_on;
     a.col(j) *= 1 - p;
-    a(on[j] ? toff[j] : ton[j], j) += p;
+    a(on[j] ? switch_off[j] : switch_on[j], j) += p;
   }
   return a;
 }
 
 void TransientChain::PropagateMean(double p_on, double p_off, Eigen::VectorXd& x) const {
-  const int K = chain_length;
-  Eigen::VectorXd y = Eigen::VectorXd::Zero(num_states());
-  // Switching: an off state's units move with p_on, an on state's with p_off.
-  // Off states: cold (level 0) -> heat1; cool<i> (level K + 1 - i) -> heat<K + 2 - i> or hot.
-  y[heat(1)] += p_on * x[cold()];
-  y[cold()] += (1 - p_on) * x[cold()];
-  for (int i = 1; i <= K; ++i) {
-    const int to = i == 1 ? hot() : heat(K + 2 - i);
-    y[to] += p_on * x[cool(i)];
-  }
-  // On states: heat<i> (level i) -> cool<K + 2 - i> or cold; hot (level K + 1) -> cool1.
-  for (int i = 1; i <= K; ++i) {
-    const int to = i == 1 ? cold() : cool(K + 2 - i);
-    y[to] += p_off * x[heat(i)];
-  }
-  y[cool(1)] += p_off * x[hot()];
-  y[hot()] += (1 - p_off) * x[hot()];
-  // Interior moves of the units that did not switch.
-  for (int i = 1; i <= K; ++i) {
-    const double h = (1 - p_off) * x[heat(i)];
-    const double a = heat_advance[i - 1];
-    y[heat(i)] += (1 - a) * h;
-    y[i == K ? hot() : heat(i + 1)] += a * h;
-    const double c = (1 - p_on) * x[cool(i)];
-    const double b = cool_advance[i - 1];
-    y[cool(i)] += (1 - b) * c;
-    y[i == K ? cold() : cool(i + 1)] += b * c;
+  const int m = num_states();
+  Eigen::VectorXd y = Eigen::VectorXd::Zero(m);
+  for (int s = 0; s < m; ++s) {
+    const bool on = s >= heat(1) && s <= hot();
+    const double p = on ? p_off : p_on;
+    y[on ? switch_off[s] : switch_on[s]] += p * x[s];
+    const double stay = (1 - p) * x[s];  // units the broadcast did not switch
+    const int next = Next(s);
+    if (next < 0) {
+      y[s] += stay;
+    } else {
+      const double a = s < hot() ? heat_advance[s - 1] : cool_advance[s - hot() - 1];
+      y[s] += (1 - a) * stay;
+      y[next] += a * stay;
+    }
   }
   x = y;
 }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <limits>
 
 namespace recruit::sim {
 
@@ -92,7 +93,7 @@ EstimatorScore ScoreEstimator(const std::vector<double>& estimated,
     s.rmse = std::sqrt(se / s.samples);
     s.within3 = static_cast<double>(within) / s.samples;
   }
-  s.mean_nees = nees_n > 0 ? nees / nees_n : 0;
+  s.mean_nees = nees_n > 0 ? nees / nees_n : std::numeric_limits<double>::quiet_NaN();
   return s;
 }
 

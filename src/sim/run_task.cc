@@ -50,6 +50,7 @@ ControllerSettings EffectiveSettings(const Task& task, const RunOptions& options
   if (options.filter_model) s.filter_model = *options.filter_model;
   if (options.dT) s.dT = *options.dT;
   if (options.lambda) s.lambda = *options.lambda;
+  if (options.force_noise_std) s.force_noise_std = *options.force_noise_std;
   return s;
 }
 
@@ -192,7 +193,8 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
   mj_forward(m, d);
 
   // One recruitment controller per bundle.
-  auto spec = control::EstimatorSpec::Parse(settings.estimator, "extended", settings.filter_model);
+  auto spec = control::EstimatorSpec::Parse(settings.estimator, "extended", settings.filter_model,
+                                            20, settings.force_noise_std);
   if (!spec.ok()) return Error{where + ".controller.estimator: " + spec.error()};
   std::vector<control::RecruitmentController> controllers;
   for (int b : bundles) {
@@ -282,14 +284,18 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
       sample.p_on = sample.bundles[0].p_on;
       sample.p_off = sample.bundles[0].p_off;
     }
-    // Pushes act through xfrc_applied while active.
+    // Pushes act through xfrc_applied while active; several may share a body, so clear all
+    // first and then add the active ones.
+    for (size_t i = 0; i < task.pushes.size(); ++i) {
+      for (int k = 0; k < 6; ++k) d->xfrc_applied[6 * push_body[i] + k] = 0;
+    }
     for (size_t i = 0; i < task.pushes.size(); ++i) {
       const Push& p = task.pushes[i];
-      const bool active = t + 0.5 * h >= p.start && t + 0.5 * h < p.start + p.duration;
+      if (t + 0.5 * h < p.start || t + 0.5 * h >= p.start + p.duration) continue;
       double* x = d->xfrc_applied + 6 * push_body[i];
       for (int k = 0; k < 3; ++k) {
-        x[k] = active ? p.force[k] : 0.0;
-        x[3 + k] = active ? p.torque[k] : 0.0;
+        x[k] += p.force[k];
+        x[3 + k] += p.torque[k];
       }
     }
 

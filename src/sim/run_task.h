@@ -22,7 +22,8 @@ struct RunOptions {
   std::optional<std::string> filter_model;  // filter model file for "kalman"
   std::optional<double> dT;                 // s
   std::optional<double> lambda;
-  std::optional<double> duration;  // s
+  std::optional<double> force_noise_std;  // N, Kalman estimators' measurement noise
+  std::optional<double> duration;         // s
   std::uint64_t seed = 1;
   bool progress = false;  // progress on stderr
 };
@@ -37,7 +38,7 @@ struct RunMetrics {
   double oscillation = 0;        // excess total variation, see metrics.h
   double switching_rate = 0;     // unit transitions per unit per second (all bundles)
   double estimator_rmse = 0;     // units, at control instants (agonist)
-  double mean_nees = 0;          // on-count NEES at control instants (agonist)
+  double mean_nees = 0;          // on-count NEES at control instants (agonist); NaN: no variance
   double estimator_within3 = 0;  // fraction of control instants with |n^ - n| <= 3
   int num_steps = 0;
 };

@@ -86,7 +86,8 @@ Result<RunSummary> RunSummaryFromJson(const json& j) {
     r.oscillation = m.at("oscillation");
     r.switching_rate = m.at("switching_rate");
     r.estimator_rmse = m.at("estimator_rmse");
-    r.mean_nees = m.at("mean_nees");
+    // NaN (no variance: output only) is stored as null.
+    r.mean_nees = m.at("mean_nees").is_null() ? std::nan("") : m.at("mean_nees").get<double>();
     r.estimator_within3 = m.at("estimator_within3");
     r.num_steps = m.at("num_steps");
     for (const json& st : j.at("steps")) {
@@ -218,7 +219,7 @@ std::vector<CellStats> Aggregate(const std::vector<RunSummary>& runs,
       osc.push_back(r->metrics.oscillation);
       sw.push_back(r->metrics.switching_rate);
       er.push_back(r->metrics.estimator_rmse);
-      nees.push_back(r->metrics.mean_nees);
+      if (std::isfinite(r->metrics.mean_nees)) nees.push_back(r->metrics.mean_nees);
       w3.push_back(r->metrics.estimator_within3);
     }
     c.overshoot_mean = Mean(os);
@@ -230,7 +231,7 @@ std::vector<CellStats> Aggregate(const std::vector<RunSummary>& runs,
     c.oscillation_mean = Mean(osc);
     c.switching_mean = Mean(sw);
     c.estimator_rmse_mean = Mean(er);
-    c.nees_mean = Mean(nees);
+    c.nees_mean = nees.empty() ? std::nan("") : Mean(nees);
     c.within3_mean = Mean(w3);
     c.margin = std::min(criterion.max_overshoot - c.overshoot_mean,
                         c.settled_fraction - criterion.min_settled);

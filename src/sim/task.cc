@@ -171,7 +171,8 @@ Result<Task> Task::FromJsonText(const std::string& text, const std::string& sour
     const json& c = j["controller"];
     const std::string where = file + ".controller";
     if (!c.is_object()) return Error{where + ": must be an object"};
-    RECRUIT_TRY(CheckKeys(c, {"estimator", "filter_model", "dT", "lambda"}, where));
+    RECRUIT_TRY(
+        CheckKeys(c, {"estimator", "filter_model", "dT", "lambda", "force_noise_std"}, where));
     RECRUIT_TRY(String(c, "estimator", where, &task.controller.estimator, false));
     RECRUIT_TRY(String(c, "filter_model", where, &task.controller.filter_model, false));
     task.controller.filter_model = Resolve(task.controller.filter_model, source);

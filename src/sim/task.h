@@ -22,6 +22,9 @@ struct ControllerSettings {
   std::string filter_model;          // filter model file for model-based estimators ("" = none)
   double dT = 2.0;                   // s, sampling period of the broadcast controller
   double lambda = 0.2;               // gain of the expectation law (the paper's lambda)
+  // Kalman estimators: force measurement noise std, N (0 = the estimator's default: the model
+  // file's R for kalman-augmented, one settled unit's force for kalman2).
+  double force_noise_std = 0;
 };
 
 // Outer loop of arm tasks: PI(D) on the joint angle error gives a net tendon force; positive

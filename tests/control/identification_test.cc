@@ -6,9 +6,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <iostream>
 
 #include "common/rng.h"
+#include "control/bench_recorder.h"
 #include "control/excitation.h"
 #include "control/transient_chain.h"
 
@@ -30,7 +33,8 @@ TEST(TransientChain, SwitchingEdgesFollowTheHeatLevel) {
   TransientChain c = TransientChain::Uniform(8, 1.0);  // K = 3
   EXPECT_EQ(c.StateNames()[4], "hot");
   EXPECT_EQ(c.StateNames()[5], "cool1");
-  const auto on = c.OnTarget(), off = c.OffTarget();
+  const auto& on = c.switch_on;
+  const auto& off = c.switch_off;
   // Switch on: cold -> heat1; cool1 (level 3) -> hot; cool2 (level 2) -> heat3;
   // cool3 (level 1) -> heat2.
   EXPECT_EQ(on[0], 1);
@@ -42,6 +46,10 @@ TEST(TransientChain, SwitchingEdgesFollowTheHeatLevel) {
   EXPECT_EQ(off[3], 6);
   EXPECT_EQ(off[2], 7);
   EXPECT_EQ(off[1], 0);
+  // A switch does not apply to the other kind of state.
+  EXPECT_EQ(on[4], -1);
+  EXPECT_EQ(off[0], -1);
+  EXPECT_EQ(off[7], -1);
 }
 
 TEST(TransientChain, MatrixIsColumnStochasticAndMatchesPropagateMean) {
@@ -152,6 +160,73 @@ TEST(Identification, RejectsTooShortLogsAndBadOptions) {
   EXPECT_NE(r.error().find("too few"), std::string::npos);
   opt.num_states = 7;
   EXPECT_FALSE(IdentifyTransientModel(log, opt).ok());
+}
+
+}  // namespace
+}  // namespace recruit::control
+
+namespace recruit::control {
+namespace {
+
+std::string TempPath(const std::string& name) {
+  return (std::filesystem::temp_directory_path() / ("recruit_control_" + name)).string();
+}
+
+TEST(SwitchingLog, CsvRoundTripsAndBadFilesNameTheLineAndColumn) {
+  SwitchingLog log = SimulateUnits(KnownChain(), 50, 40, 0.1, 2);
+  log.realized_on.assign(40, 0.25);
+  log.realized_off.assign(40, 0.0);
+  const std::string path = TempPath("log.csv");
+  ASSERT_TRUE(log.SaveCsv(path).ok());
+  auto back = SwitchingLog::FromCsv(path, 50);
+  ASSERT_TRUE(back.ok()) << back.error();
+  EXPECT_EQ(back->size(), 40);
+  EXPECT_DOUBLE_EQ(back->dT, 0.5);
+  EXPECT_NEAR(back->force[7], log.force[7], 1e-8 * std::abs(log.force[7]) + 1e-12);
+  EXPECT_DOUBLE_EQ(back->InputOn(3), 0.25);
+
+  auto write = [&](const std::string& text) {
+    std::ofstream(path) << text;
+    return SwitchingLog::FromCsv(path, 60);
+  };
+  auto no_header = write("time,p_on,force\n0,0,0\n");
+  ASSERT_FALSE(no_header.ok());
+  EXPECT_NE(no_header.error().find("p_off"), std::string::npos);
+  auto bad_number = write("time,p_on,p_off,force\n0,0,0,1\n0.5,0,0,abc\n");
+  ASSERT_FALSE(bad_number.ok());
+  EXPECT_NE(bad_number.error().find("line 3"), std::string::npos) << bad_number.error();
+  EXPECT_NE(bad_number.error().find("force"), std::string::npos);
+  auto bad_p = write("time,p_on,p_off,force\n0,1.5,0,1\n0.5,0,0,1\n");
+  ASSERT_FALSE(bad_p.ok());
+  EXPECT_NE(bad_p.error().find("p_on"), std::string::npos);
+  auto uneven = write("time,p_on,p_off,force\n0,0,0,1\n0.5,0,0,1\n1.5,0,0,1\n");
+  ASSERT_FALSE(uneven.ok());
+  EXPECT_NE(uneven.error().find("time step"), std::string::npos);
+  EXPECT_FALSE(SwitchingLog::FromCsv(TempPath("missing.csv"), 60).ok());
+  std::filesystem::remove(path);
+}
+
+TEST(Identification, BenchFitPredictsHeldOutForceBetterThanTheTwoStateModel) {
+  // 300 s of the excitation on the isometric bench at dT = 0.5 s; the last 30 % held out.
+  const Excitation e = MakeExcitation(16, 600, 5);
+  auto rec = RecordBench(RECRUIT_SOURCE_DIR "/models/isometric_bench.xml", "", e, 0.5, 5);
+  ASSERT_TRUE(rec.ok()) << rec.error();
+  EXPECT_EQ(rec->log.num_units, 60);
+  // The realized fractions agree with the plugin's ground-truth on-count.
+  for (int k = 0; k + 1 < rec->log.size(); ++k) {
+    const double on = rec->log.true_on[k], n = 60;
+    EXPECT_NEAR(rec->log.true_on[k + 1],
+                on + rec->log.realized_on[k] * (n - on) - rec->log.realized_off[k] * on, 1e-9);
+  }
+  FitOptions opt;
+  auto fit = IdentifyTransientModel(rec->log, opt);
+  ASSERT_TRUE(fit.ok()) << fit.error();
+  EXPECT_GT(fit->holdout.r2, 0.99);
+  EXPECT_LT(fit->holdout.rmse, 0.5);  // about one unit's settled force
+  EXPECT_LT(fit->holdout.rmse, fit->two_state_holdout.rmse / 4);
+  // The hot state's force is the settled force of one unit within 10 %.
+  EXPECT_NEAR(fit->chain.force[fit->chain.hot()], rec->unit_force, 0.1 * rec->unit_force);
+  EXPECT_NEAR(fit->chain.force[fit->chain.cold()], 0.0, 0.02);
 }
 
 }  // namespace

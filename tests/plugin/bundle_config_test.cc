@@ -76,6 +76,18 @@ INSTANTIATE_TEST_SUITE_P(
                       BadCase{"C_A=0", "C_A=0 is out of range"},
                       BadCase{"merge_xi=-1", "merge_xi=-1 is out of range"}));
 
+TEST(BundleConfig, EveryNumericKeyRejectsNonFiniteAndOutOfRangeValues) {
+  for (const std::string& key : BundleConfig::Keys()) {
+    if (key == "law") continue;
+    for (const char* bad : {"nan", "-inf", "1e300", "-1e300", "x"}) {
+      auto c = BundleConfig::FromText("a", key + "=" + bad);
+      ASSERT_FALSE(c.ok()) << key << "=" << bad;
+      EXPECT_THAT(c.error(), HasSubstr("actuator 'a'"));
+      EXPECT_THAT(c.error(), HasSubstr(key + "=" + bad)) << c.error();
+    }
+  }
+}
+
 TEST(BundleConfig, KeysListsEveryDocumentedKey) {
   const auto keys = BundleConfig::Keys();
   for (const char* k : {"law", "units", "wire_diameter", "coil_diameter", "turns", "prestretch",

@@ -118,6 +118,25 @@ TEST(SmaBundle, CohortCountGrowsSublinearlyWithBundleSize) {
   EXPECT_LT(mean_cohorts[1], 0.2 * 6000);
 }
 
+TEST(SmaBundle, UnitsSwitchedTogetherStayOneCohortWhateverTheirNumber) {
+  // The Fig. 4 regime: per-step work is one cohort for 6000 units, and the state matches a
+  // single unit's.
+  const SmaBundle b = MakeBundle(6000, 0.5, 0.01);
+  std::vector<double> state(b.state_size());
+  const double stretch = b.config().unit.prestretch;
+  b.Reset(state.data(), 1, stretch);
+  UnitState one = RestState(b.unit(), stretch);
+  ASSERT_TRUE(b.Broadcast(state.data(), 1, 0, stretch).ok());
+  for (int i = 0; i < 3000; ++i) {
+    b.Advance(state.data(), stretch, 1e-3);
+    AdvanceUnit(b.unit(), one, true, stretch, 1e-3);
+    ASSERT_EQ(b.NumCohorts(state.data()), 1);
+  }
+  EXPECT_EQ(b.OnCount(state.data()), 6000);
+  EXPECT_DOUBLE_EQ(b.UnitTemperature(state.data(), 4321), one.temperature);
+  EXPECT_NEAR(b.Tension(state.data(), stretch), 6000 * b.unit().Tension(one.xi, stretch), 1e-9);
+}
+
 TEST(SmaBundle, SettledCohortsMergeBackToOne) {
   const SmaBundle b = MakeBundle(600, 0.5, 0.01);
   std::vector<double> state(b.state_size());
@@ -160,6 +179,22 @@ TEST(SmaBundle, SameSeedSameDrawsDifferentSeedDifferentDraws) {
   for (auto* s : {&s1, &s2, &s3}) ASSERT_TRUE(b.Broadcast(s->data(), 0.5, 0.5, 0.0).ok());
   EXPECT_EQ(s1, s2);
   EXPECT_NE(s1, s3);
+}
+
+TEST(SmaBundle, ZeroCurrentAndSingleUnitAreWellDefined) {
+  auto c = BundleConfig::FromText("b", "units=1 current=0");
+  ASSERT_TRUE(c.ok()) << c.error();
+  auto b = SmaBundle::Create(*c, 1e-3);
+  ASSERT_TRUE(b.ok()) << b.error();
+  std::vector<double> s(b->state_size());
+  b->Reset(s.data(), 1, 3e-3);
+  ASSERT_TRUE(b->Broadcast(s.data(), 1, 0, 3e-3).ok());
+  for (int i = 0; i < 100; ++i) b->Advance(s.data(), 3e-3, 1e-3);
+  EXPECT_EQ(b->OnCount(s.data()), 1);
+  EXPECT_EQ(b->Heat(s.data()), 0.0);
+  EXPECT_EQ(b->MeanTemperature(s.data()), 20.0);
+  EXPECT_EQ(b->Tension(s.data(), 3e-3), 0.0);
+  EXPECT_EQ(b->SettledOnTension(3e-3), 0.0);
 }
 
 TEST(SmaBundle, RejectsProbabilitiesOutsideUnitInterval) {

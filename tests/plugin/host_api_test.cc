@@ -3,6 +3,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <thread>
@@ -261,7 +262,8 @@ TEST(HostApi, ResetKeyframeRestoresPoseAndColdUnits) {
   ASSERT_TRUE(p->Broadcast(d.get(), 0, 1, 0).ok());
   for (int i = 0; i < 2000; ++i) Step(m.get(), d.get(), *p);
   ASSERT_GT(p->MeanTemperature(d.get(), 0), 60);
-  p->ResetKeyframe(d.get(), 0, 1);
+  EXPECT_FALSE(p->ResetKeyframe(d.get(), 1, 1).ok());  // the model has one keyframe
+  ASSERT_TRUE(p->ResetKeyframe(d.get(), 0, 1).ok());
   EXPECT_EQ(d->qpos[0], 0.0005);
   EXPECT_EQ(d->time, 0.0);
   EXPECT_EQ(p->OnCount(d.get(), 0), 0);
@@ -270,7 +272,7 @@ TEST(HostApi, ResetKeyframeRestoresPoseAndColdUnits) {
   EXPECT_EQ(p->UnitXi(d.get(), 0, 0), 1.0);
   // Same seed after the same reset: the same draws as a fresh run.
   DataPtr fresh = MakeData(m.get());
-  p->ResetKeyframe(fresh.get(), 0, 1);
+  ASSERT_TRUE(p->ResetKeyframe(fresh.get(), 0, 1).ok());
   ASSERT_TRUE(p->Broadcast(d.get(), 0, 0.5, 0).ok());
   ASSERT_TRUE(p->Broadcast(fresh.get(), 0, 0.5, 0).ok());
   for (int i = 0; i < 60; ++i) {
@@ -505,6 +507,79 @@ TEST(HostApi, AgonistAndAntagonistBundlesAreIndependent) {
   EXPECT_LT(d->qpos[0], 0);              // the flexor pulled the slider towards its anchor
   EXPECT_EQ(d->actuator_force[0], 0.0);  // the motor is not ours: zero ctrl, zero force
   EXPECT_FALSE(p->Broadcast(d.get(), 2, 0.5, 0.5).ok());
+}
+
+}  // namespace
+}  // namespace recruit::sma
+
+namespace recruit::sma {
+namespace {
+
+TEST(Registry, PluginsCreatedAndDestroyedWhileOtherThreadsStep) {
+  ModelPtr stepping = MustLoad(BenchXml());
+  std::vector<ModelPtr> churn;
+  for (int k = 0; k < 4; ++k) churn.push_back(MustLoad(BenchXml()));
+  auto p = MustCreate(stepping.get());
+  std::atomic<bool> done{false};
+  std::thread creator([&] {
+    for (int round = 0; round < 40; ++round) {
+      std::vector<std::unique_ptr<SmaPlugin>> live;
+      for (auto& m : churn) live.push_back(MustCreate(m.get()));
+    }
+    done = true;
+  });
+  DataPtr d = MakeData(stepping.get()), ref = MakeData(stepping.get());
+  p->Reset(d.get(), 5);
+  p->Reset(ref.get(), 5);
+  ASSERT_TRUE(p->Broadcast(d.get(), 0, 0.7, 0).ok());
+  ASSERT_TRUE(p->Broadcast(ref.get(), 0, 0.7, 0).ok());
+  int steps = 0;
+  while (!done || steps < 2000) {
+    Step(stepping.get(), d.get(), *p);
+    ++steps;
+  }
+  creator.join();
+  for (int i = 0; i < steps; ++i) Step(stepping.get(), ref.get(), *p);
+  EXPECT_EQ(d->qpos[0], ref->qpos[0]);
+  EXPECT_EQ(p->Force(d.get(), 0), p->Force(ref.get(), 0));
+}
+
+}  // namespace
+}  // namespace recruit::sma
+
+namespace recruit::sma {
+namespace {
+
+TEST(HostApi, UserdataAddressLeavesTheHostsOwnEntriesAlone) {
+  const std::string xml = Replace(BenchXml("units=60", 498), "<custom>",
+                                  "<custom><numeric name=\"recruit.sma.userdata_address\" "
+                                  "data=\"10\"/>");
+  ModelPtr m = MustLoad(xml);
+  auto need = SmaPlugin::RequiredUserdata(m.get());
+  ASSERT_TRUE(need.ok()) << need.error();
+  EXPECT_EQ(*need, 10 + 8 + 8 * 60);
+  auto p = MustCreate(m.get());
+  DataPtr d = MakeData(m.get());
+  for (int i = 0; i < 10; ++i) d->userdata[i] = 100 + i;
+  p->Reset(d.get(), 1);
+  ASSERT_TRUE(p->Broadcast(d.get(), 0, 1, 0).ok());
+  for (int i = 0; i < 2000; ++i) Step(m.get(), d.get(), *p);
+  for (int i = 0; i < 10; ++i) EXPECT_EQ(d->userdata[i], 100 + i);
+  EXPECT_GT(p->Force(d.get(), 0), 5.0);
+}
+
+TEST(HostApi, UserdataAddressMustBeAWholeNonNegativeNumber) {
+  for (const char* bad : {"-1", "2.5"}) {
+    const std::string xml =
+        Replace(BenchXml("units=60", 600), "<custom>",
+                std::string("<custom><numeric name=\"recruit.sma.userdata_address\" data=\"") +
+                    bad + "\"/>");
+    ModelPtr m = MustLoad(xml);
+    auto p = SmaPlugin::Create(m.get());
+    ASSERT_FALSE(p.ok()) << bad;
+    EXPECT_THAT(p.error(), HasSubstr("recruit.sma.userdata_address"));
+    EXPECT_THAT(p.error(), HasSubstr("whole number >= 0"));
+  }
 }
 
 }  // namespace

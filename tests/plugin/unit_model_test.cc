@@ -6,6 +6,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <string>
 
 namespace recruit::sma {
 namespace {
@@ -60,6 +62,23 @@ TEST(UnitThermal, HeatingStepMatchesClosedForm) {
   }
   EXPECT_DOUBLE_EQ(s.xi, 1.0);
   EXPECT_NEAR(m.time_constant(), tau, 1e-12);
+}
+
+TEST(UnitThermal, HotUnloadedUnitSettlesAtJouleOverConvectionTemperature) {
+  // Unloaded, so fully austenite once hot: T_ss = T_amb + I^2 rho_A L / A / (h pi d L).
+  UnitParams p = Unloaded();
+  p.law = ForceLaw::kWire;
+  p.h = 120;
+  p.current = 0.2;
+  const UnitModel m = MakeModel(p);
+  const double d = p.wire_diameter;
+  const double t_ss = 20 + 0.2 * 0.2 * 100e-8 * 4 / (kPi * d * d) / (120.0 * kPi * d);
+  ASSERT_GT(t_ss, 90);
+  UnitState s = RestState(m, 0);
+  for (int i = 0; i < 40000; ++i) AdvanceUnit(m, s, true, 0, 1e-3);  // 36 tau
+  EXPECT_EQ(s.xi, 0.0);
+  EXPECT_NEAR(s.temperature, t_ss, 1e-6);
+  EXPECT_NEAR(m.on_temperature(), t_ss, 1e-9);
 }
 
 TEST(UnitThermal, CoolingStepMatchesClosedFormAndIsStableForLargeSteps) {
@@ -222,6 +241,85 @@ TEST(UnitHysteresis, LatentHeatIsAbsorbedByTheTransformation) {
   EXPECT_NEAR(s.temperature, 74 + lc * (s.xi - 1), 1e-9);
   EXPECT_NEAR(s.xi, MajorHeatingRef(s.temperature), 1e-9);
   EXPECT_GT(s.xi, MajorHeatingRef(74));  // less transformed than without latent heat
+}
+
+// Phase fraction after one step by bisection on the residual of plugin/README.md with libm's
+// cosine, to the last bit: the reference for the fast solver (Newton, polynomial sincos).
+struct RefStep {
+  double xi;
+  bool heating;
+};
+RefStep ReferencePhaseStep(const UnitModel& m, const UnitState& s, bool on, double stretch,
+                           double dt) {
+  const UnitParams& p = m.params();
+  const double rho = p.resistivity_A + s.xi * (p.resistivity_M - p.resistivity_A);
+  const double power = on ? p.current * p.current * rho * m.wire_length() / m.area() : 0.0;
+  const double t_ss = p.ambient + power / m.conductance();
+  const double t_th = t_ss + (s.temperature - t_ss) * std::exp(-dt / m.time_constant());
+  auto tension = [&](double x) {
+    const double k =
+        m.stiffness_austenite() + x * (m.stiffness_martensite() - m.stiffness_austenite());
+    return std::max(0.0, k * (stretch - x * m.recoverable_stretch()));
+  };
+  auto teff = [&](double x, double c) {
+    return t_th + p.latent_heat / p.specific_heat * (x - s.xi) - m.Stress(tension(x)) / c;
+  };
+  auto major = [](double t, double lo, double hi) {
+    if (t <= lo) return 1.0;
+    if (t >= hi) return 0.0;
+    return 0.5 * (std::cos(kPi * (t - lo) / (hi - lo)) + 1);
+  };
+  auto g_heat = [&](double x) { return x - s.heat_scale * major(teff(x, p.C_A), p.As, p.Af); };
+  auto g_cool = [&](double x) {
+    return x - 1 + s.cool_scale * (1 - major(teff(x, p.C_M), p.Mf, p.Ms));
+  };
+  auto bisect = [](auto g, double lo, double hi) {
+    for (int i = 0; i < 200 && hi - lo > 0; ++i) {
+      const double mid = 0.5 * (lo + hi);
+      if (mid <= lo || mid >= hi) break;
+      (g(mid) > 0 ? hi : lo) = mid;
+    }
+    return 0.5 * (lo + hi);
+  };
+  if (teff(s.xi, p.C_A) >= s.t_eff) {
+    return {g_heat(s.xi) > 1e-12 ? bisect(g_heat, 0.0, s.xi) : s.xi, true};
+  }
+  return {g_cool(s.xi) < -1e-12 ? bisect(g_cool, s.xi, 1.0) : s.xi, false};
+}
+
+TEST(UnitHysteresis, FastPhaseSolveMatchesBisectionWithLibmCosine) {
+  UnitParams p;  // defaults: spring law, latent heat on, loaded by the prestretch
+  const UnitModel m = MakeModel(p);
+  UnitState s = RestState(m, p.prestretch);
+  int transformed = 0;
+  double worst = 0;
+  for (int i = 0; i < 12000; ++i) {
+    // On for 4 s, off for 2 s, on for 1 s (a minor loop), off again.
+    const bool on = i < 4000 || (i >= 6000 && i < 7000);
+    const RefStep ref = ReferencePhaseStep(m, s, on, p.prestretch, 1e-3);
+    const double xi0 = s.xi;
+    AdvanceUnit(m, s, on, p.prestretch, 1e-3);
+    // Newton stops on a step below 1e-10; where the residual touches zero with zero slope
+    // (T_eff reaching Mf or Af) convergence is linear and the last step bounds the error.
+    ASSERT_NEAR(s.xi, ref.xi, 1e-10) << "step " << i << (ref.heating ? " heating" : " cooling");
+    worst = std::max(worst, std::abs(s.xi - ref.xi));
+    if (s.xi != xi0) ++transformed;
+  }
+  RecordProperty("worst_xi_error", std::to_string(worst));
+  std::printf("worst |xi - reference| = %.3g over %d transforming steps\n", worst, transformed);
+  EXPECT_GT(transformed, 3000);  // the comparison covered many transforming steps
+}
+
+TEST(UnitHysteresis, PolynomialSinCosMatchesLibmOverTheHalfTurn) {
+  double worst = 0;
+  const int n = 1 << 20;
+  for (int i = 0; i <= n; ++i) {
+    const double a = kPi * i / n;
+    double sn, cs;
+    SinCosHalfTurn(a, &sn, &cs);
+    worst = std::max({worst, std::abs(sn - std::sin(a)), std::abs(cs - std::cos(a))});
+  }
+  EXPECT_LT(worst, 1e-15);
 }
 
 TEST(UnitForce, SpringTensionMatchesSpringFormulas) {

@@ -1,0 +1,262 @@
+// Estimation benchmarks (docs/benchmarks.md, "Estimation (issue 2)"):
+//  - BM_KalmanStep<M>: one predict + update of the fixed-size extended filter, r = 1, against
+//    its floating-point operation count (counter "flops" per step and "GFLOPS" achieved);
+//    BM_KalmanStepDynamic: the same with dynamic-size matrices;
+//  - BM_Gemm: a 256 x 256 dense matrix product, the machine's achievable flop rate with the
+//    same compiler flags (the reference for the flop bound);
+//  - BM_Estimator/<kind>/m: time per step of the extended Kalman filter, the exact filter
+//    (every step a new A, and a constant, cached A) and a particle filter with the smallest
+//    particle count whose RMSE is within 5 % of the Kalman filter's (found by a calibration
+//    run at start-up, reported as counters).
+#include <benchmark/benchmark.h>
+
+#include <cmath>
+#include <map>
+#include <vector>
+
+#include "common/rng.h"
+#include "estimation/exact_filter.h"
+#include "estimation/particle_filter.h"
+#include "estimation/population_chain.h"
+#include "estimation/population_kalman_filter.h"
+
+namespace recruit {
+namespace {
+
+constexpr int kSequence = 64;
+
+double Gaussian(Rng& rng) {
+  const double u1 = 1.0 - rng.Uniform(), u2 = rng.Uniform();
+  return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * M_PI * u2);
+}
+
+// A chain of m states: a birth-death-like random column-stochastic A with all entries > 0, a
+// force sensor H (state i gives 0.45 i / (m - 1) N per unit), N = 60 units.
+FilterModel ChainModel(int m, double noise_std = 0.6) {
+  FilterModel f;
+  for (int i = 0; i < m; ++i) f.state_names.push_back("s" + std::to_string(i));
+  f.N = 60;
+  f.H.resize(1, m);
+  for (int i = 0; i < m; ++i) f.H(0, i) = m == 1 ? 0.45 : 0.45 * i / (m - 1);
+  f.R = Eigen::MatrixXd::Constant(1, 1, noise_std * noise_std);
+  f.G = Eigen::MatrixXd::Zero(m, 0);
+  f.Qw = Eigen::MatrixXd::Zero(0, 0);
+  f.transition = TransitionSource::kExplicit;
+  f.x0 = Eigen::VectorXd::Zero(m);
+  f.x0(0) = 60;
+  f.P0 = Eigen::MatrixXd::Zero(m, m);
+  return f;
+}
+
+Eigen::MatrixXd RandomStochastic(int m, Rng& rng) {
+  Eigen::MatrixXd A(m, m);
+  for (int j = 0; j < m; ++j) {
+    for (int i = 0; i < m; ++i) A(i, j) = 0.02 + rng.Uniform() * (i == j ? 4.0 : 1.0);
+    A.col(j) /= A.col(j).sum();
+  }
+  return A;
+}
+
+// Simulated inputs and measurements of one run of the chain.
+struct Sequence {
+  std::vector<Eigen::MatrixXd> A;
+  std::vector<Eigen::VectorXd> y, x;
+};
+
+Sequence Simulate(const FilterModel& f, int steps, uint64_t seed, bool distinct_A = true) {
+  Rng rng(seed);
+  Sequence s;
+  Eigen::VectorXd x = f.x0;
+  const Eigen::MatrixXd A0 = RandomStochastic(f.num_states(), rng);
+  for (int t = 0; t < steps; ++t) {
+    s.x.push_back(x);
+    s.y.push_back(f.H * x + Eigen::VectorXd::Constant(1, std::sqrt(f.R(0, 0)) * Gaussian(rng)));
+    s.A.push_back(distinct_A ? RandomStochastic(f.num_states(), rng) : A0);
+    x = SimulateStepAggregate(s.A.back(), x, rng);
+  }
+  return s;
+}
+
+// Floating-point operations of one extended step (r = 1) as implemented: predict 4 m^3 (two
+// m x m products) + 6 m^2 (A x, A xq, diagonal, reprojection), update 12 m^2 (P H^T, three
+// rank-1 terms, reprojection) + O(m).
+double StepFlops(int m) { return 4.0 * m * m * m + 18.0 * m * m + 10.0 * m; }
+
+template <int M>
+void BM_KalmanStep(benchmark::State& state) {
+  const FilterModel f = ChainModel(M);
+  const Sequence s = Simulate(f, kSequence, 1);
+  std::vector<Eigen::Matrix<double, M, M>> A(s.A.begin(), s.A.end());
+  std::vector<Eigen::Matrix<double, 1, 1>> y;
+  for (const auto& v : s.y) y.emplace_back(v(0));
+  auto kf = PopulationKalmanFilterT<M, 1>::Create(f, CovarianceMode::kExtended);
+  int t = 0;
+  for (auto _ : state) {
+    kf->Predict(A[t]);
+    kf->Update(y[t]);
+    benchmark::DoNotOptimize(kf->estimate().data());
+    t = (t + 1) % kSequence;
+  }
+  state.counters["flops"] = StepFlops(M);
+  state.counters["GFLOPS"] =
+      benchmark::Counter(StepFlops(M) * 1e-9 * state.iterations(), benchmark::Counter::kIsRate);
+}
+BENCHMARK_TEMPLATE(BM_KalmanStep, 2);
+BENCHMARK_TEMPLATE(BM_KalmanStep, 5);
+BENCHMARK_TEMPLATE(BM_KalmanStep, 10);
+BENCHMARK_TEMPLATE(BM_KalmanStep, 20);
+BENCHMARK_TEMPLATE(BM_KalmanStep, 50);
+
+void BM_KalmanStepDynamic(benchmark::State& state) {
+  const int m = static_cast<int>(state.range(0));
+  const FilterModel f = ChainModel(m);
+  const Sequence s = Simulate(f, kSequence, 1);
+  auto kf = PopulationKalmanFilter::Create(f, CovarianceMode::kExtended);
+  int t = 0;
+  for (auto _ : state) {
+    kf->Predict(s.A[t]);
+    kf->Update(s.y[t]);
+    benchmark::DoNotOptimize(kf->estimate().data());
+    t = (t + 1) % kSequence;
+  }
+  state.counters["flops"] = StepFlops(m);
+  state.counters["GFLOPS"] =
+      benchmark::Counter(StepFlops(m) * 1e-9 * state.iterations(), benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_KalmanStepDynamic)->Arg(2)->Arg(5)->Arg(10)->Arg(20)->Arg(50);
+
+// The achievable flop rate: C += A B, 256 x 256, 2 n^3 flops.
+void BM_Gemm(benchmark::State& state) {
+  const int n = 256;
+  Rng rng(3);
+  Eigen::MatrixXd A(n, n), B(n, n), C = Eigen::MatrixXd::Zero(n, n);
+  for (int i = 0; i < n * n; ++i) A.data()[i] = rng.Uniform(), B.data()[i] = rng.Uniform();
+  for (auto _ : state) {
+    C.noalias() += A * B;
+    benchmark::DoNotOptimize(C.data());
+  }
+  state.counters["GFLOPS"] =
+      benchmark::Counter(2.0 * n * n * n * 1e-9 * state.iterations(), benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_Gemm);
+
+// RMSE over `runs` simulated runs of `steps` steps (same runs for every estimator).
+template <class Step>
+double Rmse(const FilterModel& f, int runs, int steps, Step step) {
+  double se = 0;
+  for (int r = 0; r < runs; ++r) {
+    const Sequence s = Simulate(f, steps, 100 + r);
+    se += step(s, r);
+  }
+  return std::sqrt(se / (static_cast<double>(runs) * steps));
+}
+
+double KalmanSquaredErrors(const FilterModel& f, const Sequence& s) {
+  auto kf = PopulationKalmanFilter::Create(f, CovarianceMode::kExtended);
+  double se = 0;
+  for (size_t t = 0; t < s.y.size(); ++t) {
+    if (t > 0) kf->Predict(s.A[t - 1]);
+    kf->Update(s.y[t]);
+    se += (kf->estimate() - s.x[t]).squaredNorm();
+  }
+  return se;
+}
+
+double ParticleSquaredErrors(const FilterModel& f, const Sequence& s, int particles, int run) {
+  Rng rng(Rng::DeriveSeed(55, run));
+  auto pf = ParticleFilter::Create(f, {particles, 0.5}, rng);
+  double se = 0;
+  for (size_t t = 0; t < s.y.size(); ++t) {
+    if (t > 0) pf->Predict(s.A[t - 1], rng);
+    pf->Update(s.y[t], rng);
+    se += (pf->Mean() - s.x[t]).squaredNorm();
+  }
+  return se;
+}
+
+// The smallest particle count (doubling from 16) whose RMSE over 200 runs x 30 steps is within
+// 5 % of the extended Kalman filter's on the same runs.
+struct Calibration {
+  int particles = 0;
+  double rmse_kalman = 0, rmse_particle = 0;
+};
+
+const Calibration& Calibrate(int m) {
+  static std::map<int, Calibration> cache;
+  auto it = cache.find(m);
+  if (it != cache.end()) return it->second;
+  const FilterModel f = ChainModel(m);
+  Calibration c;
+  c.rmse_kalman =
+      Rmse(f, 200, 30, [&](const Sequence& s, int) { return KalmanSquaredErrors(f, s); });
+  for (int np = 16; np <= 65536; np *= 2) {
+    c.particles = np;
+    c.rmse_particle = Rmse(
+        f, 200, 30, [&](const Sequence& s, int r) { return ParticleSquaredErrors(f, s, np, r); });
+    if (c.rmse_particle <= 1.05 * c.rmse_kalman) break;
+  }
+  return cache[m] = c;
+}
+
+void BM_EstimatorKalman(benchmark::State& state) {
+  const int m = static_cast<int>(state.range(0));
+  const FilterModel f = ChainModel(m);
+  const Sequence s = Simulate(f, kSequence, 1);
+  auto kf = PopulationKalmanFilter::Create(f, CovarianceMode::kExtended);
+  int t = 0;
+  for (auto _ : state) {
+    kf->Predict(s.A[t]);
+    kf->Update(s.y[t]);
+    benchmark::DoNotOptimize(kf->estimate().data());
+    t = (t + 1) % kSequence;
+  }
+}
+BENCHMARK(BM_EstimatorKalman)->Arg(2)->Arg(3);
+
+// Exact filter; range(1) = 1: a new A every step (the transition table is rebuilt: the
+// closed-loop case), 0: one constant A (the cached table, a dense S x S matrix-vector product).
+void BM_EstimatorExact(benchmark::State& state) {
+  const int m = static_cast<int>(state.range(0));
+  const bool distinct = state.range(1) == 1;
+  const FilterModel f = ChainModel(m);
+  const Sequence s = Simulate(f, kSequence, 1, distinct);
+  ExactFilterOptions o;
+  if (distinct) o.cache_bytes = 0;
+  auto ex = ExactBayesFilter::Create(f, o);
+  int t = 0;
+  for (auto _ : state) {
+    ex->Predict(s.A[t]);
+    ex->Update(s.y[t]);
+    benchmark::DoNotOptimize(ex->probabilities().data());
+    t = (t + 1) % kSequence;
+  }
+  state.counters["count_vectors"] = static_cast<double>(ex->num_count_vectors());
+}
+BENCHMARK(BM_EstimatorExact)
+    ->Args({2, 1})
+    ->Args({2, 0})
+    ->Args({3, 1})
+    ->Args({3, 0})
+    ->Unit(benchmark::kMicrosecond);
+
+void BM_EstimatorParticle(benchmark::State& state) {
+  const int m = static_cast<int>(state.range(0));
+  const Calibration& c = Calibrate(m);
+  const FilterModel f = ChainModel(m);
+  const Sequence s = Simulate(f, kSequence, 1);
+  Rng rng(9);
+  auto pf = ParticleFilter::Create(f, {c.particles, 0.5}, rng);
+  int t = 0;
+  for (auto _ : state) {
+    pf->Predict(s.A[t], rng);
+    pf->Update(s.y[t], rng);
+    benchmark::DoNotOptimize(pf->Mean().data());
+    t = (t + 1) % kSequence;
+  }
+  state.counters["particles"] = c.particles;
+  state.counters["rmse_ratio_to_kalman"] = c.rmse_particle / c.rmse_kalman;
+}
+BENCHMARK(BM_EstimatorParticle)->Arg(2)->Arg(3)->Unit(benchmark::kMicrosecond);
+
+}  // namespace
+}  // namespace recruit
