@@ -373,12 +373,15 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
   mt.iae = IntegralAbsoluteError(ts, rs, ys, d->time + h);
   s.steps = StepResponses(ts, ys, task.reference.Steps(duration), task.settle_band);
   mt.num_steps = static_cast<int>(s.steps.size());
+  int settled = 0;
   for (const auto& st : s.steps) {
     mt.overshoot += st.overshoot / s.steps.size();
     mt.max_overshoot = std::max(mt.max_overshoot, st.overshoot);
     mt.settling_time += st.settling_time / s.steps.size();
-    mt.settled_fraction += (st.settled ? 1.0 : 0.0) / s.steps.size();
+    settled += st.settled ? 1 : 0;
   }
+  // A ratio of counts, so that "all settled" is exactly 1.
+  if (!s.steps.empty()) mt.settled_fraction = static_cast<double>(settled) / s.steps.size();
   mt.oscillation = ExcessTotalVariation(rs, ys);
   long units = 0;
   double rate = 0;
