@@ -16,6 +16,8 @@ struct BundleTelemetry {
   double on_fraction = 0;      // true_on / num_units
   double mean_temperature = 0; // deg C over all units
   double heat = 0;             // 0 at ambient .. 1 at the on-state steady temperature
+  double force_reference = 0;  // N, the force the bundle's recruitment controller tracks
+  double p_on = 0, p_off = 0;  // the bundle's last broadcast
 };
 
 struct TelemetrySample {
@@ -24,7 +26,7 @@ struct TelemetrySample {
   double measured = 0;         // the tracked quantity as measured
   std::string reference_unit;  // "N" or "rad"
   double angle = 0;            // joint angle of the limb's main joint, rad (0 on a bench)
-  double p_on = 0, p_off = 0;  // last broadcast
+  double p_on = 0, p_off = 0;  // last broadcast (of the first bundle; each bundle has its own)
   bool control_instant = false;  // true on steps where the controller broadcast
   std::vector<BundleTelemetry> bundles;
 };

@@ -2,6 +2,7 @@
 // and bad input (clear message, non-zero exit, no output file).
 #include <gtest/gtest.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
@@ -29,12 +30,15 @@ struct RunResult {
 
 // Runs `recruit ARGS` with stderr captured to a file.
 RunResult RunRecruit(const std::string& args) {
-  const std::string err_path = ::testing::TempDir() + "/estimation_cli_stderr.txt";
+  // One file per process: ctest -j runs the CLI tests in parallel.
+  const std::string err_path =
+      ::testing::TempDir() + "/estimation_cli_stderr_" + std::to_string(::getpid()) + ".txt";
   const std::string cmd = std::string(RECRUIT_BINARY) + " " + args + " > /dev/null 2> " + err_path;
   const int status = std::system(cmd.c_str());
   RunResult r{WIFEXITED(status) ? WEXITSTATUS(status) : -1, ""};
   auto text = ReadFile(err_path);
   if (text.ok()) r.err = *text;
+  std::remove(err_path.c_str());
   return r;
 }
 

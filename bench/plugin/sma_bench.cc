@@ -1,0 +1,161 @@
+// Cost of the SMA plugin per physics step.
+//  - Isometric bench, 60 units, against the same bench with one built-in <muscle> on the same
+//    tendon (models/isometric_bench_muscle.xml); BM_SmaOverMuscle interleaves the two in blocks
+//    of 1000 steps and reports their time ratio, which a shared, noisy machine cannot skew.
+//  - Cost as the bundle grows (60, 600, 6000 units) in two regimes: the Fig. 4 step (all units
+//    switch together, on for 10 s then off for 6 s) and busy random switching (p_on = p_off =
+//    0.1 every 0.5 s, so most units are in a transient with their own history).
+#include <benchmark/benchmark.h>
+#include <time.h>
+
+#include <cstdio>
+#include <string>
+
+#include "plugin/sma_plugin.h"
+
+namespace {
+
+using recruit::sma::SmaPlugin;
+
+mjModel* Load(const std::string& path) {
+  char err[1000] = "";
+  mjModel* m = mj_loadXML(path.c_str(), nullptr, err, sizeof err);
+  if (m == nullptr) std::fprintf(stderr, "%s: %s\n", path.c_str(), err);
+  return m;
+}
+
+std::string BenchWithUnits(int units, int update_ms) {
+  char buf[256];
+  std::snprintf(buf, sizeof buf, "/tmp/recruit_sma_bench_%d_%d.xml", units, update_ms);
+  std::FILE* in = std::fopen(RECRUIT_SOURCE_DIR "/models/isometric_bench.xml", "r");
+  std::string xml;
+  char chunk[4096];
+  size_t n;
+  while ((n = std::fread(chunk, 1, sizeof chunk, in)) > 0) xml.append(chunk, n);
+  std::fclose(in);
+  auto replace = [&](const std::string& from, const std::string& to) {
+    xml.replace(xml.find(from), from.size(), to);
+  };
+  replace("units=60",
+          "units=" + std::to_string(units) + " update_period=" + std::to_string(update_ms * 1e-3));
+  replace("nuserdata=\"488\"", "nuserdata=\"" + std::to_string(8 + 8 * units) + "\"");
+  std::FILE* out = std::fopen(buf, "w");
+  std::fwrite(xml.data(), 1, xml.size(), out);
+  std::fclose(out);
+  return buf;
+}
+
+enum class Regime { kFig4Step, kRandomSwitching };
+
+// One simulated second of the regime's broadcasts at step i (1 ms steps).
+void Control(const SmaPlugin& p, mjData* d, Regime regime, long i) {
+  if (regime == Regime::kFig4Step) {
+    if (i % 16000 == 0) (void)p.Broadcast(d, 0, 1, 0);
+    if (i % 16000 == 10000) (void)p.Broadcast(d, 0, 0, 1);
+  } else if (i % 500 == 0) {
+    (void)p.Broadcast(d, 0, 0.1, 0.1);
+  }
+}
+
+void BM_MuscleBaseline(benchmark::State& state) {
+  mjModel* m = Load(RECRUIT_SOURCE_DIR "/models/isometric_bench_muscle.xml");
+  mjData* d = mj_makeData(m);
+  d->ctrl[0] = 1;
+  for (auto _ : state) mj_step(m, d);
+  state.SetItemsProcessed(state.iterations());
+  mj_deleteData(d);
+  mj_deleteModel(m);
+}
+BENCHMARK(BM_MuscleBaseline);
+
+void BM_Sma(benchmark::State& state) {
+  const int units = static_cast<int>(state.range(0));
+  const auto regime = static_cast<Regime>(state.range(1));
+  const int update_ms = static_cast<int>(state.range(2));
+  mjModel* m = Load(BenchWithUnits(units, update_ms));
+  auto p = SmaPlugin::Create(m);
+  if (!p.ok()) {
+    state.SkipWithError(p.error().c_str());
+    mj_deleteModel(m);
+    return;
+  }
+  mjData* d = mj_makeData(m);
+  (*p)->Reset(d, 1);
+  long i = 0;
+  double cohorts = 0;
+  for (auto _ : state) {
+    Control(**p, d, regime, i++);
+    recruit::sma::Step(m, d, **p);
+    cohorts += (*p)->NumCohorts(d, 0);
+  }
+  state.SetItemsProcessed(state.iterations());
+  state.counters["cohorts"] = cohorts / state.iterations();
+  state.SetLabel(regime == Regime::kFig4Step ? "fig4_step" : "random_switching");
+  mj_deleteData(d);
+  p.value().reset();
+  mj_deleteModel(m);
+}
+BENCHMARK(BM_Sma)
+    ->ArgNames({"units", "regime", "update_ms"})
+    ->Args({60, 0, 0})
+    ->Args({600, 0, 0})
+    ->Args({6000, 0, 0})
+    ->Args({60, 1, 0})
+    ->Args({600, 1, 0})
+    ->Args({6000, 1, 0})
+    ->Args({60, 1, 10})
+    ->Args({600, 1, 10})
+    ->Args({6000, 1, 10})
+    ->Iterations(48000);  // 48 simulated seconds: three Fig. 4 cycles
+
+// CPU time of this thread: blocks are not charged for time the thread spends preempted.
+double ThreadCpuSeconds() {
+  timespec ts;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return ts.tv_sec + 1e-9 * ts.tv_nsec;
+}
+
+// Interleaved blocks of 1000 steps of each model; counter "ratio" = SMA CPU time / muscle CPU
+// time.
+void BM_SmaOverMuscle(benchmark::State& state) {
+  const auto regime = static_cast<Regime>(state.range(0));
+  const int update_ms = static_cast<int>(state.range(1));
+  mjModel* mm = Load(RECRUIT_SOURCE_DIR "/models/isometric_bench_muscle.xml");
+  mjModel* ms = Load(BenchWithUnits(60, update_ms));
+  auto p = SmaPlugin::Create(ms);
+  mjData* dm = mj_makeData(mm);
+  mjData* ds = mj_makeData(ms);
+  dm->ctrl[0] = 1;
+  (*p)->Reset(ds, 1);
+  double t_muscle = 0, t_sma = 0;
+  long i = 0;
+  for (auto _ : state) {
+    const double t0 = ThreadCpuSeconds();
+    for (int k = 0; k < 1000; ++k) mj_step(mm, dm);
+    const double t1 = ThreadCpuSeconds();
+    for (int k = 0; k < 1000; ++k) {
+      Control(**p, ds, regime, i++);
+      recruit::sma::Step(ms, ds, **p);
+    }
+    const double t2 = ThreadCpuSeconds();
+    t_muscle += t1 - t0;
+    t_sma += t2 - t1;
+  }
+  state.counters["ratio"] = t_sma / t_muscle;
+  state.counters["muscle_steps_per_s"] = 1000.0 * state.iterations() / t_muscle;
+  state.counters["sma_steps_per_s"] = 1000.0 * state.iterations() / t_sma;
+  state.SetLabel(regime == Regime::kFig4Step ? "fig4_step" : "random_switching");
+  mj_deleteData(dm);
+  mj_deleteData(ds);
+  p.value().reset();
+  mj_deleteModel(mm);
+  mj_deleteModel(ms);
+}
+BENCHMARK(BM_SmaOverMuscle)
+    ->ArgNames({"regime", "update_ms"})
+    ->Args({0, 0})
+    ->Args({1, 0})
+    ->Args({1, 10})
+    ->Iterations(48);
+
+}  // namespace

@@ -1,0 +1,101 @@
+// SmaBundle: N identical SMA units pulling one tendon, with each unit's on/off state machine.
+// MuJoCo-free: every mutable quantity lives in a caller-owned block of doubles (the plugin puts
+// it in mjData.userdata), so copying the block forks the bundle exactly.
+//
+// Units with identical state form a cohort (count + state); per-step cost scales with the number
+// of cohorts, not units. A broadcast splits a cohort when some of its units switch; cohorts whose
+// states coincide within (merge_temperature, merge_xi) are merged again.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "common/result.h"
+#include "plugin/bundle_config.h"
+#include "plugin/unit_model.h"
+
+namespace recruit::sma {
+
+class SmaBundle {
+ public:
+  // dt: the step it will usually advance by (its exp(-dt/tau) is precomputed).
+  static Result<SmaBundle> Create(const BundleConfig& config, double dt);
+
+  // Doubles of state needed for `units` units.
+  static int StateSize(int units) { return kHeader + (kCohortStride + 1) * units; }
+  int state_size() const { return StateSize(config_.units); }
+
+  const BundleConfig& config() const { return config_; }
+  const UnitModel& unit() const { return unit_; }
+  int num_units() const { return config_.units; }
+
+  // All units off, cold martensite at ambient (one cohort); seeds the bundle's random stream.
+  void Reset(double* s, std::uint64_t seed, double stretch) const;
+  // False for a block that was never reset (e.g. zeroed by mj_resetData).
+  static bool Initialized(const double* s);
+
+  // Every unit draws once from the bundle's stream: an off unit turns on with probability p_on,
+  // an on unit turns off with probability p_off. Probabilities must be in [0, 1].
+  // Time accumulated since the last unit update (update_period > 0) is integrated first, with
+  // the units' old on/off states, at extension `stretch` (m).
+  Status Broadcast(double* s, double p_on, double p_off, double stretch) const;
+
+  // Advances every cohort by dt at unit extension `stretch` (m); with update_period > 0 the
+  // units are integrated once the accumulated time reaches it (exact thermal step, implicit
+  // phase solve: both stay accurate for long steps).
+  void Advance(double* s, double stretch, double dt) const;
+
+  // Total tension of the bundle (N, >= 0) at unit extension `stretch`: pure, reads s only
+  // (the "compute" step of a MuJoCo 3.x actuator plugin).
+  double Tension(const double* s, double stretch) const;
+  // Rate of the actuator's MuJoCo-integrated state: none, all state advances in Advance.
+  double ActDot(const double* s) const { return 0; }
+
+  int OnCount(const double* s) const;
+  int NumCohorts(const double* s) const { return static_cast<int>(s[kCohortCountSlot]); }
+  double MeanTemperature(const double* s) const;
+  double MeanXi(const double* s) const;
+  // 0 at ambient, 1 at the steady on-temperature (austenite): for colouring tendons.
+  double Heat(const double* s) const;
+
+  // Per-unit debug interface (ground truth).
+  int UnitCohort(const double* s, int i) const;
+  bool UnitOn(const double* s, int i) const;
+  double UnitTemperature(const double* s, int i) const;
+  double UnitXi(const double* s, int i) const;
+
+  // Steady tension of one unit held on at `stretch` (N): "count = force / this" for estimators
+  // that see only the force.
+  double SettledOnTension(double stretch) const;
+
+ private:
+  // Header: magic, 4 random-stream words, cohort count, update counter, pending time (s).
+  static constexpr int kHeader = 8;
+  static constexpr int kMagicSlot = 0, kRngSlot = 1, kCohortCountSlot = 5, kCounterSlot = 6,
+                       kPendingSlot = 7;
+  // Cohort: count, on, then the UnitState fields.
+  static constexpr int kCohortStride = 7;
+  static constexpr int kCount = 0, kOn = 1, kTemp = 2, kXi = 3, kTeff = 4, kHeatScale = 5,
+                       kCoolScale = 6;
+  static constexpr int kMergeEvery = 8;  // steps between merge passes
+
+  SmaBundle(BundleConfig c, UnitModel u, double dt);
+  double* Cohort(double* s, int k) const { return s + kHeader + kCohortStride * k; }
+  const double* Cohort(const double* s, int k) const { return s + kHeader + kCohortStride * k; }
+  double* UnitIndex(double* s) const { return s + kHeader + kCohortStride * config_.units; }
+  const double* UnitIndex(const double* s) const {
+    return s + kHeader + kCohortStride * config_.units;
+  }
+  void Merge(double* s) const;
+  void Flush(double* s, double stretch) const;
+  void Integrate(double* s, double stretch, double dt) const;
+  // Drops cohorts with count 0 and relabels units; forward[j] >= 0 sends the units of an
+  // emptied cohort j to cohort forward[j].
+  void Compact(double* s, const std::vector<int>& forward) const;
+
+  BundleConfig config_;
+  UnitModel unit_;
+  double dt_ = 0, decay_ = 1, period_ = 0, decay_period_ = 1;
+};
+
+}  // namespace recruit::sma

@@ -1,0 +1,149 @@
+#include "plugin/bundle_config.h"
+
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <functional>
+#include <set>
+#include <sstream>
+
+namespace recruit::sma {
+namespace {
+
+struct Key {
+  const char* name;
+  double lo, hi;  // allowed closed range
+  bool lo_open;   // true: value must be > lo
+  const char* unit;
+  std::function<void(BundleConfig&, double)> set;
+};
+
+std::string Num(double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+
+#define UNIT_FIELD(f) [](BundleConfig& c, double v) { c.unit.f = v; }
+
+const std::vector<Key>& NumericKeys() {
+  static const std::vector<Key> keys = {
+      {"units", 1, 1e6, false, "", [](BundleConfig& c, double v) { c.units = int(v); }},
+      {"wire_diameter", 0, 0.01, true, "m", UNIT_FIELD(wire_diameter)},
+      {"wire_length", 0, 10, true, "m", UNIT_FIELD(wire_length)},
+      {"coil_diameter", 0, 0.1, true, "m", UNIT_FIELD(coil_diameter)},
+      {"turns", 0, 1e5, true, "", UNIT_FIELD(turns)},
+      {"prestrain", -1, 1, false, "", nullptr},  // wire law: prestretch = prestrain * wire_length
+      {"prestretch", -10, 10, false, "m", UNIT_FIELD(prestretch)},
+      {"current", 0, 100, false, "A", UNIT_FIELD(current)},
+      {"ambient", -100, 200, false, "C", UNIT_FIELD(ambient)},
+      {"h", 0, 1e6, false, "W/(m^2 K) (0 = natural convection)", UNIT_FIELD(h)},
+      {"emissivity", 0, 1, false, "", UNIT_FIELD(emissivity)},
+      {"density", 0, 1e5, true, "kg/m^3", UNIT_FIELD(density)},
+      {"specific_heat", 0, 1e5, true, "J/(kg K)", UNIT_FIELD(specific_heat)},
+      {"latent_heat", 0, 1e6, false, "J/kg", UNIT_FIELD(latent_heat)},
+      {"resistivity_M", 0, 1, true, "ohm m", UNIT_FIELD(resistivity_M)},
+      {"resistivity_A", 0, 1, true, "ohm m", UNIT_FIELD(resistivity_A)},
+      {"As", -100, 300, false, "C", UNIT_FIELD(As)},
+      {"Af", -100, 300, false, "C", UNIT_FIELD(Af)},
+      {"Ms", -100, 300, false, "C", UNIT_FIELD(Ms)},
+      {"Mf", -100, 300, false, "C", UNIT_FIELD(Mf)},
+      {"C_A", 0, 1e9, true, "Pa/K", UNIT_FIELD(C_A)},
+      {"C_M", 0, 1e9, true, "Pa/K", UNIT_FIELD(C_M)},
+      {"E_A", 0, 1e12, true, "Pa", UNIT_FIELD(E_A)},
+      {"E_M", 0, 1e12, true, "Pa", UNIT_FIELD(E_M)},
+      {"G_A", 0, 1e12, true, "Pa", UNIT_FIELD(G_A)},
+      {"G_M", 0, 1e12, true, "Pa", UNIT_FIELD(G_M)},
+      {"eps_L", 0, 0.2, true, "", UNIT_FIELD(eps_L)},
+      {"ref_length", 0, 1e3, true, "m", [](BundleConfig& c, double v) { c.ref_length = v; }},
+      {"merge_temperature", 0, 10, false, "C",
+       [](BundleConfig& c, double v) { c.merge_temperature = v; }},
+      {"merge_xi", 0, 0.1, false, "", [](BundleConfig& c, double v) { c.merge_xi = v; }},
+      {"update_period", 0, 1, false, "s", [](BundleConfig& c, double v) { c.update_period = v; }},
+  };
+  return keys;
+}
+
+#undef UNIT_FIELD
+
+}  // namespace
+
+std::vector<std::string> BundleConfig::Keys() {
+  std::vector<std::string> k = {"law"};
+  for (const Key& key : NumericKeys()) k.push_back(key.name);
+  return k;
+}
+
+Result<BundleConfig> BundleConfig::FromText(const std::string& actuator, const std::string& text) {
+  const std::string where =
+      "actuator '" + actuator + "' (<custom><text name=\"" + kTextPrefix + actuator + "\">): ";
+  BundleConfig c;
+  c.actuator = actuator;
+  std::istringstream in(text);
+  std::string token;
+  std::set<std::string> seen;
+  double prestrain = std::nan("");
+  while (in >> token) {
+    const auto eq = token.find('=');
+    if (eq == std::string::npos || eq == 0 || eq + 1 == token.size()) {
+      return Error{where + "'" + token + "' is not key=value"};
+    }
+    const std::string key = token.substr(0, eq);
+    const std::string value = token.substr(eq + 1);
+    if (!seen.insert(key).second) return Error{where + "key '" + key + "' given twice"};
+    if (key == "law") {
+      if (value == "wire") {
+        c.unit.law = ForceLaw::kWire;
+      } else if (value == "spring") {
+        c.unit.law = ForceLaw::kSpring;
+      } else {
+        return Error{where + "law=" + value + " is invalid: allowed values are wire, spring"};
+      }
+      continue;
+    }
+    const Key* spec = nullptr;
+    for (const Key& k : NumericKeys()) {
+      if (key == k.name) spec = &k;
+    }
+    if (spec == nullptr) {
+      std::string allowed;
+      for (const std::string& k : Keys()) allowed += (allowed.empty() ? "" : ", ") + k;
+      return Error{where + "unknown key '" + key + "' (allowed: " + allowed + ")"};
+    }
+    errno = 0;
+    char* end = nullptr;
+    const double v = std::strtod(value.c_str(), &end);
+    if (end == value.c_str() || *end != '\0' || errno == ERANGE || !std::isfinite(v)) {
+      return Error{where + key + "=" + value + " is not a finite number"};
+    }
+    const bool low_bad = spec->lo_open ? !(v > spec->lo) : !(v >= spec->lo);
+    if (low_bad || v > spec->hi) {
+      return Error{where + key + "=" + value + " is out of range: must be in " +
+                   (spec->lo_open ? "(" : "[") + Num(spec->lo) + ", " + Num(spec->hi) + "]" +
+                   (spec->unit[0] ? std::string(" ") + spec->unit : std::string())};
+    }
+    if (key == "units" && v != std::floor(v)) {
+      return Error{where + "units=" + value + " must be a whole number"};
+    }
+    if (key == "prestrain") {
+      prestrain = v;
+    } else {
+      spec->set(c, v);
+    }
+  }
+  if (!std::isnan(prestrain)) {
+    if (seen.count("prestretch")) {
+      return Error{where + "give prestrain or prestretch, not both"};
+    }
+    if (c.unit.law != ForceLaw::kWire) {
+      return Error{where + "prestrain is for law=wire; use prestretch (m) with law=spring"};
+    }
+    c.unit.prestretch = prestrain * c.unit.wire_length;
+  }
+  auto check = UnitModel::Create(c.unit);
+  if (!check.ok()) return Error{where + check.error()};
+  return c;
+}
+
+}  // namespace recruit::sma

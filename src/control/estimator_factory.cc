@@ -1,0 +1,172 @@
+// EstimatorSpec validation and MakeEstimator.
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "control/kalman_estimator.h"
+#include "control/on_count_estimator.h"
+#include "control/output_estimator.h"
+#include "estimation/filter_model.h"
+#include "estimation/population_kalman_filter.h"
+
+namespace recruit::control {
+namespace {
+
+bool IsKind(const std::string& k) {
+  return k == "output" || k == "kalman2" || k == "kalman-augmented";
+}
+bool IsCovariance(const std::string& c) {
+  return c == "extended" || c == "conservative" || c == "plain";
+}
+
+// A relative path is tried from the working directory, then from the source tree (so that the
+// shipped models/identified/ files are found from a build directory too).
+std::string ResolveModelPath(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (path.empty() || fs::path(path).is_absolute() || fs::exists(path, ec)) return path;
+#ifdef RECRUIT_SOURCE_DIR
+  const fs::path alt = fs::path(RECRUIT_SOURCE_DIR) / path;
+  if (fs::exists(alt, ec)) return alt.string();
+#endif
+  return path;
+}
+
+}  // namespace
+
+Result<EstimatorSpec> EstimatorSpec::Parse(const std::string& kind, const std::string& covariance,
+                                           const std::string& model_file, int num_states,
+                                           double force_noise_std) {
+  if (!IsKind(kind)) {
+    return Error{"estimator: kind \"" + kind +
+                 "\" is not one of \"output\", \"kalman2\", \"kalman-augmented\""};
+  }
+  if (!IsCovariance(covariance)) {
+    return Error{"estimator: covariance \"" + covariance +
+                 "\" is not one of \"extended\", \"conservative\", \"plain\""};
+  }
+  if (num_states < 4 || num_states % 2 != 0) {
+    return Error{"estimator: num_states = " + std::to_string(num_states) +
+                 " must be even and >= 4 (a heating and a cooling chain, each ending in a "
+                 "settled state)"};
+  }
+  if (!std::isfinite(force_noise_std) || force_noise_std < 0) {
+    return Error{"estimator: force_noise_std = " + std::to_string(force_noise_std) +
+                 " N must be finite and >= 0 (0 = default)"};
+  }
+  EstimatorSpec s;
+  s.kind = kind;
+  s.covariance = covariance;
+  s.model_file = model_file;
+  s.num_states = num_states;
+  s.force_noise_std = force_noise_std;
+  return s;
+}
+
+Result<EstimatorSpec> EstimatorSpec::FromJson(const nlohmann::json& j, const std::string& where) {
+  if (!j.is_object()) return Error{where + ": estimator must be a JSON object"};
+  EstimatorSpec d;
+  auto str = [&](const char* key, std::string& out) -> Status {
+    if (!j.contains(key)) return Status::Ok();
+    if (!j[key].is_string()) return Error{where + ": estimator." + key + " must be a string"};
+    out = j[key].get<std::string>();
+    return Status::Ok();
+  };
+  if (Status s = str("kind", d.kind); !s) return Error{s.error()};
+  if (Status s = str("covariance", d.covariance); !s) return Error{s.error()};
+  if (Status s = str("model_file", d.model_file); !s) return Error{s.error()};
+  if (j.contains("num_states")) {
+    if (!j["num_states"].is_number_integer()) {
+      return Error{where + ": estimator.num_states must be an integer"};
+    }
+    d.num_states = j["num_states"].get<int>();
+  }
+  if (j.contains("force_noise_std")) {
+    if (!j["force_noise_std"].is_number()) {
+      return Error{where + ": estimator.force_noise_std must be a number (N)"};
+    }
+    d.force_noise_std = j["force_noise_std"].get<double>();
+  }
+  for (auto it = j.begin(); it != j.end(); ++it) {
+    const std::string& k = it.key();
+    if (k != "kind" && k != "covariance" && k != "model_file" && k != "num_states" &&
+        k != "force_noise_std") {
+      return Error{where + ": unknown estimator field \"" + k +
+                   "\" (allowed: kind, covariance, model_file, num_states, force_noise_std)"};
+    }
+  }
+  auto r = Parse(d.kind, d.covariance, d.model_file, d.num_states, d.force_noise_std);
+  if (!r) return Error{where + ": " + r.error()};
+  return r;
+}
+
+std::string DefaultModelFile(double dT, int num_states) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.2f", dT);
+  std::string t = buf;  // "0.50" -> "0.5", "2.00" -> "2.0", "0.25" stays
+  if (t.size() > 1 && t.back() == '0' && t[t.size() - 2] != '.') t.pop_back();
+  return "models/identified/bench_n60_dt" + t + "_m" + std::to_string(num_states) + ".json";
+}
+
+Result<std::unique_ptr<OnCountEstimator>> MakeEstimator(const EstimatorSpec& spec, int num_units,
+                                                        double unit_force, double dT) {
+  auto checked = EstimatorSpec::Parse(spec.kind, spec.covariance, spec.model_file, spec.num_states,
+                                      spec.force_noise_std);
+  if (!checked) return Error{checked.error()};
+  if (num_units < 1) return Error{"estimator: num_units must be >= 1"};
+  if (!std::isfinite(unit_force) || unit_force <= 0) {
+    return Error{"estimator: unit_force must be finite and > 0 N"};
+  }
+  if (!std::isfinite(dT) || dT <= 0) return Error{"estimator: dT must be finite and > 0 s"};
+  if (spec.kind == "output") {
+    return std::unique_ptr<OnCountEstimator>(new OutputOnlyEstimator(num_units, unit_force));
+  }
+  auto mode = ParseCovarianceMode(spec.covariance);
+  if (!mode) return Error{"estimator: " + mode.error()};
+  FilterModel model;
+  if (spec.kind == "kalman2") {
+    const double sd = spec.force_noise_std > 0 ? spec.force_noise_std : unit_force;
+    model = FilterModel::TwoState(num_units, dT, unit_force, sd);
+  } else {
+    const std::string file = ResolveModelPath(
+        spec.model_file.empty() ? DefaultModelFile(dT, spec.num_states) : spec.model_file);
+    auto loaded = FilterModel::FromJson(file);
+    if (!loaded) {
+      return Error{"estimator: " + loaded.error() +
+                   (spec.model_file.empty()
+                        ? " (no identified model for this dT and number of states: make one "
+                          "with `recruit identify --dt DT --states M -o FILE` and pass it as "
+                          "the model file)"
+                        : "")};
+    }
+    model = std::move(loaded).value();
+    if (model.transition != TransitionSource::kBroadcast) {
+      return Error{"estimator: " + file + ": transition.type must be \"broadcast\""};
+    }
+    if (model.num_states() != spec.num_states) {
+      return Error{
+          "estimator: " + file + " has " + std::to_string(model.num_states()) +
+          " states, the estimator asks for num_states = " + std::to_string(spec.num_states)};
+    }
+    if (std::abs(model.broadcast.dt - dT) > 1e-9 * std::max(1.0, dT)) {
+      return Error{"estimator: " + file +
+                   " was identified for dt = " + std::to_string(model.broadcast.dt) +
+                   " s, the controller samples every dT = " + std::to_string(dT) +
+                   " s (identify a model for this dT)"};
+    }
+    if (model.num_outputs() != 1) {
+      return Error{"estimator: " + file + ": H must have one row (the bundle's force)"};
+    }
+    if (model.N != num_units) model = model.WithPopulation(num_units);
+    if (spec.force_noise_std > 0) {
+      model.R = Eigen::MatrixXd::Constant(1, 1, spec.force_noise_std * spec.force_noise_std);
+    }
+  }
+  auto est = KalmanOnCountEstimator::Create(model, *mode);
+  if (!est) return Error{"estimator: " + est.error()};
+  return std::unique_ptr<OnCountEstimator>(std::move(est).value());
+}
+
+}  // namespace recruit::control

@@ -1,0 +1,374 @@
+#include "control/identification.h"
+
+#include <Eigen/Cholesky>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace recruit::control {
+namespace {
+
+// Mean state trajectory: row k is x_k^T (counts), from all units cold.
+Eigen::MatrixXd MeanTrajectory(const TransientChain& chain, const SwitchingLog& log, int rows) {
+  const int m = chain.num_states();
+  Eigen::MatrixXd X(rows, m);
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(m);
+  x[chain.cold()] = log.num_units;
+  for (int k = 0; k < rows; ++k) {
+    X.row(k) = x.transpose();
+    chain.PropagateMean(log.InputOn(k), log.InputOff(k), x);
+  }
+  return X;
+}
+
+// Neighbour differences along the heating chain (heat1..heatK, hot) and the cooling chain
+// (cool1..coolK, cold). The entry edges (cold -> heat1, hot -> cool1) are left out: the force
+// may jump there within one period (at long dT especially), and tying hot to cool1 would drag
+// the settled force down.
+Eigen::MatrixXd ChainDifferences(const TransientChain& c) {
+  const int K = c.chain_length, m = c.num_states();
+  std::vector<int> heat_path, cool_path;
+  for (int i = 1; i <= K; ++i) heat_path.push_back(c.heat(i));
+  for (int i = 1; i <= K; ++i) cool_path.push_back(c.cool(i));
+  heat_path.push_back(c.hot());
+  cool_path.push_back(c.cold());
+  Eigen::MatrixXd d = Eigen::MatrixXd::Zero(2 * K, m);
+  int r = 0;
+  for (const auto* path : {&heat_path, &cool_path}) {
+    for (size_t i = 0; i + 1 < path->size(); ++i, ++r) {
+      d(r, (*path)[i]) = -1;
+      d(r, (*path)[i + 1]) = 1;
+    }
+  }
+  return d;
+}
+
+class Problem {
+ public:
+  Problem(const SwitchingLog& log, int train, const FitOptions& opt, TransientChain shape)
+      : log_(log), train_(train), opt_(opt), shape_(std::move(shape)) {
+    D_ = ChainDifferences(shape_);
+    y_ = Eigen::Map<const Eigen::VectorXd>(log.force.data(), train_);
+    advance_weight_ = std::sqrt(opt.advance_prior * y_.squaredNorm() / train_);
+  }
+  int num_params() const { return 2 * shape_.chain_length; }
+
+  TransientChain WithParams(const Eigen::VectorXd& a) const {
+    TransientChain c = shape_;
+    const int K = c.chain_length;
+    c.heat_advance = a.head(K);
+    c.cool_advance = a.tail(K);
+    return c;
+  }
+
+  const TransientChain& shape() const { return shape_; }
+  void set_shape(const TransientChain& c) { shape_ = c; }
+
+  // Solves for H given the advance probabilities; returns the stacked residual
+  // [y - X H; sqrt(mu) D H] and H.
+  Eigen::VectorXd Residual(const Eigen::VectorXd& a, Eigen::VectorXd* h_out = nullptr) const {
+    return ResidualOf(WithParams(a), h_out);
+  }
+  Eigen::VectorXd ResidualOf(const TransientChain& c, Eigen::VectorXd* h_out = nullptr) const {
+    const Eigen::MatrixXd X = MeanTrajectory(c, log_, train_);
+    Eigen::MatrixXd normal = X.transpose() * X;
+    const double mu = opt_.smoothness * std::max(normal.trace() / normal.rows(), 1e-300);
+    normal += mu * D_.transpose() * D_;
+    // A tiny ridge keeps states the data never reach (and the regularisation does not pin)
+    // well-defined.
+    normal.diagonal().array() += 1e-12 * std::max(normal.trace() / normal.rows(), 1e-300);
+    const Eigen::VectorXd h = normal.ldlt().solve(X.transpose() * y_);
+    const int K = c.chain_length;
+    Eigen::VectorXd r(train_ + D_.rows() + 2 * K);
+    r.head(train_) = y_ - X * h;
+    r.segment(train_, D_.rows()) = std::sqrt(mu) * (D_ * h);
+    // Prior towards progress (a = 1): an edge the data do not constrain lets units move on to
+    // the settled state instead of stalling in a state whose force nothing pins down.
+    r.segment(train_ + D_.rows(), K) = advance_weight_ * (1.0 - c.heat_advance.array()).matrix();
+    r.tail(K) = advance_weight_ * (1.0 - c.cool_advance.array()).matrix();
+    if (h_out) *h_out = h;
+    return r;
+  }
+
+ private:
+  const SwitchingLog& log_;
+  int train_;
+  FitOptions opt_;
+  TransientChain shape_;
+  Eigen::MatrixXd D_;
+  Eigen::VectorXd y_;
+  double advance_weight_ = 0;
+};
+
+// Bounded Levenberg-Marquardt with forward-difference Jacobian. Returns the final parameters;
+// `cost` and `iterations` report the run.
+Eigen::VectorXd FitAdvance(const Problem& p, Eigen::VectorXd a, double lo, int max_iter,
+                           double* cost, int* iterations) {
+  const int n = p.num_params();
+  Eigen::VectorXd r = p.Residual(a);
+  double f = r.squaredNorm();
+  double damping = 1e-3;
+  int it = 0;
+  for (; it < max_iter; ++it) {
+    Eigen::MatrixXd J(r.size(), n);
+    for (int i = 0; i < n; ++i) {
+      double h = 1e-6 + 1e-4 * std::abs(a[i]);
+      Eigen::VectorXd ap = a;
+      if (ap[i] + h > 1) h = -h;  // stay inside the box
+      ap[i] += h;
+      J.col(i) = (p.Residual(ap) - r) / h;
+    }
+    const Eigen::VectorXd g = J.transpose() * r;
+    const Eigen::MatrixXd JtJ = J.transpose() * J;
+    // Parameters held at a bound by the gradient do not move (projected step).
+    std::vector<bool> free(n, true);
+    for (int i = 0; i < n; ++i) {
+      if ((a[i] >= 1 && g[i] < 0) || (a[i] <= lo && g[i] > 0)) free[i] = false;
+    }
+    bool improved = false;
+    for (int tries = 0; tries < 12 && !improved; ++tries) {
+      Eigen::MatrixXd M = JtJ;
+      for (int i = 0; i < n; ++i) {
+        M(i, i) += damping * (JtJ(i, i) + 1e-12 * JtJ.trace() / n + 1e-300);
+        if (!free[i]) {
+          M.row(i).setZero();
+          M.col(i).setZero();
+          M(i, i) = 1;
+        }
+      }
+      Eigen::VectorXd rhs = -g;
+      for (int i = 0; i < n; ++i) {
+        if (!free[i]) rhs[i] = 0;
+      }
+      const Eigen::VectorXd step = M.ldlt().solve(rhs);
+      const Eigen::VectorXd an = (a + step).cwiseMax(lo).cwiseMin(1.0);
+      const Eigen::VectorXd rn = p.Residual(an);
+      const double fn = rn.squaredNorm();
+      if (fn < f) {
+        const double rel = (f - fn) / std::max(f, 1e-300);
+        a = an;
+        r = rn;
+        f = fn;
+        damping = std::max(damping / 3, 1e-9);
+        improved = true;
+        if (rel < 1e-10) {
+          *cost = f;
+          *iterations = it + 1;
+          return a;
+        }
+      } else {
+        damping *= 4;
+      }
+    }
+    if (!improved) break;
+  }
+  *cost = f;
+  *iterations = it;
+  return a;
+}
+
+// Greedy least-squares choice of the mid-transient switching targets: for every source state
+// (heat<i>, cool<i>), try each state of the other chain as its target, keep the one with the
+// smallest cost (H re-solved each time, advance probabilities fixed). Returns true if any
+// target changed.
+bool RefineTargets(Problem& p, const Eigen::VectorXd& a) {
+  TransientChain c = p.WithParams(a);
+  double best = p.ResidualOf(c).squaredNorm();
+  bool changed = false;
+  const int K = c.chain_length;
+  for (int s = 1; s < c.num_states(); ++s) {
+    if (s == c.hot()) continue;
+    const bool on = s < c.hot();
+    std::vector<int> candidates;
+    if (on) {
+      candidates.push_back(c.cold());
+      for (int i = 1; i <= K; ++i) candidates.push_back(c.cool(i));
+    } else {
+      for (int i = 1; i <= K; ++i) candidates.push_back(c.heat(i));
+      candidates.push_back(c.hot());
+    }
+    std::vector<int>& target = on ? c.switch_off : c.switch_on;
+    const int original = target[s];
+    int chosen = original;
+    for (int t : candidates) {
+      if (t == original) continue;
+      target[s] = t;
+      const double f = p.ResidualOf(c).squaredNorm();
+      if (f < best * (1 - 1e-9)) {
+        best = f;
+        chosen = t;
+      }
+    }
+    target[s] = chosen;
+    changed |= chosen != original;
+  }
+  p.set_shape(c);
+  return changed;
+}
+
+// Negative log-likelihood (up to constants) of the force samples [0, rows) under the population
+// Kalman filter on `c` with measurement variance R (extended covariance, eqs. 15-27).
+double NegLogLikelihood(const TransientChain& c, const SwitchingLog& log, int rows, double R) {
+  const int m = c.num_states();
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(m);
+  x[c.cold()] = log.num_units;
+  Eigen::MatrixXd P = Eigen::MatrixXd::Zero(m, m);
+  const Eigen::VectorXd& h = c.force;
+  const Eigen::MatrixXd I = Eigen::MatrixXd::Identity(m, m);
+  double nll = 0;
+  for (int k = 0; k < rows; ++k) {
+    const Eigen::VectorXd ph = P * h;
+    const double S = h.dot(ph) + R;
+    const double nu = log.force[k] - h.dot(x);
+    nll += std::log(S) + nu * nu / S;
+    const Eigen::VectorXd gain = ph / S;
+    x += gain * nu;
+    const Eigen::MatrixXd ikh = I - gain * h.transpose();
+    P = ikh * P * ikh.transpose() + R * gain * gain.transpose();  // Joseph form
+    const Eigen::MatrixXd A = c.Matrix(log.p_on[k], log.p_off[k]);
+    const Eigen::VectorXd xp = x.cwiseMax(0.0);  // Qz stays PSD on the feasible counts
+    Eigen::MatrixXd Q = -A * xp.asDiagonal() * A.transpose();
+    Q.diagonal() += A * xp;
+    P = A * P * A.transpose() + Q;
+    x = A * x;
+  }
+  return nll;
+}
+
+}  // namespace
+
+// R by maximum likelihood: golden-section search on log R in [lo, hi].
+double MaxLikelihoodNoise(const TransientChain& c, const SwitchingLog& log, int rows, double lo,
+                          double hi) {
+  double a = std::log(lo), b = std::log(hi);
+  const double g = (std::sqrt(5.0) - 1) / 2;
+  double x1 = b - g * (b - a), x2 = a + g * (b - a);
+  double f1 = NegLogLikelihood(c, log, rows, std::exp(x1));
+  double f2 = NegLogLikelihood(c, log, rows, std::exp(x2));
+  for (int it = 0; it < 40 && b - a > 1e-3; ++it) {
+    if (f1 < f2) {
+      b = x2;
+      x2 = x1;
+      f2 = f1;
+      x1 = b - g * (b - a);
+      f1 = NegLogLikelihood(c, log, rows, std::exp(x1));
+    } else {
+      a = x1;
+      x1 = x2;
+      f1 = f2;
+      x2 = a + g * (b - a);
+      f2 = NegLogLikelihood(c, log, rows, std::exp(x2));
+    }
+  }
+  return std::exp((a + b) / 2);
+}
+
+namespace {
+
+// The two-state model's mean force prediction: on-count from the broadcasts, H = [h0, h1]
+// fitted on the training samples.
+Eigen::VectorXd TwoStatePrediction(const SwitchingLog& log, int train) {
+  const int n = log.size();
+  Eigen::MatrixXd X(n, 2);
+  double on = 0;
+  for (int k = 0; k < n; ++k) {
+    X(k, 0) = log.num_units - on;
+    X(k, 1) = on;
+    on = on + log.InputOn(k) * (log.num_units - on) - log.InputOff(k) * on;
+  }
+  const Eigen::MatrixXd Xt = X.topRows(train);
+  const Eigen::VectorXd y = Eigen::Map<const Eigen::VectorXd>(log.force.data(), train);
+  Eigen::Matrix2d normal = Xt.transpose() * Xt;
+  normal.diagonal().array() += 1e-12 * normal.trace();
+  const Eigen::Vector2d h = normal.ldlt().solve(Xt.transpose() * y);
+  return X * h;
+}
+
+}  // namespace
+
+Eigen::VectorXd PredictMeanForce(const TransientChain& chain, const SwitchingLog& log) {
+  return MeanTrajectory(chain, log, log.size()) * chain.force;
+}
+
+FitMetrics Score(const Eigen::VectorXd& predicted, const SwitchingLog& log, int begin, int end) {
+  FitMetrics m;
+  m.samples = end - begin;
+  if (m.samples <= 0) return m;
+  double mean = 0;
+  for (int k = begin; k < end; ++k) mean += log.force[k];
+  mean /= m.samples;
+  double ss_res = 0, ss_tot = 0;
+  for (int k = begin; k < end; ++k) {
+    ss_res += std::pow(log.force[k] - predicted[k], 2);
+    ss_tot += std::pow(log.force[k] - mean, 2);
+  }
+  m.rmse = std::sqrt(ss_res / m.samples);
+  m.r2 = ss_tot > 0 ? 1 - ss_res / ss_tot : std::numeric_limits<double>::quiet_NaN();
+  return m;
+}
+
+Result<IdentificationResult> IdentifyTransientModel(const SwitchingLog& log,
+                                                    const FitOptions& opt) {
+  if (Status s = log.Validate("switching log"); !s) return Error{s.error()};
+  if (opt.num_states < 4 || opt.num_states % 2 != 0) {
+    return Error{"identify: num_states = " + std::to_string(opt.num_states) +
+                 " must be even and >= 4"};
+  }
+  if (!(opt.holdout_fraction >= 0 && opt.holdout_fraction < 1)) {
+    return Error{"identify: holdout fraction must be in [0, 1)"};
+  }
+  if (!(opt.min_advance > 0 && opt.min_advance <= 1)) {
+    return Error{"identify: min_advance must be in (0, 1]"};
+  }
+  if (!(opt.smoothness >= 0)) return Error{"identify: smoothness must be >= 0"};
+  const int n = log.size();
+  const int train = static_cast<int>(std::lround(n * (1 - opt.holdout_fraction)));
+  if (train < opt.num_states * 3) {
+    return Error{"identify: " + std::to_string(train) + " training samples are too few for " +
+                 std::to_string(opt.num_states) + " states (need at least 3 per state)"};
+  }
+  // Start from the deterministic chain (each state = k periods since the switch) with the
+  // heat-level targets; alternate the switching targets (greedy) and the advance probabilities
+  // (Levenberg-Marquardt) until the targets settle.
+  Problem problem(log, train, opt, TransientChain::Uniform(opt.num_states, 1.0));
+  IdentificationResult best;
+  Eigen::VectorXd a = Eigen::VectorXd::Ones(problem.num_params());
+  for (int round = 0; round < opt.max_rounds; ++round) {
+    // Targets first: with the heat-level targets the mid-transient switches can be far off, and
+    // fitting the advance probabilities to them would bend the chains.
+    bool changed = false;
+    for (int sweep = 0; sweep < 3 && RefineTargets(problem, a); ++sweep) changed = true;
+    if (round > 0 && !changed) break;
+    double cost = 0;
+    int iters = 0;
+    a = FitAdvance(problem, a, opt.min_advance, opt.max_iterations, &cost, &iters);
+    best.iterations += iters;
+  }
+  best.chain = problem.WithParams(a);
+  {
+    Eigen::VectorXd h;
+    best.cost = problem.Residual(a, &h).squaredNorm();
+    best.chain.force = h;
+  }
+
+  const Eigen::VectorXd pred = PredictMeanForce(best.chain, log);
+  best.train = Score(pred, log, 0, train);
+  best.holdout = Score(pred, log, train, n);
+  best.two_state_holdout = Score(TwoStatePrediction(log, train), log, train, n);
+
+  // R by maximum likelihood of the training forces under the population Kalman filter: the
+  // measurement variance (sensor noise and per-unit model error) that the population's own
+  // spread, which the filter carries in P, does not explain.
+  const double unit = best.chain.force[best.chain.hot()] - best.chain.force[best.chain.cold()];
+  const double floor = std::max(opt.noise_floor * unit * unit, 1e-12);
+  double var_y = 0;
+  {
+    const Eigen::VectorXd y = Eigen::Map<const Eigen::VectorXd>(log.force.data(), train);
+    var_y = (y.array() - y.mean()).square().mean();
+  }
+  best.force_noise_var =
+      MaxLikelihoodNoise(best.chain, log, train, floor, std::max(var_y, 100 * floor));
+  return best;
+}
+
+}  // namespace recruit::control

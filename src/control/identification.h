@@ -1,0 +1,64 @@
+// Identification of the augmented transient model (TransientChain) from a switching log, by
+// least squares on the predicted mean force (docs/identification.md):
+//   x_0 = N e_cold,  x_{k+1} = A(p_on_k, p_off_k; a) x_k,   y^_k = H x_k
+//   min over a in [a_min, 1]^{2K}, H of
+//       sum_{k in train} (y_k - H x_k(a))^2 + mu |D H|^2 + nu sum_i (1 - a_i)^2
+// H enters linearly, so for each a it is the regularised linear least-squares solution
+// (variable projection); a is fitted by a bounded Levenberg-Marquardt on the projected residual,
+// alternating with a greedy least-squares choice of the mid-transient switching targets.
+// D takes differences between neighbouring states along each chain (heat1.., hot) and
+// (cool1.., cold), so states the data barely separate get a force between their neighbours.
+#pragma once
+
+#include "common/result.h"
+#include "control/switching_log.h"
+#include "control/transient_chain.h"
+
+namespace recruit::control {
+
+struct FitOptions {
+  int num_states = 20;            // m (even, >= 4)
+  double holdout_fraction = 0.3;  // the last part of the log, not used to fit
+  double smoothness = 1e-3;       // mu, relative to trace(X^T X) / m
+  // Weight of the prior sum (1 - a_i)^2, relative to the mean square force: keeps the advance
+  // probabilities the data do not constrain at 1.
+  double advance_prior = 1e-4;
+  double min_advance = 0.02;  // lower bound on every advance probability
+  int max_iterations = 200;   // Levenberg-Marquardt iterations per round
+  int max_rounds = 4;         // rounds of (advance probabilities, switching targets)
+  // R is fitted by maximum likelihood under the population Kalman filter, searched in
+  // [noise_floor * (settled unit force)^2, variance of the force].
+  double noise_floor = 1e-4;
+};
+
+struct FitMetrics {
+  int samples = 0;
+  double rmse = 0;  // N, of the predicted mean force
+  double r2 = 0;    // 1 - SS_res / SS_tot
+};
+
+struct IdentificationResult {
+  TransientChain chain;
+  double force_noise_var = 0;  // R, N^2: what the population's own spread does not explain
+  FitMetrics train, holdout;
+  // The two-state model (H = [h_off, h_on] fitted the same way) on the same held-out data.
+  FitMetrics two_state_holdout;
+  double cost = 0;     // final training cost
+  int iterations = 0;  // Levenberg-Marquardt iterations, all rounds
+};
+
+Result<IdentificationResult> IdentifyTransientModel(const SwitchingLog& log,
+                                                    const FitOptions& options);
+
+// Predicted mean force y^_k = H x_k for every sample of the log, from rest.
+Eigen::VectorXd PredictMeanForce(const TransientChain& chain, const SwitchingLog& log);
+
+// The measurement variance R maximising the likelihood of log.force[0, rows) under the
+// population Kalman filter on `chain` (extended covariance), searched in [lo, hi] N^2.
+double MaxLikelihoodNoise(const TransientChain& chain, const SwitchingLog& log, int rows, double lo,
+                          double hi);
+
+// RMSE and R^2 of `predicted` against log.force over samples [begin, end).
+FitMetrics Score(const Eigen::VectorXd& predicted, const SwitchingLog& log, int begin, int end);
+
+}  // namespace recruit::control

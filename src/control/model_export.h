@@ -1,0 +1,17 @@
+// Conversion of an identified TransientChain to the estimation part's FilterModel file.
+#pragma once
+
+#include <cstdint>
+
+#include "control/transient_chain.h"
+#include "estimation/filter_model.h"
+
+namespace recruit::control {
+
+// states = chain.StateNames(), H = chain.force^T (1 x m), R = [force_noise_var],
+// no process noise, transition "broadcast" with the chain's interior, is_on and switching
+// targets (-1 where a switch does not apply), dt = dT; x0 = N in "cold", P0 = 0.
+FilterModel ToFilterModel(const TransientChain& chain, std::int64_t num_units, double dT,
+                          double force_noise_var);
+
+}  // namespace recruit::control

@@ -1,0 +1,78 @@
+// On-count estimators: how many units of a bundle have their heater on, from the bundle's force.
+//
+// One estimator per bundle, called once per sampling period dT, in this order at each control
+// instant k:
+//   Observe(y_k)       update with the force sampled at instant k (before broadcasting)
+//   EstimatedOn()      the a-posteriori on-count at instant k, which the law uses
+//   Broadcasted(b_k)   the broadcast just sent: predict to instant k + 1
+// Kinds (docs/controller.md):
+//   "output"            count = force / settled force of one unit (the paper's failing baseline)
+//   "kalman2"           population Kalman filter on the two-state (off/on) model
+//   "kalman-augmented"  population Kalman filter on the identified transient model
+//                       (models/identified/, `recruit identify`); "on" = the states whose heater
+//                       is on (heating chain and hot settled state)
+#pragma once
+
+#include <Eigen/Core>
+#include <memory>
+#include <nlohmann/json_fwd.hpp>
+#include <string>
+#include <vector>
+
+#include "common/result.h"
+#include "control/broadcast.h"
+
+namespace recruit::control {
+
+class OnCountEstimator {
+ public:
+  virtual ~OnCountEstimator() = default;
+  // Back to the initial belief: every unit off, at ambient (cold settled state).
+  virtual void Reset() = 0;
+  // The force (N) sampled at this control instant.
+  virtual void Observe(double measured_force) = 0;
+  // The broadcast just sent at this instant: predict to the next instant (dT later).
+  virtual void Broadcasted(const Broadcast& b) = 0;
+  // Units whose heater is on.
+  virtual double EstimatedOn() const = 0;
+  // Variance of EstimatedOn(), units^2; NaN when the estimator has none (output only).
+  virtual double EstimatedOnVariance() const = 0;
+  // Counts per model state (entries named by StateNames()), for NEES and RMSE.
+  virtual Eigen::VectorXd StateEstimate() const = 0;
+  virtual std::vector<std::string> StateNames() const = 0;
+  // Which model states count as "on" (heater on); same length as StateNames().
+  virtual std::vector<bool> OnStates() const = 0;
+};
+
+// What estimator to build. Validated by Parse / FromJson.
+struct EstimatorSpec {
+  std::string kind = "kalman-augmented";  // "output", "kalman2", "kalman-augmented"
+  std::string covariance = "extended";    // "extended", "conservative", "plain" (Kalman kinds)
+  // kalman-augmented: the FilterModel file. Empty: DefaultModelFile(dT, num_states).
+  std::string model_file;
+  int num_states = 20;  // kalman-augmented: states of the model (checked against the file)
+  // Force measurement noise standard deviation, N. <= 0: the default, which is the model file's
+  // R for kalman-augmented and one settled unit's force for kalman2 (the two-state model's error
+  // while units are in transient is of that size).
+  double force_noise_std = 0;
+
+  static Result<EstimatorSpec> Parse(const std::string& kind,
+                                     const std::string& covariance = "extended",
+                                     const std::string& model_file = "", int num_states = 20,
+                                     double force_noise_std = 0);
+  // {"kind": ..., "covariance": ..., "model_file": ..., "num_states": ..., "force_noise_std": ...}
+  // (all optional); `where` names the file for error messages.
+  static Result<EstimatorSpec> FromJson(const nlohmann::json& j, const std::string& where);
+};
+
+// The identified model shipped for a sampling period, e.g.
+// "models/identified/bench_n60_dt0.5_m20.json".
+std::string DefaultModelFile(double dT, int num_states);
+
+// Builds the estimator for a bundle of `num_units` units whose settled on-force is `unit_force`
+// (N), sampled every `dT` seconds. A kalman-augmented model identified for another N is rescaled
+// to num_units (the per-unit model does not depend on N); its dt must equal dT.
+Result<std::unique_ptr<OnCountEstimator>> MakeEstimator(const EstimatorSpec& spec, int num_units,
+                                                        double unit_force, double dT);
+
+}  // namespace recruit::control

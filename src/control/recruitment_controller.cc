@@ -1,0 +1,60 @@
+#include "control/recruitment_controller.h"
+
+#include <cmath>
+#include <string>
+
+namespace recruit::control {
+
+Status ControllerParams::Validate() const {
+  if (num_units < 1) {
+    return Error{"controller: num_units = " + std::to_string(num_units) + " must be >= 1"};
+  }
+  if (!std::isfinite(unit_force) || unit_force <= 0) {
+    return Error{"controller: unit_force = " + std::to_string(unit_force) +
+                 " N must be finite and > 0"};
+  }
+  if (!std::isfinite(dT) || dT <= 0) {
+    return Error{"controller: dT = " + std::to_string(dT) + " s must be finite and > 0"};
+  }
+  if (!std::isfinite(lambda) || lambda <= 0 || lambda > 1) {
+    return Error{"controller: lambda = " + std::to_string(lambda) + " must be in (0, 1]"};
+  }
+  return Status::Ok();
+}
+
+Result<RecruitmentController> RecruitmentController::Create(
+    const ControllerParams& params, std::unique_ptr<OnCountEstimator> estimator) {
+  if (Status s = params.Validate(); !s) return Error{s.error()};
+  if (!estimator) return Error{"controller: no estimator"};
+  RecruitmentController c(params, std::move(estimator));
+  c.Reset();
+  return c;
+}
+
+Result<RecruitmentController> RecruitmentController::Create(const ControllerParams& params,
+                                                            const EstimatorSpec& spec) {
+  if (Status s = params.Validate(); !s) return Error{s.error()};
+  auto est = MakeEstimator(spec, params.num_units, params.unit_force, params.dT);
+  if (!est) return Error{est.error()};
+  return Create(params, std::move(est).value());
+}
+
+void RecruitmentController::Reset() {
+  estimator_->Reset();
+  target_on_ = 0;
+  estimated_on_ = estimator_->EstimatedOn();
+  estimated_on_variance_ = estimator_->EstimatedOnVariance();
+  last_ = Broadcast{};
+}
+
+Broadcast RecruitmentController::Step(double reference_force, double measured_force) {
+  estimator_->Observe(measured_force);
+  target_on_ = reference_force / params_.unit_force;
+  estimated_on_ = estimator_->EstimatedOn();
+  estimated_on_variance_ = estimator_->EstimatedOnVariance();
+  last_ = ExpectationLaw(target_on_, estimated_on_, params_.num_units, params_.lambda);
+  estimator_->Broadcasted(last_);
+  return last_;
+}
+
+}  // namespace recruit::control

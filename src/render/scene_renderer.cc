@@ -1,0 +1,213 @@
+#include "render/scene_renderer.h"
+
+#include <cmath>
+#include <cstdio>
+
+#include "render/tendon_heat.h"
+
+namespace recruit::render {
+namespace {
+
+std::string Size(int w, int h) { return std::to_string(w) + "x" + std::to_string(h); }
+
+// 0.12 -> ".12", 1 -> "1.00": the panel column is narrow.
+std::string Fraction(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%.2f", x);
+  return buf[0] == '0' && buf[1] == '.' ? std::string(buf + 1) : std::string(buf);
+}
+
+struct ModelCopy {
+  mjModel* m = nullptr;
+  ~ModelCopy() {
+    if (m) mj_deleteModel(m);
+  }
+};
+
+}  // namespace
+
+Status RenderOptions::Validate() const {
+  if (width < kMinSide || height < kMinSide || width > kMaxSide || height > kMaxSide) {
+    return Error{"frame size " + Size(width, height) +
+                 " is out of range: width and height must be "
+                 "in [" +
+                 std::to_string(kMinSide) + ", " + std::to_string(kMaxSide) + "] pixels"};
+  }
+  if (!(figure_window > 0) || !std::isfinite(figure_window)) {
+    return Error{"figure window must be a positive number of seconds"};
+  }
+  if (!std::isfinite(min_tendon_width) || min_tendon_width < 0 || min_tendon_width > 1) {
+    return Error{"minimum tendon width must be in [0, 1] m (0 = the model's), got " +
+                 std::to_string(min_tendon_width)};
+  }
+  if (multisamples != -1 && (multisamples < 0 || multisamples > 16)) {
+    return Error{"multisamples must be -1 (the model's value) or in [0, 16], got " +
+                 std::to_string(multisamples)};
+  }
+  return Status::Ok();
+}
+
+SceneRenderer::SceneRenderer(const RenderOptions& options, const RunLabel& label)
+    : options_(options), label_(label) {
+  mjv_defaultScene(&scene_);
+  mjv_defaultOption(&option_);
+  mjv_defaultCamera(&camera_);
+  mjv_defaultPerturb(&perturb_);
+  mjr_defaultContext(&context_);
+}
+
+SceneRenderer::~SceneRenderer() {
+  if (gl_) (void)gl_->MakeCurrent();
+  if (context_made_) mjr_freeContext(&context_);
+  if (scene_made_) mjv_freeScene(&scene_);
+}
+
+Result<std::unique_ptr<SceneRenderer>> SceneRenderer::Create(const mjModel* m,
+                                                             const RenderOptions& options,
+                                                             const RunLabel& label) {
+  if (!m) return Error{"render: no model"};
+  if (Status s = options.Validate(); !s.ok()) return Error{s.error()};
+  auto camera = ResolveCamera(m, options.camera);
+  if (!camera.ok()) return Error{camera.error()};
+
+  std::unique_ptr<SceneRenderer> r(new SceneRenderer(options, label));
+  r->camera_ = *camera;
+  auto gl = GlContext::Create(options.backend, options.width, options.height);
+  if (!gl.ok()) return Error{gl.error()};
+  r->gl_ = std::move(*gl);
+  r->gl_description_ = r->gl_->Description();
+  const int max_side = r->gl_->MaxRenderbufferSize();
+  if (max_side > 0 && (options.width > max_side || options.height > max_side)) {
+    return Error{"frame size " + Size(options.width, options.height) +
+                 " exceeds this GL driver's largest offscreen buffer side, " +
+                 std::to_string(max_side) + " pixels (" + r->gl_description_ + ")"};
+  }
+
+  // A private copy whose offscreen buffer fits the frame: mjr_makeContext sizes the buffer from
+  // <visual><global offwidth offheight> (default 640x480).
+  ModelCopy copy;
+  copy.m = mj_copyModel(nullptr, m);
+  if (!copy.m) return Error{"render: could not copy the model"};
+  copy.m->vis.global.offwidth = std::max(copy.m->vis.global.offwidth, options.width);
+  copy.m->vis.global.offheight = std::max(copy.m->vis.global.offheight, options.height);
+  if (options.multisamples >= 0) copy.m->vis.quality.offsamples = options.multisamples;
+
+  mjv_makeScene(m, &r->scene_, 2000);
+  r->scene_made_ = true;
+  const int font = options.height >= 1000  ? mjFONTSCALE_200
+                   : options.height >= 700 ? mjFONTSCALE_150
+                                           : mjFONTSCALE_100;
+  mjr_makeContext(copy.m, &r->context_, font);
+  r->context_made_ = true;
+  if (r->context_.offWidth < options.width || r->context_.offHeight < options.height) {
+    return Error{"render: MuJoCo made a " + Size(r->context_.offWidth, r->context_.offHeight) +
+                 " offscreen buffer, smaller than the " + Size(options.width, options.height) +
+                 " frame"};
+  }
+  mjr_setBuffer(mjFB_OFFSCREEN, &r->context_);
+  if (r->context_.currentBuffer != mjFB_OFFSCREEN) {
+    return Error{"render: the offscreen framebuffer is not supported by " + r->gl_description_};
+  }
+  if (options.figures) r->plots_ = std::make_unique<TelemetryPlots>(options.figure_window);
+  return r;
+}
+
+void SceneRenderer::AddPlotPoint(const TelemetrySample& sample) {
+  if (plots_) plots_->Add(sample);
+}
+
+int SceneRenderer::PanelRows(const TelemetrySample* s) const {
+  return (ShowTaskRow() ? 1 : 0) + 3 + (s ? 1 + static_cast<int>(s->bundles.size()) : 0);
+}
+
+void SceneRenderer::DrawPanel(const TelemetrySample* s, mjrRect viewport) {
+  std::string titles, values;
+  auto row = [&](const std::string& title, const std::string& value) {
+    if (!titles.empty()) {
+      titles += "\n";
+      values += "\n";
+    }
+    titles += title;
+    values += value;
+  };
+  char buf[160];
+  if (ShowTaskRow()) row("task", label_.task);
+  std::snprintf(buf, sizeof(buf), "%.2f s", s ? s->time : 0.0);
+  row("time", buf);
+  std::snprintf(buf, sizeof(buf), "%.3g s / %.3g", label_.dT, label_.lambda);
+  row("dT / lambda", buf);
+  row("estimator", label_.estimator.empty() ? "none" : label_.estimator);
+  if (s) {
+    if (s->reference_unit == "rad") {
+      std::snprintf(buf, sizeof(buf), "%.1f deg (ref %.1f)", s->measured * 180 / M_PI,
+                    s->reference * 180 / M_PI);
+      row("angle", buf);
+    } else {
+      std::snprintf(buf, sizeof(buf), "%.3g %s (ref %.3g)", s->measured, s->reference_unit.c_str(),
+                    s->reference);
+      row("force", buf);
+    }
+    for (const BundleTelemetry& b : s->bundles) {
+      if (std::isfinite(b.estimated_on)) {
+        std::snprintf(buf, sizeof(buf), "%d on, est %.1f, heat %s", b.true_on, b.estimated_on,
+                      Fraction(b.heat).c_str());
+      } else {
+        std::snprintf(buf, sizeof(buf), "%d on, heat %s", b.true_on, Fraction(b.heat).c_str());
+      }
+      row(b.actuator, buf);
+    }
+  }
+  mjr_overlay(mjFONT_NORMAL, mjGRID_TOPLEFT, viewport, titles.c_str(), values.c_str(), &context_);
+}
+
+Status SceneRenderer::Render(const mjModel* m, const mjData* d, const TelemetrySample* sample,
+                             unsigned char* rgb) {
+  if (Status s = gl_->MakeCurrent(); !s.ok()) return s;
+  // mjv_updateScene only reads d; its C signature is not const-correct.
+  mjv_updateScene(m, const_cast<mjData*>(d), &option_, &perturb_, &camera_, mjCAT_ALL, &scene_);
+  last_recoloured_ = 0;
+  if (sample && options_.heat_colours) {
+    last_recoloured_ = ColourTendonsByHeat(m, *sample, &scene_);
+  }
+  if (options_.transparent) {
+    // Every geom but planes (the floor) at 35 % opacity; tendons stay opaque.
+    for (int g = 0; g < scene_.ngeom; ++g) {
+      mjvGeom& geom = scene_.geoms[g];
+      if (geom.objtype == mjOBJ_GEOM && geom.type != mjGEOM_PLANE) geom.rgba[3] *= 0.35f;
+    }
+  }
+  if (sample && options_.min_tendon_width > 0) {
+    WidenTendons(m, *sample, options_.min_tendon_width, &scene_);
+  }
+  mjr_setBuffer(mjFB_OFFSCREEN, &context_);
+  const mjrRect viewport = {0, 0, options_.width, options_.height};
+  // With plots, the scene takes the left 55 % of the frame and the right 45 % hold the text
+  // panel on top and the plots below it, so nothing covers the model.
+  const int side = plots_ ? options_.width * 9 / 20 : 0;
+  const mjrRect scene_viewport = {0, 0, options_.width - side, options_.height};
+  mjr_render(scene_viewport, &scene_, &context_);
+  if (plots_) {
+    const mjrRect column = {options_.width - side, 0, side, options_.height};
+    mjr_rectangle(column, 0.f, 0.f, 0.f, 1.f);
+    // mjr_overlay's box is rows * (charHeight + 5) + 5 pixels tall, 5 pixels from the edge.
+    const int panel =
+        options_.text_panel
+            ? std::min(options_.height / 2, PanelRows(sample) * (context_.charHeight + 5) + 12)
+            : 0;
+    if (options_.text_panel) {
+      DrawPanel(sample, {column.left, options_.height - panel, side, panel});
+    }
+    plots_->Draw({column.left, 0, side, options_.height - panel}, &context_);
+  } else if (options_.text_panel) {
+    DrawPanel(sample, scene_viewport);
+  }
+  mjr_readPixels(rgb, nullptr, viewport, &context_);
+  if (const int err = mjr_getError(); err != 0) {
+    char code[16];
+    std::snprintf(code, sizeof(code), "0x%04X", static_cast<unsigned>(err));
+    return Error{std::string("render: OpenGL error ") + code + " while drawing the frame"};
+  }
+  return Status::Ok();
+}
+
+}  // namespace recruit::render

@@ -1,0 +1,68 @@
+// RunTask: one closed-loop run of a task (plant = the MuJoCo model with its SMA bundles,
+// estimator, broadcast controller, optional outer angle loop), reporting every physics step to
+// the observers (CSV writer, video recorder) and returning the run's metrics.
+#pragma once
+
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "common/result.h"
+#include "common/step_observer.h"
+#include "sim/metrics.h"
+#include "sim/task.h"
+
+namespace recruit::sim {
+
+// Settings of one run. Unset optionals keep the task file's values.
+struct RunOptions {
+  std::optional<std::string> estimator;     // "output", "kalman", ...
+  std::optional<std::string> filter_model;  // filter model file for "kalman"
+  std::optional<double> dT;                 // s
+  std::optional<double> lambda;
+  std::optional<double> force_noise_std;  // N, Kalman estimators' measurement noise
+  std::optional<double> duration;         // s
+  std::uint64_t seed = 1;
+  bool progress = false;  // progress on stderr
+};
+
+struct RunMetrics {
+  double tracking_rmse = 0;      // N or rad
+  double iae = 0;                // N s or rad s
+  double overshoot = 0;          // mean over steps, fraction of the step size
+  double max_overshoot = 0;      // largest over steps
+  double settling_time = 0;      // mean over steps, s (an unsettled step counts its whole hold)
+  double settled_fraction = 0;   // steps that settled within their hold
+  double oscillation = 0;        // excess total variation, see metrics.h
+  double switching_rate = 0;     // unit transitions per unit per second (all bundles)
+  double estimator_rmse = 0;     // units, at control instants (agonist)
+  double mean_nees = 0;          // on-count NEES at control instants (agonist); NaN: no variance
+  double estimator_within3 = 0;  // fraction of control instants with |n^ - n| <= 3
+  int num_steps = 0;
+};
+
+struct RunSummary {
+  std::string task;
+  std::string estimator;
+  double dT = 0, lambda = 0;
+  std::uint64_t seed = 0;
+  double duration = 0;      // simulated s
+  double wall_seconds = 0;  // s
+  long physics_steps = 0;
+  long control_instants = 0;
+  std::string unit;  // "N" or "rad"
+  RunMetrics metrics;
+  std::vector<StepResponse> steps;
+
+  nlohmann::json ToJson() const;
+};
+
+// The effective settings after applying `options` to the task's defaults.
+ControllerSettings EffectiveSettings(const Task& task, const RunOptions& options);
+
+Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
+                           const std::vector<StepObserver*>& observers = {});
+
+}  // namespace recruit::sim

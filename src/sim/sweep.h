@@ -1,0 +1,89 @@
+// Sweep: a grid of closed-loop runs (dT x lambda x estimator x seeds) spread over threads with
+// TBB. Each run's seed comes from Rng::DeriveSeed(base_seed, seed index), so the results do not
+// depend on the number of threads or the order runs finish in; runs with the same seed index
+// share their random stream across grid cells (common random numbers). Every finished run is
+// recorded in its own file under `<out>/runs/` (written atomically), so an interrupted sweep
+// started again skips the runs it already has.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "common/result.h"
+#include "sim/run_task.h"
+
+namespace recruit::sim {
+
+struct SweepSpec {
+  std::vector<double> dTs;
+  std::vector<double> lambdas;
+  std::vector<std::string> estimators;
+  int seeds = 1;  // seed indices 0 .. seeds-1
+  std::uint64_t base_seed = 1;
+  std::optional<double> duration;  // override of the task's
+  std::optional<std::string> filter_model;
+};
+
+struct SweepRun {
+  int index = 0;  // position in the grid (dT outermost, then lambda, estimator, seed)
+  double dT = 0, lambda = 0;
+  std::string estimator;
+  int seed_index = 0;
+  std::uint64_t seed = 0;
+  std::string Key() const;  // file-name-safe identity of the run, e.g. "dT0.5_l0.2_kalman_s3"
+};
+
+Result<std::vector<SweepRun>> ExpandGrid(const SweepSpec& spec);
+
+// What the sweep runs for one grid point (RunTask in production, a fake in tests).
+using SweepRunFn = std::function<Result<RunSummary>(const SweepRun&)>;
+
+struct SweepOutcome {
+  std::vector<RunSummary> runs;  // in grid order
+  int executed = 0;              // runs made now
+  int reused = 0;                // runs read back from <out>/runs
+};
+
+// Runs every grid point not yet recorded under `out_dir`/runs on `threads` threads (0 = all
+// cores). `progress(done, total)` is called from worker threads (serialised) after each run.
+Result<SweepOutcome> RunSweep(const std::vector<SweepRun>& grid, const std::string& out_dir,
+                              const SweepRunFn& run, int threads,
+                              const std::function<void(int, int)>& progress = {});
+
+// A stated tracking criterion for one grid cell (all seeds of one dT, lambda, estimator).
+struct TrackingCriterion {
+  double max_overshoot = 0.10;  // mean step overshoot, fraction of the step
+  double min_settled = 0.90;    // fraction of steps that settle within the 10 % band
+};
+
+// One grid cell aggregated over seeds.
+struct CellStats {
+  double dT = 0, lambda = 0;
+  std::string estimator;
+  int seeds = 0;
+  double overshoot_mean = 0, overshoot_sd = 0;
+  double settling_mean = 0;
+  double settled_fraction = 0;
+  double rmse_mean = 0, iae_mean = 0;
+  double oscillation_mean = 0;
+  double switching_mean = 0;
+  double estimator_rmse_mean = 0, nees_mean = 0, within3_mean = 0;
+  bool meets = false;
+  double margin = 0;  // min(max_overshoot - overshoot, settled - min_settled); >= 0 iff meets
+};
+
+std::vector<CellStats> Aggregate(const std::vector<RunSummary>& runs,
+                                 const TrackingCriterion& criterion);
+
+// Writes table.csv, table.md, stability.dat/.gp/.png (when gnuplot is found) and
+// shortest_dT.md into `out_dir`. The files depend only on the runs' results.
+Status WriteSweepReport(const std::vector<CellStats>& cells, const TrackingCriterion& criterion,
+                        const std::string& out_dir, const std::string& title);
+
+// RunSummary <-> JSON for the per-run record files.
+Result<RunSummary> RunSummaryFromJson(const nlohmann::json& j);
+
+}  // namespace recruit::sim

@@ -1,0 +1,243 @@
+#include "sim/task.h"
+
+#include <cmath>
+#include <filesystem>
+#include <set>
+
+#include "common/atomic_file.h"
+
+namespace recruit::sim {
+namespace {
+
+using nlohmann::json;
+namespace fs = std::filesystem;
+
+std::string Join(const std::set<std::string>& s) {
+  std::string out;
+  for (const auto& x : s) out += (out.empty() ? "" : ", ") + x;
+  return out;
+}
+
+Status CheckKeys(const json& j, const std::set<std::string>& allowed, const std::string& where) {
+  for (auto it = j.begin(); it != j.end(); ++it) {
+    if (!allowed.count(it.key())) {
+      return Error{where + ": unknown field '" + it.key() + "'; allowed: " + Join(allowed)};
+    }
+  }
+  return Status::Ok();
+}
+
+// Reads an optional number at j[key] into *out, checking lo <= x (lo_open: lo < x) and x <= hi.
+Status Number(const json& j, const std::string& key, const std::string& where, double* out,
+              bool required, double lo, double hi, bool lo_open, const std::string& allowed) {
+  if (!j.contains(key)) {
+    if (required) return Error{where + ": missing field '" + key + "' (" + allowed + ")"};
+    return Status::Ok();
+  }
+  const json& v = j.at(key);
+  if (!v.is_number()) {
+    return Error{where + "." + key + ": must be a number (" + allowed + "), got " + v.dump()};
+  }
+  const double x = v.get<double>();
+  if (!std::isfinite(x) || x < lo || (lo_open && x == lo) || x > hi) {
+    return Error{where + "." + key + ": " + v.dump() + " is out of range; allowed: " + allowed};
+  }
+  *out = x;
+  return Status::Ok();
+}
+
+Status String(const json& j, const std::string& key, const std::string& where, std::string* out,
+              bool required) {
+  if (!j.contains(key)) {
+    if (required) return Error{where + ": missing field '" + key + "' (a string)"};
+    return Status::Ok();
+  }
+  if (!j.at(key).is_string() || j.at(key).get<std::string>().empty()) {
+    return Error{where + "." + key + ": must be a non-empty string, got " + j.at(key).dump()};
+  }
+  *out = j.at(key).get<std::string>();
+  return Status::Ok();
+}
+
+Status Vec3(const json& j, const std::string& key, const std::string& where, Eigen::Vector3d* out) {
+  if (!j.contains(key)) return Status::Ok();
+  const json& v = j.at(key);
+  if (!v.is_array() || v.size() != 3) {
+    return Error{where + "." + key + ": must be an array of 3 numbers [x, y, z], got " + v.dump()};
+  }
+  for (int i = 0; i < 3; ++i) {
+    if (!v[i].is_number() || !std::isfinite(v[i].get<double>())) {
+      return Error{where + "." + key + ": must be an array of 3 finite numbers, got " + v.dump()};
+    }
+    (*out)[i] = v[i].get<double>();
+  }
+  return Status::Ok();
+}
+
+std::string Resolve(const std::string& path, const std::string& source) {
+  if (path.empty() || fs::path(path).is_absolute() || source.empty()) return path;
+  return (fs::path(source).parent_path() / path).lexically_normal().string();
+}
+
+#define RECRUIT_TRY(expr)                   \
+  do {                                      \
+    Status _s = (expr);                     \
+    if (!_s.ok()) return Error{_s.error()}; \
+  } while (0)
+
+}  // namespace
+
+Result<Task> Task::FromFile(const std::string& path) {
+  auto text = ReadFile(path);
+  if (!text.ok()) return Error{"task file: " + text.error()};
+  return FromJsonText(*text, path);
+}
+
+Result<Task> Task::FromJsonText(const std::string& text, const std::string& source) {
+  const std::string file = source.empty() ? std::string("<task>") : source;
+  json j;
+  try {
+    j = json::parse(text);
+  } catch (const json::parse_error& e) {
+    return Error{file + ": not valid JSON: " + e.what()};
+  }
+  if (!j.is_object()) return Error{file + ": the task must be a JSON object"};
+  RECRUIT_TRY(CheckKeys(
+      j,
+      {"name", "description", "model", "tracked", "agonist", "antagonist", "joint", "duration",
+       "timestep", "reference", "controller", "outer_loop", "pushes", "payloads", "settle_band"},
+      file));
+  Task task;
+  task.source = source;
+  RECRUIT_TRY(String(j, "name", file, &task.name, true));
+  if (j.contains("description"))
+    RECRUIT_TRY(String(j, "description", file, &task.description, false));
+  RECRUIT_TRY(String(j, "model", file, &task.model_path, true));
+  task.model_path = Resolve(task.model_path, source);
+  if (!fs::exists(task.model_path)) {
+    return Error{file + ".model: model file '" + task.model_path + "' does not exist"};
+  }
+  std::string tracked;
+  RECRUIT_TRY(String(j, "tracked", file, &tracked, true));
+  if (tracked == "force") {
+    task.tracked = Tracked::kForce;
+  } else if (tracked == "angle") {
+    task.tracked = Tracked::kAngle;
+  } else {
+    return Error{file + ".tracked: unknown '" + tracked + "'; allowed: force, angle"};
+  }
+  RECRUIT_TRY(String(j, "agonist", file, &task.agonist, true));
+  RECRUIT_TRY(String(j, "antagonist", file, &task.antagonist, false));
+  if (task.antagonist == task.agonist) {
+    return Error{file + ".antagonist: must differ from 'agonist' ('" + task.agonist + "')"};
+  }
+  RECRUIT_TRY(String(j, "joint", file, &task.joint, task.tracked == Tracked::kAngle));
+  RECRUIT_TRY(Number(j, "duration", file, &task.duration, true, 0, 1e6, true,
+                     "seconds, 0 < duration <= 1e6"));
+  RECRUIT_TRY(Number(j, "timestep", file, &task.timestep, false, 1e-5, 0.05, false,
+                     "seconds, 1e-5 <= timestep <= 0.05"));
+  RECRUIT_TRY(Number(j, "settle_band", file, &task.settle_band, false, 0, 1, true,
+                     "a fraction of the step size, 0 < settle_band <= 1"));
+
+  // Reference, in the unit the file states.
+  if (!j.contains("reference")) return Error{file + ": missing field 'reference'"};
+  {
+    const json& r = j["reference"];
+    const std::string where = file + ".reference";
+    std::string unit = task.tracked == Tracked::kForce ? "N" : "deg";
+    if (r.is_object() && r.contains("unit")) {
+      if (!r["unit"].is_string()) return Error{where + ".unit: must be a string"};
+      unit = r["unit"];
+    }
+    double scale = 1;
+    if (task.tracked == Tracked::kForce) {
+      if (unit != "N") return Error{where + ".unit: '" + unit + "' for a force task; allowed: N"};
+    } else if (unit == "deg") {
+      scale = M_PI / 180;
+    } else if (unit != "rad") {
+      return Error{where + ".unit: '" + unit + "' for an angle task; allowed: deg, rad"};
+    }
+    json body = r;
+    if (body.is_object()) body.erase("unit");
+    auto ref = Reference::FromJson(body, where, scale);
+    if (!ref.ok()) return Error{ref.error()};
+    task.reference = std::move(ref).value();
+    if (task.tracked == Tracked::kForce && task.reference.MinValue() < 0) {
+      return Error{where + ": a force reference must be >= 0 N (a bundle can only pull)"};
+    }
+  }
+
+  if (j.contains("controller")) {
+    const json& c = j["controller"];
+    const std::string where = file + ".controller";
+    if (!c.is_object()) return Error{where + ": must be an object"};
+    RECRUIT_TRY(
+        CheckKeys(c, {"estimator", "filter_model", "dT", "lambda", "force_noise_std"}, where));
+    RECRUIT_TRY(String(c, "estimator", where, &task.controller.estimator, false));
+    RECRUIT_TRY(String(c, "filter_model", where, &task.controller.filter_model, false));
+    task.controller.filter_model = Resolve(task.controller.filter_model, source);
+    RECRUIT_TRY(Number(c, "dT", where, &task.controller.dT, false, 0, 1000, true,
+                       "seconds, 0 < dT <= 1000"));
+    RECRUIT_TRY(
+        Number(c, "lambda", where, &task.controller.lambda, false, 0, 1, true, "0 < lambda <= 1"));
+  }
+
+  if (j.contains("outer_loop")) {
+    const json& o = j["outer_loop"];
+    const std::string where = file + ".outer_loop";
+    if (task.tracked != Tracked::kAngle) {
+      return Error{where + ": only angle tasks have an outer loop (tracked is 'force')"};
+    }
+    if (!o.is_object()) return Error{where + ": must be an object"};
+    RECRUIT_TRY(CheckKeys(o, {"kp", "ki", "kd", "feedforward", "tone", "max_force"}, where));
+    OuterLoop loop;
+    RECRUIT_TRY(Number(o, "kp", where, &loop.kp, true, 0, 1e6, false, "N/rad, >= 0"));
+    RECRUIT_TRY(Number(o, "ki", where, &loop.ki, false, 0, 1e6, false, "N/(rad s), >= 0"));
+    RECRUIT_TRY(Number(o, "kd", where, &loop.kd, false, 0, 1e6, false, "N s/rad, >= 0"));
+    RECRUIT_TRY(
+        Number(o, "feedforward", where, &loop.feedforward, false, -1e6, 1e6, false, "N, finite"));
+    RECRUIT_TRY(Number(o, "tone", where, &loop.tone, false, 0, 1e6, false, "N, >= 0"));
+    RECRUIT_TRY(Number(o, "max_force", where, &loop.max_force, false, 0, 1e6, true, "N, > 0"));
+    if (loop.tone > loop.max_force) {
+      return Error{where + ".tone: must not exceed max_force"};
+    }
+    task.outer = loop;
+  } else if (task.tracked == Tracked::kAngle) {
+    return Error{file + ": missing field 'outer_loop' (an angle task needs the PI gains kp, ki)"};
+  }
+
+  if (j.contains("pushes")) {
+    if (!j["pushes"].is_array()) return Error{file + ".pushes: must be an array"};
+    for (size_t i = 0; i < j["pushes"].size(); ++i) {
+      const json& p = j["pushes"][i];
+      const std::string where = file + ".pushes[" + std::to_string(i) + "]";
+      if (!p.is_object()) return Error{where + ": must be an object"};
+      RECRUIT_TRY(CheckKeys(p, {"body", "start", "duration", "force", "torque"}, where));
+      Push push;
+      RECRUIT_TRY(String(p, "body", where, &push.body, true));
+      RECRUIT_TRY(Number(p, "start", where, &push.start, true, 0, 1e6, false, "seconds, >= 0"));
+      RECRUIT_TRY(Number(p, "duration", where, &push.duration, true, 0, 1e6, true, "seconds, > 0"));
+      RECRUIT_TRY(Vec3(p, "force", where, &push.force));
+      RECRUIT_TRY(Vec3(p, "torque", where, &push.torque));
+      task.pushes.push_back(push);
+    }
+  }
+  if (j.contains("payloads")) {
+    if (!j["payloads"].is_array()) return Error{file + ".payloads: must be an array"};
+    for (size_t i = 0; i < j["payloads"].size(); ++i) {
+      const json& p = j["payloads"][i];
+      const std::string where = file + ".payloads[" + std::to_string(i) + "]";
+      if (!p.is_object()) return Error{where + ": must be an object"};
+      RECRUIT_TRY(CheckKeys(p, {"body", "mass", "time"}, where));
+      Payload pl;
+      RECRUIT_TRY(String(p, "body", where, &pl.body, true));
+      RECRUIT_TRY(
+          Number(p, "mass", where, &pl.mass, true, 1e-6, 1e3, false, "kg, 1e-6 <= mass <= 1000"));
+      RECRUIT_TRY(Number(p, "time", where, &pl.time, false, 0, 1e6, false, "seconds, >= 0"));
+      task.payloads.push_back(pl);
+    }
+  }
+  return task;
+}
+
+}  // namespace recruit::sim

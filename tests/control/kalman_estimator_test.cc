@@ -1,0 +1,118 @@
+// The Kalman on-count estimators: the prediction and update of the two-state model against the
+// binomial moments and the scalar Kalman update worked by hand, the on-count of the augmented
+// model as the sum over its "on" states, and the factory's checks of the model file.
+#include "control/kalman_estimator.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <nlohmann/json.hpp>
+
+#include "control/model_export.h"
+#include "control/on_count_estimator.h"
+#include "control/transient_chain.h"
+#include "estimation/filter_model.h"
+
+namespace recruit::control {
+namespace {
+
+TEST(KalmanTwoState, PredictionIsTheBinomialAndUpdateTheScalarKalmanGain) {
+  const int N = 60;
+  const double f = 0.5, sd = 0.4;
+  auto spec = EstimatorSpec::Parse("kalman2", "extended", "", 20, sd);
+  ASSERT_TRUE(spec.ok());
+  auto e = MakeEstimator(*spec, N, f, 0.5);
+  ASSERT_TRUE(e.ok()) << e.error();
+  OnCountEstimator& est = **e;
+  EXPECT_DOUBLE_EQ(est.EstimatedOn(), 0.0);
+  // From all off, p_on = 0.3: on ~ Bin(60, 0.3): mean 18, variance 60 * 0.3 * 0.7 = 12.6.
+  est.Broadcasted({0.3, 0.0});
+  EXPECT_NEAR(est.EstimatedOn(), 18.0, 1e-9);
+  EXPECT_NEAR(est.EstimatedOnVariance(), 12.6, 1e-9);
+  // y = 10 N: gain on the on-count k = v f / (f^2 v + R), estimate 18 + k (10 - 0.5 * 18),
+  // variance v - k f v.
+  const double v = 12.6, R = sd * sd, k = v * f / (f * f * v + R);
+  est.Observe(10.0);
+  EXPECT_NEAR(est.EstimatedOn(), 18.0 + k * (10.0 - f * 18.0), 1e-9);
+  EXPECT_NEAR(est.EstimatedOnVariance(), v - k * f * v, 1e-9);
+  EXPECT_NEAR(est.StateEstimate().sum(), N, 1e-9);
+  est.Reset();
+  EXPECT_DOUBLE_EQ(est.EstimatedOn(), 0.0);
+}
+
+TEST(KalmanAugmented, OnCountIsTheSumOverTheHeaterOnStates) {
+  auto spec = EstimatorSpec::Parse("kalman-augmented");
+  ASSERT_TRUE(spec.ok());
+  auto e = MakeEstimator(*spec, 60, 0.45, 0.5);  // the shipped dT = 0.5 s model
+  ASSERT_TRUE(e.ok()) << e.error();
+  OnCountEstimator& est = **e;
+  const auto on = est.OnStates();
+  ASSERT_EQ(on.size(), 20u);
+  // Switch everyone on: one period later all 60 are in heat1, an "on" state whose force is
+  // still about zero, and the estimate counts them as on with no uncertainty.
+  est.Broadcasted({1.0, 0.0});
+  EXPECT_NEAR(est.EstimatedOn(), 60.0, 1e-9);
+  EXPECT_NEAR(est.EstimatedOnVariance(), 0.0, 1e-9);
+  EXPECT_EQ(est.StateNames()[1], "heat1");
+  EXPECT_NEAR(est.StateEstimate()[1], 60.0, 1e-9);
+  // Half of them switched off again: 30 are on (whatever their force), 30 off.
+  est.Broadcasted({0.0, 0.5});
+  const Eigen::VectorXd x = est.StateEstimate();
+  double sum_on = 0;
+  for (int i = 0; i < 20; ++i) sum_on += on[i] ? x[i] : 0.0;
+  EXPECT_NEAR(est.EstimatedOn(), sum_on, 1e-9);
+  EXPECT_NEAR(est.EstimatedOn(), 30.0, 1e-9);
+  EXPECT_NEAR(x.sum(), 60.0, 1e-9);
+}
+
+TEST(KalmanAugmented, ModelIsRescaledToTheBundlesUnits) {
+  auto spec = EstimatorSpec::Parse("kalman-augmented");
+  auto e = MakeEstimator(*spec, 120, 0.45, 0.5);
+  ASSERT_TRUE(e.ok()) << e.error();
+  (*e)->Broadcasted({0.25, 0.0});
+  EXPECT_NEAR((*e)->EstimatedOn(), 30.0, 1e-9);
+  EXPECT_NEAR((*e)->EstimatedOnVariance(), 120 * 0.25 * 0.75, 1e-9);
+}
+
+TEST(KalmanAugmented, FactoryRejectsAModelForAnotherPeriodOrSize) {
+  auto spec = EstimatorSpec::Parse("kalman-augmented", "extended",
+                                   "models/identified/bench_n60_dt2.0_m20.json");
+  auto e = MakeEstimator(*spec, 60, 0.45, 0.5);
+  ASSERT_FALSE(e.ok());
+  EXPECT_NE(e.error().find("dt = 2"), std::string::npos) << e.error();
+  // No shipped model for dT = 1 s: the message says how to make one.
+  auto d = MakeEstimator(*EstimatorSpec::Parse("kalman-augmented"), 60, 0.45, 1.0);
+  ASSERT_FALSE(d.ok());
+  EXPECT_NE(d.error().find("recruit identify"), std::string::npos) << d.error();
+  auto s = MakeEstimator(*EstimatorSpec::Parse("kalman-augmented", "extended",
+                                               "models/identified/bench_n60_dt0.5_m20.json", 12),
+                         60, 0.45, 0.5);
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.error().find("num_states"), std::string::npos) << s.error();
+  auto missing = MakeEstimator(
+      *EstimatorSpec::Parse("kalman-augmented", "extended", "/nonexistent/model.json"), 60, 0.45,
+      0.5);
+  ASSERT_FALSE(missing.ok());
+  EXPECT_NE(missing.error().find("/nonexistent/model.json"), std::string::npos);
+}
+
+TEST(ModelExport, FilterModelFileRoundTripsTheChain) {
+  TransientChain c = TransientChain::Uniform(8, 0.7);
+  c.heat_advance << 1.0, 0.6, 0.4;
+  c.force << 0.0, 0.05, 0.2, 0.35, 0.45, 0.42, 0.3, 0.12;
+  c.switch_on[5] = 2;  // cool1 -> heat2
+  const FilterModel f = ToFilterModel(c, 60, 0.5, 0.01);
+  ASSERT_TRUE(f.Validate().ok()) << f.Validate().error();
+  auto back = FilterModel::FromJsonValue(f.ToJson(), "round trip");
+  ASSERT_TRUE(back.ok()) << back.error();
+  for (auto [pon, poff] : {std::pair{0.0, 0.0}, {0.3, 0.6}, {1.0, 1.0}}) {
+    EXPECT_LT((back->broadcast.Matrix(pon, poff) - c.Matrix(pon, poff)).norm(), 1e-12);
+  }
+  EXPECT_LT((back->H.transpose() - c.force).norm(), 1e-12);
+  EXPECT_DOUBLE_EQ(back->R(0, 0), 0.01);
+  EXPECT_EQ(back->N, 60);
+  EXPECT_DOUBLE_EQ(back->x0[0], 60.0);
+}
+
+}  // namespace
+}  // namespace recruit::control

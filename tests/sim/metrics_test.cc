@@ -1,0 +1,140 @@
+// Metrics against closed forms on synthetic signals.
+#include "sim/metrics.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace recruit::sim {
+namespace {
+
+std::vector<double> Times(double dt, double T) {
+  std::vector<double> t;
+  for (long k = 0; k * dt < T - 1e-12; ++k) t.push_back(k * dt);
+  return t;
+}
+
+TEST(Metrics, RmseOfConstantOffsetIsTheOffset) {
+  std::vector<double> r(100, 3.0), y(100, 3.5);
+  EXPECT_DOUBLE_EQ(TrackingRmse(r, y), 0.5);
+}
+
+TEST(Metrics, RmseOfSineErrorIsAmplitudeOverRootTwo) {
+  // Over whole periods, mean sin^2 = 1/2.
+  const auto t = Times(1e-3, 10.0);
+  std::vector<double> r(t.size(), 0.0), y;
+  for (double x : t) y.push_back(2.0 * std::sin(2 * M_PI * x));
+  EXPECT_NEAR(TrackingRmse(r, y), 2.0 / std::sqrt(2.0), 1e-9);
+}
+
+TEST(Metrics, IaeOfExponentialErrorIsItsIntegral) {
+  // e(t) = exp(-t / tau): integral over [0, T) = tau (1 - exp(-T / tau)).
+  const double dt = 1e-4, T = 5, tau = 0.7;
+  const auto t = Times(dt, T);
+  std::vector<double> r(t.size(), 1.0), y;
+  for (double x : t) y.push_back(1.0 - std::exp(-x / tau));
+  const double exact = tau * (1 - std::exp(-T / tau));
+  // Rectangle rule with left samples overestimates by about e(0) dt / 2.
+  EXPECT_NEAR(IntegralAbsoluteError(t, r, y, T), exact, dt);
+}
+
+// A second-order underdamped step response: y = 1 - exp(-z w t) (cos(wd t) + z/sqrt(1-z^2)
+// sin(wd t)). Overshoot exp(-pi z / sqrt(1 - z^2)); the last exit from a band b is at an
+// extremum or a crossing we locate by brute force on a finer grid.
+TEST(Metrics, SecondOrderStepOvershootMatchesClosedForm) {
+  const double z = 0.3, w = 2.0, wd = w * std::sqrt(1 - z * z), dt = 1e-4;
+  const auto t = Times(dt, 30.0);
+  std::vector<double> y;
+  for (double x : t) {
+    y.push_back(1 - std::exp(-z * w * x) *
+                        (std::cos(wd * x) + z / std::sqrt(1 - z * z) * std::sin(wd * x)));
+  }
+  const ReferenceStep step{0.0, 0.0, 1.0, 30.0};
+  const auto resp = StepResponses(t, y, {step}, 0.1);
+  ASSERT_EQ(resp.size(), 1u);
+  EXPECT_NEAR(resp[0].overshoot, std::exp(-M_PI * z / std::sqrt(1 - z * z)), 1e-6);
+  EXPECT_TRUE(resp[0].settled);
+  // The envelope bound exp(-z w t) / sqrt(1 - z^2) = 0.1 gives an upper bound on settling time;
+  // the true last exit lies within half a period below it.
+  const double envelope = -std::log(0.1 * std::sqrt(1 - z * z)) / (z * w);
+  EXPECT_LE(resp[0].settling_time, envelope + dt);
+  EXPECT_GE(resp[0].settling_time, envelope - M_PI / wd);
+}
+
+TEST(Metrics, FirstOrderStepSettlesAtTauLnTenWithoutOvershoot) {
+  // y = 20 - 10 exp(-t / tau) for a step 10 -> 20 at t = 2: within 10 % after tau ln 10.
+  const double tau = 1.5, dt = 1e-3;
+  const auto t = Times(dt, 20.0);
+  std::vector<double> y;
+  for (double x : t) y.push_back(x < 2 ? 10.0 : 20 - 10 * std::exp(-(x - 2) / tau));
+  const auto resp = StepResponses(t, y, {{2.0, 10.0, 20.0, 20.0}}, 0.1);
+  ASSERT_EQ(resp.size(), 1u);
+  EXPECT_DOUBLE_EQ(resp[0].overshoot, 0.0);
+  EXPECT_NEAR(resp[0].settling_time, tau * std::log(10.0), 2 * dt);
+  EXPECT_TRUE(resp[0].settled);
+}
+
+TEST(Metrics, DownwardStepOvershootCountsExcursionBelowTarget) {
+  // 30 -> 10, undershooting to 7: overshoot 3 / 20 = 0.15, never back in the band: unsettled.
+  std::vector<double> t{0, 1, 2, 3, 4}, y{30, 20, 7, 7, 7};
+  const auto resp = StepResponses(t, y, {{0.0, 30.0, 10.0, 5.0}}, 0.1);
+  ASSERT_EQ(resp.size(), 1u);
+  EXPECT_DOUBLE_EQ(resp[0].overshoot, 0.15);
+  EXPECT_FALSE(resp[0].settled);
+  EXPECT_DOUBLE_EQ(resp[0].settling_time, 5.0);
+}
+
+TEST(Metrics, ExcessTotalVariationCountsExtraSwings) {
+  // Reference: one step of 1. Response: rises to 1, then one full swing of amplitude 0.2 (up
+  // 0.2, down 0.4, up 0.2): extra variation 0.8 -> 0.8 / 1.
+  std::vector<double> r{0, 1, 1, 1, 1, 1}, y{0, 1, 1.2, 0.8, 1.0, 1.0};
+  EXPECT_NEAR(ExcessTotalVariation(r, y), 0.8, 1e-12);
+  // A monotone response has none.
+  std::vector<double> y2{0, 0.5, 0.9, 1.0, 1.0, 1.0};
+  EXPECT_NEAR(ExcessTotalVariation(r, y2), 0.0, 1e-12);
+}
+
+TEST(Metrics, ExcessTotalVariationOfSineAroundConstantIsFourAmplitudesPerPeriod) {
+  const auto t = Times(1e-4, 3.0);  // three periods of 1 s
+  std::vector<double> r(t.size(), 5.0), y;
+  for (double x : t) y.push_back(5.0 + 0.5 * std::sin(2 * M_PI * x));
+  EXPECT_NEAR(ExcessTotalVariation(r, y), 3 * 4 * 0.5, 1e-3);
+}
+
+TEST(Metrics, SwitchingRateIsTransitionsPerUnitPerSecond) {
+  // 10 units over 5 s: +4, -2, +3 = 9 transitions -> 9 / (10 * 5).
+  std::vector<int> on{0, 4, 4, 2, 5};
+  EXPECT_DOUBLE_EQ(SwitchingRate(on, 10, 5.0), 9.0 / 50.0);
+}
+
+TEST(Metrics, EstimatorScoreRmseNeesAndWithinThree) {
+  std::vector<double> est{10, 12, 20, 30}, truth{10, 10, 16, 30}, var{1, 4, 4, 0};
+  const EstimatorScore s = ScoreEstimator(est, truth, var);
+  EXPECT_EQ(s.samples, 4);
+  EXPECT_DOUBLE_EQ(s.rmse, std::sqrt((0 + 4 + 16 + 0) / 4.0));
+  // NEES over samples with var > 0: 0/1, 4/4, 16/4 -> mean 5/3.
+  EXPECT_DOUBLE_EQ(s.mean_nees, (0 + 1 + 4) / 3.0);
+  EXPECT_DOUBLE_EQ(s.within3, 3.0 / 4.0);
+}
+
+TEST(Metrics, NeesOfGaussianErrorsWithTrueVarianceIsNearOne) {
+  // Deterministic normal quantiles as errors: the sample mean of e^2 / s^2 is ~1.
+  std::vector<double> est, truth, var;
+  const int n = 2000;
+  for (int i = 0; i < n; ++i) {
+    const double p = (i + 0.5) / n;
+    // Inverse normal CDF by bisection on erfc.
+    double lo = -10, hi = 10;
+    for (int it = 0; it < 100; ++it) {
+      const double mid = 0.5 * (lo + hi);
+      (0.5 * std::erfc(-mid / std::sqrt(2.0)) < p ? lo : hi) = mid;
+    }
+    est.push_back(3.0 * lo);
+    truth.push_back(0);
+    var.push_back(9.0);
+  }
+  EXPECT_NEAR(ScoreEstimator(est, truth, var).mean_nees, 1.0, 0.01);
+}
+
+}  // namespace
+}  // namespace recruit::sim
