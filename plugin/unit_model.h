@@ -106,8 +106,9 @@ class UnitModel {
 // sin and cos of an angle a in [0, pi] (the cosine curves' range), as a polynomial: with
 // b = a - pi/2 in [-pi/2, pi/2], sin a = cos b and cos a = -sin b by their Taylor series to
 // b^20 and b^19. The truncation error is below (pi/2)^21 / 21! < 3e-16 and the rounding error a
-// few ulp, so both are within 1e-15 of the exact values (test FastSinCosMatchesLibm); the phase
-// solve's tolerances are 1e-13 and above. About 4x cheaper than libm's sincos.
+// few ulp, so both are within 1e-15 of the exact values (test
+// PolynomialSinCosMatchesLibmOverTheHalfTurn); the phase solve's tolerances are 1e-13 and above.
+// Inlined, 64 instructions against about 94 for glibc's sincos call (callgrind).
 inline void SinCosHalfTurn(double a, double* sin_a, double* cos_a) {
   const double b = a - 0.5 * 3.14159265358979323846;
   const double z = b * b, z2 = z * z, z4 = z2 * z2, z8 = z4 * z4;
