@@ -5,6 +5,7 @@
 // render_fps. Arguments: width, height, encoder queue frames (0 = encode inline on the render
 // thread), x264 preset (0 ultrafast, 1 veryfast, 2 medium), x264 threads (0 = automatic).
 #include <benchmark/benchmark.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -47,6 +48,13 @@ double Seconds(std::chrono::steady_clock::time_point a, std::chrono::steady_cloc
   return std::chrono::duration<double>(b - a).count();
 }
 
+// CPU time of the whole process (every thread: llvmpipe's, x264's, the encoder's), s.
+double ProcessCpuSeconds() {
+  rusage u;
+  getrusage(RUSAGE_SELF, &u);
+  return u.ru_utime.tv_sec + u.ru_stime.tv_sec + 1e-6 * (u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
+
 void BM_RenderVsRenderEncode(benchmark::State& state) {
   const int width = static_cast<int>(state.range(0));
   const int height = static_cast<int>(state.range(1));
@@ -75,10 +83,11 @@ void BM_RenderVsRenderEncode(benchmark::State& state) {
     return;
   }
   EncodePipeline pipeline(width, height, std::move(*mp4), nullptr, 1, queue);
-  double render_time = 0, pipeline_time = 0;
+  double render_time = 0, pipeline_time = 0, render_cpu = 0, pipeline_cpu = 0;
   int64_t batches = 0, index = 0;
   for (auto _ : state) {
     // Render alone (the encoder is idle: the previous batch waited for it).
+    const double c0 = ProcessCpuSeconds();
     auto t0 = std::chrono::steady_clock::now();
     for (int i = 0; i < kBatch; ++i) {
       const TelemetrySample s = scene.Advance();
@@ -89,6 +98,7 @@ void BM_RenderVsRenderEncode(benchmark::State& state) {
       }
     }
     auto t1 = std::chrono::steady_clock::now();
+    const double c1 = ProcessCpuSeconds();
     // Render + encode: the batch ends when the encoder has taken every frame of it.
     for (int i = 0; i < kBatch; ++i) {
       const TelemetrySample s = scene.Advance();
@@ -107,8 +117,11 @@ void BM_RenderVsRenderEncode(benchmark::State& state) {
     }
     pipeline.WaitIdle();
     auto t2 = std::chrono::steady_clock::now();
+    const double c2 = ProcessCpuSeconds();
     render_time += Seconds(t0, t1);
     pipeline_time += Seconds(t1, t2);
+    render_cpu += c1 - c0;
+    pipeline_cpu += c2 - c1;
     ++batches;
   }
   if (Status s = pipeline.Finish(); !s.ok()) {
@@ -126,9 +139,44 @@ void BM_RenderVsRenderEncode(benchmark::State& state) {
   state.counters["render_fps"] = frames / render_time;
   state.counters["pipeline_fps"] = frames / pipeline_time;
   state.counters["ratio"] = render_time / pipeline_time;
+  // CPU milliseconds per frame over all threads, and their ratio: what the pipeline keeps of the
+  // render rate when both cores are saturated (a load-independent bound; see docs/benchmarks.md).
+  state.counters["render_cpu_ms"] = 1e3 * render_cpu / frames;
+  state.counters["pipeline_cpu_ms"] = 1e3 * pipeline_cpu / frames;
+  state.counters["cpu_ratio"] = render_cpu / pipeline_cpu;
   state.counters["KB_per_s_video"] = bytes / 1024.0 / (frames / 30.0);
   state.SetLabel(std::string(kPresets[state.range(3)]) + (queue ? ", encoder thread" : ", inline"));
 }
+
+// Render alone with the model's 4x multisampling against none (arg msaa), frames per second.
+void BM_RenderOnly(benchmark::State& state) {
+  Scene scene;
+  RenderOptions options;
+  options.width = static_cast<int>(state.range(0));
+  options.height = static_cast<int>(state.range(1));
+  options.multisamples = static_cast<int>(state.range(2));
+  options.camera.name = "front";
+  auto renderer = SceneRenderer::Create(scene.m.get(), options, RunLabel{});
+  if (!renderer.ok()) {
+    state.SkipWithError(renderer.error().c_str());
+    return;
+  }
+  std::vector<unsigned char> rgb(static_cast<size_t>(options.width) * options.height * 3);
+  for (auto _ : state) {
+    const TelemetrySample s = scene.Advance();
+    (*renderer)->AddPlotPoint(s);
+    benchmark::DoNotOptimize((*renderer)->Render(scene.m.get(), scene.d.get(), &s, rgb.data()));
+  }
+  state.counters["fps"] = benchmark::Counter(state.iterations(), benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_RenderOnly)
+    ->ArgNames({"w", "h", "msaa"})
+    ->Args({640, 480, 4})
+    ->Args({640, 480, 0})
+    ->Args({1280, 720, 4})
+    ->Args({1280, 720, 0})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 // 640x480 and 1280x720; encoder thread (queue 4) against inline encoding (queue 0); x264's own
 // threads (automatic) against one; three presets.

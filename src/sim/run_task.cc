@@ -267,6 +267,8 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
       }
       for (int i = 0; i < nb; ++i) {
         const int b = bundles[i];
+        // The a-posteriori estimate is of the state at this instant, before its broadcast.
+        const int on_before = plugin.OnCount(d, b);
         const control::Broadcast bc = controllers[i].Step(force_ref[i], plugin.Force(d, b));
         Status st = plugin.Broadcast(d, b, bc.p_on, bc.p_off);
         if (!st.ok()) return Error{where + ": " + st.error()};
@@ -278,7 +280,7 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
         if (i == 0) {
           est_on.push_back(controllers[i].estimated_on());
           est_var.push_back(controllers[i].estimated_on_variance());
-          true_on.push_back(plugin.OnCount(d, b));  // before this broadcast, as the estimate
+          true_on.push_back(on_before);
         }
       }
       sample.p_on = sample.bundles[0].p_on;
