@@ -133,6 +133,41 @@ TEST(EstimationKalman, MatchesTextbookFilterWithTwoOutputsAndProcessNoise) {
   EXPECT_NEAR(kf->estimate().sum(), 30.0, 1e-12);
 }
 
+// An estimate with a negative count (possible after an update): the extended mode evaluates Qz
+// at the projection onto {n >= 0, sum = N}, so the predicted P is A P A^T + Qz(proj X^) with a
+// PSD Qz. Reference: the free functions ProjectOntoSimplex and ProcessCovarianceQz.
+TEST(EstimationKalman, ExtendedModeProjectsNegativeEstimates) {
+  FilterModel f;
+  f.state_names = {"a", "b", "c"};
+  f.N = 10;
+  f.H = Eigen::RowVector3d(1.0, 0.0, 0.0);
+  f.R = Eigen::MatrixXd::Constant(1, 1, 0.01);
+  f.G = Eigen::MatrixXd::Zero(3, 0);
+  f.Qw = Eigen::MatrixXd::Zero(0, 0);
+  f.transition = TransitionSource::kExplicit;
+  f.x0 = Eigen::Vector3d(2, 4, 4);
+  f.P0 = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3d P0;
+  P0 << 8, -4, -4, -4, 8, -4, -4, -4, 8;
+  auto kf = PopulationKalmanFilter::Create(f, CovarianceMode::kExtended, f.x0, P0);
+  ASSERT_TRUE(kf.ok());
+  kf->Update(Eigen::VectorXd::Constant(1, 12.0));  // above N: pushes b and c below 0
+  const Eigen::VectorXd x = kf->estimate();
+  const Eigen::MatrixXd P = kf->covariance();
+  ASSERT_LT(x.minCoeff(), 0.0) << x.transpose();
+  Eigen::Matrix3d A;
+  A << 0.5, 0.2, 0.1, 0.3, 0.6, 0.2, 0.2, 0.2, 0.7;
+  kf->Predict(A);
+  const Eigen::VectorXd xp = ProjectOntoSimplex(x, 10.0);
+  const Eigen::MatrixXd Qz = ProcessCovarianceQz(A, xp);
+  EXPECT_GE(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(Qz).eigenvalues().minCoeff(), -1e-12);
+  const Eigen::MatrixXd expected = A * P * A.transpose() + Qz;
+  EXPECT_LT((kf->covariance() - expected).cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_LT((kf->estimate() - A * x).cwiseAbs().maxCoeff(), 1e-12);
+  // The projection mattered: Qz at the raw estimate is a different matrix.
+  EXPECT_GT((ProcessCovarianceQz(A, x) - Qz).cwiseAbs().maxCoeff(), 0.1);
+}
+
 TEST(EstimationKalman, RejectsBadInitialBeliefAndInputs) {
   const FilterModel f = HandModel();
   auto bad_sum = PopulationKalmanFilter::Create(f, CovarianceMode::kExtended, Eigen::Vector2d(6, 5),
