@@ -44,26 +44,6 @@ std::string Num(double v) {
 
 }  // namespace
 
-void SinCosHalfTurn(double a, double* sin_a, double* cos_a) {
-  const double b = a - 0.5 * kPi;
-  const double z = b * b, z2 = z * z, z4 = z2 * z2, z8 = z4 * z4;
-  // Taylor coefficients (-1)^k / (2k)! (cosine) and (-1)^k / (2k+1)! (sine) of z^k, k = 0..10
-  // and 0..9, summed by Estrin's scheme (shorter dependency chains than Horner's).
-  constexpr double c0 = 1, c1 = -1.0 / 2, c2 = 1.0 / 24, c3 = -1.0 / 720, c4 = 1.0 / 40320,
-                   c5 = -1.0 / 3628800, c6 = 1.0 / 479001600, c7 = -1.0 / 87178291200,
-                   c8 = 1.0 / 20922789888000, c9 = -1.0 / 6402373705728000,
-                   c10 = 1.0 / 2432902008176640000;
-  constexpr double s0 = 1, s1 = -1.0 / 6, s2 = 1.0 / 120, s3 = -1.0 / 5040, s4 = 1.0 / 362880,
-                   s5 = -1.0 / 39916800, s6 = 1.0 / 6227020800, s7 = -1.0 / 1307674368000,
-                   s8 = 1.0 / 355687428096000, s9 = -1.0 / 121645100408832000;
-  const double cos_b = ((c0 + c1 * z) + (c2 + c3 * z) * z2) +
-                       ((c4 + c5 * z) + (c6 + c7 * z) * z2) * z4 + ((c8 + c9 * z) + c10 * z2) * z8;
-  const double sin_b = b * (((s0 + s1 * z) + (s2 + s3 * z) * z2) +
-                            ((s4 + s5 * z) + (s6 + s7 * z) * z2) * z4 + (s8 + s9 * z) * z8);
-  *sin_a = cos_b;
-  *cos_a = -sin_b;
-}
-
 double UnitModel::NaturalConvectionH(double d, double ambient, double dT, double emissivity) {
   dT = std::max(dT, 1.0);
   const double t_amb = ambient + 273.15;
@@ -251,12 +231,17 @@ void SolvePhase(const UnitModel& m, UnitState& s, double t_thermal, double stret
 
   double xi = xi0;
   double te;
-  const double te_h0 = teff_h(xi0);
+  // Tension and its slope at xi0, shared by the branch test and the first residual of either
+  // branch (the values gd_h(xi0) and gd_c(xi0) would compute; temp(xi0) = t_thermal).
+  double dfdx0;
+  const double f0 = m.Tension(xi0, stretch, &dfdx0);
+  const double te_h0 = t_thermal - per_newton_h * f0;
   if (te_h0 >= s.t_eff) {
     // Heating (or steady): M -> A only, xi can only fall.
     te = te_h0;
-    double g0, dg0;
-    gd_h(xi0, &g0, &dg0);
+    double slope0;
+    const double g0 = xi0 - s.heat_scale * m.MajorHeating(te_h0, &slope0);
+    const double dg0 = 1 - s.heat_scale * slope0 * (latent - per_newton_h * dfdx0);
     if (g0 > 1e-12) {
       xi = SolveNewton(gd_h, 0.0, xi0, xi0, g0, dg0);
       te = teff_h(xi);
@@ -266,9 +251,10 @@ void SolvePhase(const UnitModel& m, UnitState& s, double t_thermal, double stret
     }
   } else {
     // Cooling: A -> M only, xi can only rise.
-    te = teff_c(xi0);
-    double g0, dg0;
-    gd_c(xi0, &g0, &dg0);
+    te = t_thermal - per_newton_c * f0;
+    double slope0;
+    const double g0 = xi0 - 1 + s.cool_scale * (1 - m.MajorCooling(te, &slope0));
+    const double dg0 = 1 - s.cool_scale * slope0 * (latent - per_newton_c * dfdx0);
     if (g0 < -1e-12) {
       xi = SolveNewton(gd_c, xi0, 1.0, xi0, g0, dg0);
       te = teff_c(xi);

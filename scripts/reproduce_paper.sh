@@ -68,7 +68,7 @@ echo "== dT x lambda sweeps (stability maps)"
 "$RECRUIT" sweep --task "$TASK" --out "$OUT/map_output" --dT 0.25,0.5,1.0,2.0 \
   --lambda 0.1,0.2,0.35,0.5 --estimator output --seeds "${MAP_SEEDS:-5}"
 cp "$OUT/map_output/stability.png" docs/img/sweep_stability_output.png
-"$RECRUIT" sweep --task "$TASK" --out "$OUT/map_kalman" --dT 0.5 \
+"$RECRUIT" sweep --task "$TASK" --out "$OUT/map_kalman" --dT 0.5,2.0 \
   --lambda 0.1,0.2,0.35,0.5 --estimator kalman-augmented --seeds "${MAP_SEEDS:-5}" "${FM[@]}"
 cp "$OUT/map_kalman/stability.png" docs/img/sweep_stability_kalman.png
 echo "== arm tasks (seed 1, output only)"

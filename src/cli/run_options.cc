@@ -5,13 +5,15 @@ namespace recruit::cli {
 void AddRunOptions(CLI::App* cmd, sim::RunOptions* options) {
   cmd->add_option_function<std::string>(
          "--estimator", [options](const std::string& v) { options->estimator = v; },
-         "How the controller counts units that are on: output (force / per-unit force, the "
-         "paper's output-only count), kalman (population Kalman filter on the filter model) "
-         "[default: the task file's]")
+         "How the controller counts units that are on: output (force / settled unit force, the "
+         "paper's output-only count), kalman2 (population Kalman filter, two-state model), "
+         "kalman-augmented (population Kalman filter on the identified 20-state model, "
+         "models/identified/) [default: the task file's]")
       ->type_name("NAME");
   cmd->add_option_function<std::string>(
          "--filter-model", [options](const std::string& v) { options->filter_model = v; },
-         "Filter model file (JSON) for the kalman estimator [default: the task file's]")
+         "Filter model file (JSON) for kalman-augmented [default: the task file's, else the "
+         "one identified for dT]")
       ->type_name("FILE")
       ->check(CLI::ExistingFile);
   cmd->add_option_function<double>(

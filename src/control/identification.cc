@@ -329,26 +329,35 @@ Result<IdentificationResult> IdentifyTransientModel(const SwitchingLog& log,
   }
   // Start from the deterministic chain (each state = k periods since the switch) with the
   // heat-level targets; alternate the switching targets (greedy) and the advance probabilities
-  // (Levenberg-Marquardt) until the targets settle.
-  Problem problem(log, train, opt, TransientChain::Uniform(opt.num_states, 1.0));
+  // (Levenberg-Marquardt) until the targets settle. Two schedules, the better kept: targets
+  // first (when the heat-level targets are far off, fitting the advance probabilities to them
+  // would bend the chains) and advance probabilities first (when they are right, a greedy step
+  // taken with all a = 1 can move a target to compensate for the wrong a).
   IdentificationResult best;
-  Eigen::VectorXd a = Eigen::VectorXd::Ones(problem.num_params());
-  for (int round = 0; round < opt.max_rounds; ++round) {
-    // Targets first: with the heat-level targets the mid-transient switches can be far off, and
-    // fitting the advance probabilities to them would bend the chains.
-    bool changed = false;
-    for (int sweep = 0; sweep < 3 && RefineTargets(problem, a); ++sweep) changed = true;
-    if (round > 0 && !changed) break;
-    double cost = 0;
-    int iters = 0;
-    a = FitAdvance(problem, a, opt.min_advance, opt.max_iterations, &cost, &iters);
-    best.iterations += iters;
-  }
-  best.chain = problem.WithParams(a);
-  {
+  best.cost = std::numeric_limits<double>::infinity();
+  for (bool targets_first : {true, false}) {
+    Problem problem(log, train, opt, TransientChain::Uniform(opt.num_states, 1.0));
+    Eigen::VectorXd a = Eigen::VectorXd::Ones(problem.num_params());
+    int total_iters = 0;
+    for (int round = 0; round < opt.max_rounds; ++round) {
+      bool changed = false;
+      if (targets_first || round > 0) {
+        for (int sweep = 0; sweep < 3 && RefineTargets(problem, a); ++sweep) changed = true;
+        if (round > 0 && !changed) break;
+      }
+      double cost = 0;
+      int iters = 0;
+      a = FitAdvance(problem, a, opt.min_advance, opt.max_iterations, &cost, &iters);
+      total_iters += iters;
+    }
     Eigen::VectorXd h;
-    best.cost = problem.Residual(a, &h).squaredNorm();
-    best.chain.force = h;
+    const double cost = problem.Residual(a, &h).squaredNorm();
+    if (cost < best.cost) {
+      best.cost = cost;
+      best.iterations = total_iters;
+      best.chain = problem.WithParams(a);
+      best.chain.force = h;
+    }
   }
 
   const Eigen::VectorXd pred = PredictMeanForce(best.chain, log);

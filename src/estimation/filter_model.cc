@@ -1,5 +1,6 @@
 #include "estimation/filter_model.h"
 
+#include <algorithm>
 #include <cmath>
 #include <nlohmann/json.hpp>
 #include <set>
@@ -257,9 +258,49 @@ nlohmann::json FilterModel::ToJson() const {
   return j;
 }
 
+namespace {
+
+// Human-readable JSON: objects one key per line in a fixed order, matrices one row per line,
+// everything else compact.
+void WriteReadable(const nlohmann::json& v, int indent, std::string& out) {
+  const std::string pad(indent, ' ');
+  if (v.is_object()) {
+    static const std::vector<std::string> order = {
+        "format", "version",    "states",  "N",     "H",        "R",         "G",
+        "Qw",     "type",       "dt",      "is_on", "interior", "on_target", "off_target",
+        "A",      "transition", "initial", "x0",    "P0"};
+    std::vector<std::string> keys;
+    for (const auto& k : order) {
+      if (v.contains(k)) keys.push_back(k);
+    }
+    for (const auto& [k, _] : v.items()) {
+      if (std::find(keys.begin(), keys.end(), k) == keys.end()) keys.push_back(k);
+    }
+    out += "{\n";
+    for (size_t i = 0; i < keys.size(); ++i) {
+      out += pad + "  " + nlohmann::json(keys[i]).dump() + ": ";
+      WriteReadable(v[keys[i]], indent + 2, out);
+      out += i + 1 < keys.size() ? ",\n" : "\n";
+    }
+    out += pad + "}";
+  } else if (v.is_array() && !v.empty() && v[0].is_array()) {
+    out += "[\n";
+    for (size_t i = 0; i < v.size(); ++i) {
+      out += pad + "  " + v[i].dump() + (i + 1 < v.size() ? ",\n" : "\n");
+    }
+    out += pad + "]";
+  } else {
+    out += v.dump();
+  }
+}
+
+}  // namespace
+
 Status FilterModel::Save(const std::string& path) const {
   if (Status s = Validate(path); !s.ok()) return s;
-  return WriteFileAtomically(path, ToJson().dump(2) + "\n");
+  std::string text;
+  WriteReadable(ToJson(), 0, text);
+  return WriteFileAtomically(path, text + "\n");
 }
 
 FilterModel FilterModel::TwoState(int64_t N, double dt, double unit_force, double noise_std) {

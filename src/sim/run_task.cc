@@ -267,6 +267,8 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
       }
       for (int i = 0; i < nb; ++i) {
         const int b = bundles[i];
+        // The a-posteriori estimate is of the state at this instant, before its broadcast.
+        const int on_before = plugin.OnCount(d, b);
         const control::Broadcast bc = controllers[i].Step(force_ref[i], plugin.Force(d, b));
         Status st = plugin.Broadcast(d, b, bc.p_on, bc.p_off);
         if (!st.ok()) return Error{where + ": " + st.error()};
@@ -278,7 +280,7 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
         if (i == 0) {
           est_on.push_back(controllers[i].estimated_on());
           est_var.push_back(controllers[i].estimated_on_variance());
-          true_on.push_back(plugin.OnCount(d, b));  // before this broadcast, as the estimate
+          true_on.push_back(on_before);
         }
       }
       sample.p_on = sample.bundles[0].p_on;
@@ -371,12 +373,15 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
   mt.iae = IntegralAbsoluteError(ts, rs, ys, d->time + h);
   s.steps = StepResponses(ts, ys, task.reference.Steps(duration), task.settle_band);
   mt.num_steps = static_cast<int>(s.steps.size());
+  int settled = 0;
   for (const auto& st : s.steps) {
     mt.overshoot += st.overshoot / s.steps.size();
     mt.max_overshoot = std::max(mt.max_overshoot, st.overshoot);
     mt.settling_time += st.settling_time / s.steps.size();
-    mt.settled_fraction += (st.settled ? 1.0 : 0.0) / s.steps.size();
+    settled += st.settled ? 1 : 0;
   }
+  // A ratio of counts, so that "all settled" is exactly 1.
+  if (!s.steps.empty()) mt.settled_fraction = static_cast<double>(settled) / s.steps.size();
   mt.oscillation = ExcessTotalVariation(rs, ys);
   long units = 0;
   double rate = 0;

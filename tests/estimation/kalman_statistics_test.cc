@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <iostream>
 #include <vector>
 
 #include "estimation/population_chain.h"
@@ -88,6 +89,8 @@ TEST(EstimationKalmanStatistics, TracePMatchesMonteCarloMeanSquaredError) {
         [&](int r) { return (mc.xhat[r][t] - mc.x[r][t]).squaredNorm() - mc.P[r][t].trace(); });
     const auto [mse, mse_se] =
         MeanAndError([&](int r) { return (mc.xhat[r][t] - mc.x[r][t]).squaredNorm(); });
+    std::cout << "step " << t << ": MC mean |e|^2 " << mse << " +- " << mse_se << ", mean trace P "
+              << mse - diff << ", difference " << diff << " +- " << se << "\n";
     EXPECT_LT(std::abs(diff), 4.0 * se)
         << "step " << t << ": MSE " << mse << " +- " << mse_se << ", mean trace P " << mse - diff;
   }
@@ -158,8 +161,11 @@ int NeesBlocksOutsideBand(const MonteCarlo& mc, double* worst) {
 TEST(EstimationKalmanStatistics, NeesInsideChiSquareBand) {
   double worst = 0.0;
   const int outside = NeesBlocksOutsideBand(Extended(), &worst);
+  std::cout << "NEES block means outside the 95 % band: " << outside << " of 56, worst |NEES - 2| "
+            << worst << "\n";
   EXPECT_LE(outside, 8) << "of 56 block means; worst |NEES - 2| = " << worst;
   const int outside_plain = NeesBlocksOutsideBand(RunMonteCarlo(CovarianceMode::kPlain), &worst);
+  std::cout << "plain filter: " << outside_plain << " of 56 outside\n";
   EXPECT_GE(outside_plain, 40) << "the plain filter's NEES should be far too large";
 }
 
