@@ -51,7 +51,13 @@ TelemetryPlots::TelemetryPlots(double window)
   Style(recruitment_.get());
   std::snprintf(tracking_->title, sizeof(tracking_->title), "tracking");
   std::snprintf(tracking_->yformat, sizeof(tracking_->yformat), "%%.1f");
-  std::snprintf(recruitment_->yformat, sizeof(recruitment_->yformat), "%%.0f");
+  std::snprintf(recruitment_->yformat, sizeof(recruitment_->yformat), "%%.1f");
+  // y starts at [0, 1] and extends to fit the data (flg_extend), so a flat start (nothing on
+  // yet) gets readable ticks instead of MuJoCo's minimum range of 1e-5.
+  for (mjvFigure* fig : {tracking_.get(), recruitment_.get()}) {
+    fig->range[1][0] = 0;
+    fig->range[1][1] = 1;
+  }
   std::snprintf(recruitment_->title, sizeof(recruitment_->title), "units on (pale: estimated)");
   SetLine(tracking_.get(), 0, "reference", 1.f, 1.f, 1.f);
   SetLine(tracking_.get(), 1, "measured", 1.f, 0.35f, 0.2f);
