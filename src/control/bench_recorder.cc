@@ -6,25 +6,16 @@
 #include <memory>
 #include <vector>
 
+#include "common/mujoco_ptr.h"
 #include "plugin/sma_plugin.h"
 
 namespace recruit::control {
-namespace {
-
-struct ModelDeleter {
-  void operator()(mjModel* m) const { mj_deleteModel(m); }
-};
-struct DataDeleter {
-  void operator()(mjData* d) const { mj_deleteData(d); }
-};
-
-}  // namespace
+namespace {}  // namespace
 
 Result<BenchRecording> RecordBench(const std::string& model_path, const std::string& actuator,
                                    const Excitation& excitation, double dT, std::uint64_t seed) {
   char err[1000] = "";
-  std::unique_ptr<mjModel, ModelDeleter> m(
-      mj_loadXML(model_path.c_str(), nullptr, err, sizeof err));
+  ModelPtr m(mj_loadXML(model_path.c_str(), nullptr, err, sizeof err));
   if (!m) return Error{model_path + ": " + err};
   auto plugin = sma::SmaPlugin::Create(m.get());
   if (!plugin) return Error{model_path + ": " + plugin.error()};
@@ -39,7 +30,7 @@ Result<BenchRecording> RecordBench(const std::string& model_path, const std::str
     return Error{"identify: dT = " + std::to_string(dT) + " s must be a positive whole number of " +
                  model_path + "'s timesteps (" + std::to_string(h) + " s)"};
   }
-  std::unique_ptr<mjData, DataDeleter> d(mj_makeData(m.get()));
+  DataPtr d(mj_makeData(m.get()));
   p.Reset(d.get(), seed);
   BenchRecording rec;
   rec.unit_force = p.SettledUnitForce(b);

@@ -9,6 +9,8 @@
 #include <limits>
 #include <memory>
 
+#include "common/mujoco_ptr.h"
+
 #if RECRUIT_CONTROL_AVAILABLE && RECRUIT_SMA_AVAILABLE
 #include "control/recruitment_controller.h"
 #include "plugin/sma_plugin.h"
@@ -17,13 +19,6 @@
 
 namespace recruit::sim {
 namespace {
-
-struct ModelDeleter {
-  void operator()(mjModel* m) const { mj_deleteModel(m); }
-};
-struct DataDeleter {
-  void operator()(mjData* d) const { mj_deleteData(d); }
-};
 
 // Outer loop state of an angle task (PI with anti-windup, derivative on the measured velocity).
 struct AngleLoop {
@@ -113,8 +108,7 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
 
   // Plant.
   char load_error[1000] = "";
-  std::unique_ptr<mjModel, ModelDeleter> model(
-      mj_loadXML(task.model_path.c_str(), nullptr, load_error, sizeof load_error));
+  ModelPtr model(mj_loadXML(task.model_path.c_str(), nullptr, load_error, sizeof load_error));
   if (!model) {
     return Error{where + ".model: cannot load '" + task.model_path + "': " + load_error};
   }
@@ -187,7 +181,7 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
   };
   apply_payloads(0);
 
-  std::unique_ptr<mjData, DataDeleter> data(mj_makeData(m));
+  DataPtr data(mj_makeData(m));
   mjData* d = data.get();
   plugin.Reset(d, options.seed);
   mj_forward(m, d);

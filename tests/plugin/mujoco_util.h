@@ -7,16 +7,12 @@
 #include <memory>
 #include <string>
 
+#include "common/mujoco_ptr.h"
+
 namespace recruit::sma::testing {
 
-struct ModelDeleter {
-  void operator()(mjModel* m) const { mj_deleteModel(m); }
-};
-struct DataDeleter {
-  void operator()(mjData* d) const { mj_deleteData(d); }
-};
-using ModelPtr = std::unique_ptr<mjModel, ModelDeleter>;
-using DataPtr = std::unique_ptr<mjData, DataDeleter>;
+using ::recruit::DataPtr;
+using ::recruit::ModelPtr;
 
 // Compiles `xml`; on failure returns null and puts MuJoCo's message in *error.
 inline ModelPtr LoadXmlString(const std::string& xml, std::string* error = nullptr) {

@@ -11,6 +11,7 @@
 #include <memory>
 #include <string>
 
+#include "common/mujoco_ptr.h"
 #include "common/telemetry.h"
 
 namespace recruit::render::testing {
@@ -47,14 +48,8 @@ inline constexpr const char* kArmXml = R"(
 </mujoco>
 )";
 
-struct ModelDeleter {
-  void operator()(mjModel* m) const { mj_deleteModel(m); }
-};
-struct DataDeleter {
-  void operator()(mjData* d) const { mj_deleteData(d); }
-};
-using ModelPtr = std::unique_ptr<mjModel, ModelDeleter>;
-using DataPtr = std::unique_ptr<mjData, DataDeleter>;
+using ::recruit::DataPtr;
+using ::recruit::ModelPtr;
 
 inline ModelPtr LoadXml(const char* xml) {
   char error[1000] = "";
