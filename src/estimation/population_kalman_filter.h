@@ -242,7 +242,8 @@ template <int M, int R>
 void PopulationKalmanFilterT<M, R>::Predict(const Mat& A) {
   PrepareCovariancePredict();
   AM_.noalias() = A * M_;
-  P_.noalias() = AM_ * A.transpose();
+  // P is symmetric: only its upper triangle is computed (mirrored before the projection).
+  P_.template triangularView<Eigen::Upper>() = AM_ * A.transpose();
   if (mode_ != CovarianceMode::kPlain) ax_.noalias() = A * xq_;
   tmp_.noalias() = A * x_;
   FinishPredict();
@@ -292,9 +293,19 @@ void PopulationKalmanFilterT<M, R>::Update(const OutVec& y) {
   // Joseph form (I - K H) P (I - K H)^T + K R K^T, expanded with U = P H^T so that it costs
   // O(m^2 r): P - K U^T - U K^T + K S K^T. Valid for any K, symmetric by construction.
   KS_.noalias() = K_ * S_;
-  P_.noalias() -= K_ * U_.transpose();
-  P_.noalias() -= U_ * K_.transpose();
-  P_.noalias() += KS_ * K_.transpose();
+  if constexpr (R == 1) {
+    // One pass over the upper triangle (the same arithmetic per entry as the products below).
+    for (Eigen::Index j = 0; j < P_.cols(); ++j) {
+      const Eigen::Index n = j + 1;
+      P_.col(j).head(n) =
+          ((P_.col(j).head(n) - K_.col(0).head(n) * U_(j, 0)) - U_.col(0).head(n) * K_(j, 0)) +
+          KS_.col(0).head(n) * K_(j, 0);
+    }
+  } else {
+    P_.noalias() -= K_ * U_.transpose();
+    P_.noalias() -= U_ * K_.transpose();
+    P_.noalias() += KS_ * K_.transpose();
+  }
   MirrorUpperAndReproject();
 }
 
@@ -318,8 +329,8 @@ void PopulationKalmanFilterT<M, R>::Reproject() {
 template <int M, int R>
 void PopulationKalmanFilterT<M, R>::MirrorUpperAndReproject() {
   const Eigen::Index m = x_.size();
-  for (Eigen::Index j = 0; j < m; ++j) {
-    for (Eigen::Index i = 0; i < j; ++i) P_(j, i) = P_(i, j);
+  for (Eigen::Index i = 0; i < m; ++i) {
+    for (Eigen::Index j = i + 1; j < m; ++j) P_(j, i) = P_(i, j);  // contiguous writes
   }
   const double inv_m = 1.0 / static_cast<double>(m);
   x_.array() += (N_ - x_.sum()) * inv_m;
