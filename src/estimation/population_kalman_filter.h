@@ -106,6 +106,8 @@ class PopulationKalmanFilterT {
   // The same after copying P's upper triangle to its lower one (the predict and update compute
   // P up to round-off asymmetry; the upper triangle is taken as exact), cheaper than Reproject.
   void MirrorUpperAndReproject();
+  // Reproject for an exactly symmetric P.
+  void ReprojectSymmetric();
 
   CovarianceMode mode_ = CovarianceMode::kExtended;
   double N_ = 0.0;
@@ -294,19 +296,21 @@ void PopulationKalmanFilterT<M, R>::Update(const OutVec& y) {
   // O(m^2 r): P - K U^T - U K^T + K S K^T. Valid for any K, symmetric by construction.
   KS_.noalias() = K_ * S_;
   if constexpr (R == 1) {
-    // One pass over the upper triangle (the same arithmetic per entry as the products below).
+    // One pass per column: P_ij - (k_i u_j + u_i k_j) + (k_i k_j) s, the same arithmetic for
+    // (i, j) and (j, i), so P stays exactly symmetric and needs no mirroring.
+    const double s = S_(0, 0);
     for (Eigen::Index j = 0; j < P_.cols(); ++j) {
-      const Eigen::Index n = j + 1;
-      P_.col(j).head(n) =
-          ((P_.col(j).head(n) - K_.col(0).head(n) * U_(j, 0)) - U_.col(0).head(n) * K_(j, 0)) +
-          KS_.col(0).head(n) * K_(j, 0);
+      P_.col(j).array() =
+          (P_.col(j).array() - (K_.col(0).array() * U_(j, 0) + U_.col(0).array() * K_(j, 0))) +
+          (K_.col(0).array() * K_(j, 0)) * s;
     }
+    ReprojectSymmetric();
   } else {
     P_.noalias() -= K_ * U_.transpose();
     P_.noalias() -= U_ * K_.transpose();
     P_.noalias() += KS_ * K_.transpose();
+    MirrorUpperAndReproject();
   }
-  MirrorUpperAndReproject();
 }
 
 template <int M, int R>
@@ -332,6 +336,12 @@ void PopulationKalmanFilterT<M, R>::MirrorUpperAndReproject() {
   for (Eigen::Index i = 0; i < m; ++i) {
     for (Eigen::Index j = i + 1; j < m; ++j) P_(j, i) = P_(i, j);  // contiguous writes
   }
+  ReprojectSymmetric();
+}
+
+template <int M, int R>
+void PopulationKalmanFilterT<M, R>::ReprojectSymmetric() {
+  const Eigen::Index m = x_.size();
   const double inv_m = 1.0 / static_cast<double>(m);
   x_.array() += (N_ - x_.sum()) * inv_m;
   // As Reproject with sym(P) = P: column sums are the row sums (contiguous), and the update
