@@ -131,6 +131,9 @@ void BM_KalmanStepLegacy(benchmark::State& state) {
   }
   state.counters["flops"] = StepFlops(M);
 }
+BENCHMARK_TEMPLATE(BM_KalmanStepLegacy, 2);
+BENCHMARK_TEMPLATE(BM_KalmanStepLegacy, 3);
+BENCHMARK_TEMPLATE(BM_KalmanStepLegacy, 5);
 BENCHMARK_TEMPLATE(BM_KalmanStepLegacy, 10);
 BENCHMARK_TEMPLATE(BM_KalmanStepLegacy, 20);
 BENCHMARK_TEMPLATE(BM_KalmanStepLegacy, 50);
@@ -203,6 +206,23 @@ void BM_KalmanStepDynamic(benchmark::State& state) {
       benchmark::Counter(StepFlops(m) * 1e-9 * state.iterations(), benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_KalmanStepDynamic)->Arg(2)->Arg(5)->Arg(10)->Arg(20)->Arg(50);
+
+// The same with the filter of commit f33d0b3 (side-by-side baseline).
+void BM_KalmanStepDynamicLegacy(benchmark::State& state) {
+  const int m = static_cast<int>(state.range(0));
+  const FilterModel f = ChainModel(m);
+  const Sequence s = Simulate(f, kSequence, 1);
+  auto kf = legacy::LegacyKalmanFilterT<Eigen::Dynamic, Eigen::Dynamic>::Create(
+      f, CovarianceMode::kExtended);
+  int t = 0;
+  for (auto _ : state) {
+    kf->Predict(s.A[t]);
+    kf->Update(s.y[t]);
+    benchmark::DoNotOptimize(kf->estimate().data());
+    t = (t + 1) % kSequence;
+  }
+}
+BENCHMARK(BM_KalmanStepDynamicLegacy)->Arg(2)->Arg(5)->Arg(10)->Arg(20)->Arg(50);
 
 // The achievable flop rate: C += A B, 256 x 256, 2 n^3 flops.
 void BM_Gemm(benchmark::State& state) {

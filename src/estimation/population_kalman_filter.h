@@ -244,8 +244,13 @@ template <int M, int R>
 void PopulationKalmanFilterT<M, R>::Predict(const Mat& A) {
   PrepareCovariancePredict();
   AM_.noalias() = A * M_;
-  // P is symmetric: only its upper triangle is computed (mirrored before the projection).
-  P_.template triangularView<Eigen::Upper>() = AM_ * A.transpose();
+  if constexpr (M != Eigen::Dynamic && M < 8) {
+    // Small fixed sizes: Eigen's coefficient-wise product beats its triangular product.
+    P_.noalias() = AM_ * A.transpose();
+  } else {
+    // P is symmetric: only its upper triangle is computed (mirrored before the projection).
+    P_.template triangularView<Eigen::Upper>() = AM_ * A.transpose();
+  }
   if (mode_ != CovarianceMode::kPlain) ax_.noalias() = A * xq_;
   tmp_.noalias() = A * x_;
   FinishPredict();
