@@ -244,8 +244,8 @@ template <int M, int R>
 void PopulationKalmanFilterT<M, R>::Predict(const Mat& A) {
   PrepareCovariancePredict();
   AM_.noalias() = A * M_;
-  if constexpr (M != Eigen::Dynamic && M < 8) {
-    // Small fixed sizes: Eigen's coefficient-wise product beats its triangular product.
+  if (M != Eigen::Dynamic ? M < 8 : A.rows() < 16) {
+    // Small sizes: Eigen's full product beats its triangular product (measured).
     P_.noalias() = AM_ * A.transpose();
   } else {
     // P is symmetric: only its upper triangle is computed (mirrored before the projection).
