@@ -45,7 +45,7 @@ struct BroadcastTransitionModel {
   }
 
   // The sparsity pattern of A(p_on, p_off) for every (p_on, p_off): the nonzeros of `interior`
-  // and each column's switch target; values are A(0, 0). Build once, then FillSparse.
+  // and each column's switch target; values those of A(0, 0). Build once, then FillSparse.
   Eigen::SparseMatrix<double> SparsePattern() const;
   // Writes the values of A(p_on, p_off) into a matrix with the structure SparsePattern()
   // returned (no allocation; for PopulationKalmanFilterT::Predict's sparse overload).
