@@ -1,6 +1,11 @@
 // Estimation benchmarks (docs/benchmarks.md, "Estimation (issue 2)"):
 //  - BM_KalmanStep<M>: one predict + update of the fixed-size extended filter, r = 1, against
 //    its floating-point operation count (counter "flops" per step and "GFLOPS" achieved);
+//    BM_KalmanStepLegacy<M>: the same with the filter of commit f33d0b3 (legacy_kalman_filter.h),
+//    the side-by-side baseline of this run;
+//  - BM_BroadcastStep/<path>: one predict + update of PopulationKalmanFilterT<20, 1> with the
+//    identified 20-state broadcast model (models/identified/bench_n60_dt0.5_m20.json), A built
+//    from (p_on, p_off) inside the timed step: path 0 = legacy dense, 1 = dense, 2 = sparse A;
 //    BM_KalmanStepDynamic: the same with dynamic-size matrices;
 //  - BM_Gemm: a 256 x 256 dense matrix product, the machine's achievable flop rate with the
 //    same compiler flags (the reference for the flop bound);
@@ -19,6 +24,7 @@
 #include "estimation/particle_filter.h"
 #include "estimation/population_chain.h"
 #include "estimation/population_kalman_filter.h"
+#include "legacy_kalman_filter.h"
 
 namespace recruit {
 namespace {
@@ -108,6 +114,81 @@ BENCHMARK_TEMPLATE(BM_KalmanStep, 10);
 BENCHMARK_TEMPLATE(BM_KalmanStep, 20);
 BENCHMARK_TEMPLATE(BM_KalmanStep, 50);
 
+template <int M>
+void BM_KalmanStepLegacy(benchmark::State& state) {
+  const FilterModel f = ChainModel(M);
+  const Sequence s = Simulate(f, kSequence, 1);
+  std::vector<Eigen::Matrix<double, M, M>> A(s.A.begin(), s.A.end());
+  std::vector<Eigen::Matrix<double, 1, 1>> y;
+  for (const auto& v : s.y) y.emplace_back(v(0));
+  auto kf = legacy::LegacyKalmanFilterT<M, 1>::Create(f, CovarianceMode::kExtended);
+  int t = 0;
+  for (auto _ : state) {
+    kf->Predict(A[t]);
+    kf->Update(y[t]);
+    benchmark::DoNotOptimize(kf->estimate().data());
+    t = (t + 1) % kSequence;
+  }
+  state.counters["flops"] = StepFlops(M);
+}
+BENCHMARK_TEMPLATE(BM_KalmanStepLegacy, 2);
+BENCHMARK_TEMPLATE(BM_KalmanStepLegacy, 3);
+BENCHMARK_TEMPLATE(BM_KalmanStepLegacy, 5);
+BENCHMARK_TEMPLATE(BM_KalmanStepLegacy, 10);
+BENCHMARK_TEMPLATE(BM_KalmanStepLegacy, 20);
+BENCHMARK_TEMPLATE(BM_KalmanStepLegacy, 50);
+
+// The identified 20-state broadcast model, stepped with random (p_on, p_off) and force
+// measurements of a simulated run; range(0): 0 = legacy dense, 1 = dense, 2 = sparse A.
+void BM_BroadcastStep(benchmark::State& state) {
+  constexpr int kM = 20;
+  auto model =
+      FilterModel::FromJson(RECRUIT_SOURCE_DIR "/models/identified/bench_n60_dt0.5_m20.json");
+  if (!model.ok()) {
+    state.SkipWithError(model.error().c_str());
+    return;
+  }
+  const FilterModel& f = *model;
+  const BroadcastTransitionModel& b = f.broadcast;
+  Rng rng(7);
+  std::vector<double> p_on(kSequence), p_off(kSequence);
+  std::vector<Eigen::Matrix<double, 1, 1>> y(kSequence);
+  Eigen::VectorXd x = f.x0;
+  for (int t = 0; t < kSequence; ++t) {
+    p_on[t] = rng.Uniform();
+    p_off[t] = rng.Uniform();
+    y[t] = f.H * x + Eigen::VectorXd::Constant(1, std::sqrt(f.R(0, 0)) * Gaussian(rng));
+    x = SimulateStepAggregate(b.Matrix(p_on[t], p_off[t]), x, rng);
+  }
+  const int path = static_cast<int>(state.range(0));
+  auto kf = PopulationKalmanFilterT<kM, 1>::Create(f, CovarianceMode::kExtended);
+  auto old = legacy::LegacyKalmanFilterT<kM, 1>::Create(f, CovarianceMode::kExtended);
+  Eigen::Matrix<double, kM, kM> A;
+  Eigen::SparseMatrix<double> As = b.SparsePattern();
+  int t = 0;
+  for (auto _ : state) {
+    if (path == 0) {
+      b.FillMatrix(p_on[t], p_off[t], A);
+      old->Predict(A);
+      old->Update(y[t]);
+      benchmark::DoNotOptimize(old->estimate().data());
+    } else if (path == 1) {
+      b.FillMatrix(p_on[t], p_off[t], A);
+      kf->Predict(A);
+      kf->Update(y[t]);
+      benchmark::DoNotOptimize(kf->estimate().data());
+    } else {
+      b.FillSparse(p_on[t], p_off[t], As);
+      kf->Predict(As);
+      kf->Update(y[t]);
+      benchmark::DoNotOptimize(kf->estimate().data());
+    }
+    t = (t + 1) % kSequence;
+  }
+  state.counters["nnz_A"] = static_cast<double>(As.nonZeros());
+}
+BENCHMARK(BM_BroadcastStep)->Arg(0)->Arg(1)->Arg(2);
+
 void BM_KalmanStepDynamic(benchmark::State& state) {
   const int m = static_cast<int>(state.range(0));
   const FilterModel f = ChainModel(m);
@@ -125,6 +206,23 @@ void BM_KalmanStepDynamic(benchmark::State& state) {
       benchmark::Counter(StepFlops(m) * 1e-9 * state.iterations(), benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_KalmanStepDynamic)->Arg(2)->Arg(5)->Arg(10)->Arg(20)->Arg(50);
+
+// The same with the filter of commit f33d0b3 (side-by-side baseline).
+void BM_KalmanStepDynamicLegacy(benchmark::State& state) {
+  const int m = static_cast<int>(state.range(0));
+  const FilterModel f = ChainModel(m);
+  const Sequence s = Simulate(f, kSequence, 1);
+  auto kf = legacy::LegacyKalmanFilterT<Eigen::Dynamic, Eigen::Dynamic>::Create(
+      f, CovarianceMode::kExtended);
+  int t = 0;
+  for (auto _ : state) {
+    kf->Predict(s.A[t]);
+    kf->Update(s.y[t]);
+    benchmark::DoNotOptimize(kf->estimate().data());
+    t = (t + 1) % kSequence;
+  }
+}
+BENCHMARK(BM_KalmanStepDynamicLegacy)->Arg(2)->Arg(5)->Arg(10)->Arg(20)->Arg(50);
 
 // The achievable flop rate: C += A B, 256 x 256, 2 n^3 flops.
 void BM_Gemm(benchmark::State& state) {

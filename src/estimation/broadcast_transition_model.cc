@@ -8,6 +8,22 @@
 
 namespace recruit {
 
+Eigen::SparseMatrix<double> BroadcastTransitionModel::SparsePattern() const {
+  const int m = num_states();
+  std::vector<Eigen::Triplet<double>> entries;
+  for (int j = 0; j < m; ++j) {
+    const int target = is_on[j] ? off_target[j] : on_target[j];
+    for (int i = 0; i < m; ++i) {
+      if (interior(i, j) != 0.0 || i == target) entries.emplace_back(i, j, 0.0);
+    }
+  }
+  Eigen::SparseMatrix<double> A(m, m);
+  A.setFromTriplets(entries.begin(), entries.end());
+  A.makeCompressed();
+  FillSparse(0.0, 0.0, A);
+  return A;
+}
+
 Eigen::MatrixXd BroadcastTransitionModel::Matrix(double p_on, double p_off) const {
   Eigen::MatrixXd A(num_states(), num_states());
   FillMatrix(p_on, p_off, A);

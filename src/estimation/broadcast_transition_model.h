@@ -3,6 +3,7 @@
 #pragma once
 
 #include <Eigen/Dense>
+#include <Eigen/SparseCore>
 #include <nlohmann/json_fwd.hpp>
 #include <string>
 #include <vector>
@@ -40,6 +41,22 @@ struct BroadcastTransitionModel {
       const int target = is_on[j] ? off_target[j] : on_target[j];
       for (int i = 0; i < m; ++i) A(i, j) = (1.0 - p) * interior(i, j);
       A(target, j) += p;
+    }
+  }
+
+  // The sparsity pattern of A(p_on, p_off) for every (p_on, p_off): the nonzeros of `interior`
+  // and each column's switch target; values those of A(0, 0). Build once, then FillSparse.
+  Eigen::SparseMatrix<double> SparsePattern() const;
+  // Writes the values of A(p_on, p_off) into a matrix with the structure SparsePattern()
+  // returned (no allocation; for PopulationKalmanFilterT::Predict's sparse overload).
+  void FillSparse(double p_on, double p_off, Eigen::SparseMatrix<double>& A) const {
+    for (int j = 0; j < A.outerSize(); ++j) {
+      const double p = is_on[j] ? p_off : p_on;
+      const int target = is_on[j] ? off_target[j] : on_target[j];
+      for (Eigen::SparseMatrix<double>::InnerIterator it(A, j); it; ++it) {
+        const int i = static_cast<int>(it.row());
+        it.valueRef() = (1.0 - p) * interior(i, j) + (i == target ? p : 0.0);
+      }
     }
   }
 

@@ -24,6 +24,7 @@
 #pragma once
 
 #include <Eigen/Dense>
+#include <Eigen/SparseCore>
 #include <algorithm>
 #include <functional>
 #include <string>
@@ -64,6 +65,11 @@ class PopulationKalmanFilterT {
   // Time update with the transition A(t) (eqs. 16, 22/27). A must be column-stochastic (the
   // caller validates it, or uses PredictChecked). A step without a measurement is Predict alone.
   void Predict(const Mat& A);
+  // The same for a sparse A (column-major, compressed; e.g. BroadcastTransitionModel::
+  // SparsePattern filled by FillSparse): A (P - diag xq) A^T as 2 m nnz(A) column updates
+  // instead of two dense m x m products; O(m^2 nnz / m) instead of O(m^3). A must be m x m and
+  // column-stochastic (not checked); no allocation. Equal to Predict(Mat(A)) up to round-off.
+  void Predict(const Eigen::SparseMatrix<double>& A);
   // Measurement update with y(t) (eqs. 15, 17, 19, 20 in Joseph form).
   void Update(const OutVec& y);
 
@@ -90,7 +96,18 @@ class PopulationKalmanFilterT {
 
  private:
   PopulationKalmanFilterT() = default;
+  // Sets M_ = P - diag xq (xq per the mode) before the covariance prediction.
+  void PrepareCovariancePredict();
+  // Adds diag(A xq) and G Qw G^T to P_ (ax_ = A xq computed by the caller), x_ = tmp_ (= A x),
+  // re-projects.
+  void FinishPredict();
+  // Projects X^ onto sum = N and P onto Pi sym(P) Pi, Pi = I - 1 1^T / m (any P).
   void Reproject();
+  // The same after copying P's upper triangle to its lower one (the predict and update compute
+  // P up to round-off asymmetry; the upper triangle is taken as exact), cheaper than Reproject.
+  void MirrorUpperAndReproject();
+  // Reproject for an exactly symmetric P.
+  void ReprojectSymmetric();
 
   CovarianceMode mode_ = CovarianceMode::kExtended;
   double N_ = 0.0;
@@ -198,7 +215,7 @@ Result<PopulationKalmanFilterT<M, R>> PopulationKalmanFilterT<M, R>::Create(
 }
 
 template <int M, int R>
-void PopulationKalmanFilterT<M, R>::Predict(const Mat& A) {
+void PopulationKalmanFilterT<M, R>::PrepareCovariancePredict() {
   // A P A^T + Qz(xq) = A (P - diag xq) A^T + diag(A xq); xq is the point Qz is evaluated at.
   M_ = P_;
   switch (mode_) {
@@ -209,19 +226,63 @@ void PopulationKalmanFilterT<M, R>::Predict(const Mat& A) {
       xq_.setConstant(N_);
       break;
     case CovarianceMode::kPlain:
+      xq_.setZero();
       break;
   }
   if (mode_ != CovarianceMode::kPlain) M_.diagonal() -= xq_;
-  AM_.noalias() = A * M_;
-  P_.noalias() = AM_ * A.transpose();
-  if (mode_ != CovarianceMode::kPlain) {
-    ax_.noalias() = A * xq_;
-    P_.diagonal() += ax_;
-  }
+}
+
+template <int M, int R>
+void PopulationKalmanFilterT<M, R>::FinishPredict() {
+  if (mode_ != CovarianceMode::kPlain) P_.diagonal() += ax_;
   if (has_process_noise_) P_ += GQG_;
-  tmp_.noalias() = A * x_;
   x_ = tmp_;
-  Reproject();
+  MirrorUpperAndReproject();
+}
+
+template <int M, int R>
+void PopulationKalmanFilterT<M, R>::Predict(const Mat& A) {
+  PrepareCovariancePredict();
+  AM_.noalias() = A * M_;
+  if (M != Eigen::Dynamic ? M < 8 : A.rows() < 16) {
+    // Small sizes: Eigen's full product beats its triangular product (measured).
+    P_.noalias() = AM_ * A.transpose();
+  } else {
+    // P is symmetric: only its upper triangle is computed (mirrored before the projection).
+    P_.template triangularView<Eigen::Upper>() = AM_ * A.transpose();
+  }
+  if (mode_ != CovarianceMode::kPlain) ax_.noalias() = A * xq_;
+  tmp_.noalias() = A * x_;
+  FinishPredict();
+}
+
+template <int M, int R>
+void PopulationKalmanFilterT<M, R>::Predict(const Eigen::SparseMatrix<double>& A) {
+  using It = Eigen::SparseMatrix<double>::InnerIterator;
+  PrepareCovariancePredict();
+  const Eigen::Index m = x_.size();
+  // B = M A^T column by column: A(i, l) = a adds a M(:, l) to B(:, i) (contiguous columns).
+  AM_.setZero();
+  ax_.setZero();
+  tmp_.setZero();
+  for (Eigen::Index l = 0; l < m; ++l) {
+    for (It it(A, l); it; ++it) {
+      AM_.col(it.row()) += it.value() * M_.col(l);
+      ax_(it.row()) += it.value() * xq_(l);
+      tmp_(it.row()) += it.value() * x_(l);
+    }
+  }
+  // B^T = A M (M is symmetric), then P = (A M) A^T by the same column updates.
+  // P is symmetric: only its upper triangle (rows 0..i of column i) is computed.
+  M_ = AM_.transpose();
+  P_.setZero();
+  for (Eigen::Index l = 0; l < m; ++l) {
+    for (It it(A, l); it; ++it) {
+      const Eigen::Index i = it.row();
+      P_.col(i).head(i + 1) += it.value() * M_.col(l).head(i + 1);
+    }
+  }
+  FinishPredict();
 }
 
 template <int M, int R>
@@ -239,10 +300,22 @@ void PopulationKalmanFilterT<M, R>::Update(const OutVec& y) {
   // Joseph form (I - K H) P (I - K H)^T + K R K^T, expanded with U = P H^T so that it costs
   // O(m^2 r): P - K U^T - U K^T + K S K^T. Valid for any K, symmetric by construction.
   KS_.noalias() = K_ * S_;
-  P_.noalias() -= K_ * U_.transpose();
-  P_.noalias() -= U_ * K_.transpose();
-  P_.noalias() += KS_ * K_.transpose();
-  Reproject();
+  if constexpr (R == 1) {
+    // One pass per column: P_ij - (k_i u_j + u_i k_j) + (k_i k_j) s, the same arithmetic for
+    // (i, j) and (j, i), so P stays exactly symmetric and needs no mirroring.
+    const double s = S_(0, 0);
+    for (Eigen::Index j = 0; j < P_.cols(); ++j) {
+      P_.col(j).array() =
+          (P_.col(j).array() - (K_.col(0).array() * U_(j, 0) + U_.col(0).array() * K_(j, 0))) +
+          (K_.col(0).array() * K_(j, 0)) * s;
+    }
+    ReprojectSymmetric();
+  } else {
+    P_.noalias() -= K_ * U_.transpose();
+    P_.noalias() -= U_ * K_.transpose();
+    P_.noalias() += KS_ * K_.transpose();
+    MirrorUpperAndReproject();
+  }
 }
 
 template <int M, int R>
@@ -259,6 +332,30 @@ void PopulationKalmanFilterT<M, R>::Reproject() {
       P_(i, j) = v;
       P_(j, i) = v;
     }
+  }
+}
+
+template <int M, int R>
+void PopulationKalmanFilterT<M, R>::MirrorUpperAndReproject() {
+  const Eigen::Index m = x_.size();
+  for (Eigen::Index i = 0; i < m; ++i) {
+    for (Eigen::Index j = i + 1; j < m; ++j) P_(j, i) = P_(i, j);  // contiguous writes
+  }
+  ReprojectSymmetric();
+}
+
+template <int M, int R>
+void PopulationKalmanFilterT<M, R>::ReprojectSymmetric() {
+  const Eigen::Index m = x_.size();
+  const double inv_m = 1.0 / static_cast<double>(m);
+  x_.array() += (N_ - x_.sum()) * inv_m;
+  // As Reproject with sym(P) = P: column sums are the row sums (contiguous), and the update
+  // P_ij - (c_i + c_j) / m + s / m^2 is the same arithmetic for (i, j) and (j, i), so P stays
+  // exactly symmetric; column by column, so that it vectorises.
+  rowsum_ = P_.colwise().sum().transpose();
+  const double s = rowsum_.sum() * inv_m * inv_m;
+  for (Eigen::Index j = 0; j < m; ++j) {
+    P_.col(j).array() -= (rowsum_.array() + rowsum_(j)) * inv_m - s;
   }
 }
 

@@ -51,6 +51,40 @@ long AllocationsPerSteps(CovarianceMode mode) {
   return g_allocations.load() - before;
 }
 
+// The sparse-A Predict with a broadcast model's pattern built once (outside the count):
+// FillSparse and Predict write in place.
+long AllocationsPerSparseSteps() {
+  constexpr int M = 3;
+  FilterModel f;
+  f.state_names = {"off", "warming", "on"};
+  f.N = 60;
+  f.H = Eigen::RowVector3d(0.0, 0.2, 0.45);
+  f.R = Eigen::MatrixXd::Constant(1, 1, 0.3);
+  f.G = Eigen::MatrixXd::Zero(M, 0);
+  f.Qw = Eigen::MatrixXd::Zero(0, 0);
+  f.transition = TransitionSource::kBroadcast;
+  BroadcastTransitionModel& b = f.broadcast;
+  b.state_names = f.state_names;
+  b.is_on = {false, true, true};
+  b.interior = Eigen::Matrix3d{{1, 0, 0}, {0, 0.4, 0}, {0, 0.6, 1}};
+  b.on_target = {1, -1, -1};
+  b.off_target = {-1, 0, 0};
+  b.dt = 0.5;
+  f.x0 = Eigen::Vector3d(60, 0, 0);
+  f.P0 = Eigen::Matrix3d::Zero();
+  auto kf = PopulationKalmanFilterT<M, 1>::Create(f, CovarianceMode::kExtended);
+  EXPECT_TRUE(kf.ok());
+  Eigen::SparseMatrix<double> A = b.SparsePattern();
+  const Eigen::Matrix<double, 1, 1> y(5.0);
+  const long before = g_allocations.load();
+  for (int t = 0; t < 100; ++t) {
+    b.FillSparse(0.01 * t, 0.005 * t, A);
+    kf->Predict(A);
+    kf->Update(y);
+  }
+  return g_allocations.load() - before;
+}
+
 // No dynamic-size member: the whole filter state lives in the object.
 static_assert(PopulationKalmanFilterT<20, 1>::Mat::RowsAtCompileTime == 20);
 static_assert(sizeof(PopulationKalmanFilterT<20, 1>) >= 4 * 20 * 20 * sizeof(double));
@@ -60,6 +94,7 @@ TEST(EstimationKalmanNoAllocation, FixedSizePredictAndUpdate) {
   EXPECT_EQ(AllocationsPerSteps<3>(CovarianceMode::kConservative), 0);
   EXPECT_EQ(AllocationsPerSteps<20>(CovarianceMode::kExtended), 0);
   EXPECT_EQ(AllocationsPerSteps<20>(CovarianceMode::kPlain), 0);
+  EXPECT_EQ(AllocationsPerSparseSteps(), 0);
   // The counter works (a std::vector allocates through operator new). Eigen's own heap
   // matrices go through malloc directly; the fixed-size filter has none (its members are
   // fixed-size Eigen types, checked by the static assertion below).

@@ -1,0 +1,170 @@
+// The sparse-A Predict overload against the dense Predict (the reference) and against the
+// prediction equations written out with dense matrices; BroadcastTransitionModel's sparse
+// pattern and FillSparse against its dense Matrix.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <string>
+#include <vector>
+
+#include "common/rng.h"
+#include "estimation/population_kalman_filter.h"
+
+namespace recruit {
+namespace {
+
+// m states, N = 60, a force sensor (state i gives 0.45 i / (m - 1) per unit), P0 a random
+// PSD matrix (projected onto 1^T P0 = 0 by the filter), x0 a random point of the simplex.
+FilterModel RandomModel(int m, Rng& rng, bool process_noise) {
+  FilterModel f;
+  for (int i = 0; i < m; ++i) f.state_names.push_back("s" + std::to_string(i));
+  f.N = 60;
+  f.H.resize(1, m);
+  for (int i = 0; i < m; ++i) f.H(0, i) = 0.45 * i / (m - 1);
+  f.R = Eigen::MatrixXd::Constant(1, 1, 0.36);
+  if (process_noise) {
+    // Columns summing to zero so that 1^T G Qw G^T = 0 (required by the model).
+    f.G = Eigen::MatrixXd::Zero(m, 2);
+    f.G(0, 0) = 1, f.G(1, 0) = -1, f.G(m - 1, 1) = 1, f.G(m / 2, 1) = -1;
+    f.Qw = Eigen::Matrix2d{{0.3, 0.1}, {0.1, 0.2}};
+  } else {
+    f.G = Eigen::MatrixXd::Zero(m, 0);
+    f.Qw = Eigen::MatrixXd::Zero(0, 0);
+  }
+  f.transition = TransitionSource::kExplicit;
+  Eigen::VectorXd w(m);
+  for (int i = 0; i < m; ++i) w(i) = rng.Uniform();
+  f.x0 = 60.0 * w / w.sum();
+  Eigen::MatrixXd L(m, m);
+  for (int i = 0; i < m * m; ++i) L.data()[i] = rng.Uniform() - 0.5;
+  f.P0 = 4.0 * L * L.transpose();
+  return f;
+}
+
+// A random column-stochastic m x m matrix with 1 to 3 nonzeros per column at random rows.
+Eigen::SparseMatrix<double> RandomSparseStochastic(int m, Rng& rng) {
+  std::vector<Eigen::Triplet<double>> entries;
+  for (int j = 0; j < m; ++j) {
+    const int k = 1 + static_cast<int>(rng.Uniform() * 3.0);
+    std::vector<int> rows;
+    while (static_cast<int>(rows.size()) < k) {
+      const int i = static_cast<int>(rng.Uniform() * m);
+      if (std::find(rows.begin(), rows.end(), i) == rows.end()) rows.push_back(i);
+    }
+    std::vector<double> v(k);
+    double sum = 0;
+    for (double& e : v) sum += e = 0.05 + rng.Uniform();
+    for (int e = 0; e < k; ++e) entries.emplace_back(rows[e], j, v[e] / sum);
+  }
+  Eigen::SparseMatrix<double> A(m, m);
+  A.setFromTriplets(entries.begin(), entries.end());
+  A.makeCompressed();
+  return A;
+}
+
+double Scale(const Eigen::MatrixXd& P) { return 1.0 + P.cwiseAbs().maxCoeff(); }
+
+// 40 predict + update steps with random sparse A: the sparse and the dense Predict give the
+// same estimate and covariance to 1e-12 (relative to the covariance's size) at every step.
+template <int M>
+void SparseMatchesDense(CovarianceMode mode, bool process_noise, uint64_t seed) {
+  Rng rng(seed);
+  const int m = M == Eigen::Dynamic ? 20 : M;
+  const FilterModel f = RandomModel(m, rng, process_noise);
+  auto sparse = PopulationKalmanFilterT<M, 1>::Create(f, mode);
+  auto dense = PopulationKalmanFilterT<M, 1>::Create(f, mode);
+  ASSERT_TRUE(sparse.ok()) << sparse.error();
+  ASSERT_TRUE(dense.ok());
+  using Mat = typename PopulationKalmanFilterT<M, 1>::Mat;
+  for (int t = 0; t < 40; ++t) {
+    const Eigen::SparseMatrix<double> A = RandomSparseStochastic(m, rng);
+    const Mat Ad = Eigen::MatrixXd(A);
+    sparse->Predict(A);
+    dense->Predict(Ad);
+    const double scale = Scale(dense->covariance());
+    ASSERT_LT((sparse->covariance() - dense->covariance()).cwiseAbs().maxCoeff(), 1e-12 * scale)
+        << "step " << t;
+    ASSERT_LT((sparse->estimate() - dense->estimate()).cwiseAbs().maxCoeff(), 1e-12 * 60.0);
+    const Eigen::Matrix<double, 1, 1> y(f.H.row(0).dot(dense->estimate()) +
+                                        0.6 * (rng.Uniform() - 0.5));
+    sparse->Update(y);
+    dense->Update(y);
+  }
+}
+
+TEST(EstimationKalmanSparse, MatchesDensePredictFixedSize) {
+  SparseMatchesDense<20>(CovarianceMode::kExtended, false, 1);
+  SparseMatchesDense<20>(CovarianceMode::kConservative, false, 2);
+  SparseMatchesDense<20>(CovarianceMode::kPlain, false, 3);
+  SparseMatchesDense<20>(CovarianceMode::kExtended, true, 4);
+  SparseMatchesDense<3>(CovarianceMode::kExtended, false, 5);
+}
+
+TEST(EstimationKalmanSparse, MatchesDensePredictDynamicSize) {
+  SparseMatchesDense<Eigen::Dynamic>(CovarianceMode::kExtended, false, 6);
+  SparseMatchesDense<Eigen::Dynamic>(CovarianceMode::kConservative, true, 7);
+}
+
+// One prediction against the equations with dense matrices (eqs. 16, 22, 26): P' = A P A^T +
+// diag(A x) - A diag(x) A^T + G Qw G^T at a feasible x, x' = A x, then the projection onto
+// 1^T P = 0 (P already satisfies it, and so does the prediction: no change beyond round-off).
+TEST(EstimationKalmanSparse, MatchesPredictionEquations) {
+  Rng rng(11);
+  const int m = 20;
+  const FilterModel f = RandomModel(m, rng, true);
+  auto kf = PopulationKalmanFilter::Create(f, CovarianceMode::kExtended);
+  ASSERT_TRUE(kf.ok());
+  const Eigen::VectorXd x = kf->estimate();
+  const Eigen::MatrixXd P = kf->covariance();
+  ASSERT_TRUE((x.array() >= 0).all());
+  const Eigen::SparseMatrix<double> As = RandomSparseStochastic(m, rng);
+  const Eigen::MatrixXd A(As);
+  kf->Predict(As);
+  const Eigen::MatrixXd expected = A * P * A.transpose() + Eigen::MatrixXd((A * x).asDiagonal()) -
+                                   A * x.asDiagonal() * A.transpose() +
+                                   f.G * f.Qw * f.G.transpose();
+  EXPECT_LT((kf->covariance() - expected).cwiseAbs().maxCoeff(), 1e-11 * Scale(expected));
+  EXPECT_LT((kf->estimate() - A * x).cwiseAbs().maxCoeff(), 1e-11 * 60.0);
+}
+
+// The identified 20-state models: SparsePattern + FillSparse equal Matrix (exactly: the same
+// arithmetic), nonzeros at most 3 per column, and the filters agree to 1e-12 over 64 steps of
+// random (p_on, p_off) including the ends 0 and 1.
+TEST(EstimationKalmanSparse, IdentifiedBroadcastModels) {
+  for (const char* name : {"bench_n60_dt0.5_m20.json", "bench_n60_dt2.0_m20.json"}) {
+    SCOPED_TRACE(name);
+    auto model =
+        FilterModel::FromJson(std::string(RECRUIT_SOURCE_DIR) + "/models/identified/" + name);
+    ASSERT_TRUE(model.ok()) << model.error();
+    const BroadcastTransitionModel& b = model->broadcast;
+    ASSERT_EQ(b.num_states(), 20);
+    Eigen::SparseMatrix<double> As = b.SparsePattern();
+    for (int j = 0; j < 20; ++j) EXPECT_LE(As.col(j).nonZeros(), 3);
+    auto sparse = PopulationKalmanFilterT<20, 1>::Create(*model, CovarianceMode::kExtended);
+    auto dense = PopulationKalmanFilterT<20, 1>::Create(*model, CovarianceMode::kExtended);
+    ASSERT_TRUE(sparse.ok()) << sparse.error();
+    ASSERT_TRUE(dense.ok());
+    Rng rng(13);
+    Eigen::VectorXd x = model->x0;
+    for (int t = 0; t < 64; ++t) {
+      const double p_on = t == 0 ? 0.0 : t == 1 ? 1.0 : rng.Uniform();
+      const double p_off = t == 0 ? 1.0 : t == 1 ? 0.0 : rng.Uniform();
+      b.FillSparse(p_on, p_off, As);
+      const Eigen::MatrixXd A = b.Matrix(p_on, p_off);
+      ASSERT_EQ((Eigen::MatrixXd(As) - A).cwiseAbs().maxCoeff(), 0.0) << "step " << t;
+      sparse->Predict(As);
+      dense->Predict(Eigen::Matrix<double, 20, 20>(A));
+      const double scale = Scale(dense->covariance());
+      ASSERT_LT((sparse->covariance() - dense->covariance()).cwiseAbs().maxCoeff(), 1e-12 * scale)
+          << "step " << t;
+      ASSERT_LT((sparse->estimate() - dense->estimate()).cwiseAbs().maxCoeff(), 1e-12 * 60.0);
+      x = SimulateStepAggregate(A, x, rng);
+      const Eigen::Matrix<double, 1, 1> y(model->H.row(0).dot(x) + 0.3 * (rng.Uniform() - 0.5));
+      sparse->Update(y);
+      dense->Update(y);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace recruit
