@@ -8,16 +8,16 @@
 namespace recruit {
 
 struct BundleTelemetry {
-  std::string actuator;        // actuator name in the model
-  int tendon_id = -1;          // tendon the bundle pulls (for colouring it in renders)
-  double force = 0;            // tension, N
-  int true_on = 0;             // units on (ground truth, the paper's debug interface)
-  double estimated_on = 0;     // the estimator's on-count (NaN when none)
-  double on_fraction = 0;      // true_on / num_units
-  double mean_temperature = 0; // deg C over all units
-  double heat = 0;             // 0 at ambient .. 1 at the on-state steady temperature
-  double force_reference = 0;  // N, the force the bundle's recruitment controller tracks
-  double p_on = 0, p_off = 0;  // the bundle's last broadcast
+  std::string actuator;         // actuator name in the model
+  int tendon_id = -1;           // tendon the bundle pulls (for colouring it in renders)
+  double force = 0;             // tension, N
+  int true_on = 0;              // units on (ground truth, the paper's debug interface)
+  double estimated_on = 0;      // the estimator's on-count (NaN when none)
+  double on_fraction = 0;       // true_on / num_units
+  double mean_temperature = 0;  // deg C over all units
+  double heat = 0;              // 0 at ambient .. 1 at the on-state steady temperature
+  double force_reference = 0;   // N, the force the bundle's recruitment controller tracks
+  double p_on = 0, p_off = 0;   // the bundle's last broadcast
 };
 
 struct TelemetrySample {
