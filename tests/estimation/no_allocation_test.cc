@@ -3,11 +3,13 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <cmath>
 #include <cstdlib>
 #include <new>
 #include <vector>
 
 #include "estimation/population_kalman_filter.h"
+#include "test_util.h"
 
 namespace {
 std::atomic<long> g_allocations{0};
@@ -55,23 +57,8 @@ long AllocationsPerSteps(CovarianceMode mode) {
 // FillSparse and Predict write in place.
 long AllocationsPerSparseSteps() {
   constexpr int M = 3;
-  FilterModel f;
-  f.state_names = {"off", "warming", "on"};
-  f.N = 60;
-  f.H = Eigen::RowVector3d(0.0, 0.2, 0.45);
-  f.R = Eigen::MatrixXd::Constant(1, 1, 0.3);
-  f.G = Eigen::MatrixXd::Zero(M, 0);
-  f.Qw = Eigen::MatrixXd::Zero(0, 0);
-  f.transition = TransitionSource::kBroadcast;
-  BroadcastTransitionModel& b = f.broadcast;
-  b.state_names = f.state_names;
-  b.is_on = {false, true, true};
-  b.interior = Eigen::Matrix3d{{1, 0, 0}, {0, 0.4, 0}, {0, 0.6, 1}};
-  b.on_target = {1, -1, -1};
-  b.off_target = {-1, 0, 0};
-  b.dt = 0.5;
-  f.x0 = Eigen::Vector3d(60, 0, 0);
-  f.P0 = Eigen::Matrix3d::Zero();
+  const FilterModel f = testing_util::ThreeStateModel(60, std::sqrt(0.3));
+  const BroadcastTransitionModel& b = f.broadcast;
   auto kf = PopulationKalmanFilterT<M, 1>::Create(f, CovarianceMode::kExtended);
   EXPECT_TRUE(kf.ok());
   Eigen::SparseMatrix<double> A = b.SparsePattern();
