@@ -19,6 +19,9 @@ struct Key {
   std::function<void(BundleConfig&, double)> set;
 };
 
+// A value as quoted in a message: at most 40 characters.
+std::string Short(const std::string& v) { return v.size() <= 40 ? v : v.substr(0, 37) + "..."; }
+
 std::string Num(double v) {
   char buf[64];
   std::snprintf(buf, sizeof buf, "%g", v);
@@ -76,21 +79,29 @@ std::vector<std::string> BundleConfig::Keys() {
 }
 
 Result<BundleConfig> BundleConfig::FromText(const std::string& actuator, const std::string& text) {
-  const std::string where =
-      "actuator '" + actuator + "' (<custom><text name=\"" + kTextPrefix + actuator + "\">): ";
-  BundleConfig c;
-  c.actuator = actuator;
+  const std::string where = "actuator '" + actuator + "': ";
   std::istringstream in(text);
   std::string token;
-  std::set<std::string> seen;
-  double prestrain = std::nan("");
+  std::vector<std::pair<std::string, std::string>> pairs;
   while (in >> token) {
     const auto eq = token.find('=');
     if (eq == std::string::npos || eq == 0 || eq + 1 == token.size()) {
-      return Error{where + "'" + token + "' is not key=value"};
+      return Error{where + "'" + Short(token) + "' is not key=value"};
     }
-    const std::string key = token.substr(0, eq);
-    const std::string value = token.substr(eq + 1);
+    pairs.emplace_back(token.substr(0, eq), token.substr(eq + 1));
+  }
+  return FromPairs(actuator, where, pairs);
+}
+
+Result<BundleConfig> BundleConfig::FromPairs(
+    const std::string& actuator, const std::string& where,
+    const std::vector<std::pair<std::string, std::string>>& pairs) {
+  BundleConfig c;
+  c.actuator = actuator;
+  std::set<std::string> seen;
+  double prestrain = std::nan("");
+  for (const auto& [key, value] : pairs) {
+    if (value.empty()) continue;  // an unset MJCF config key: keep the default
     if (!seen.insert(key).second) return Error{where + "key '" + key + "' given twice"};
     if (key == "law") {
       if (value == "wire") {
@@ -98,7 +109,7 @@ Result<BundleConfig> BundleConfig::FromText(const std::string& actuator, const s
       } else if (value == "spring") {
         c.unit.law = ForceLaw::kSpring;
       } else {
-        return Error{where + "law=" + value + " is invalid: allowed values are wire, spring"};
+        return Error{where + "law=" + Short(value) + " is invalid: allowed values are wire, spring"};
       }
       continue;
     }
@@ -109,22 +120,22 @@ Result<BundleConfig> BundleConfig::FromText(const std::string& actuator, const s
     if (spec == nullptr) {
       std::string allowed;
       for (const std::string& k : Keys()) allowed += (allowed.empty() ? "" : ", ") + k;
-      return Error{where + "unknown key '" + key + "' (allowed: " + allowed + ")"};
+      return Error{where + "unknown key '" + Short(key) + "' (allowed: " + allowed + ")"};
     }
     errno = 0;
     char* end = nullptr;
     const double v = std::strtod(value.c_str(), &end);
     if (end == value.c_str() || *end != '\0' || errno == ERANGE || !std::isfinite(v)) {
-      return Error{where + key + "=" + value + " is not a finite number"};
+      return Error{where + key + "=" + Short(value) + " is not a finite number"};
     }
     const bool low_bad = spec->lo_open ? !(v > spec->lo) : !(v >= spec->lo);
     if (low_bad || v > spec->hi) {
-      return Error{where + key + "=" + value + " is out of range: must be in " +
+      return Error{where + key + "=" + Short(value) + " is out of range: must be in " +
                    (spec->lo_open ? "(" : "[") + Num(spec->lo) + ", " + Num(spec->hi) + "]" +
                    (spec->unit[0] ? std::string(" ") + spec->unit : std::string())};
     }
     if (key == "units" && v != std::floor(v)) {
-      return Error{where + "units=" + value + " must be a whole number"};
+      return Error{where + "units=" + Short(value) + " must be a whole number"};
     }
     if (key == "prestrain") {
       prestrain = v;

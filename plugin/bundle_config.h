@@ -1,18 +1,16 @@
-// BundleConfig: one SMA bundle's configuration, parsed and validated from the key=value text of
-// <custom><text name="recruit.sma.ACTUATOR" data="..."> (plugin/README.md lists every key).
+// BundleConfig: one SMA bundle's configuration, parsed and validated from key/value pairs (the
+// MJCF <config key value> of a recruit.sma plugin; plugin/README.md lists every key).
 #pragma once
 
 #include <cmath>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "common/result.h"
 #include "plugin/unit_model.h"
 
 namespace recruit::sma {
-
-// Prefix of the <custom><text> element that configures an actuator.
-inline constexpr const char* kTextPrefix = "recruit.sma.";
 
 struct BundleConfig {
   std::string actuator;  // actuator name in the model
@@ -34,7 +32,12 @@ struct BundleConfig {
   // few ms keeps the force within a fraction of a percent at a fraction of the cost.
   double update_period = 0;
 
-  // Parses `text` (whitespace-separated key=value). Errors name the actuator and the key.
+  // Parses key/value pairs; an empty value keeps the default (MuJoCo gives "" for a declared key
+  // that MJCF did not set). Errors start with `where` and name the key and value.
+  static Result<BundleConfig> FromPairs(
+      const std::string& actuator, const std::string& where,
+      const std::vector<std::pair<std::string, std::string>>& pairs);
+  // Whitespace-separated key=value text (tests, tools); errors name the actuator and the key.
   static Result<BundleConfig> FromText(const std::string& actuator, const std::string& text);
   // The accepted keys, in the order of the README's table.
   static std::vector<std::string> Keys();
