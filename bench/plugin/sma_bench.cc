@@ -11,11 +11,11 @@
 #include <cstdio>
 #include <string>
 
-#include "plugin/sma_plugin.h"
+#include "plugin/sma_host.h"
 
 namespace {
 
-using recruit::sma::SmaPlugin;
+using recruit::sma::SmaHost;
 
 mjModel* Load(const std::string& path) {
   char err[1000] = "";
@@ -48,7 +48,7 @@ std::string BenchWithUnits(int units, int update_ms) {
 enum class Regime { kFig4Step, kRandomSwitching };
 
 // One simulated second of the regime's broadcasts at step i (1 ms steps).
-void Control(const SmaPlugin& p, mjData* d, Regime regime, long i) {
+void Control(const SmaHost& p, mjData* d, Regime regime, long i) {
   if (regime == Regime::kFig4Step) {
     if (i % 16000 == 0) (void)p.Broadcast(d, 0, 1, 0);
     if (i % 16000 == 10000) (void)p.Broadcast(d, 0, 0, 1);
@@ -73,7 +73,7 @@ void BM_Sma(benchmark::State& state) {
   const auto regime = static_cast<Regime>(state.range(1));
   const int update_ms = static_cast<int>(state.range(2));
   mjModel* m = Load(BenchWithUnits(units, update_ms));
-  auto p = SmaPlugin::Create(m);
+  auto p = SmaHost::Create(m);
   if (!p.ok()) {
     state.SkipWithError(p.error().c_str());
     mj_deleteModel(m);
@@ -85,7 +85,7 @@ void BM_Sma(benchmark::State& state) {
   double cohorts = 0;
   for (auto _ : state) {
     Control(**p, d, regime, i++);
-    recruit::sma::Step(m, d, **p);
+    mj_step(m, d);
     cohorts += (*p)->NumCohorts(d, 0);
   }
   state.SetItemsProcessed(state.iterations());
@@ -122,7 +122,7 @@ void BM_SmaOverMuscle(benchmark::State& state) {
   const int update_ms = static_cast<int>(state.range(1));
   mjModel* mm = Load(RECRUIT_SOURCE_DIR "/models/isometric_bench_muscle.xml");
   mjModel* ms = Load(BenchWithUnits(60, update_ms));
-  auto p = SmaPlugin::Create(ms);
+  auto p = SmaHost::Create(ms);
   mjData* dm = mj_makeData(mm);
   mjData* ds = mj_makeData(ms);
   dm->ctrl[0] = 1;
@@ -135,7 +135,7 @@ void BM_SmaOverMuscle(benchmark::State& state) {
     const double t1 = ThreadCpuSeconds();
     for (int k = 0; k < 1000; ++k) {
       Control(**p, ds, regime, i++);
-      recruit::sma::Step(ms, ds, **p);
+      mj_step(ms, ds);
     }
     const double t2 = ThreadCpuSeconds();
     t_muscle += t1 - t0;

@@ -6,7 +6,7 @@
 #include <cstdlib>
 #include <memory>
 
-#include "plugin/sma_plugin.h"
+#include "plugin/sma_host.h"
 #include "sim/run_task.h"
 #include "sim/task.h"
 
@@ -67,7 +67,7 @@ void PhysicsOnly(benchmark::State& state, const std::string& model_file) {
     state.SkipWithError(err);
     return;
   }
-  auto plugin = sma::SmaPlugin::Create(m);
+  auto plugin = sma::SmaHost::Create(m);
   mjData* d = mj_makeData(m);
   double simulated = 0;
   for (auto _ : state) {
@@ -75,7 +75,7 @@ void PhysicsOnly(benchmark::State& state, const std::string& model_file) {
     (*plugin)->Reset(d, 1);
     for (int b = 0; b < (*plugin)->num_bundles(); ++b) (void)(*plugin)->Broadcast(d, b, 0.5, 0);
     const long n = std::lround(20.0 / m->opt.timestep);
-    for (long i = 0; i < n; ++i) sma::Step(m, d, **plugin);
+    for (long i = 0; i < n; ++i) mj_step(m, d);
     simulated += d->time;
   }
   state.counters["x_real_time"] = benchmark::Counter(simulated, benchmark::Counter::kIsRate);

@@ -2,7 +2,7 @@
 // print the ground truth. Built as sma_demo and run by ctest (plugin_demo).
 #include <cstdio>
 
-#include "plugin/sma_plugin.h"
+#include "plugin/sma_host.h"
 
 int main() {
   char err[1000] = "";
@@ -12,19 +12,19 @@ int main() {
     std::fprintf(stderr, "isometric_bench.xml: %s\n", err);
     return 1;
   }
-  auto plugin = recruit::sma::SmaPlugin::Create(m);
+  auto plugin = recruit::sma::SmaHost::Create(m);
   if (!plugin.ok()) {
     std::fprintf(stderr, "isometric_bench.xml: %s\n", plugin.error().c_str());
     mj_deleteModel(m);
     return 1;
   }
-  const recruit::sma::SmaPlugin& sma = **plugin;
+  const recruit::sma::SmaHost& sma = **plugin;
   const int b = sma.BundleIndex("bundle");
   mjData* d = mj_makeData(m);
   sma.Reset(d, /*seed=*/42);                           // all units off, at ambient
   recruit::Status st = sma.Broadcast(d, b, 0.5, 0.0);  // each off unit turns on with p = 0.5
   if (!st.ok()) std::fprintf(stderr, "%s\n", st.error().c_str());
-  while (d->time < 3.0) recruit::sma::Step(m, d, sma);  // mj_step, then the units advance
+  while (d->time < 3.0) mj_step(m, d);  // mj_step, then the units advance
   std::printf(
       "t=%.1f s: %d of %d units on, tension %.2f N (%.2f N per settled unit), "
       "mean temperature %.1f C, heat %.2f\n",

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "plugin/sma_plugin.h"
+#include "plugin/sma_host.h"
 
 int main(int argc, char** argv) {
   const std::string path = argc > 1 ? argv[1] : RECRUIT_SOURCE_DIR "/models/isometric_bench.xml";
@@ -21,7 +21,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "%s: %s\n", path.c_str(), err);
     return 1;
   }
-  auto plugin = recruit::sma::SmaPlugin::Create(m);
+  auto plugin = recruit::sma::SmaHost::Create(m);
   if (!plugin.ok()) {
     std::fprintf(stderr, "%s: %s\n", path.c_str(), plugin.error().c_str());
     mj_deleteModel(m);
@@ -44,7 +44,7 @@ int main(int argc, char** argv) {
       (void)p.Broadcast(d, b, 0.0, 1.0);
       off = true;
     }
-    recruit::sma::Step(m, d, p);
+    mj_step(m, d);
     ts.push_back(d->time);
     fs.push_back(p.Force(d, b));
     const int step = static_cast<int>(d->time / m->opt.timestep + 0.5);

@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "common/mujoco_ptr.h"
-#include "plugin/sma_plugin.h"
+#include "plugin/sma_host.h"
 
 namespace recruit::control {
 namespace {}  // namespace
@@ -17,9 +17,9 @@ Result<BenchRecording> RecordBench(const std::string& model_path, const std::str
   char err[1000] = "";
   ModelPtr m(mj_loadXML(model_path.c_str(), nullptr, err, sizeof err));
   if (!m) return Error{model_path + ": " + err};
-  auto plugin = sma::SmaPlugin::Create(m.get());
+  auto plugin = sma::SmaHost::Create(m.get());
   if (!plugin) return Error{model_path + ": " + plugin.error()};
-  const sma::SmaPlugin& p = **plugin;
+  const sma::SmaHost& p = **plugin;
   if (p.num_bundles() == 0) return Error{model_path + ": no SMA bundle (recruit.sma.* text)"};
   const int b = actuator.empty() ? 0 : p.BundleIndex(actuator);
   if (b < 0) return Error{model_path + ": no SMA bundle on actuator \"" + actuator + "\""};
@@ -62,7 +62,7 @@ Result<BenchRecording> RecordBench(const std::string& model_path, const std::str
     }
     log.realized_on.push_back(on_before < n ? double(turned_on) / (n - on_before) : 0.0);
     log.realized_off.push_back(on_before > 0 ? double(turned_off) / on_before : 0.0);
-    for (int i = 0; i < steps; ++i) sma::Step(m.get(), d.get(), p);
+    for (int i = 0; i < steps; ++i) mj_step(m.get(), d.get());
   }
   return rec;
 }

@@ -13,7 +13,7 @@
 
 #if RECRUIT_CONTROL_AVAILABLE && RECRUIT_SMA_AVAILABLE
 #include "control/recruitment_controller.h"
-#include "plugin/sma_plugin.h"
+#include "plugin/sma_host.h"
 #define RECRUIT_SIM_CLOSED_LOOP 1
 #endif
 
@@ -116,9 +116,9 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
   if (task.timestep > 0) m->opt.timestep = task.timestep;
   const double h = m->opt.timestep;
 
-  auto plugin_or = sma::SmaPlugin::Create(m);
+  auto plugin_or = sma::SmaHost::Create(m);
   if (!plugin_or.ok()) return Error{where + ".model: " + plugin_or.error()};
-  const sma::SmaPlugin& plugin = **plugin_or;
+  const sma::SmaHost& plugin = **plugin_or;
 
   std::vector<int> bundles;
   for (const std::string* name : {&task.agonist, &task.antagonist}) {
@@ -295,7 +295,7 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
       }
     }
 
-    sma::Step(m, d, plugin);
+    mj_step(m, d);
 
     const double y = measured();
     const double r = task.reference(d->time);

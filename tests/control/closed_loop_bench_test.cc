@@ -13,7 +13,7 @@
 #include <string>
 
 #include "control/recruitment_controller.h"
-#include "plugin/sma_plugin.h"
+#include "plugin/sma_host.h"
 
 namespace recruit::control {
 namespace {
@@ -35,10 +35,10 @@ LoopResult RunBench(const EstimatorSpec& spec, double dT, double lambda, std::ui
       mj_deleteModel);
   EXPECT_TRUE(m) << err;
   if (!m) return r;
-  auto plugin = sma::SmaPlugin::Create(m.get());
+  auto plugin = sma::SmaHost::Create(m.get());
   EXPECT_TRUE(plugin.ok()) << plugin.error();
   if (!plugin.ok()) return r;
-  const sma::SmaPlugin& p = **plugin;
+  const sma::SmaHost& p = **plugin;
   std::unique_ptr<mjData, void (*)(mjData*)> d(mj_makeData(m.get()), mj_deleteData);
   p.Reset(d.get(), seed);
   mj_forward(m.get(), d.get());
@@ -64,7 +64,7 @@ LoopResult RunBench(const EstimatorSpec& spec, double dT, double lambda, std::ui
     r.max_on = std::max(r.max_on, on);
     if (k >= late_from) r.late_error += std::abs(force - reference) / (instants - late_from);
     EXPECT_TRUE(p.Broadcast(d.get(), 0, b.p_on, b.p_off).ok());
-    for (int i = 0; i < steps; ++i) sma::Step(m.get(), d.get(), p);
+    for (int i = 0; i < steps; ++i) mj_step(m.get(), d.get());
   }
   r.count_rmse = std::sqrt(sq / instants);
   // The figures docs/controller.md quotes.

@@ -1,0 +1,105 @@
+// SmaInstance: the SMA bundles of one recruit.sma plugin instance of a compiled MuJoCo model.
+// Immutable after Create (parsed config, unit model, actuator and tendon ids); every unit's state
+// lives in the instance's block of mjData.plugin_state, so mj_copyData forks a run exactly and
+// one mjData per thread steps in parallel. Used by the engine callbacks (sma_plugin.cc) and by
+// the host API (sma_host.h).
+//
+// plugin_state of an instance: for each of its actuators, in actuator order,
+//   [0] time of the next ctrl broadcast (s), [1] reserved, then the bundle's block
+//   (SmaBundle::StateSize(units) doubles; layout in plugin/README.md).
+#pragma once
+
+#include <mujoco/mujoco.h>
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "common/result.h"
+#include "plugin/bundle.h"
+
+namespace recruit::sma {
+
+inline constexpr const char* kPluginName = "recruit.sma";
+
+// Config keys of the binding, besides BundleConfig::Keys().
+inline constexpr const char* kSeedKey = "seed";
+inline constexpr const char* kBroadcastPeriodKey = "broadcast_period";
+
+// Values a recruit.sma sensor reports per bundle, in this order.
+inline constexpr int kSensorValues = 4;  // on count, tension (N), mean T (C), mean xi
+
+struct SmaActuator {
+  int actuator = -1;         // actuator id
+  int tendon = -1;           // tendon id
+  int bundle = -1;           // index among all recruit.sma actuators of the model (seed stream)
+  int offset = 0;            // start of this actuator's slots in the instance's plugin_state
+  double ref_length = 0;     // tendon length (m) at which a unit's extension is its prestretch
+  double settled_force = 0;  // steady tension of one unit held on at the prestretch (N)
+  SmaBundle model;
+};
+
+class SmaInstance {
+ public:
+  static constexpr int kSlots = 2;  // per actuator, before the bundle's block
+  static constexpr int kNextBroadcastSlot = 0;
+
+  // Parses and validates the instance's config and actuators. Errors name the actuator, the
+  // config key, its value and what is allowed.
+  static Result<std::unique_ptr<SmaInstance>> Create(const mjModel* m, int instance);
+  // plugin_state doubles the instance needs (0 when its config is invalid: Create reports it).
+  // Called by the compiler before the actuators' transmissions are filled in: reads only the
+  // config and which actuators use the instance.
+  static int StateSize(const mjModel* m, int instance);
+
+  int instance() const { return instance_; }
+  const std::vector<SmaActuator>& actuators() const { return actuators_; }
+  std::uint64_t seed() const { return seed_; }
+  double broadcast_period() const { return broadcast_period_; }
+
+  // The engine's callbacks. `block` is the instance's plugin_state.
+  void Reset(const mjModel* m, double* block) const;  // every unit off at actuator_length0
+  void Compute(const mjModel* m, mjData* d) const;    // actuator_force = -tension (pure)
+  void Advance(const mjModel* m, mjData* d) const;    // ctrl broadcasts, then one timestep
+  void Sensor(const mjModel* m, mjData* d) const;     // kSensorValues per actuator
+
+  // Unit extension (m) of actuator k at tendon length `length`.
+  double Stretch(int k, double length) const {
+    const SmaActuator& a = actuators_[k];
+    return a.model.config().unit.prestretch + (length - a.ref_length);
+  }
+  double* State(double* plugin_state, const mjModel* m, int k) const {
+    return plugin_state + m->plugin_stateadr[instance_] + actuators_[k].offset + kSlots;
+  }
+  const double* State(const double* plugin_state, const mjModel* m, int k) const {
+    return plugin_state + m->plugin_stateadr[instance_] + actuators_[k].offset + kSlots;
+  }
+  double& NextBroadcast(mjData* d, const mjModel* m, int k) const {
+    return d
+        ->plugin_state[m->plugin_stateadr[instance_] + actuators_[k].offset + kNextBroadcastSlot];
+  }
+  // Current length of actuator k's tendon (m).
+  static double Length(const mjModel* m, const mjData* d, int actuator) {
+    return d->actuator_length[m->actuator_outadr[actuator]];
+  }
+
+ private:
+  SmaInstance() = default;
+  // check_actuators = false skips the checks of the actuators' transmission and dynamics.
+  static Result<std::unique_ptr<SmaInstance>> Build(const mjModel* m, int instance,
+                                                    bool check_actuators);
+
+  int instance_ = -1;
+  std::uint64_t seed_ = 0;
+  double broadcast_period_ = 0;
+  int state_size_ = 0;
+  std::vector<SmaActuator> actuators_;
+};
+
+// The registered slot of recruit.sma, or -1 when the plugin is not registered in this process.
+int SmaPluginSlot();
+// True when instance `instance` of `m` is a recruit.sma instance.
+bool IsSmaInstance(const mjModel* m, int instance);
+
+}  // namespace recruit::sma
