@@ -11,6 +11,7 @@
 #include <memory>
 #include <string>
 
+#include "common/mujoco_load.h"
 #include "common/mujoco_ptr.h"
 #include "common/telemetry.h"
 
@@ -52,17 +53,9 @@ using ::recruit::DataPtr;
 using ::recruit::ModelPtr;
 
 inline ModelPtr LoadXml(const char* xml) {
-  char error[1000] = "";
-  auto vfs = std::make_unique<mjVFS>();  // about 2 MB: not on the stack
-  mj_defaultVFS(vfs.get());
-  const size_t size = std::strlen(xml);
-  mj_makeEmptyFileVFS(vfs.get(), "model.xml", static_cast<int>(size));
-  const int idx = mj_findFileVFS(vfs.get(), "model.xml");
-  std::memcpy(vfs->filedata[idx], xml, size);
-  mjModel* m = mj_loadXML("model.xml", vfs.get(), error, sizeof(error));
-  mj_deleteVFS(vfs.get());
-  if (!m) std::fprintf(stderr, "model error: %s\n", error);
-  return ModelPtr(m);
+  auto m = ::recruit::LoadModelFromString(xml);
+  if (!m.ok()) std::fprintf(stderr, "model error: %s\n", m.error().c_str());
+  return m.ok() ? std::move(m).value() : ModelPtr();
 }
 
 // A sample with one bundle on tendon 0 at the given heat.
