@@ -124,7 +124,8 @@ FigureLayout ComputeLayout(const Figure& figure, double width, double height, co
   f.legend_below = legend_w > 0.45 * width - 6.5 * f.font_px;
   const int cols_below = std::max(1, static_cast<int>((width - 2 * f.pad) / (entry_w + 2 * f.pad)));
 
-  const double top = figure.title.empty() ? f.pad : 1.8 * f.title_px;
+  // Room above the first panel for the title, or for half of the top y tick label.
+  const double top = figure.title.empty() ? f.font_px : 2.0 * f.title_px;
   const double x_tick_h = 1.6 * f.font_px, x_label_h = 1.5 * f.font_px;
   const double panel_h = (height - top - f.pad) / n;
 
@@ -138,8 +139,9 @@ FigureLayout ComputeLayout(const Figure& figure, double width, double height, co
     p.draw_x_label = i + 1 == n || figure.panels[i].x_label != figure.panels[i + 1].x_label;
     const double below = x_tick_h + (p.draw_x_label ? x_label_h : 0) +
                          (f.legend_below ? LegendHeight(items[i].size(), cols_below, f) : 0);
-    p.data.y = top + i * panel_h + (i == 0 ? 0 : f.pad);
-    p.data.h = std::max(1.0, panel_h - below - (i == 0 ? 0 : f.pad));
+    const double gap = i == 0 ? 0 : f.font_px;  // keeps tick labels of stacked panels apart
+    p.data.y = top + i * panel_h + gap;
+    p.data.h = std::max(1.0, panel_h - below - gap);
     p.y_ticks = YTicksFor(figure.panels[i], p.data.h, f.font_px);
     for (const auto& l : p.y_ticks.labels)
       widest_y_label = std::max(widest_y_label, tw(l, f.font_px));

@@ -74,7 +74,9 @@ Result<std::vector<std::string>> RunPlot(const PlotOptions& o) {
   const std::string name = o.name.empty() ? DefaultName(o.csv) : o.name;
   std::vector<Rendered> files;
   for (const NamedFigure& f : MakeRunFigures(*csv, info)) {
-    const int h = f.name == "all" ? std::min(kMaxSide, static_cast<int>(2.2 * o.height)) : o.height;
+    // The combined figure gives each panel 55 % of a single figure's height.
+    const double scale = f.name == "all" ? 0.55 * f.figure.panels.size() : 1.0;
+    const int h = std::min(kMaxSide, static_cast<int>(scale * o.height));
     for (Format fmt : *formats) {
       auto bytes = RenderFigure(f.figure, o.width, h, fmt);
       if (!bytes.ok()) return Error{fmt::format("figure '{}': {}", f.name, bytes.error())};

@@ -32,7 +32,8 @@ bool ParseCell(const std::string& cell, double& out) {
 Status CheckColumns(const RunCsv& csv) {
   std::vector<std::string> required = {"time", "reference", "measured"};
   for (const auto& b : csv.bundles) {
-    for (const char* c : {"true_on", "estimated_on", "p_on", "p_off", "mean_temperature"}) {
+    for (const char* c : {"force", "force_reference", "true_on", "estimated_on", "p_on", "p_off",
+                          "mean_temperature"}) {
       required.push_back(b + "." + c);
     }
   }

@@ -24,7 +24,8 @@ struct RunCsv {
 
 // Parses and validates `text` (read from `path`, used in messages): a header and >= 1 data row,
 // every row as many cells as the header, every cell empty or a number; the columns time,
-// reference, measured and, per bundle, true_on, estimated_on, p_on, p_off, mean_temperature
+// reference, measured and, per bundle, force, force_reference, true_on, estimated_on, p_on,
+// p_off, mean_temperature
 // must exist, and all but estimated_on must hold at least one finite value.
 // `<bundle>.estimated_on_std` is optional (older CSVs lack it): absent = all NaN.
 Result<RunCsv> ParseRunCsv(const std::string& text, const std::string& path);

@@ -55,6 +55,22 @@ Axes TrackingAxes(const RunCsv& csv, bool angle) {
   return a;
 }
 
+Axes ForceAxes(const RunCsv& csv) {
+  Axes a;
+  a.x_label = kTime;
+  a.y_label = "force (N)";
+  const auto& t = csv.At("time");
+  const Color refs[] = {kReference, {0.65, 0.65, 0.65}};
+  for (size_t b = 0; b < csv.bundles.size(); ++b) {
+    const std::string& n = csv.bundles[b];
+    a.series.push_back({Prefixed(csv, b, "force reference"), t, csv.At(n + ".force_reference"),
+                        refs[b % 2], LineStyle::kDashed, 1.2});
+    a.series.push_back({Prefixed(csv, b, "force"), t, csv.At(n + ".force"),
+                        b == 0 ? kMeasured : Pick(kTrue, 1), LineStyle::kSolid, 1.2});
+  }
+  return a;
+}
+
 Axes CountAxes(const RunCsv& csv) {
   Axes a;
   a.x_label = kTime;
@@ -115,12 +131,13 @@ Axes TemperatureAxes(const RunCsv& csv) {
 
 std::vector<NamedFigure> MakeRunFigures(const RunCsv& csv, const RunInfo& info) {
   const std::string title = TitleOf(info);
-  std::vector<NamedFigure> out = {
-      {"tracking", {title, {TrackingAxes(csv, IsAngleRun(csv, info))}}},
-      {"count", {title, {CountAxes(csv)}}},
-      {"broadcast", {title, {BroadcastAxes(csv)}}},
-      {"temperature", {title, {TemperatureAxes(csv)}}},
-  };
+  const bool angle = IsAngleRun(csv, info);
+  std::vector<NamedFigure> out = {{"tracking", {title, {TrackingAxes(csv, angle)}}}};
+  // An angle task's bundles track force references of their own (from the outer loop).
+  if (angle) out.push_back({"forces", {title, {ForceAxes(csv)}}});
+  out.push_back({"count", {title, {CountAxes(csv)}}});
+  out.push_back({"broadcast", {title, {BroadcastAxes(csv)}}});
+  out.push_back({"temperature", {title, {TemperatureAxes(csv)}}});
   Figure all{title, {}};
   for (const auto& f : out) all.panels.push_back(f.figure.panels[0]);
   out.push_back({"all", std::move(all)});

@@ -12,7 +12,8 @@
 namespace recruit::plot {
 
 struct NamedFigure {
-  std::string name;  // file name part: tracking, count, broadcast, temperature, all
+  // File name part: tracking, forces (angle tasks only), count, broadcast, temperature, all.
+  std::string name;
   Figure figure;
 };
 
@@ -21,11 +22,12 @@ struct NamedFigure {
 bool IsAngleRun(const RunCsv& csv, const RunInfo& info);
 
 Axes TrackingAxes(const RunCsv& csv, bool angle);
+Axes ForceAxes(const RunCsv& csv);  // each bundle's force and force reference
 Axes CountAxes(const RunCsv& csv);
 Axes BroadcastAxes(const RunCsv& csv);
 Axes TemperatureAxes(const RunCsv& csv);
 
-// The four figures and the combined one, titled with TitleOf(info).
+// The single figures and the combined one (all panels stacked), titled with TitleOf(info).
 std::vector<NamedFigure> MakeRunFigures(const RunCsv& csv, const RunInfo& info);
 
 }  // namespace recruit::plot

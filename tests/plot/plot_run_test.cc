@@ -84,7 +84,7 @@ TEST(PlotRun, BadInputIsNamedAndWritesNothing) {
       {"empty csv", opts([&](PlotOptions& o) { o.csv = empty; }), {empty, "empty file"}},
       {"missing columns",
        opts([&](PlotOptions& o) { o.csv = header_only; }),
-       {header_only, "mean_temperature"}},
+       {header_only, "no column 'b.force'"}},
       {"bad summary", opts([&](PlotOptions& o) { o.summary = bad_json; }), {bad_json, "JSON"}},
       {"bad unit",
        opts([&](PlotOptions& o) { o.summary = bad_unit; }),
