@@ -1,5 +1,6 @@
 #include "plot/run_figures.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace recruit::plot {
@@ -113,7 +114,13 @@ Axes BroadcastAxes(const RunCsv& csv) {
     a.series.push_back({Prefixed(csv, b, "p_off"), t, csv.At(n + ".p_off"), Pick(kEstimate, b),
                         LineStyle::kDashed, 1});
   }
-  a.y_range = Range{0, 1};
+  // From 0 to the largest broadcast: probabilities are often small (< 0.2), so 0..1 would
+  // flatten them.
+  double top = 0;
+  for (const Series& s : a.series) {
+    for (double v : s.y) top = std::isfinite(v) ? std::max(top, v) : top;
+  }
+  a.y_range = Range{0, top > 0 ? top : 1};
   return a;
 }
 
