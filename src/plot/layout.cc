@@ -52,6 +52,33 @@ double LegendEntryWidth(const std::vector<LegendItem>& items, const FigureLayout
   return f.swatch_px + f.pad + w;
 }
 
+}  // namespace
+
+std::vector<std::string> WrapAtCommas(const std::string& text, double max_w, double px,
+                                      const TextWidth& tw) {
+  std::vector<std::string> lines;
+  size_t start = 0;
+  while (start < text.size()) {
+    // Take the longest run of ", "-separated parts that fits (at least one part).
+    size_t end = text.find(", ", start), best = end;
+    while (end != std::string::npos) {
+      if (tw(text.substr(start, end - start), px) > max_w) break;
+      best = end;
+      end = text.find(", ", end + 2);
+    }
+    if (end == std::string::npos && tw(text.substr(start), px) <= max_w) best = end;
+    if (best == std::string::npos) {
+      lines.push_back(text.substr(start));
+      break;
+    }
+    lines.push_back(text.substr(start, best - start + 1));  // keeps the comma
+    start = best + 2;
+  }
+  return lines;
+}
+
+namespace {
+
 double RowHeight(const FigureLayout& f) { return 1.4 * f.font_px; }
 
 // The y range of a panel: fixed, or from the data (0..1 when there is none).
@@ -115,11 +142,13 @@ FigureLayout ComputeLayout(const Figure& figure, double width, double height, co
   f.pad = 0.5 * f.font_px;
   f.line_px = std::max(1.0, f.font_px / 7);
   f.swatch_px = 2.2 * f.font_px;
-  // The title shrinks (not below the minimum font) rather than run off the canvas.
+  // The title shrinks (not below the minimum font), then wraps at ", ", rather than run off
+  // the canvas.
   f.title_px = 1.15 * f.font_px;
   if (!figure.title.empty()) {
     const double w = tw(figure.title, f.title_px);
     if (w > 0.96 * width) f.title_px = std::max(kMinFontPx, f.title_px * 0.96 * width / w);
+    f.title_lines = WrapAtCommas(figure.title, 0.96 * width, f.title_px, tw);
   }
   const size_t n = figure.panels.size();
   if (n == 0) return f;
@@ -137,7 +166,8 @@ FigureLayout ComputeLayout(const Figure& figure, double width, double height, co
   const int cols_below = std::max(1, static_cast<int>((width - 2 * f.pad) / (entry_w + 2 * f.pad)));
 
   // Room above the first panel for the title, or for half of the top y tick label.
-  const double top = figure.title.empty() ? f.font_px : 2.0 * f.title_px;
+  const double top =
+      f.title_lines.empty() ? f.font_px : (1.25 * f.title_lines.size() + 0.75) * f.title_px;
   const double x_tick_h = 1.6 * f.font_px, x_label_h = 1.5 * f.font_px;
   const double panel_h = (height - top - f.pad) / n;
 

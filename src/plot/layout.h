@@ -47,9 +47,10 @@ struct FigureLayout {
   double width = 0, height = 0;
   double font_px = kMinFontPx;  // tick labels, axis labels, legend
   double title_px = kMinFontPx;
-  double line_px = 1;     // base line width
-  double pad = 5;         // the unit of the gaps between elements
-  double swatch_px = 20;  // length of a legend's line sample
+  std::vector<std::string> title_lines;  // the title, wrapped to the canvas width
+  double line_px = 1;                    // base line width
+  double pad = 5;                        // the unit of the gaps between elements
+  double swatch_px = 20;                 // length of a legend's line sample
   bool legend_below = false;
   std::vector<PanelLayout> panels;
 };
@@ -61,6 +62,11 @@ double EstimateTextWidth(const std::string& text, double font_px);
 
 // The font size for a canvas: grows with min(width, 1.6 height), never below kMinFontPx.
 double FontPxFor(double width, double height);
+
+// `text` split after ", " into lines no wider than max_w where possible (a single part wider
+// than max_w gets a line of its own).
+std::vector<std::string> WrapAtCommas(const std::string& text, double max_w, double px,
+                                      const TextWidth& tw);
 
 FigureLayout ComputeLayout(const Figure& figure, double width, double height,
                            const TextWidth& text_width = EstimateTextWidth);

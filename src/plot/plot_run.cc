@@ -74,8 +74,10 @@ Result<std::vector<std::string>> RunPlot(const PlotOptions& o) {
   const std::string name = o.name.empty() ? DefaultName(o.csv) : o.name;
   std::vector<Rendered> files;
   for (const NamedFigure& f : MakeRunFigures(*csv, info)) {
-    // The combined figure gives each panel 55 % of a single figure's height.
-    const double scale = f.name == "all" ? 0.55 * f.figure.panels.size() : 1.0;
+    // The combined figure gives each panel 55 % of a single figure's height, or all of it on a
+    // narrow canvas, where each legend goes below its panel.
+    const double per_panel = o.width < 640 ? 1.0 : 0.55;
+    const double scale = f.name == "all" ? per_panel * f.figure.panels.size() : 1.0;
     const int h = std::min(kMaxSide, static_cast<int>(scale * o.height));
     for (Format fmt : *formats) {
       auto bytes = RenderFigure(f.figure, o.width, h, fmt);

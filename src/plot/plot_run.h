@@ -19,7 +19,8 @@ struct PlotOptions {
   std::string out_dir;          // created if missing
   std::string name;             // file name prefix; empty = the CSV's name without "_steps.csv"
   std::string formats = "png";  // comma-separated: png, svg
-  // Of each single figure; the combined one is 0.55 x height per panel (2.2 x for 4 panels).
+  // Of each single figure; the combined one is 0.55 x height per panel (2.2 x for 4 panels),
+  // 1 x height per panel when width < 640 px.
   int width = 1000, height = 600;
 };
 

@@ -172,7 +172,9 @@ void DrawLegend(cairo_t* cr, const Axes& a, const PanelLayout& p, const FigureLa
 void DrawFigure(cairo_t* cr, const Figure& fig, const FigureLayout& f) {
   cairo_set_source_rgb(cr, 1, 1, 1);
   cairo_paint(cr);
-  if (!fig.title.empty()) Text(cr, fig.title, 0.5 * f.width, 0.9 * f.title_px, f.title_px, 0.5);
+  for (size_t i = 0; i < f.title_lines.size(); ++i) {
+    Text(cr, f.title_lines[i], 0.5 * f.width, (0.9 + 1.25 * i) * f.title_px, f.title_px, 0.5);
+  }
   for (size_t i = 0; i < fig.panels.size(); ++i) {
     const PanelLayout& p = f.panels[i];
     DrawGridAndFrame(cr, p, f);

@@ -127,7 +127,7 @@ Axes BroadcastAxes(const RunCsv& csv) {
 Axes TemperatureAxes(const RunCsv& csv) {
   Axes a;
   a.x_label = kTime;
-  a.y_label = "mean temperature (°C)";
+  a.y_label = "temperature (°C)";  // mean over the units
   const auto& t = csv.At("time");
   for (size_t b = 0; b < csv.bundles.size(); ++b) {
     a.series.push_back({csv.bundles[b], t, csv.At(csv.bundles[b] + ".mean_temperature"),

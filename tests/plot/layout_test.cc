@@ -29,7 +29,9 @@ Axes RampToTopRight(int n = 500) {
 }
 
 Figure OnePanel() {
-  return Figure{"task isometric_paper, estimator output, dT = 0.5 s", {RampToTopRight()}};
+  return Figure{
+      "task isometric_paper, estimator kalman-augmented, dT = 0.5 s, lambda = 0.2, seed 1",
+      {RampToTopRight()}};
 }
 
 Figure FourPanels() {
@@ -99,6 +101,15 @@ void ExpectReadable(const Figure& fig, double w, double h) {
   const FigureLayout f = ComputeLayout(fig, w, h);
   EXPECT_GE(f.font_px, kMinFontPx);
   EXPECT_GE(f.line_px, 1);
+  EXPECT_GE(f.title_px, kMinFontPx);
+  ASSERT_FALSE(f.title_lines.empty());
+  std::string joined;
+  for (const auto& line : f.title_lines) {
+    EXPECT_LE(EstimateTextWidth(line, f.title_px), w) << line;  // the title stays on the canvas
+    joined += (joined.empty() ? "" : " ") + line;
+  }
+  EXPECT_EQ(joined, fig.title);  // and loses nothing
+  EXPECT_LE(f.title_lines.size() * f.title_px * 1.25, f.panels[0].data.y);
   for (const PanelLayout& p : f.panels) {
     EXPECT_GE(p.data.w, 0.55 * w);  // the data keep most of the width
     EXPECT_GE(p.data.h, 3 * f.font_px);
