@@ -217,6 +217,8 @@ Result<std::string> RenderFigure(const Figure& figure, int width, int height, Fo
   if (auto st = cairo_surface_status(surface.get()); st != CAIRO_STATUS_SUCCESS) {
     return Check(st, "");
   }
+  // In pixels, like the PNG (cairo's default unit is pt: 4/3 larger on screen).
+  if (format == Format::kSvg) cairo_svg_surface_set_document_unit(surface.get(), CAIRO_SVG_UNIT_PX);
   {
     CairoPtr cr(cairo_create(surface.get()), cairo_destroy);
     DrawFigure(cr.get(), figure, layout);

@@ -75,9 +75,9 @@ void ExpectWellFormedSvg(const std::string& xml, int w, int h) {
       ++roots;
       EXPECT_EQ(name, "svg");
       std::smatch m;
-      ASSERT_TRUE(std::regex_search(tag, m, std::regex("width=\"([0-9.]+)(pt|px)?\"")));
+      ASSERT_TRUE(std::regex_search(tag, m, std::regex("width=\"([0-9.]+)px\"")));
       EXPECT_DOUBLE_EQ(std::stod(m[1]), w);
-      ASSERT_TRUE(std::regex_search(tag, m, std::regex("height=\"([0-9.]+)(pt|px)?\"")));
+      ASSERT_TRUE(std::regex_search(tag, m, std::regex("height=\"([0-9.]+)px\"")));
       EXPECT_DOUBLE_EQ(std::stod(m[1]), h);
     }
     if (tag.back() != '/') stack.push_back(name);
