@@ -135,7 +135,10 @@ double LegendHeight(size_t items, int cols, const FigureLayout& f) {
 
 }  // namespace
 
-FigureLayout ComputeLayout(const Figure& figure, double width, double height, const TextWidth& tw) {
+namespace {
+
+FigureLayout LayoutWith(const Figure& figure, double width, double height, const TextWidth& tw,
+                        bool force_below) {
   FigureLayout f;
   f.width = width, f.height = height;
   f.font_px = FontPxFor(width, height);
@@ -162,7 +165,7 @@ FigureLayout ComputeLayout(const Figure& figure, double width, double height, co
   const double legend_w = entry_w > 0 ? entry_w + 2 * f.pad : 0;
   // Legend on the right while the data keeps >= 55 % of the width; else below each panel
   // (the left margin is about 6.5 em).
-  f.legend_below = legend_w > 0.45 * width - 6.5 * f.font_px;
+  f.legend_below = force_below || legend_w > 0.45 * width - 6.5 * f.font_px;
   const int cols_below = std::max(1, static_cast<int>((width - 2 * f.pad) / (entry_w + 2 * f.pad)));
 
   // Room above the first panel for the title, or for half of the top y tick label.
@@ -209,6 +212,24 @@ FigureLayout ComputeLayout(const Figure& figure, double width, double height, co
       PlaceLegend(p, f, entry_w, 1);
     }
   }
+  return f;
+}
+
+// A legend to the right taller than its panel's slot would run into the next panel's legend or
+// off the canvas.
+bool RightLegendsFit(const FigureLayout& f) {
+  for (size_t i = 0; i < f.panels.size(); ++i) {
+    const double limit = i + 1 < f.panels.size() ? f.panels[i + 1].data.y : f.height;
+    if (f.panels[i].legend.bottom() > limit) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+FigureLayout ComputeLayout(const Figure& figure, double width, double height, const TextWidth& tw) {
+  FigureLayout f = LayoutWith(figure, width, height, tw, false);
+  if (!f.legend_below && !RightLegendsFit(f)) f = LayoutWith(figure, width, height, tw, true);
   return f;
 }
 

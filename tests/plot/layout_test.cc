@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
 
 namespace recruit::plot {
 namespace {
@@ -78,10 +79,25 @@ void ExpectLegendClearOfData(const Figure& fig, double w, double h) {
   }
 }
 
+// A legend longer than its panel is tall (eight entries on a short canvas).
+Figure ManyEntries() {
+  Figure f = FourPanels();
+  for (Axes& a : f.panels) {
+    for (int i = 0; i < 6; ++i) {
+      a.series.push_back(a.series[0]);
+      a.series.back().label = "entry " + std::to_string(i);
+    }
+  }
+  return f;
+}
+
 TEST(Layout, LegendNeverCoversDataAtAnySize) {
   for (const auto& [w, h] : kSizes) {
     ExpectLegendClearOfData(OnePanel(), w, h);
     ExpectLegendClearOfData(FourPanels(), w, 2.2 * h);
+    // Four panels of eight entries need room: from 640 px wide (the command gives a narrower
+    // combined figure a full height per panel).
+    if (w >= 640) ExpectLegendClearOfData(ManyEntries(), w, 1.7 * h);
   }
 }
 
