@@ -14,6 +14,7 @@ int main(int argc, char** argv) {
   recruit::cli::AddSimulateCommand(app, exit_code);
   recruit::cli::AddSweepCommand(app, exit_code);
   recruit::cli::AddRenderCommand(app, exit_code);
+  recruit::cli::AddPlotCommand(app, exit_code);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -2,17 +2,21 @@
 // writer, video recorder). Shared by src/sim (producer) and src/render (consumer).
 #pragma once
 
+#include <limits>
 #include <string>
 #include <vector>
 
 namespace recruit {
 
 struct BundleTelemetry {
-  std::string actuator;         // actuator name in the model
-  int tendon_id = -1;           // tendon the bundle pulls (for colouring it in renders)
-  double force = 0;             // tension, N
-  int true_on = 0;              // units on (ground truth, the paper's debug interface)
-  double estimated_on = 0;      // the estimator's on-count (NaN when none)
+  std::string actuator;     // actuator name in the model
+  int tendon_id = -1;       // tendon the bundle pulls (for colouring it in renders)
+  double force = 0;         // tension, N
+  int true_on = 0;          // units on (ground truth, the paper's debug interface)
+  double estimated_on = 0;  // the estimator's on-count (NaN when none)
+  // Standard deviation of estimated_on (NaN when the estimator gives none, e.g. output only);
+  // `recruit plot` draws estimated_on +- 2 std as the filter's band.
+  double estimated_on_std = std::numeric_limits<double>::quiet_NaN();
   double on_fraction = 0;       // true_on / num_units
   double mean_temperature = 0;  // deg C over all units
   double heat = 0;              // 0 at ambient .. 1 at the on-state steady temperature

@@ -15,8 +15,8 @@ Status CsvStepWriter::OnStep(const mjModel*, const mjData*, const TelemetrySampl
   if (!header_written_) {
     buffer_ += "time,reference,measured,angle";
     for (const auto& b : s.bundles) {
-      for (const char* col : {"force", "force_reference", "true_on", "estimated_on", "p_on",
-                              "p_off", "mean_temperature"}) {
+      for (const char* col : {"force", "force_reference", "true_on", "estimated_on",
+                              "estimated_on_std", "p_on", "p_off", "mean_temperature"}) {
         buffer_ += fmt::format(",{}.{}", b.actuator, col);
       }
     }
@@ -28,7 +28,10 @@ Status CsvStepWriter::OnStep(const mjModel*, const mjData*, const TelemetrySampl
   fmt::format_to(out, "{:.6g},{:.9g},{:.9g},{:.9g}", s.time, s.reference, s.measured, s.angle);
   for (const auto& b : s.bundles) {
     fmt::format_to(out, ",{:.9g},{:.9g},{},", b.force, b.force_reference, b.true_on);
+    // Non-finite estimates (no estimator, no variance) are left empty: readers take them as NaN.
     if (std::isfinite(b.estimated_on)) fmt::format_to(out, "{:.6g}", b.estimated_on);
+    buffer_ += ',';
+    if (std::isfinite(b.estimated_on_std)) fmt::format_to(out, "{:.6g}", b.estimated_on_std);
     fmt::format_to(out, ",{:.6g},{:.6g},{:.6g}", b.p_on, b.p_off, b.mean_temperature);
   }
   fmt::format_to(out, ",{}\n", s.control_instant ? 1 : 0);

@@ -1,0 +1,45 @@
+// `recruit plot`: the paper-style figures of one `recruit simulate` run (docs/plotting.md).
+#include <iostream>
+#include <memory>
+
+#include "cli/commands.h"
+#include "plot/plot_run.h"
+
+namespace recruit::cli {
+
+void AddPlotCommand(CLI::App& app, int& exit_code) {
+  auto o = std::make_shared<plot::PlotOptions>();
+  auto* cmd = app.add_subcommand(
+      "plot",
+      "Plot a run of `recruit simulate`: force (or angle) vs reference, true vs estimated "
+      "on-count with the filter's +-2 sd band, broadcast probabilities, mean unit temperature, "
+      "and all panels in one figure. PNG and/or SVG (docs/plotting.md).");
+  cmd->add_option("--csv", o->csv, "The run's per-step CSV (<name>_steps.csv)")->required();
+  cmd->add_option("--summary", o->summary,
+                  "The run's summary (<name>_summary.json): title line (task, estimator, dT, "
+                  "lambda, seed) and the tracked unit");
+  cmd->add_option("--out", o->out_dir, "Output directory (created if missing)")->required();
+  cmd->add_option(
+      "--name", o->name,
+      "File name prefix (default: the CSV's name without _steps.csv); files are "
+      "<name>_{tracking,forces,count,broadcast,temperature,all}.<format> (forces: angle "
+      "tasks only)");
+  cmd->add_option("--format", o->formats, "png, svg or png,svg")->capture_default_str();
+  cmd->add_option("--width", o->width, "Width of each figure, px")->capture_default_str();
+  cmd->add_option("--height", o->height,
+                  "Height of each single figure, px (the combined figure: 0.55x per panel, 1x "
+                  "per panel below 640 px wide)")
+      ->capture_default_str();
+  cmd->callback([o, &exit_code] {
+    auto written = plot::RunPlot(*o);
+    if (!written.ok()) {
+      std::cerr << "recruit plot: " << written.error() << "\n";
+      exit_code = 1;
+      return;
+    }
+    for (const auto& p : *written) std::cout << p << "\n";
+    exit_code = 0;
+  });
+}
+
+}  // namespace recruit::cli

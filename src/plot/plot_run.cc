@@ -1,0 +1,104 @@
+#include "plot/plot_run.h"
+
+#include <fmt/format.h>
+
+#include <filesystem>
+#include <sstream>
+
+#include "common/atomic_file.h"
+#include "plot/render.h"
+#include "plot/run_data.h"
+#include "plot/run_figures.h"
+
+namespace recruit::plot {
+namespace {
+
+namespace fs = std::filesystem;
+
+Result<std::vector<Format>> ParseFormats(const std::string& list) {
+  std::vector<Format> out;
+  std::istringstream in(list);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    if (item == "png")
+      out.push_back(Format::kPng);
+    else if (item == "svg")
+      out.push_back(Format::kSvg);
+    else
+      return Error{
+          fmt::format("--format: '{}' is not allowed (png, svg, or both: png,svg)", Shorten(item))};
+  }
+  if (out.empty()) return Error{"--format: empty (png, svg, or both: png,svg)"};
+  return out;
+}
+
+Status CheckSize(const char* option, int value, int min) {
+  if (value >= min && value <= kMaxSide) return Status::Ok();
+  return Error{
+      fmt::format("{}: {} px is out of range ({}..{} px allowed)", option, value, min, kMaxSide)};
+}
+
+std::string DefaultName(const std::string& csv) {
+  std::string stem = fs::path(csv).filename().string();
+  for (const std::string suffix : {".csv", "_steps"}) {
+    if (stem.size() > suffix.size() &&
+        stem.compare(stem.size() - suffix.size(), suffix.size(), suffix) == 0) {
+      stem.resize(stem.size() - suffix.size());
+    }
+  }
+  return stem;
+}
+
+struct Rendered {
+  std::string path, bytes;
+};
+
+}  // namespace
+
+Result<std::vector<std::string>> RunPlot(const PlotOptions& o) {
+  auto formats = ParseFormats(o.formats);
+  if (!formats.ok()) return Error{formats.error()};
+  for (Status s :
+       {CheckSize("--width", o.width, kMinWidth), CheckSize("--height", o.height, kMinHeight)}) {
+    if (!s.ok()) return Error{s.error()};
+  }
+  if (o.out_dir.empty()) return Error{"--out: empty (a directory for the figures)"};
+  auto csv = ReadRunCsv(o.csv);
+  if (!csv.ok()) return Error{csv.error()};
+  RunInfo info;
+  if (!o.summary.empty()) {
+    auto s = ReadRunSummary(o.summary);
+    if (!s.ok()) return Error{s.error()};
+    info = *s;
+  }
+  const std::string name = o.name.empty() ? DefaultName(o.csv) : o.name;
+  std::vector<Rendered> files;
+  for (const NamedFigure& f : MakeRunFigures(*csv, info)) {
+    // The combined figure gives each panel 55 % of a single figure's height, or all of it on a
+    // narrow canvas, where each legend goes below its panel.
+    const double per_panel = o.width < 640 ? 1.0 : 0.55;
+    const double scale = f.name == "all" ? per_panel * f.figure.panels.size() : 1.0;
+    const int h = std::min(kMaxSide, static_cast<int>(scale * o.height));
+    for (Format fmt : *formats) {
+      auto bytes = RenderFigure(f.figure, o.width, h, fmt);
+      if (!bytes.ok()) return Error{fmt::format("figure '{}': {}", f.name, bytes.error())};
+      const char* ext = fmt == Format::kPng ? "png" : "svg";
+      files.push_back({(fs::path(o.out_dir) / fmt::format("{}_{}.{}", name, f.name, ext)).string(),
+                       std::move(*bytes)});
+    }
+  }
+  // Everything rendered: only now touch the disk.
+  std::error_code ec;
+  fs::create_directories(o.out_dir, ec);
+  if (ec)
+    return Error{
+        fmt::format("--out: cannot create directory '{}': {}", Shorten(o.out_dir), ec.message())};
+  std::vector<std::string> written;
+  for (const Rendered& r : files) {
+    if (Status s = WriteFileAtomically(r.path, r.bytes); !s.ok()) return Error{s.error()};
+    written.push_back(r.path);
+  }
+  return written;
+}
+
+}  // namespace recruit::plot
