@@ -6,6 +6,8 @@
 #include <cstdio>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
 
 #include "estimation/population_chain.h"
 
@@ -119,6 +121,62 @@ TEST(EstimationFilterModel, MissingAndMalformedFiles) {
   ASSERT_FALSE(bad.ok());
   EXPECT_NE(bad.error().find("malformed JSON"), std::string::npos) << bad.error();
   std::remove(path.c_str());
+}
+
+// Issue 12 regressions: JSON that nlohmann rejects with something other than a parse error,
+// or that is dangerous to build a tree from, gives a clear error naming the file and field.
+std::string WriteTemp(const std::string& name, const std::string& text) {
+  const std::string path = testing::TempDir() + "/" + name;
+  std::ofstream(path) << text;
+  return path;
+}
+
+TEST(EstimationFilterModel, NumberTooLargeForADoubleNamesFileAndField) {
+  const std::string path =
+      WriteTemp("estimation_overflow.json",
+                R"({"states": ["off", "on"], "N": 60, "H": [[0, 1e999]], "R": [[0.09]],
+          "transition": {"type": "explicit"}})");
+  auto f = FilterModel::FromJson(path);
+  ASSERT_FALSE(f.ok());
+  EXPECT_NE(f.error().find(path + ": field H[0][1]: number '1e999' is too large for a double"),
+            std::string::npos)
+      << f.error();
+  std::remove(path.c_str());
+}
+
+TEST(EstimationFilterModel, DeepNestingIsRejectedBeforeRecursion) {
+  const int depth = 70000;
+  const std::string path =
+      WriteTemp("estimation_deep.json",
+                R"({"states": )" + std::string(depth, '[') + std::string(depth, ']') + "}");
+  auto f = FilterModel::FromJson(path);
+  ASSERT_FALSE(f.ok());
+  EXPECT_NE(f.error().find(path + ": field states[0]"), std::string::npos) << f.error();
+  EXPECT_NE(f.error().find("nested deeper than 64 levels"), std::string::npos) << f.error();
+  std::remove(path.c_str());
+}
+
+// A 2 MB value comes back shortened to about 40 characters, in every kind of message.
+TEST(EstimationFilterModel, LongValuesAreShortenedInMessages) {
+  const std::string big(2000000, 'x');
+  const std::vector<std::string> docs = {
+      R"({"states": ["off", "on"], "N": 60, "H": [[0, 0.45]], "R": [[0.09]],
+          "transition": {"type": ")" +
+          big + R"("}})",
+      R"({"states": [")" + big + R"(", ")" + big + R"("], "N": 60, "H": [[0, 0.45]],
+          "R": [[0.09]], "transition": {"type": "explicit"}})",
+      R"({"states": ["off", "on"], "N": 60, "H": [[0, 1)" + std::string(400, '0') + "e999]]}",
+      R"({"states": ["off", "on"], "N": 60, "H": [[0, )" + big + "]]}",
+      R"({")" + big + R"(": [[)" + std::string(100, '[') + "1e999",
+  };
+  for (size_t i = 0; i < docs.size(); ++i) {
+    SCOPED_TRACE(i);
+    const std::string path = WriteTemp("estimation_long.json", docs[i]);
+    auto f = FilterModel::FromJson(path);
+    ASSERT_FALSE(f.ok());
+    EXPECT_LT(f.error().size(), 400u) << f.error().substr(0, 400);
+    std::remove(path.c_str());
+  }
 }
 
 }  // namespace
