@@ -36,6 +36,7 @@ FilterModel Model(int m) {
   f.x0 = Eigen::VectorXd::Zero(m);
   f.x0(0) = 60;
   f.P0 = Eigen::MatrixXd::Zero(m, m);
+  f.G = Eigen::MatrixXd::Zero(m, 0);
   return f;
 }
 

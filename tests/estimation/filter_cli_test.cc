@@ -285,8 +285,10 @@ TEST_F(EstimationCli, StreamedRunMatchesTheDenseFilter) {
   f.x0 = Eigen::VectorXd::Zero(m);
   f.x0(0) = 60;
   f.P0 = Eigen::MatrixXd::Zero(m, m);
+  f.G = Eigen::MatrixXd::Zero(m, 0);
   const std::string model = (dir_ / "model.json").string();
-  ASSERT_TRUE(f.Save(model).ok());
+  const Status saved = f.Save(model);
+  ASSERT_TRUE(saved.ok()) << saved.error();
   std::string log = "t,p_on,p_off,y\n";
   std::vector<double> p_on, p_off, y;
   for (int k = 0; k < 300; ++k) {
