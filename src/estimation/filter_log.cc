@@ -42,11 +42,6 @@ bool ParseNumber(std::string_view s, double* v) {
   return r.ec == std::errc() && r.ptr == s.data() + s.size() && std::isfinite(*v);
 }
 
-void AppendNumber(std::string& out, double v) {
-  char buf[32];
-  const auto r = std::to_chars(buf, buf + sizeof buf, v);  // shortest round-trip form
-  out.append(buf, r.ptr);
-}
 
 }  // namespace
 
@@ -267,7 +262,7 @@ Status RunFilterStream(const FilterModel& model, FilterLogReader& log, CountFilt
                        std::ostream& out) {
   const int m = model.num_states();
   std::string buf;
-  buf.reserve(kChunk + 4096);
+  buf.reserve(kChunk + 24 * (2 * static_cast<size_t>(m) + 3) + 4096);
   buf += "step";
   if (log.has_time()) buf += ",t";
   buf += ",updated";
@@ -305,22 +300,29 @@ Status RunFilterStream(const FilterModel& model, FilterLogReader& log, CountFilt
     if (!mean.allFinite() || !var.allFinite()) {
       return Error{log.path() + ": step " + std::to_string(k) + ": the estimate is not finite"};
     }
-    char step[24];
-    buf.append(step, std::to_chars(step, step + sizeof step, k).ptr);
+    // The row is formatted straight into the buffer's tail (room for the longest row: 24
+    // characters per number), then the buffer is cut to what was written.
+    const size_t start = buf.size();
+    buf.resize(start + 24 * (2 * m + 3) + 8);
+    char* p = buf.data() + start;
+    char* const end = buf.data() + buf.size();
+    p = std::to_chars(p, end, k).ptr;
     if (log.has_time()) {
-      buf += ',';
-      AppendNumber(buf, row.t);
+      *p++ = ',';
+      p = std::to_chars(p, end, row.t).ptr;  // shortest round-trip form
     }
-    buf += row.has_y ? ",1" : ",0";
+    *p++ = ',';
+    *p++ = row.has_y ? '1' : '0';
     for (int i = 0; i < m; ++i) {
-      buf += ',';
-      AppendNumber(buf, mean(i));
+      *p++ = ',';
+      p = std::to_chars(p, end, mean(i)).ptr;
     }
     for (int i = 0; i < m; ++i) {
-      buf += ',';
-      AppendNumber(buf, var(i));
+      *p++ = ',';
+      p = std::to_chars(p, end, var(i)).ptr;
     }
-    buf += '\n';
+    *p++ = '\n';
+    buf.resize(static_cast<size_t>(p - buf.data()));
     if (buf.size() >= kChunk) {
       if (Status s = flush(); !s.ok()) return s;
     }
