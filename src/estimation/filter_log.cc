@@ -42,7 +42,6 @@ bool ParseNumber(std::string_view s, double* v) {
   return r.ec == std::errc() && r.ptr == s.data() + s.size() && std::isfinite(*v);
 }
 
-
 }  // namespace
 
 FilterLogReader::~FilterLogReader() {
@@ -77,7 +76,7 @@ bool FilterLogReader::Refill() {
   if (file_ == nullptr || eof_) return false;
   // Keep the unread tail (a partial line) at the front; grow only for a line longer than a chunk.
   const size_t keep = text_.size();
-  std::memmove(buf_.data(), text_.data(), keep);
+  if (keep > 0) std::memmove(buf_.data(), text_.data(), keep);  // (an empty view may be null)
   if (buf_.size() < keep + kChunk) buf_.resize(keep + kChunk);
   const size_t n = std::fread(buf_.data() + keep, 1, buf_.size() - keep, file_);
   if (n == 0) eof_ = true;

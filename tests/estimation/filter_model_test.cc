@@ -3,12 +3,17 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <sstream>
 #include <string>
 #include <vector>
 
+#include "estimation/count_filter.h"
+#include "estimation/filter_log.h"
 #include "estimation/population_chain.h"
 
 namespace recruit {
@@ -177,6 +182,34 @@ TEST(EstimationFilterModel, LongValuesAreShortenedInMessages) {
     EXPECT_LT(f.error().size(), 400u) << f.error().substr(0, 400);
     std::remove(path.c_str());
   }
+}
+
+// The file reader (1 MiB chunks, lines cut at chunk boundaries) gives the same output as the
+// in-memory text, for a log of about 3 MB with a byte-order mark, comments and blank lines.
+TEST(EstimationFilterLog, FileStreamMatchesInMemoryText) {
+  const FilterModel f = FilterModel::TwoState(60, 0.5, 0.45, 0.3);
+  std::string text = "\xEF\xBB\xBFt,p_on,p_off,y\n# a comment\n";
+  for (int k = 0; k < 100000; ++k) {
+    text += std::to_string(0.5 * k) + "," + std::to_string(0.001 * (k % 300)) + "," +
+            std::to_string(0.001 * (k % 200)) + "," +
+            (k % 9 == 4 ? std::string() : std::to_string(13.0 + 5.0 * std::sin(0.01 * k))) +
+            (k % 1000 == 7 ? "\n\n" : "\n");
+  }
+  const std::string path = WriteTemp("estimation_stream_log.csv", text);
+  auto a = MakeCountFilter(f, {});
+  auto b = MakeCountFilter(f, {});
+  ASSERT_TRUE(a.ok() && b.ok());
+  auto in_memory = RunFilterOverText(f, text, path, **a);
+  ASSERT_TRUE(in_memory.ok()) << in_memory.error();
+  auto reader = FilterLogReader::OpenFile(path, f);
+  ASSERT_TRUE(reader.ok()) << reader.error();
+  std::ostringstream out;
+  const Status s = RunFilterStream(f, **reader, **b, out);
+  ASSERT_TRUE(s.ok()) << s.error();
+  const std::string streamed = out.str();
+  EXPECT_EQ(streamed, *in_memory);
+  EXPECT_EQ(std::count(streamed.begin(), streamed.end(), '\n'), 100001);
+  std::remove(path.c_str());
 }
 
 }  // namespace
