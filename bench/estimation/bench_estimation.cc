@@ -83,10 +83,25 @@ Sequence Simulate(const FilterModel& f, int steps, uint64_t seed, bool distinct_
   return s;
 }
 
-// Floating-point operations of one extended step (r = 1) as implemented: predict 4 m^3 (two
-// m x m products) + 6 m^2 (A x, A xq, diagonal, reprojection), update 12 m^2 (P H^T, three
-// rank-1 terms, reprojection) + O(m).
-double StepFlops(int m) { return 4.0 * m * m * m + 18.0 * m * m + 10.0 * m; }
+// Floating-point operations of one extended step (r = 1) with a dense A, as implemented:
+// predict 2 m^3 (A M) + m^3 (upper triangle of (A M) A^T; the full 2 m^3 for m < 16)
+// + 4 m^2 (A x, A xq) + 3 m^2 (reprojection), update 4 m^2 (P h^T, P - w w^T) + O(m).
+double StepFlops(int m) { return (m < 16 ? 4.0 : 3.0) * m * m * m + 11.0 * m * m + 10.0 * m; }
+
+// The same with a sparse A (PopulationKalmanFilterT::Predict(SparseMatrix)): first pass
+// 2 m nnz + 6 nnz, second pass sum over the nonzeros A(i, l) of 2 (i + 1) (upper triangle),
+// reprojection 3 m^2 + O(m), update 4 m^2 + O(m).
+double SparseStepFlops(const Eigen::SparseMatrix<double>& A) {
+  const double m = static_cast<double>(A.rows());
+  double second = 0.0;
+  for (int l = 0; l < A.outerSize(); ++l) {
+    for (Eigen::SparseMatrix<double>::InnerIterator it(A, l); it; ++it) {
+      second += 2.0 * static_cast<double>(it.row() + 1);
+    }
+  }
+  const double nnz = static_cast<double>(A.nonZeros());
+  return 2.0 * m * nnz + 6.0 * nnz + second + 7.0 * m * m + 10.0 * m;
+}
 
 template <int M>
 void BM_KalmanStep(benchmark::State& state) {
@@ -188,6 +203,60 @@ void BM_BroadcastStep(benchmark::State& state) {
   state.counters["nnz_A"] = static_cast<double>(As.nonZeros());
 }
 BENCHMARK(BM_BroadcastStep)->Arg(0)->Arg(1)->Arg(2);
+
+// The m-state heating / cooling chain (BroadcastTransitionModel::HeatingChain, at most 3
+// nonzeros per column of A), N = 60, a force sensor, random (p_on, p_off) in [0, 0.3] and the
+// measurements of a simulated run. range(0): 0 = dense A (FillMatrix + Predict(Mat), the
+// reference of this run), 1 = sparse A (PredictBroadcast: FillSparse in place + sparse
+// predict). Counters: flops per step of the algorithm the path runs, GFLOPS achieved.
+template <int M>
+void BM_ChainStep(benchmark::State& state) {
+  FilterModel f = ChainModel(M);
+  f.transition = TransitionSource::kBroadcast;
+  f.broadcast = BroadcastTransitionModel::HeatingChain(M, 0.5);
+  f.state_names = f.broadcast.state_names;
+  for (int i = 0; i < M; ++i) {
+    const int h = M / 2;
+    f.H(0, i) = i == 0 ? 0.0 : i <= h ? 0.45 * i / h : 0.45 * (1.0 - double(i - h) / (M - h));
+  }
+  const BroadcastTransitionModel& b = f.broadcast;
+  Rng rng(7);
+  std::vector<double> p_on(kSequence), p_off(kSequence);
+  std::vector<Eigen::Matrix<double, 1, 1>> y(kSequence);
+  Eigen::VectorXd x = f.x0;
+  for (int t = 0; t < kSequence; ++t) {
+    p_on[t] = 0.3 * rng.Uniform();
+    p_off[t] = 0.3 * rng.Uniform();
+    y[t] = f.H * x + Eigen::VectorXd::Constant(1, std::sqrt(f.R(0, 0)) * Gaussian(rng));
+    x = SimulateStepAggregate(b.Matrix(p_on[t], p_off[t]), x, rng);
+  }
+  const bool sparse = state.range(0) == 1;
+  auto kf = PopulationKalmanFilterT<M, 1>::Create(f, CovarianceMode::kExtended);
+  if (!kf.ok()) {
+    state.SkipWithError(kf.error().c_str());
+    return;
+  }
+  Eigen::Matrix<double, M, M> A;
+  int t = 0;
+  for (auto _ : state) {
+    if (sparse) {
+      kf->PredictBroadcast(p_on[t], p_off[t]);
+    } else {
+      b.FillMatrix(p_on[t], p_off[t], A);
+      kf->Predict(A);
+    }
+    kf->Update(y[t]);
+    benchmark::DoNotOptimize(kf->estimate().data());
+    t = (t + 1) % kSequence;
+  }
+  const double flops = sparse ? SparseStepFlops(kf->broadcast_matrix()) : StepFlops(M);
+  state.counters["nnz_A"] = static_cast<double>(kf->broadcast_matrix().nonZeros());
+  state.counters["flops"] = flops;
+  state.counters["GFLOPS"] =
+      benchmark::Counter(flops * 1e-9 * state.iterations(), benchmark::Counter::kIsRate);
+}
+BENCHMARK_TEMPLATE(BM_ChainStep, 20)->Arg(0)->Arg(1);
+BENCHMARK_TEMPLATE(BM_ChainStep, 50)->Arg(0)->Arg(1);
 
 void BM_KalmanStepDynamic(benchmark::State& state) {
   const int m = static_cast<int>(state.range(0));

@@ -1,12 +1,16 @@
 // `recruit filter`: runs one estimator offline over a recorded log (docs/formats/filter.md).
+#include <filesystem>
 #include <iostream>
 #include <string>
+#include <system_error>
+#include <utility>
 
 #include "cli/commands.h"
 #include "common/atomic_file.h"
 #include "estimation/count_filter.h"
 #include "estimation/filter_log.h"
 #include "estimation/filter_model.h"
+#include "estimation/json_matrix.h"
 
 namespace recruit::cli {
 namespace {
@@ -16,20 +20,38 @@ struct FilterArgs {
   CountFilterOptions options;
 };
 
+// The output is written through a temporary file renamed onto --out, which would replace an
+// input given under the same name, another path or a link to it: refused before anything runs.
+Status CheckOutputIsNoInput(const std::string& out, const FilterArgs& a) {
+  for (const auto& [option, input] : {std::pair{"--log", a.log}, std::pair{"--model", a.model}}) {
+    std::error_code ec;
+    if (out == input || std::filesystem::equivalent(out, input, ec)) {
+      return Error{"--out '" + json_io::ShortValue(out) + "' is the same file as " + option + " '" +
+                   json_io::ShortValue(input) + "'; refusing to overwrite an input"};
+    }
+  }
+  return Status::Ok();
+}
+
 int RunFilter(const FilterArgs& a) {
   auto fail = [](const std::string& msg) {
     std::cerr << "recruit filter: " << msg << "\n";
     return 1;
   };
+  if (Status s = CheckOutputIsNoInput(a.out, a); !s.ok()) return fail(s.error());
   auto model = FilterModel::FromJson(a.model);
   if (!model.ok()) return fail(model.error());
-  auto log = ReadFilterLog(a.log, *model);
-  if (!log.ok()) return fail(log.error());
   auto filter = MakeCountFilter(*model, a.options);
   if (!filter.ok()) return fail(filter.error());
-  auto csv = RunFilterOverLog(*model, *log, **filter);
-  if (!csv.ok()) return fail(a.log + ": " + csv.error());
-  if (Status s = WriteFileAtomically(a.out, *csv); !s.ok()) return fail(s.error());
+  // Streamed: the log is read, stepped and written row by row (memory flat in its length).
+  auto log = FilterLogReader::OpenFile(a.log, *model);
+  if (!log.ok()) return fail(log.error());
+  AtomicFile out(a.out, std::ios::out | std::ios::binary);
+  if (!out.ok()) return fail(out.error());
+  if (Status s = RunFilterStream(*model, **log, **filter, out.stream()); !s.ok()) {
+    return fail(s.error());  // AtomicFile removes its temporary file: nothing is written
+  }
+  if (Status s = out.Commit(); !s.ok()) return fail(s.error());
   return 0;
 }
 

@@ -1,5 +1,6 @@
 #include "estimation/broadcast_transition_model.h"
 
+#include <algorithm>
 #include <cmath>
 #include <nlohmann/json.hpp>
 
@@ -41,6 +42,39 @@ BroadcastTransitionModel BroadcastTransitionModel::TwoState(double dt) {
   return b;
 }
 
+BroadcastTransitionModel BroadcastTransitionModel::HeatingChain(int m, double dt) {
+  BroadcastTransitionModel b;
+  const int h = m / 2;
+  const int cooling = m - 1 - h;  // states h+1..m-1
+  b.interior = Eigen::MatrixXd::Zero(m, m);
+  b.interior(0, 0) = 1.0;
+  for (int i = 1; i <= h; ++i) {
+    if (i < h) {
+      b.interior(i, i) = 0.5;
+      b.interior(i + 1, i) = 0.5;
+    } else {
+      b.interior(i, i) = 1.0;
+    }
+  }
+  for (int c = h + 1; c < m; ++c) {
+    b.interior(c, c) = 0.5;
+    b.interior(c + 1 < m ? c + 1 : 0, c) += 0.5;
+  }
+  for (int i = 0; i < m; ++i) {
+    b.state_names.push_back(i == 0   ? "off"
+                            : i <= h ? "heat" + std::to_string(i)
+                                     : "cool" + std::to_string(i - h));
+    b.is_on.push_back(i >= 1 && i <= h);
+    b.on_target.push_back(b.is_on[i] ? -1 : 1);
+    // On state i (temperature i / h) to the cooling state at about that temperature.
+    int off = 0;
+    if (b.is_on[i] && cooling > 0) off = h + 1 + (cooling - 1) * (h - i) / std::max(1, h - 1);
+    b.off_target.push_back(b.is_on[i] ? off : -1);
+  }
+  b.dt = dt;
+  return b;
+}
+
 Status BroadcastTransitionModel::Validate(const std::string& where) const {
   const int m = num_states();
   if (m < 1) return Error{where + ": needs at least one state"};
@@ -61,8 +95,9 @@ Status BroadcastTransitionModel::Validate(const std::string& where) const {
     const char* field = is_on[j] ? ".off_target" : ".on_target";
     if (t < 0 || t >= m) {
       return Error{where + field + "[" + std::to_string(j) + "] = " + std::to_string(t) +
-                   " (state '" + state_names[j] + "', " + (is_on[j] ? "on" : "off") +
-                   ") must be a state index in [0, " + std::to_string(m - 1) + "]"};
+                   " (state '" + json_io::ShortValue(state_names[j]) + "', " +
+                   (is_on[j] ? "on" : "off") + ") must be a state index in [0, " +
+                   std::to_string(m - 1) + "]"};
     }
   }
   if (!(std::isfinite(dt) && dt > 0.0)) {

@@ -61,6 +61,13 @@ struct BroadcastTransitionModel {
   }
 
   static BroadcastTransitionModel TwoState(double dt);
+  // A generic m-state heating / cooling chain (m >= 2), the shape of the identified SMA models:
+  // state 0 is off and settled; states 1..h (h = m / 2) are on, a unit moving one state up per
+  // step with probability 1/2 (h settled); states h+1..m-1 are off and cooling, one state on
+  // per step with probability 1/2, the last one back to 0. p_on sends an off state to 1; p_off
+  // sends on state i to the cooling state of the same temperature. At most 3 nonzeros per
+  // column of A (benchmarks and tests of the sparse filter for any m).
+  static BroadcastTransitionModel HeatingChain(int m, double dt);
 
   // Checks sizes, names, interior (column-stochastic), targets in range, dt > 0.
   // `where` prefixes messages, e.g. "model.json: transition".

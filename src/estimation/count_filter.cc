@@ -2,23 +2,55 @@
 
 #include "common/rng.h"
 #include "estimation/exact_filter.h"
+#include "estimation/json_matrix.h"
 #include "estimation/particle_filter.h"
 #include "estimation/population_kalman_filter.h"
 
 namespace recruit {
 namespace {
 
+// F: PopulationKalmanFilterT<M, R>; fixed sizes for the common models (no heap, unrolled).
+template <class F>
 class KalmanAdapter final : public CountFilter {
  public:
-  explicit KalmanAdapter(PopulationKalmanFilter f) : f_(std::move(f)) {}
-  void Predict(const Eigen::MatrixXd& A) override { f_.Predict(A); }
-  void Update(const Eigen::VectorXd& y) override { f_.Update(y); }
+  explicit KalmanAdapter(F f) : f_(std::move(f)) {}
+  void Predict(const Eigen::MatrixXd& A) override {
+    if constexpr (F::Mat::RowsAtCompileTime == Eigen::Dynamic) {
+      f_.Predict(A);
+    } else {
+      f_.Predict(typename F::Mat(A));  // fixed size: a stack copy
+    }
+  }
+  void Update(const Eigen::VectorXd& y) override {
+    y_ = y;  // fixed size: a copy, no allocation
+    f_.Update(y_);
+  }
   Eigen::VectorXd Mean() const override { return f_.estimate(); }
   Eigen::MatrixXd Covariance() const override { return f_.covariance(); }
+  void PredictBroadcast(const BroadcastTransitionModel& b, double p_on, double p_off) override {
+    if (f_.has_broadcast()) {
+      f_.PredictBroadcast(p_on, p_off);
+    } else {
+      CountFilter::PredictBroadcast(b, p_on, p_off);
+    }
+  }
+  void MeanAndVariance(Eigen::VectorXd& mean, Eigen::VectorXd& var) const override {
+    mean = f_.estimate();
+    var = f_.covariance().diagonal();
+  }
 
  private:
-  PopulationKalmanFilter f_;
+  F f_;
+  typename F::OutVec y_;
 };
+
+template <int M, int R>
+Result<std::unique_ptr<CountFilter>> MakeKalman(const FilterModel& model, CovarianceMode mode) {
+  auto f = PopulationKalmanFilterT<M, R>::Create(model, mode);
+  if (!f.ok()) return Error{f.error()};
+  return std::unique_ptr<CountFilter>(
+      new KalmanAdapter<PopulationKalmanFilterT<M, R>>(std::move(*f)));
+}
 
 class ExactAdapter final : public CountFilter {
  public:
@@ -52,9 +84,17 @@ Result<std::unique_ptr<CountFilter>> MakeCountFilter(const FilterModel& model,
   const std::string& e = options.estimator;
   if (e == "extended" || e == "conservative" || e == "plain") {
     auto mode = ParseCovarianceMode(e);
-    auto f = PopulationKalmanFilter::Create(model, *mode);
-    if (!f.ok()) return Error{f.error()};
-    return std::unique_ptr<CountFilter>(new KalmanAdapter(std::move(*f)));
+    if (model.num_outputs() == 1) {
+      switch (model.num_states()) {
+        case 2:
+          return MakeKalman<2, 1>(model, *mode);
+        case 3:
+          return MakeKalman<3, 1>(model, *mode);
+        case 20:
+          return MakeKalman<20, 1>(model, *mode);
+      }
+    }
+    return MakeKalman<Eigen::Dynamic, Eigen::Dynamic>(model, *mode);
   }
   if (e == "exact") {
     ExactFilterOptions o;
@@ -71,7 +111,7 @@ Result<std::unique_ptr<CountFilter>> MakeCountFilter(const FilterModel& model,
     if (!f.ok()) return Error{f.error()};
     return std::unique_ptr<CountFilter>(new ParticleAdapter(std::move(*f), rng));
   }
-  return Error{"estimator '" + e + "' is not one of " + kEstimatorNames};
+  return Error{"estimator '" + json_io::ShortValue(e) + "' is not one of " + kEstimatorNames};
 }
 
 }  // namespace recruit

@@ -19,6 +19,18 @@ class CountFilter {
   virtual void Update(const Eigen::VectorXd& y) = 0;
   virtual Eigen::VectorXd Mean() const = 0;        // counts per state
   virtual Eigen::MatrixXd Covariance() const = 0;  // of the counts
+  // Predict with A(p_on, p_off) of `b` (the model's broadcast transition; inputs validated by
+  // the caller). The Kalman filter uses its sparse, allocation-free path; the default builds
+  // the dense matrix.
+  virtual void PredictBroadcast(const BroadcastTransitionModel& b, double p_on, double p_off) {
+    Predict(b.Matrix(p_on, p_off));
+  }
+  // Mean and the diagonal of the covariance into vectors of m entries (the Kalman filter
+  // copies them without allocating).
+  virtual void MeanAndVariance(Eigen::VectorXd& mean, Eigen::VectorXd& var) const {
+    mean = Mean();
+    var = Covariance().diagonal();
+  }
 };
 
 struct CountFilterOptions {

@@ -23,7 +23,8 @@ Status FilterModel::Validate(const std::string& where) const {
   std::set<std::string> seen;
   for (const auto& s : state_names) {
     if (s.empty()) return Error{where + ": states: names must be non-empty"};
-    if (!seen.insert(s).second) return Error{where + ": states: duplicate name '" + s + "'"};
+    if (!seen.insert(s).second)
+      return Error{where + ": states: duplicate name '" + json_io::ShortValue(s) + "'"};
   }
   if (N < 1)
     return Error{where + ": N: must be a positive number of agents, got " + std::to_string(N)};
@@ -130,13 +131,9 @@ FilterModel FilterModel::WithPopulation(int64_t N_new) const {
 Result<FilterModel> FilterModel::FromJson(const std::string& path) {
   auto text = ReadFile(path);
   if (!text.ok()) return Error{text.error()};
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(*text);
-  } catch (const nlohmann::json::parse_error& e) {
-    return Error{path + ": malformed JSON: " + e.what()};
-  }
-  return FromJsonValue(j, path);
+  auto j = json_io::ParseJson(*text, path);
+  if (!j.ok()) return Error{j.error()};
+  return FromJsonValue(*j, path);
 }
 
 Result<FilterModel> FilterModel::FromJsonValue(const nlohmann::json& j, const std::string& where) {
@@ -207,7 +204,7 @@ Result<FilterModel> FilterModel::FromJsonValue(const nlohmann::json& j, const st
     if (!A.ok()) return Error{A.error()};
     f.A = *A;
   } else {
-    return Error{where + ": transition.type: \"" + type +
+    return Error{where + ": transition.type: \"" + json_io::ShortValue(type) +
                  "\" is not one of \"broadcast\", \"explicit\", \"constant\""};
   }
   f.x0 = Eigen::VectorXd::Zero(m);

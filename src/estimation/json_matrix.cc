@@ -1,8 +1,109 @@
 #include "estimation/json_matrix.h"
 
 #include <cmath>
+#include <vector>
 
 namespace recruit::json_io {
+
+std::string ShortValue(const std::string& s, size_t max) {
+  if (s.size() <= max) return s;
+  return s.substr(0, max) + "... (" + std::to_string(s.size()) + " characters)";
+}
+
+namespace {
+
+// SAX pass that builds nothing: tracks the field path and the depth, and turns nlohmann's
+// errors into messages (returning false stops the parser at once).
+class CheckingSax final : public nlohmann::json_sax<nlohmann::json> {
+ public:
+  std::string error;
+
+  bool null() override { return Value(); }
+  bool boolean(bool) override { return Value(); }
+  bool number_integer(number_integer_t) override { return Value(); }
+  bool number_unsigned(number_unsigned_t) override { return Value(); }
+  bool number_float(number_float_t, const string_t&) override { return Value(); }
+  bool string(string_t&) override { return Value(); }
+  bool binary(binary_t&) override { return Value(); }
+  bool start_object(std::size_t) override { return Open(false); }
+  bool key(string_t& k) override {
+    stack_.back().key = k;
+    return true;
+  }
+  bool end_object() override { return Close(); }
+  bool start_array(std::size_t) override { return Open(true); }
+  bool end_array() override { return Close(); }
+  bool parse_error(std::size_t position, const std::string& last_token,
+                   const nlohmann::detail::exception& ex) override {
+    if (ex.id == 406) {  // out_of_range: number overflow
+      error = Field() + "number '" + ShortValue(last_token) +
+              "' is too large for a double (finite numbers only)";
+    } else {
+      std::string what = ex.what();
+      // nlohmann echoes the last token ("last read: '...'"); keep ~40 characters of it.
+      const size_t lr = what.find("last read: '");
+      if (lr != std::string::npos) {
+        std::string tok = what.substr(lr + 12);
+        if (!tok.empty() && tok.back() == '\'') tok.pop_back();
+        what = what.substr(0, lr + 12) + ShortValue(tok) + "'";
+      }
+      error = "malformed JSON: " + Field() + what;
+    }
+    (void)position;
+    return false;
+  }
+
+ private:
+  struct Frame {
+    bool array;
+    size_t index = 0;
+    std::string key;
+  };
+  bool Value() {
+    if (!stack_.empty() && stack_.back().array) ++stack_.back().index;
+    return true;
+  }
+  bool Open(bool array) {
+    if (static_cast<int>(stack_.size()) >= kMaxJsonDepth) {
+      error = Field() + "nested deeper than " + std::to_string(kMaxJsonDepth) +
+              " levels (a filter model nests at most 4)";
+      return false;
+    }
+    stack_.push_back({array, 0, ""});
+    return true;
+  }
+  bool Close() {
+    stack_.pop_back();
+    return Value();
+  }
+  // "field a.b[2]: " for the value being read, or "" at the top level.
+  std::string Field() const {
+    std::string f;
+    for (const Frame& fr : stack_) {
+      if (fr.array) {
+        f += "[" + std::to_string(fr.index) + "]";
+      } else if (!fr.key.empty()) {
+        f += (f.empty() ? "" : ".") + ShortValue(fr.key);
+      }
+    }
+    return f.empty() ? "" : "field " + f + ": ";
+  }
+  std::vector<Frame> stack_;
+};
+
+}  // namespace
+
+Result<nlohmann::json> ParseJson(const std::string& text, const std::string& path) {
+  CheckingSax sax;
+  if (!nlohmann::json::sax_parse(text, &sax) || !sax.error.empty()) {
+    return Error{path + ": " + (sax.error.empty() ? "malformed JSON" : sax.error)};
+  }
+  try {
+    return nlohmann::json::parse(text);
+  } catch (const nlohmann::json::exception& e) {  // not expected after the SAX pass
+    return Error{path + ": malformed JSON: " + ShortValue(e.what(), 200)};
+  }
+}
 
 Result<Eigen::MatrixXd> ReadMatrix(const nlohmann::json& j, const std::string& field, int rows,
                                    int cols) {

@@ -15,6 +15,20 @@ Result<Eigen::MatrixXd> ReadMatrix(const nlohmann::json& j, const std::string& f
 // A JSON array of `size` finite numbers (size < 0: any).
 Result<Eigen::VectorXd> ReadVector(const nlohmann::json& j, const std::string& field, int size);
 
+// The deepest nesting ParseJson accepts (filter model files nest 4 levels).
+inline constexpr int kMaxJsonDepth = 64;
+
+// Parses JSON `text` read from `path`. Errors are messages, never exceptions: malformed JSON
+// (line, column), a number too large for a double (e.g. 1e999) and nesting deeper than
+// kMaxJsonDepth (checked by a SAX pass before any tree is built, so that a 70,000-deep document
+// cannot exhaust the stack) each name the file and the field path (e.g.
+// "transition.interior[1][0]"), with the offending text shortened (ShortValue).
+Result<nlohmann::json> ParseJson(const std::string& text, const std::string& path);
+
+// `s` for an error message: at most `max` characters, longer values cut with "..." and their
+// length, so that a 2 MB field does not come back whole.
+std::string ShortValue(const std::string& s, size_t max = 40);
+
 nlohmann::json WriteMatrix(const Eigen::MatrixXd& M);
 nlohmann::json WriteVector(const Eigen::VectorXd& v);
 

@@ -1,5 +1,7 @@
 #include "estimation/population_kalman_filter.h"
 
+#include "estimation/json_matrix.h"
+
 namespace recruit {
 
 const char* ToString(CovarianceMode mode) {
@@ -18,7 +20,8 @@ Result<CovarianceMode> ParseCovarianceMode(const std::string& name) {
   if (name == "extended") return CovarianceMode::kExtended;
   if (name == "conservative") return CovarianceMode::kConservative;
   if (name == "plain") return CovarianceMode::kPlain;
-  return Error{"covariance mode '" + name + "' is not one of extended, conservative, plain"};
+  return Error{"covariance mode '" + json_io::ShortValue(name) +
+               "' is not one of extended, conservative, plain"};
 }
 
 // The dynamic-size filter and the common small sizes are compiled once here.

@@ -5,6 +5,12 @@
 //   gain     K = P H^T (H P H^T + R)^-1                                       (19)
 //   update   X^ = X^(t|t-1) + K (y - H X^(t|t-1))                             (15), (17)
 //            P  = (I - K H) P (I - K H)^T + K R K^T   (Joseph form of (20))
+// For r = 1 the innovation variance is a scalar s (no factorisation) and the Joseph form with
+// the optimal gain is exactly P - u u^T / s, u = P H^T.
+//
+// A broadcast model's A is sparse (at most 3 nonzeros per column): PredictBroadcast(p_on,
+// p_off) fills the filter's own sparse A in place and predicts in O(m nnz(A)) (docs/
+// equations.md); this is the call a controller with a broadcast model uses.
 //
 // Qz depends on the covariance mode (docs/equations.md):
 //   kExtended:     Qz(X^) = diag(A X^) - A diag(X^) A^T at the a-posteriori estimate (26),
@@ -26,6 +32,7 @@
 #include <Eigen/Dense>
 #include <Eigen/SparseCore>
 #include <algorithm>
+#include <cmath>
 #include <functional>
 #include <string>
 
@@ -70,6 +77,15 @@ class PopulationKalmanFilterT {
   // instead of two dense m x m products; O(m^2 nnz / m) instead of O(m^3). A must be m x m and
   // column-stochastic (not checked); no allocation. Equal to Predict(Mat(A)) up to round-off.
   void Predict(const Eigen::SparseMatrix<double>& A);
+  // The natural call for a broadcast model (model.transition == kBroadcast): fills the filter's
+  // own sparse A(p_on, p_off) in place (BroadcastTransitionModel::FillSparse on the pattern
+  // built at Create) and predicts with it, O(m nnz(A)), no allocation. p_on, p_off in [0, 1]
+  // (not checked; BroadcastTransitionModel::ValidateInputs). Not for other transition sources
+  // (has_broadcast() is false; then this is a no-op guarded by an assertion in debug builds).
+  void PredictBroadcast(double p_on, double p_off);
+  bool has_broadcast() const { return has_broadcast_; }
+  // The A of the last PredictBroadcast (the broadcast pattern, values of that call).
+  const Eigen::SparseMatrix<double>& broadcast_matrix() const { return As_; }
   // Measurement update with y(t) (eqs. 15, 17, 19, 20 in Joseph form).
   void Update(const OutVec& y);
 
@@ -96,8 +112,12 @@ class PopulationKalmanFilterT {
 
  private:
   PopulationKalmanFilterT() = default;
+  // Sets xq_, the point Qz is evaluated at (per the mode).
+  void SetQzPoint();
   // Sets M_ = P - diag xq (xq per the mode) before the covariance prediction.
   void PrepareCovariancePredict();
+  // The r = 1 update: scalar innovation variance, no factorisation.
+  void UpdateScalar(double y);
   // Adds diag(A xq) and G Qw G^T to P_ (ax_ = A xq computed by the caller), x_ = tmp_ (= A x),
   // re-projects.
   void FinishPredict();
@@ -119,13 +139,18 @@ class PopulationKalmanFilterT {
   Vec x_;
   Mat P_;
   // Workspaces (sized at Create so that Predict / Update do not allocate).
-  Vec xq_, ax_, tmp_, rowsum_;
+  Vec xq_, ax_, tmp_, rowsum_, kw_;
   Mat M_, AM_;
   GainMat U_, K_, KS_;
   OutMat S_;
   OutVec innov_;
   Eigen::Matrix<double, R, M> Kt_;
-  Eigen::LLT<OutMat> llt_;
+  Eigen::LLT<OutMat> llt_;  // r > 1 only; computed once at Create so that no member is
+                            // left uninitialised (moving it was undefined behaviour)
+  // PredictBroadcast: the model's broadcast transition and the sparse A it fills.
+  bool has_broadcast_ = false;
+  BroadcastTransitionModel broadcast_;
+  Eigen::SparseMatrix<double> As_;
 };
 
 using PopulationKalmanFilter = PopulationKalmanFilterT<Eigen::Dynamic, Eigen::Dynamic>;
@@ -202,6 +227,7 @@ Result<PopulationKalmanFilterT<M, R>> PopulationKalmanFilterT<M, R>::Create(
   f.ax_.resize(m);
   f.tmp_.resize(m);
   f.rowsum_.resize(m);
+  f.kw_.resize(m);
   f.M_.resize(m, m);
   f.AM_.resize(m, m);
   f.U_.resize(m, r);
@@ -210,14 +236,18 @@ Result<PopulationKalmanFilterT<M, R>> PopulationKalmanFilterT<M, R>::Create(
   f.S_.resize(r, r);
   f.innov_.setZero(r);
   f.Kt_.resize(r, m);
+  f.llt_.compute(OutMat::Identity(r, r));
+  if (model.transition == TransitionSource::kBroadcast) {
+    f.has_broadcast_ = true;
+    f.broadcast_ = model.broadcast;
+    f.As_ = model.broadcast.SparsePattern();
+  }
   f.Reproject();
   return f;
 }
 
 template <int M, int R>
-void PopulationKalmanFilterT<M, R>::PrepareCovariancePredict() {
-  // A P A^T + Qz(xq) = A (P - diag xq) A^T + diag(A xq); xq is the point Qz is evaluated at.
-  M_ = P_;
+void PopulationKalmanFilterT<M, R>::SetQzPoint() {
   switch (mode_) {
     case CovarianceMode::kExtended:
       kf_detail::ProjectOntoSimplexInto(x_, N_, xq_, tmp_);
@@ -229,6 +259,13 @@ void PopulationKalmanFilterT<M, R>::PrepareCovariancePredict() {
       xq_.setZero();
       break;
   }
+}
+
+template <int M, int R>
+void PopulationKalmanFilterT<M, R>::PrepareCovariancePredict() {
+  // A P A^T + Qz(xq) = A (P - diag xq) A^T + diag(A xq); xq is the point Qz is evaluated at.
+  SetQzPoint();
+  M_ = P_;
   if (mode_ != CovarianceMode::kPlain) M_.diagonal() -= xq_;
 }
 
@@ -259,21 +296,30 @@ void PopulationKalmanFilterT<M, R>::Predict(const Mat& A) {
 template <int M, int R>
 void PopulationKalmanFilterT<M, R>::Predict(const Eigen::SparseMatrix<double>& A) {
   using It = Eigen::SparseMatrix<double>::InnerIterator;
-  PrepareCovariancePredict();
+  SetQzPoint();
   const Eigen::Index m = x_.size();
-  // B = M A^T column by column: A(i, l) = a adds a M(:, l) to B(:, i) (contiguous columns).
+  const bool qz = mode_ != CovarianceMode::kPlain;
+  // B = (P - diag xq) A^T column by column: A(i, l) = a adds a P(:, l) to B(:, i) (contiguous
+  // columns) and -a xq_l to B(l, i); P itself is read, not copied. 2 m nnz(A) flops.
   AM_.setZero();
   ax_.setZero();
   tmp_.setZero();
   for (Eigen::Index l = 0; l < m; ++l) {
+    const double xl = x_(l), ql = xq_(l);
     for (It it(A, l); it; ++it) {
-      AM_.col(it.row()) += it.value() * M_.col(l);
-      ax_(it.row()) += it.value() * xq_(l);
-      tmp_(it.row()) += it.value() * x_(l);
+      const Eigen::Index i = it.row();
+      const double a = it.value();
+      AM_.col(i) += a * P_.col(l);
+      tmp_(i) += a * xl;
+      if (qz) {
+        AM_(l, i) -= a * ql;
+        ax_(i) += a * ql;
+      }
     }
   }
-  // B^T = A M (M is symmetric), then P = (A M) A^T by the same column updates.
-  // P is symmetric: only its upper triangle (rows 0..i of column i) is computed.
+  // P = A B: column i is sum_l A(i, l) B(l, :)^T; rows of B are made columns by one transpose
+  // (m^2 moves) so that the second pass is contiguous too. P is symmetric: only its upper
+  // triangle (rows 0..i of column i) is computed, about m nnz(A) flops.
   M_ = AM_.transpose();
   P_.setZero();
   for (Eigen::Index l = 0; l < m; ++l) {
@@ -286,7 +332,41 @@ void PopulationKalmanFilterT<M, R>::Predict(const Eigen::SparseMatrix<double>& A
 }
 
 template <int M, int R>
+void PopulationKalmanFilterT<M, R>::PredictBroadcast(double p_on, double p_off) {
+  eigen_assert(has_broadcast_ && "PredictBroadcast needs a broadcast model");
+  if (!has_broadcast_) return;
+  broadcast_.FillSparse(p_on, p_off, As_);
+  Predict(As_);
+}
+
+template <int M, int R>
+void PopulationKalmanFilterT<M, R>::UpdateScalar(double y) {
+  // r = 1: S = h P h^T + R is a scalar, K = P h^T / S; no factorisation, no matrix inverse.
+  const auto h = H_.row(0);
+  auto u = U_.col(0);
+  auto k = K_.col(0);
+  u.noalias() = P_ * h.transpose();  // P h^T (P symmetric)
+  const double s = h.dot(u) + R_(0, 0);
+  S_(0, 0) = s;
+  k = u / s;
+  innov_(0) = y - h.dot(x_);
+  x_ += innov_(0) * k;
+  // Joseph form (I - K H) P (I - K H)^T + K R K^T with the optimal gain k = u / s reduces to
+  // P - u u^T / s = P - w w^T, w = u / sqrt(s): 2 m^2 flops instead of 7 m^2 for the expanded
+  // form, and w_i w_j == w_j w_i exactly, so P stays exactly symmetric. 1^T P = 0 before gives
+  // 1^T u = 0, so the update keeps 1^T P = 0 up to round-off, removed at the next Predict; the
+  // estimate is re-centred on sum = N at once (O(m)).
+  kw_ = u / std::sqrt(s);
+  for (Eigen::Index j = 0; j < P_.cols(); ++j) P_.col(j) -= kw_(j) * kw_;
+  x_.array() += (N_ - x_.sum()) / static_cast<double>(x_.size());
+}
+
+template <int M, int R>
 void PopulationKalmanFilterT<M, R>::Update(const OutVec& y) {
+  if (R == 1 || (R == Eigen::Dynamic && H_.rows() == 1)) {
+    UpdateScalar(y(0));
+    return;
+  }
   U_.noalias() = P_ * H_.transpose();  // P H^T
   S_ = R_;
   S_.noalias() += H_ * U_;  // H P H^T + R
@@ -300,22 +380,10 @@ void PopulationKalmanFilterT<M, R>::Update(const OutVec& y) {
   // Joseph form (I - K H) P (I - K H)^T + K R K^T, expanded with U = P H^T so that it costs
   // O(m^2 r): P - K U^T - U K^T + K S K^T. Valid for any K, symmetric by construction.
   KS_.noalias() = K_ * S_;
-  if constexpr (R == 1) {
-    // One pass per column: P_ij - (k_i u_j + u_i k_j) + (k_i k_j) s, the same arithmetic for
-    // (i, j) and (j, i), so P stays exactly symmetric and needs no mirroring.
-    const double s = S_(0, 0);
-    for (Eigen::Index j = 0; j < P_.cols(); ++j) {
-      P_.col(j).array() =
-          (P_.col(j).array() - (K_.col(0).array() * U_(j, 0) + U_.col(0).array() * K_(j, 0))) +
-          (K_.col(0).array() * K_(j, 0)) * s;
-    }
-    ReprojectSymmetric();
-  } else {
-    P_.noalias() -= K_ * U_.transpose();
-    P_.noalias() -= U_ * K_.transpose();
-    P_.noalias() += KS_ * K_.transpose();
-    MirrorUpperAndReproject();
-  }
+  P_.noalias() -= K_ * U_.transpose();
+  P_.noalias() -= U_ * K_.transpose();
+  P_.noalias() += KS_ * K_.transpose();
+  MirrorUpperAndReproject();
 }
 
 template <int M, int R>

@@ -17,6 +17,7 @@
 #include "estimation/count_filter.h"
 #include "estimation/filter_log.h"
 #include "estimation/filter_model.h"
+#include "estimation/population_kalman_filter.h"
 
 namespace recruit {
 namespace {
@@ -110,12 +111,10 @@ TEST_F(EstimationCli, DocumentedExampleRunsAndTracksTheTruth) {
   // Same numbers as the library run in process.
   auto m = FilterModel::FromJson(model);
   ASSERT_TRUE(m.ok());
-  auto l = ReadFilterLog(log, *m);
-  ASSERT_TRUE(l.ok());
   auto f = MakeCountFilter(*m, {});
   ASSERT_TRUE(f.ok());
-  auto csv = RunFilterOverLog(*m, *l, **f);
-  ASSERT_TRUE(csv.ok());
+  auto csv = RunFilterOverText(*m, *ReadFile(log), log, **f);
+  ASSERT_TRUE(csv.ok()) << csv.error();
   EXPECT_EQ(*ReadFile(Out()), *csv);
 }
 
@@ -223,6 +222,107 @@ TEST_F(EstimationCli, UnwritableOutputFails) {
                  Write("log.csv", kGoodLog) + " --out /nonexistent_dir/out.csv");
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.err.find("cannot write '/nonexistent_dir/out.csv'"), std::string::npos) << r.err;
+}
+
+// Issue 12: a log saved with a UTF-8 byte-order mark (spreadsheet exports) reads as without.
+TEST_F(EstimationCli, ByteOrderMarkIsAccepted) {
+  const std::string model = Write("model.json", kTwoStateModel);
+  const RunResult r =
+      RunRecruit("filter --model " + model + " --log " +
+                 Write("log.csv", "\xEF\xBB\xBF" + std::string(kGoodLog)) + " --out " + Out());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string with_bom = *ReadFile(Out());
+  const std::string plain = (dir_ / "plain.csv").string();
+  ASSERT_EQ(RunRecruit("filter --model " + model + " --log " + Write("log2.csv", kGoodLog) +
+                       " --out " + plain)
+                .exit_code,
+            0);
+  EXPECT_EQ(with_bom, *ReadFile(plain));
+  EXPECT_EQ(with_bom.rfind("step,t,updated,", 0), 0u) << with_bom;
+}
+
+// Issue 12: --out naming an input (same path, another path to it, a symbolic link to it)
+// is refused before anything is read or written; the input is unchanged.
+TEST_F(EstimationCli, OutputEqualToAnInputIsRefused) {
+  const std::string model = Write("model.json", kTwoStateModel);
+  const std::string log = Write("log.csv", kGoodLog);
+  fs::create_symlink(log, dir_ / "link.csv");
+  const std::string other_path = (dir_ / "." / "log.csv").string();
+  for (const std::string& out : {log, other_path, (dir_ / "link.csv").string(), model}) {
+    SCOPED_TRACE(out);
+    const RunResult r = RunRecruit("filter --model " + model + " --log " + log + " --out " + out);
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_NE(r.err.find("is the same file as"), std::string::npos) << r.err;
+    EXPECT_EQ(*ReadFile(log), kGoodLog);
+    EXPECT_EQ(*ReadFile(model), kTwoStateModel);
+    EXPECT_TRUE(fs::is_symlink(dir_ / "link.csv"));
+  }
+}
+
+// Issue 12: a 2 MB cell comes back shortened in the message.
+TEST_F(EstimationCli, LongCellIsShortenedInTheMessage) {
+  const std::string big(2000000, '7');
+  const RunResult r =
+      RunRecruit("filter --model " + Write("model.json", kTwoStateModel) + " --log " +
+                 Write("log.csv", "t,p_on,p_off,y\n0,0.2,0,1x" + big + "\n") + " --out " + Out());
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find(":2: column 'y': '1x7777"), std::string::npos) << r.err.substr(0, 300);
+  EXPECT_LT(r.err.size(), 300u);
+  EXPECT_TRUE(NoOutput());
+}
+
+// The streamed CLI (sparse broadcast predict, shortest round-trip numbers) against the dense
+// dynamic-size filter stepped here with the broadcast model's dense matrix: every number of
+// every row equal to 1e-12 relative, on a 20-state heating / cooling chain with missing
+// measurements; the output numbers read back exactly (to_chars shortest form).
+TEST_F(EstimationCli, StreamedRunMatchesTheDenseFilter) {
+  const int m = 20;
+  FilterModel f = FilterModel::TwoState(60, 0.5, 0.45, 0.3);
+  f.broadcast = BroadcastTransitionModel::HeatingChain(m, 0.5);
+  f.state_names = f.broadcast.state_names;
+  f.H = Eigen::MatrixXd::Zero(1, m);
+  for (int i = 1; i < m; ++i) f.H(0, i) = 0.45 * (i <= m / 2 ? i : m - i) / (m / 2);
+  f.x0 = Eigen::VectorXd::Zero(m);
+  f.x0(0) = 60;
+  f.P0 = Eigen::MatrixXd::Zero(m, m);
+  f.G = Eigen::MatrixXd::Zero(m, 0);
+  const std::string model = (dir_ / "model.json").string();
+  const Status saved = f.Save(model);
+  ASSERT_TRUE(saved.ok()) << saved.error();
+  std::string log = "t,p_on,p_off,y\n";
+  std::vector<double> p_on, p_off, y;
+  for (int k = 0; k < 300; ++k) {
+    p_on.push_back(0.001 * ((k * 37) % 300));
+    p_off.push_back(0.001 * ((k * 53) % 200));
+    y.push_back(k % 7 == 3 ? NAN : 5.0 + 4.0 * std::sin(0.05 * k));
+    char line[96];
+    std::snprintf(line, sizeof line, "%g,%.3f,%.3f,", 0.5 * k, p_on[k], p_off[k]);
+    log += line;
+    if (!std::isnan(y[k])) log += std::to_string(y[k]);
+    log += "\n";
+  }
+  const RunResult r =
+      RunRecruit("filter --model " + model + " --log " + Write("log.csv", log) + " --out " + Out());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  auto loaded = FilterModel::FromJson(model);
+  ASSERT_TRUE(loaded.ok());
+  auto kf = PopulationKalmanFilter::Create(*loaded, CovarianceMode::kExtended);
+  ASSERT_TRUE(kf.ok());
+  std::string header;
+  const auto rows = ReadCsvNumbers(Out(), &header);
+  ASSERT_EQ(rows.size(), 300u);
+  for (int k = 0; k < 300; ++k) {
+    if (k > 0) kf->Predict(loaded->broadcast.Matrix(p_on[k - 1], p_off[k - 1]));
+    if (!std::isnan(y[k]))
+      kf->Update(Eigen::VectorXd::Constant(1, std::stod(std::to_string(y[k]))));
+    const double scale = 1.0 + kf->covariance().diagonal().cwiseAbs().maxCoeff();
+    ASSERT_EQ(rows[k].size(), 3u + 2 * m);
+    EXPECT_EQ(rows[k][2], std::isnan(y[k]) ? 0.0 : 1.0);
+    for (int i = 0; i < m; ++i) {
+      ASSERT_NEAR(rows[k][3 + i], kf->estimate()(i), 1e-12 * 60.0) << "row " << k;
+      ASSERT_NEAR(rows[k][3 + m + i], kf->covariance()(i, i), 1e-12 * scale) << "row " << k;
+    }
+  }
 }
 
 }  // namespace

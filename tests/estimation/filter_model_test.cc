@@ -3,10 +3,17 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <vector>
 
+#include "estimation/count_filter.h"
+#include "estimation/filter_log.h"
 #include "estimation/population_chain.h"
 
 namespace recruit {
@@ -118,6 +125,90 @@ TEST(EstimationFilterModel, MissingAndMalformedFiles) {
   auto bad = FilterModel::FromJson(path);
   ASSERT_FALSE(bad.ok());
   EXPECT_NE(bad.error().find("malformed JSON"), std::string::npos) << bad.error();
+  std::remove(path.c_str());
+}
+
+// Issue 12 regressions: JSON that nlohmann rejects with something other than a parse error,
+// or that is dangerous to build a tree from, gives a clear error naming the file and field.
+std::string WriteTemp(const std::string& name, const std::string& text) {
+  const std::string path = testing::TempDir() + "/" + name;
+  std::ofstream(path) << text;
+  return path;
+}
+
+TEST(EstimationFilterModel, NumberTooLargeForADoubleNamesFileAndField) {
+  const std::string path =
+      WriteTemp("estimation_overflow.json",
+                R"({"states": ["off", "on"], "N": 60, "H": [[0, 1e999]], "R": [[0.09]],
+          "transition": {"type": "explicit"}})");
+  auto f = FilterModel::FromJson(path);
+  ASSERT_FALSE(f.ok());
+  EXPECT_NE(f.error().find(path + ": field H[0][1]: number '1e999' is too large for a double"),
+            std::string::npos)
+      << f.error();
+  std::remove(path.c_str());
+}
+
+TEST(EstimationFilterModel, DeepNestingIsRejectedBeforeRecursion) {
+  const int depth = 70000;
+  const std::string path =
+      WriteTemp("estimation_deep.json",
+                R"({"states": )" + std::string(depth, '[') + std::string(depth, ']') + "}");
+  auto f = FilterModel::FromJson(path);
+  ASSERT_FALSE(f.ok());
+  EXPECT_NE(f.error().find(path + ": field states[0]"), std::string::npos) << f.error();
+  EXPECT_NE(f.error().find("nested deeper than 64 levels"), std::string::npos) << f.error();
+  std::remove(path.c_str());
+}
+
+// A 2 MB value comes back shortened to about 40 characters, in every kind of message.
+TEST(EstimationFilterModel, LongValuesAreShortenedInMessages) {
+  const std::string big(2000000, 'x');
+  const std::vector<std::string> docs = {
+      R"({"states": ["off", "on"], "N": 60, "H": [[0, 0.45]], "R": [[0.09]],
+          "transition": {"type": ")" +
+          big + R"("}})",
+      R"({"states": [")" + big + R"(", ")" + big + R"("], "N": 60, "H": [[0, 0.45]],
+          "R": [[0.09]], "transition": {"type": "explicit"}})",
+      R"({"states": ["off", "on"], "N": 60, "H": [[0, 1)" + std::string(400, '0') + "e999]]}",
+      R"({"states": ["off", "on"], "N": 60, "H": [[0, )" + big + "]]}",
+      R"({")" + big + R"(": [[)" + std::string(100, '[') + "1e999",
+  };
+  for (size_t i = 0; i < docs.size(); ++i) {
+    SCOPED_TRACE(i);
+    const std::string path = WriteTemp("estimation_long.json", docs[i]);
+    auto f = FilterModel::FromJson(path);
+    ASSERT_FALSE(f.ok());
+    EXPECT_LT(f.error().size(), 400u) << f.error().substr(0, 400);
+    std::remove(path.c_str());
+  }
+}
+
+// The file reader (1 MiB chunks, lines cut at chunk boundaries) gives the same output as the
+// in-memory text, for a log of about 3 MB with a byte-order mark, comments and blank lines.
+TEST(EstimationFilterLog, FileStreamMatchesInMemoryText) {
+  const FilterModel f = FilterModel::TwoState(60, 0.5, 0.45, 0.3);
+  std::string text = "\xEF\xBB\xBFt,p_on,p_off,y\n# a comment\n";
+  for (int k = 0; k < 100000; ++k) {
+    text += std::to_string(0.5 * k) + "," + std::to_string(0.001 * (k % 300)) + "," +
+            std::to_string(0.001 * (k % 200)) + "," +
+            (k % 9 == 4 ? std::string() : std::to_string(13.0 + 5.0 * std::sin(0.01 * k))) +
+            (k % 1000 == 7 ? "\n\n" : "\n");
+  }
+  const std::string path = WriteTemp("estimation_stream_log.csv", text);
+  auto a = MakeCountFilter(f, {});
+  auto b = MakeCountFilter(f, {});
+  ASSERT_TRUE(a.ok() && b.ok());
+  auto in_memory = RunFilterOverText(f, text, path, **a);
+  ASSERT_TRUE(in_memory.ok()) << in_memory.error();
+  auto reader = FilterLogReader::OpenFile(path, f);
+  ASSERT_TRUE(reader.ok()) << reader.error();
+  std::ostringstream out;
+  const Status s = RunFilterStream(f, **reader, **b, out);
+  ASSERT_TRUE(s.ok()) << s.error();
+  const std::string streamed = out.str();
+  EXPECT_EQ(streamed, *in_memory);
+  EXPECT_EQ(std::count(streamed.begin(), streamed.end(), '\n'), 100001);
   std::remove(path.c_str());
 }
 

@@ -168,3 +168,125 @@ TEST(EstimationKalmanSparse, IdentifiedBroadcastModels) {
 
 }  // namespace
 }  // namespace recruit
+
+namespace recruit {
+namespace {
+
+// The heating / cooling chain: valid, column-stochastic for any (p_on, p_off), at most 3
+// nonzeros per column, and its sparse pattern holds every nonzero of the dense matrix.
+TEST(EstimationKalmanSparse, HeatingChainIsAValidSparseBroadcastModel) {
+  for (int m : {2, 3, 20, 50}) {
+    SCOPED_TRACE(m);
+    const auto b = BroadcastTransitionModel::HeatingChain(m, 0.5);
+    ASSERT_TRUE(b.Validate().ok()) << b.Validate().error();
+    Eigen::SparseMatrix<double> As = b.SparsePattern();
+    for (double p : {0.0, 0.37, 1.0}) {
+      const Eigen::MatrixXd A = b.Matrix(p, 1.0 - p);
+      EXPECT_TRUE(ValidateColumnStochastic(A).ok());
+      b.FillSparse(p, 1.0 - p, As);
+      EXPECT_EQ((Eigen::MatrixXd(As) - A).cwiseAbs().maxCoeff(), 0.0);
+    }
+    for (int j = 0; j < m; ++j) {
+      int nnz = 0;
+      for (Eigen::SparseMatrix<double>::InnerIterator it(As, j); it; ++it) ++nnz;
+      EXPECT_LE(nnz, 3);
+    }
+  }
+}
+
+// PredictBroadcast (the filter's own sparse A, filled in place) against the dense Predict with
+// the broadcast model's dense matrix: 64 predict + update steps with random broadcasts, every
+// covariance mode, m = 20 and 50 (fixed size) and the dynamic-size filter; equal to 1e-12
+// relative at every step.
+template <int M>
+void BroadcastMatchesDense(int m, CovarianceMode mode, uint64_t seed) {
+  Rng rng(seed);
+  FilterModel f = RandomModel(m, rng, false);
+  f.transition = TransitionSource::kBroadcast;
+  f.broadcast = BroadcastTransitionModel::HeatingChain(m, 0.5);
+  f.state_names = f.broadcast.state_names;
+  auto sparse = PopulationKalmanFilterT<M, 1>::Create(f, mode);
+  auto dense = PopulationKalmanFilterT<M, 1>::Create(f, mode);
+  ASSERT_TRUE(sparse.ok()) << sparse.error();
+  ASSERT_TRUE(dense.ok());
+  ASSERT_TRUE(sparse->has_broadcast());
+  for (int t = 0; t < 64; ++t) {
+    const double p_on = 0.3 * rng.Uniform(), p_off = 0.3 * rng.Uniform();
+    sparse->PredictBroadcast(p_on, p_off);
+    dense->Predict(typename PopulationKalmanFilterT<M, 1>::Mat(f.broadcast.Matrix(p_on, p_off)));
+    const double scale = Scale(dense->covariance());
+    ASSERT_LT((sparse->covariance() - dense->covariance()).cwiseAbs().maxCoeff(), 1e-12 * scale)
+        << "step " << t;
+    ASSERT_LT((sparse->estimate() - dense->estimate()).cwiseAbs().maxCoeff(), 1e-12 * 60.0);
+    const Eigen::Matrix<double, 1, 1> y(f.H.row(0).dot(dense->estimate()) +
+                                        0.6 * (rng.Uniform() - 0.5));
+    sparse->Update(y);
+    dense->Update(y);
+  }
+}
+
+TEST(EstimationKalmanSparse, PredictBroadcastMatchesDensePredict) {
+  for (CovarianceMode mode :
+       {CovarianceMode::kExtended, CovarianceMode::kConservative, CovarianceMode::kPlain}) {
+    SCOPED_TRACE(ToString(mode));
+    BroadcastMatchesDense<20>(20, mode, 21);
+    BroadcastMatchesDense<50>(50, mode, 22);
+    BroadcastMatchesDense<Eigen::Dynamic>(20, mode, 23);
+  }
+}
+
+// A filter of a non-broadcast model has no broadcast matrix.
+TEST(EstimationKalmanSparse, PredictBroadcastNeedsABroadcastModel) {
+  Rng rng(3);
+  auto kf = PopulationKalmanFilter::Create(RandomModel(4, rng, false), CovarianceMode::kExtended);
+  ASSERT_TRUE(kf.ok());
+  EXPECT_FALSE(kf->has_broadcast());
+}
+
+// The r = 1 update (scalar innovation, P - w w^T) against the textbook equations (19), (15)
+// and the Joseph form of (20) written out with dense matrices and a matrix inverse.
+TEST(EstimationKalmanSparse, ScalarUpdateMatchesJosephForm) {
+  Rng rng(5);
+  const FilterModel f = RandomModel(7, rng, false);
+  auto kf = PopulationKalmanFilter::Create(f, CovarianceMode::kExtended);
+  ASSERT_TRUE(kf.ok());
+  const Eigen::MatrixXd P = kf->covariance();
+  const Eigen::VectorXd x = kf->estimate();
+  const Eigen::VectorXd y = Eigen::VectorXd::Constant(1, 7.5);
+  const Eigen::MatrixXd S = f.H * P * f.H.transpose() + f.R;
+  const Eigen::MatrixXd K = P * f.H.transpose() * S.inverse();
+  const Eigen::MatrixXd IKH = Eigen::MatrixXd::Identity(7, 7) - K * f.H;
+  const Eigen::MatrixXd P_ref = IKH * P * IKH.transpose() + K * f.R * K.transpose();
+  const Eigen::VectorXd x_ref = x + K * (y - f.H * x);
+  kf->Update(y);
+  EXPECT_LT((kf->covariance() - P_ref).cwiseAbs().maxCoeff(), 1e-12 * Scale(P_ref));
+  EXPECT_LT((kf->estimate() - x_ref).cwiseAbs().maxCoeff(), 1e-12 * 60.0);
+  EXPECT_EQ(kf->covariance(), kf->covariance().transpose());  // exactly symmetric
+}
+
+// Regression (issue 12): Create used to move an Eigen::LLT whose members were never
+// initialised (undefined behaviour that UndefinedBehaviorSanitizer reports and aborts on).
+// Copies and moves of a created filter, fixed and dynamic, r = 1 and r = 2, keep working.
+TEST(EstimationKalmanSparse, CreatedFiltersCopyAndMove) {
+  Rng rng(8);
+  FilterModel f = RandomModel(5, rng, false);
+  auto a = PopulationKalmanFilter::Create(f, CovarianceMode::kExtended);
+  ASSERT_TRUE(a.ok());
+  PopulationKalmanFilter b = *a;
+  PopulationKalmanFilter c = std::move(*a);
+  b.Update(Eigen::VectorXd::Constant(1, 3.0));
+  c.Update(Eigen::VectorXd::Constant(1, 3.0));
+  EXPECT_EQ(b.estimate(), c.estimate());
+  f.H = Eigen::MatrixXd::Ones(2, 5);
+  f.H(1, 0) = 0.0;
+  f.R = Eigen::Matrix2d{{0.5, 0.1}, {0.1, 0.4}};
+  auto d = PopulationKalmanFilterT<5, 2>::Create(f, CovarianceMode::kConservative);
+  ASSERT_TRUE(d.ok()) << d.error();
+  auto e = std::move(*d);
+  e.Update(Eigen::Vector2d(60.0, 50.0));
+  EXPECT_TRUE(e.estimate().allFinite());
+  EXPECT_NEAR(e.estimate().sum(), 60.0, 1e-9);
+}
+
+}  // namespace
+}  // namespace recruit

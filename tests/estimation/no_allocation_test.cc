@@ -72,7 +72,33 @@ long AllocationsPerSparseSteps() {
   return g_allocations.load() - before;
 }
 
-// No dynamic-size member: the whole filter state lives in the object.
+// PredictBroadcast (the filter's own sparse A, filled in place) and the scalar update, with the
+// m = 20 heating / cooling chain.
+long AllocationsPerBroadcastSteps() {
+  constexpr int M = 20;
+  FilterModel f = testing_util::ThreeStateModel(60, std::sqrt(0.3));
+  f.broadcast = BroadcastTransitionModel::HeatingChain(M, 0.5);
+  f.state_names = f.broadcast.state_names;
+  f.H = Eigen::MatrixXd::Constant(1, M, 0.2);
+  f.H(0, 0) = 0.0;
+  f.G = Eigen::MatrixXd::Zero(M, 0);
+  f.x0 = Eigen::VectorXd::Zero(M);
+  f.x0(0) = 60;
+  f.P0 = Eigen::MatrixXd::Zero(M, M);
+  auto kf = PopulationKalmanFilterT<M, 1>::Create(f, CovarianceMode::kExtended);
+  EXPECT_TRUE(kf.ok()) << kf.error();
+  if (!kf.ok()) return -1;
+  const Eigen::Matrix<double, 1, 1> y(5.0);
+  const long before = g_allocations.load();
+  for (int t = 0; t < 100; ++t) {
+    kf->PredictBroadcast(0.002 * t, 0.001 * t);
+    kf->Update(y);
+  }
+  return g_allocations.load() - before;
+}
+
+// No dynamic-size matrix in the numeric state: (X^, P) and the workspaces live in the object
+// (the broadcast pattern of PredictBroadcast is built once at Create and written in place).
 static_assert(PopulationKalmanFilterT<20, 1>::Mat::RowsAtCompileTime == 20);
 static_assert(sizeof(PopulationKalmanFilterT<20, 1>) >= 4 * 20 * 20 * sizeof(double));
 
@@ -82,6 +108,7 @@ TEST(EstimationKalmanNoAllocation, FixedSizePredictAndUpdate) {
   EXPECT_EQ(AllocationsPerSteps<20>(CovarianceMode::kExtended), 0);
   EXPECT_EQ(AllocationsPerSteps<20>(CovarianceMode::kPlain), 0);
   EXPECT_EQ(AllocationsPerSparseSteps(), 0);
+  EXPECT_EQ(AllocationsPerBroadcastSteps(), 0);
   // The counter works (a std::vector allocates through operator new). Eigen's own heap
   // matrices go through malloc directly; the fixed-size filter has none (its members are
   // fixed-size Eigen types, checked by the static assertion below).
