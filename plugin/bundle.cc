@@ -26,7 +26,11 @@ void StoreRng(const Rng& rng, double* words) {
 }  // namespace
 
 SmaBundle::SmaBundle(BundleConfig c, UnitModel u, double dt)
-    : config_(std::move(c)), unit_(std::move(u)), dt_(dt), decay_(unit_.DecayFactor(dt)) {
+    : config_(std::move(c)),
+      unit_(std::move(u)),
+      limits_(UnitLimits::ForWire(config_.unit.wire_diameter)),
+      dt_(dt),
+      decay_(unit_.DecayFactor(dt)) {
   if (config_.update_period > 0) {
     // The pending time reaches about a whole number of steps >= update_period.
     period_ = dt_ * std::max(1.0, std::round(config_.update_period / dt_));
@@ -247,6 +251,20 @@ double SmaBundle::Heat(const double* s) const {
   const double span = unit_.on_temperature() - amb;
   if (!(span > 0)) return 0;  // current=0: on units do not heat
   return std::clamp((MeanTemperature(s) - amb) / span, 0.0, 1.0);
+}
+
+double SmaBundle::MaxTemperature(const double* s) const {
+  const int k = NumCohorts(s);
+  double t = config_.unit.ambient;
+  for (int j = 0; j < k; ++j) t = j == 0 ? Cohort(s, j)[kTemp] : std::max(t, Cohort(s, j)[kTemp]);
+  return t;
+}
+
+double SmaBundle::MaxWireStress(const double* s, double stretch) const {
+  const int k = NumCohorts(s);
+  double f = 0;
+  for (int j = 0; j < k; ++j) f = std::max(f, unit_.Tension(Cohort(s, j)[kXi], stretch));
+  return unit_.WireStress(f);
 }
 
 int SmaBundle::UnitCohort(const double* s, int i) const {

@@ -58,6 +58,14 @@ class SmaBundle {
   // 0 at ambient, 1 at the steady on-temperature (austenite): for colouring tendons.
   double Heat(const double* s) const;
 
+  // Peak-relevant values now, for a run loop that tracks peaks and warns against limits():
+  // the hottest unit's temperature (C) and the highest wire stress (Pa) at unit extension
+  // `stretch` (UnitModel::WireStress of the most tensioned cohort).
+  double MaxTemperature(const double* s) const;
+  double MaxWireStress(const double* s, double stretch) const;
+  // Datasheet limits for the units' wire diameter (UnitLimits::ForWire).
+  const UnitLimits& limits() const { return limits_; }
+
   // Per-unit debug interface (ground truth).
   int UnitCohort(const double* s, int i) const;
   bool UnitOn(const double* s, int i) const;
@@ -95,6 +103,7 @@ class SmaBundle {
 
   BundleConfig config_;
   UnitModel unit_;
+  UnitLimits limits_;
   double dt_ = 0, decay_ = 1, period_ = 0, decay_period_ = 1;
 };
 

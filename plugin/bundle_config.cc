@@ -37,7 +37,11 @@ const std::vector<Key>& NumericKeys() {
       {"wire_length", 0, 10, true, "m", UNIT_FIELD(wire_length)},
       {"coil_diameter", 0, 0.1, true, "m", UNIT_FIELD(coil_diameter)},
       {"turns", 0, 1e5, true, "", UNIT_FIELD(turns)},
-      {"prestrain", -1, 1, false, "", nullptr},  // wire law: prestretch = prestrain * wire_length
+      {"series", 1, 1000, false, "", [](BundleConfig& c, double v) { c.unit.series = int(v); }},
+      {"parallel", 1, 1000, false, "", [](BundleConfig& c, double v) { c.unit.parallel = int(v); }},
+      {"series_spring", 0, 1e9, false, "N/m (0 = rigid)", UNIT_FIELD(series_spring)},
+      // wire law: prestretch = prestrain * wire_length * series (every segment strained alike)
+      {"prestrain", -1, 1, false, "", nullptr},
       {"prestretch", -10, 10, false, "m", UNIT_FIELD(prestretch)},
       {"current", 0, 100, false, "A", UNIT_FIELD(current)},
       {"ambient", -100, 200, false, "C", UNIT_FIELD(ambient)},
@@ -109,7 +113,8 @@ Result<BundleConfig> BundleConfig::FromPairs(
       } else if (value == "spring") {
         c.unit.law = ForceLaw::kSpring;
       } else {
-        return Error{where + "law=" + Short(value) + " is invalid: allowed values are wire, spring"};
+        return Error{where + "law=" + Short(value) +
+                     " is invalid: allowed values are wire, spring"};
       }
       continue;
     }
@@ -134,8 +139,8 @@ Result<BundleConfig> BundleConfig::FromPairs(
                    (spec->lo_open ? "(" : "[") + Num(spec->lo) + ", " + Num(spec->hi) + "]" +
                    (spec->unit[0] ? std::string(" ") + spec->unit : std::string())};
     }
-    if (key == "units" && v != std::floor(v)) {
-      return Error{where + "units=" + Short(value) + " must be a whole number"};
+    if ((key == "units" || key == "series" || key == "parallel") && v != std::floor(v)) {
+      return Error{where + key + "=" + Short(value) + " must be a whole number"};
     }
     if (key == "prestrain") {
       prestrain = v;
@@ -150,7 +155,7 @@ Result<BundleConfig> BundleConfig::FromPairs(
     if (c.unit.law != ForceLaw::kWire) {
       return Error{where + "prestrain is for law=wire; use prestretch (m) with law=spring"};
     }
-    c.unit.prestretch = prestrain * c.unit.wire_length;
+    c.unit.prestretch = prestrain * c.unit.wire_length * c.unit.series;  // whole unit
   }
   auto check = UnitModel::Create(c.unit);
   if (!check.ok()) return Error{where + check.error()};

@@ -42,7 +42,33 @@ std::string Num(double v) {
   return buf;
 }
 
+// Dynalloy Flexinol wire table: diameter (mm), current for a 1 s contraction (mA), still-air
+// cooling time of LT wire (s).
+struct DatasheetRow {
+  double d_mm, current_ma, cooling_s;
+};
+constexpr DatasheetRow kFlexinol[] = {{0.025, 45, 0.18},  {0.038, 55, 0.24},   {0.050, 85, 0.4},
+                                      {0.076, 150, 0.8},  {0.100, 200, 1.1},   {0.127, 320, 1.6},
+                                      {0.150, 410, 2.0},  {0.200, 660, 3.2},   {0.250, 1050, 5.4},
+                                      {0.310, 1500, 8.1}, {0.380, 2250, 10.5}, {0.510, 4000, 16.8}};
+
 }  // namespace
+
+UnitLimits UnitLimits::ForWire(double d) {
+  UnitLimits lim;
+  const double dmm = d * 1e3;
+  constexpr int n = sizeof kFlexinol / sizeof kFlexinol[0];
+  int i = 0;
+  while (i < n - 2 && dmm > kFlexinol[i + 1].d_mm) ++i;
+  const DatasheetRow& a = kFlexinol[i];
+  const DatasheetRow& b = kFlexinol[i + 1];
+  const double x = std::clamp(dmm, kFlexinol[0].d_mm, kFlexinol[n - 1].d_mm);
+  const double w = std::log(x / a.d_mm) / std::log(b.d_mm / a.d_mm);
+  auto interp = [w](double ya, double yb) { return ya * std::pow(yb / ya, w); };
+  lim.max_current = 1e-3 * interp(a.current_ma, b.current_ma);
+  lim.cooling_time = interp(a.cooling_s, b.cooling_s);
+  return lim;
+}
 
 double UnitModel::NaturalConvectionH(double d, double ambient, double dT, double emissivity) {
   dT = std::max(dT, 1.0);
@@ -78,6 +104,13 @@ Result<UnitModel> UnitModel::Create(const UnitParams& p) {
     return Error{"coil_diameter=" + Num(p.coil_diameter) +
                  " must exceed wire_diameter=" + Num(p.wire_diameter)};
   }
+  if (p.series < 1 || p.parallel < 1) {
+    return Error{"series=" + Num(p.series) + " and parallel=" + Num(p.parallel) +
+                 " must be whole numbers >= 1"};
+  }
+  if (!(p.series_spring >= 0)) {
+    return Error{"series_spring=" + Num(p.series_spring) + " must be >= 0 (0 = rigid)"};
+  }
   UnitModel m;
   m.p_ = p;
   const double d = p.wire_diameter;
@@ -106,6 +139,15 @@ Result<UnitModel> UnitModel::Create(const UnitParams& p) {
     const double wahl = (4 * index - 1) / (4 * index - 4) + 0.615 / index;
     m.stress_per_newton_ = std::sqrt(3.0) * 8 * D * wahl / (kPi * d * d * d);
   }
+  // One segment of `parallel` wires takes stretch / series: the unit's stiffness is
+  // parallel / series times one wire's, its stroke series times, and each wire carries
+  // 1 / parallel of the unit's tension.
+  const double scale = static_cast<double>(p.parallel) / p.series;
+  m.k_A_ *= scale;
+  m.k_M_ *= scale;
+  m.k_s_ = p.series_spring * scale;
+  m.stretch_L_ *= p.series;
+  m.stress_per_newton_ /= p.parallel;
   m.heat_shift_per_newton_ = m.stress_per_newton_ / p.C_A;
   m.cool_shift_per_newton_ = m.stress_per_newton_ / p.C_M;
   const double joule = p.current * p.current * m.length_ / m.area_;  // W per (ohm m)
@@ -162,19 +204,33 @@ double UnitModel::TensionSlope(double xi, double stretch) const {
   return slope;
 }
 
+double UnitModel::Stiffness(double xi, double* dk) const {
+  const double kw = k_A_ + xi * (k_M_ - k_A_);
+  if (k_s_ <= 0) {
+    *dk = k_M_ - k_A_;
+    return kw;
+  }
+  // Springs in series: k = kw ks / (kw + ks); dk/dxi = ks^2 kw' / (kw + ks)^2.
+  const double inv = 1.0 / (kw + k_s_);
+  *dk = k_s_ * k_s_ * (k_M_ - k_A_) * inv * inv;
+  return kw * k_s_ * inv;
+}
+
 double UnitModel::Tension(double xi, double stretch, double* slope) const {
-  const double k = k_A_ + xi * (k_M_ - k_A_);
+  double dk;
+  const double k = Stiffness(xi, &dk);
   const double e = stretch - xi * stretch_L_;
   if (k * e <= 0) {
     *slope = 0;
     return 0;
   }
-  *slope = (k_M_ - k_A_) * e - k * stretch_L_;
+  *slope = dk * e - k * stretch_L_;
   return k * e;
 }
 
 double UnitModel::Tension(double xi, double stretch) const {
-  const double k = k_A_ + xi * (k_M_ - k_A_);
+  double dk;
+  const double k = Stiffness(xi, &dk);
   return std::max(0.0, k * (stretch - xi * stretch_L_));
 }
 

@@ -24,20 +24,48 @@ struct UnitParams {
   double E_A = 75e9, E_M = 28e9;              // Young's moduli, Pa (wire law)
   double G_A = 28e9, G_M = 10.5e9;            // shear moduli, Pa (spring law)
   double eps_L = 0.04;                        // recoverable strain
-  // Geometry.
-  // Defaults: a helical unit (the paper's units are single helical SMA wires) wound from
-  // 0.1 mm wire; coil diameter, prestretch and current calibrated to the paper's Fig. 4.
-  ForceLaw law = ForceLaw::kSpring;
+  // Geometry. Defaults (docs/sma-units.md has the numbers and the limit check): a straight
+  // 0.1 mm Flexinol-type LT wire, 100 mm long, in series with a 114 N/m coupling spring, taken
+  // up by 4 mm (= eps_L * wire_length, so the unit is just taut in martensite), heated at
+  // 0.18 A. Steady on-temperature about 116 C (Af = 78 C), settled isometric force 0.447 N
+  // per unit (26.8 N for 60: the paper's Fig. 4) at 57 MPa wire stress (Dynalloy rates 172 MPa
+  // for long life), current 90 % of Dynalloy's 200 mA "1 s contraction" value for 0.1 mm,
+  // thermal time constant 0.98 s against Dynalloy's 1.1 s cooling time. The previous default
+  // (0.1 mm wire coiled to 0.33 mm, 0.235 A) ran at 171 C and about 1 GPa equivalent stress.
+  ForceLaw law = ForceLaw::kWire;
   double wire_diameter = 0.1e-3;   // m
   double wire_length = 0.1;        // m, wire law only (a spring's wire is pi * D * turns long)
   double coil_diameter = 0.33e-3;  // m (spring law: mean coil diameter)
   double turns = 20;               // active turns (spring law)
-  double prestretch = 3e-3;        // m: the unit's extension at the reference tendon length
+  double prestretch = 4e-3;        // m: the whole unit's extension at the reference tendon length
+  // Elastic element in series with each wire (a coupling spring, N/m per segment; 0 = rigid).
+  // It makes a straight wire's isometric force grow across the transformation instead of jumping.
+  double series_spring = 114;
+  // Unit made of `series` segments in series (each takes stretch / series: stroke multiplies)
+  // of `parallel` identical wires each (the unit's tension is parallel * one wire's: force
+  // multiplies). Every wire carries `current` and has the same temperature.
+  int series = 1;
+  int parallel = 1;
   // Thermal and electrical.
-  double current = 0.235;   // A, heating current when on
+  double current = 0.18;    // A per wire, heating current when on
   double ambient = 20;      // C
   double h = 0;             // W/(m^2 K); 0 = from the natural-convection correlation
   double emissivity = 0.3;  // for the linearised radiation term added to h
+};
+
+// Datasheet limits for one wire (Dynalloy Flexinol, technical characteristics F1140 and its
+// wire table; docs/sma-units.md): what a run loop compares MaxTemperature / MaxWireStress with.
+struct UnitLimits {
+  double max_wire_stress = 172e6;  // Pa: Dynalloy's rated pull stress for long cycle life
+  // C: steady wire temperature an LT (As 68 C, Af 78 C) wire should not exceed: about 40 K
+  // above Af; hotter only costs power and cooling time and ages the alloy.
+  double max_temperature = 120;
+  double max_current = 0.2;   // A: Dynalloy's current for a 1 s contraction (0.1 mm wire)
+  double cooling_time = 1.1;  // s: Dynalloy's still-air cooling time, LT wire (0.1 mm wire)
+
+  // The defaults with max_current and cooling_time from Dynalloy's table for diameter d (m),
+  // log-log interpolated between the stock sizes 0.025 to 0.51 mm (clamped outside).
+  static UnitLimits ForWire(double d);
 };
 
 // Quantities derived once from UnitParams, used in every step.
@@ -63,6 +91,10 @@ class UnitModel {
   double Tension(double xi, double stretch, double* slope) const;  // both at once
   // Equivalent tensile stress (Pa) that shifts the transformation temperatures at tension f.
   double Stress(double f) const { return stress_per_newton_ * f; }
+  // Stress in one wire when the unit pulls with tension f (N): true tensile stress
+  // f / (parallel A) for the wire law, the Wahl-corrected equivalent sqrt(3) tau for a spring.
+  // The same number as Stress(f); named for checks against the datasheet's rated stress.
+  double WireStress(double f) const { return Stress(f); }
 
   // Lumped thermal model with constant power over dt, integrated exactly.
   double HeatingPower(bool on, double xi) const;       // W
@@ -72,13 +104,14 @@ class UnitModel {
 
   double heat_transfer_coefficient() const { return h_; }    // W/(m^2 K), used value
   double time_constant() const { return tau_; }              // s
-  double heat_capacity() const { return heat_capacity_; }    // J/K of one unit
-  double conductance() const { return conductance_; }        // W/K = h A_s
+  double heat_capacity() const { return heat_capacity_; }    // J/K of one wire
+  double conductance() const { return conductance_; }        // W/K = h A_s of one wire
   double area() const { return area_; }                      // wire cross-section, m^2
-  double wire_length() const { return length_; }             // m (pi D n for a spring)
+  double wire_length() const { return length_; }             // m, one wire (pi D n for a spring)
   double stiffness_austenite() const { return k_A_; }        // N/m
   double stiffness_martensite() const { return k_M_; }       // N/m
-  double recoverable_stretch() const { return stretch_L_; }  // m
+  double recoverable_stretch() const { return stretch_L_; }  // m (whole unit: series segments)
+  double series_stiffness() const { return k_s_; }           // N/m of the unit, 0 = rigid
   // Hottest steady temperature when on (austenite resistivity): the "heat = 1" point.
   double on_temperature() const { return SteadyTemperature(true, 0.0); }
 
@@ -96,6 +129,9 @@ class UnitModel {
   UnitParams p_;
   double area_ = 0, length_ = 0, h_ = 0, heat_capacity_ = 0, conductance_ = 0, tau_ = 0;
   double k_A_ = 0, k_M_ = 0, stretch_L_ = 0;  // unit stiffness (N/m) and recoverable stretch (m)
+  double k_s_ = 0;                            // series spring of the unit (N/m), 0 = rigid
+  // Unit stiffness at xi (wire in series with the coupling spring) and its xi-derivative.
+  double Stiffness(double xi, double* dk) const;
   double stress_per_newton_ = 0;
   double heat_rate_ = 0, cool_rate_ = 0;  // pi / (Af - As), pi / (Ms - Mf)
   double latent_rise_ = 0, heat_shift_per_newton_ = 0, cool_shift_per_newton_ = 0;
