@@ -32,6 +32,15 @@ double MajorCoolingRef(double t) {  // Mf = 42, Ms = 52
   return 0.5 * (std::cos(kPi * (t - 42) / 10) + 1);
 }
 
+// The previous default unit: 0.1 mm wire coiled to 0.33 mm, 20 turns, no coupling spring.
+UnitParams Coil() {
+  UnitParams p;
+  p.law = ForceLaw::kSpring;
+  p.series_spring = 0;
+  p.prestretch = 3e-3;
+  return p;
+}
+
 // Unloaded quasi-static unit: zero extension gives zero tension at any xi, so T_eff = T.
 UnitParams Unloaded() {
   UnitParams p;
@@ -184,7 +193,7 @@ TEST(UnitHysteresis, CoolingAboveMsAndReheatingDoesNotTransformAgain) {
 TEST(UnitHysteresis, StressShiftsTransformationByStressOverC) {
   // A blocked spring: the solved state satisfies xi = M+(T - sigma(xi) / C_A), with sigma from
   // the spring formulas written out here.
-  UnitParams p;
+  UnitParams p = Coil();
   p.latent_heat = 0;
   const UnitModel m = MakeModel(p);
   const double d = p.wire_diameter, D = p.coil_diameter, n = p.turns;
@@ -257,8 +266,9 @@ RefStep ReferencePhaseStep(const UnitModel& m, const UnitState& s, bool on, doub
   const double t_ss = p.ambient + power / m.conductance();
   const double t_th = t_ss + (s.temperature - t_ss) * std::exp(-dt / m.time_constant());
   auto tension = [&](double x) {
-    const double k =
-        m.stiffness_austenite() + x * (m.stiffness_martensite() - m.stiffness_austenite());
+    double k = m.stiffness_austenite() + x * (m.stiffness_martensite() - m.stiffness_austenite());
+    const double ks = m.series_stiffness();
+    if (ks > 0) k = k * ks / (k + ks);  // coupling spring in series
     return std::max(0.0, k * (stretch - x * m.recoverable_stretch()));
   };
   auto teff = [&](double x, double c) {
@@ -287,8 +297,12 @@ RefStep ReferencePhaseStep(const UnitModel& m, const UnitState& s, bool on, doub
   return {g_cool(s.xi) < -1e-12 ? bisect(g_cool, s.xi, 1.0) : s.xi, false};
 }
 
-TEST(UnitHysteresis, FastPhaseSolveMatchesBisectionWithLibmCosine) {
-  UnitParams p;  // defaults: spring law, latent heat on, loaded by the prestretch
+class FastPhaseSolve : public ::testing::TestWithParam<bool> {};
+
+TEST_P(FastPhaseSolve, MatchesBisectionWithLibmCosine) {
+  // Defaults (wire and coupling spring) and the old coil, latent heat on, loaded by the
+  // prestretch.
+  const UnitParams p = GetParam() ? UnitParams{} : Coil();
   const UnitModel m = MakeModel(p);
   UnitState s = RestState(m, p.prestretch);
   int transformed = 0;
@@ -307,8 +321,10 @@ TEST(UnitHysteresis, FastPhaseSolveMatchesBisectionWithLibmCosine) {
   }
   RecordProperty("worst_xi_error", std::to_string(worst));
   std::printf("worst |xi - reference| = %.3g over %d transforming steps\n", worst, transformed);
-  EXPECT_GT(transformed, 3000);  // the comparison covered many transforming steps
+  EXPECT_GT(transformed, 1000);  // the comparison covered many transforming steps
 }
+
+INSTANTIATE_TEST_SUITE_P(DefaultAndCoil, FastPhaseSolve, ::testing::Bool());
 
 TEST(UnitHysteresis, PolynomialSinCosMatchesLibmOverTheHalfTurn) {
   double worst = 0;
@@ -323,7 +339,7 @@ TEST(UnitHysteresis, PolynomialSinCosMatchesLibmOverTheHalfTurn) {
 }
 
 TEST(UnitForce, SpringTensionMatchesSpringFormulas) {
-  UnitParams p;
+  UnitParams p = Coil();
   const UnitModel m = MakeModel(p);
   const double d = p.wire_diameter, D = p.coil_diameter, n = p.turns;
   const double k_a = p.G_A * std::pow(d, 4) / (8 * D * D * D * n);
@@ -340,6 +356,7 @@ TEST(UnitForce, SpringTensionMatchesSpringFormulas) {
 TEST(UnitForce, WireTensionMatchesMixtureLaw) {
   UnitParams p;
   p.law = ForceLaw::kWire;
+  p.series_spring = 0;
   p.wire_length = 0.2;
   const UnitModel m = MakeModel(p);
   const double a = kPi * p.wire_diameter * p.wire_diameter / 4;
@@ -353,16 +370,189 @@ TEST(UnitForce, WireTensionMatchesMixtureLaw) {
   }
 }
 
-TEST(UnitModelCreate, RejectsInconsistentTransformationTemperatures) {
+TEST(UnitForce, CouplingSpringActsInSeriesWithTheWire) {
+  // Wire (E A / L) and coupling spring k_s in series: 1 / k = 1 / k_w(xi) + 1 / k_s,
+  // F = k (stretch - xi eps_L L).
   UnitParams p;
+  p.series_spring = 114;
+  const UnitModel m = MakeModel(p);
+  const double a = kPi * p.wire_diameter * p.wire_diameter / 4;
+  for (double xi : {0.0, 0.4, 1.0}) {
+    const double kw = (p.E_A + xi * (p.E_M - p.E_A)) * a / p.wire_length;
+    const double k = 1 / (1 / kw + 1 / 114.0);
+    const double stretch = 6e-3;
+    const double f = k * (stretch - xi * p.eps_L * p.wire_length);
+    EXPECT_NEAR(m.Tension(xi, stretch), f, 1e-12) << "xi=" << xi;
+    // Slope against a central difference.
+    const double h = 1e-6;
+    const double fd =
+        (m.Tension(xi + (xi < 1 ? h : -h), stretch) - m.Tension(xi, stretch)) / (xi < 1 ? h : -h);
+    EXPECT_NEAR(m.TensionSlope(xi, stretch), fd, 1e-4 * std::abs(fd));
+  }
+}
+
+// A unit of `series` segments of `parallel` wires (plain wires, no coupling spring).
+UnitModel Segments(int series, int parallel, double series_spring) {
+  UnitParams p;
+  p.series = series;
+  p.parallel = parallel;
+  p.series_spring = series_spring;
+  return MakeModel(p);
+}
+
+TEST(UnitGeometry, ParallelWiresMultiplyForceAndShareStress) {
+  for (double ks : {0.0, 114.0}) {
+    const UnitModel one = Segments(1, 1, ks), two = Segments(1, 2, ks), three = Segments(1, 3, ks);
+    for (double xi : {0.0, 0.5, 1.0}) {
+      const double f1 = one.Tension(xi, 5e-3);
+      EXPECT_NEAR(two.Tension(xi, 5e-3), 2 * f1, 1e-12);
+      EXPECT_NEAR(three.Tension(xi, 5e-3), 3 * f1, 1e-12);
+      // Each wire carries 1 / parallel of the unit's tension: the same wire stress.
+      EXPECT_NEAR(two.WireStress(2 * f1), one.WireStress(f1), 1e-6);
+    }
+    // True tensile stress of the plain wire law: F / (parallel A).
+    const double a = kPi * 0.1e-3 * 0.1e-3 / 4;
+    EXPECT_NEAR(two.WireStress(1.0), 1.0 / (2 * a), 1e-3);
+  }
+}
+
+TEST(UnitGeometry, SeriesSegmentsMultiplyStrokeAtTheSameForce) {
+  for (double ks : {0.0, 114.0}) {
+    const UnitModel one = Segments(1, 1, ks), two = Segments(2, 1, ks);
+    // A tendon extension e splits into e / 2 per segment: the same force at twice the stretch.
+    for (double xi : {0.0, 0.3, 1.0}) {
+      for (double e : {1e-3, 4e-3, 7e-3}) {
+        EXPECT_NEAR(two.Tension(xi, 2 * e), one.Tension(xi, e), 1e-12);
+      }
+    }
+    // Free stroke (stretch at which the martensite unit goes slack): eps_L L per segment.
+    EXPECT_NEAR(two.recoverable_stretch(), 2 * 0.04 * 0.1, 1e-15);
+    EXPECT_EQ(two.Tension(1, 2 * 0.04 * 0.1 - 1e-6), 0.0);
+    EXPECT_GT(two.Tension(1, 2 * 0.04 * 0.1 + 1e-6), 0.0);
+  }
+}
+
+TEST(UnitModelCreate, RejectsSeriesParallelBelowOneAndNegativeSpring) {
+  UnitParams p;
+  p.series = 0;
+  auto m = UnitModel::Create(p);
+  ASSERT_FALSE(m.ok());
+  EXPECT_NE(m.error().find("series=0"), std::string::npos) << m.error();
+  p = UnitParams{};
+  p.parallel = -2;
+  EXPECT_FALSE(UnitModel::Create(p).ok());
+  p = UnitParams{};
+  p.series_spring = -1;
+  EXPECT_FALSE(UnitModel::Create(p).ok());
+}
+
+// Dynalloy Flexinol wire table (diameter mm, current for a 1 s contraction A, LT cooling time
+// s), written out here independently of plugin/unit_model.cc.
+struct Row {
+  double d_mm, current, cooling;
+};
+constexpr Row kDatasheet[] = {
+    {0.050, 0.085, 0.4}, {0.100, 0.200, 1.1}, {0.150, 0.410, 2.0}, {0.250, 1.050, 5.4}};
+
+TEST(UnitLimits, ForWireReproducesTheDatasheetRows) {
+  for (const Row& r : kDatasheet) {
+    const UnitLimits lim = UnitLimits::ForWire(r.d_mm * 1e-3);
+    EXPECT_NEAR(lim.max_current, r.current, 1e-9) << r.d_mm;
+    EXPECT_NEAR(lim.cooling_time, r.cooling, 1e-9) << r.d_mm;
+    EXPECT_EQ(lim.max_wire_stress, 172e6);
+  }
+  // Between 0.1 and 0.127 mm (200 and 320 mA) the current lies between the rows.
+  const UnitLimits mid = UnitLimits::ForWire(0.11e-3);
+  EXPECT_GT(mid.max_current, 0.2);
+  EXPECT_LT(mid.max_current, 0.32);
+}
+
+// Steady isometric state of one default unit held on at its prestretch (20 s = 20 tau).
+UnitState SettledOn(const UnitModel& m) {
+  UnitState s = RestState(m, m.params().prestretch);
+  for (int i = 0; i < 20000; ++i) AdvanceUnit(m, s, true, m.params().prestretch, 1e-3);
+  return s;
+}
+
+TEST(DefaultUnit, SteadyOnTemperatureIsAboveAfAndWithinTheLimit) {
+  const UnitParams p;
+  const UnitModel m = MakeModel(p);
+  const UnitState s = SettledOn(m);
+  // Energy balance of a fully transformed wire: I^2 rho_A / A = h pi d (T - T_amb).
+  const double d = p.wire_diameter, a = kPi * d * d / 4;
+  const double h = m.heat_transfer_coefficient();
+  const double t_ss = p.ambient + p.current * p.current * p.resistivity_A / a / (h * kPi * d);
+  EXPECT_NEAR(s.temperature, t_ss, 1e-6);
+  EXPECT_EQ(s.xi, 0.0);  // fully contracted: the force is set by geometry, not by temperature
+  EXPECT_GT(s.temperature, p.Af + 20);
+  EXPECT_LE(s.temperature, UnitLimits{}.max_temperature);
+  // Natural convection around a 0.1 mm wire: SMA-NOTES give about 140 W/(m^2 K).
+  EXPECT_GT(h, 100);
+  EXPECT_LT(h, 160);
+}
+
+TEST(DefaultUnit, WireStressAtTheSettledForceIsWithinTheRatedPull) {
+  const UnitParams p;
+  const UnitModel m = MakeModel(p);
+  const UnitState s = SettledOn(m);
+  const double f = m.Tension(s.xi, p.prestretch);
+  const double sigma = f / (kPi * p.wire_diameter * p.wire_diameter / 4);
+  EXPECT_NEAR(m.WireStress(f), sigma, 1e-6 * sigma);
+  EXPECT_LE(sigma, 172e6);  // Dynalloy: 172 MPa for long cycle life
+  // Worst case at this length: fully austenite wire (xi = 0) pulls k_A * prestretch.
+  EXPECT_LE(m.WireStress(m.Tension(0, p.prestretch)), 172e6);
+  // And the wire reset stress in martensite is below Dynalloy's 70 MPa deformation guidance.
+  EXPECT_LE(m.WireStress(m.Tension(1, p.prestretch)), 70e6);
+}
+
+TEST(DefaultUnit, CurrentAndPowerAreWithinTheDatasheetValueForTheDiameter) {
+  const UnitParams p;
+  ASSERT_DOUBLE_EQ(p.wire_diameter, 0.1e-3);
+  EXPECT_LE(p.current, kDatasheet[1].current);  // 200 mA for 0.1 mm
+  // Resistance per metre against the datasheet's 126 ohm/m (austenite resistivity).
+  const double r_per_m = p.resistivity_A / (kPi * 0.1e-3 * 0.1e-3 / 4);
+  EXPECT_NEAR(r_per_m, 126, 5);
+  const UnitModel m = MakeModel(p);
+  EXPECT_NEAR(m.HeatingPower(true, 0), p.current * p.current * r_per_m * p.wire_length, 1e-12);
+}
+
+TEST(DefaultUnit, CoolingTimeMatchesTheDatasheet) {
+  // Dynalloy's cooling time: still air, from just contracted until relaxed but for the last
+  // 0.5 % of the stroke. Here: an unloaded default wire heated at its current until fully
+  // austenite, then switched off; time until xi >= 0.995. Band: within a factor 2 of the
+  // datasheet's 1.1 s. The model comes out slow (about 2.0 s, docs/sma-units.md): unloaded it
+  // must cool to Mf = 42 C (a loaded wire relaxes about 7 K earlier at 70 MPa) and it releases
+  // the latent heat (29 K worth) on the way; the table is "approximate" besides.
+  UnitParams p;
+  p.prestretch = 0;
+  const UnitModel m = MakeModel(p);
+  UnitState s = RestState(m, 0);
+  int i = 0;
+  while (s.xi > 0 && i < 100000) {
+    AdvanceUnit(m, s, true, 0, 1e-4);
+    ++i;
+  }
+  ASSERT_EQ(s.xi, 0.0);
+  double t = 0;
+  while (s.xi < 0.995 && t < 100) {
+    AdvanceUnit(m, s, false, 0, 1e-4);
+    t += 1e-4;
+  }
+  std::printf("cooling time %.2f s (datasheet 1.1 s), tau %.2f s\n", t, m.time_constant());
+  EXPECT_GT(t, 1.1 / 2);
+  EXPECT_LT(t, 1.1 * 2);
+}
+
+TEST(UnitModelCreate, RejectsInconsistentTransformationTemperatures) {
+  UnitParams p = Coil();
   p.Ms = 40;  // below Mf = 42
   auto m = UnitModel::Create(p);
   ASSERT_FALSE(m.ok());
   EXPECT_NE(m.error().find("Mf"), std::string::npos);
-  p = UnitParams{};
+  p = Coil();
   p.Af = 60;
   EXPECT_FALSE(UnitModel::Create(p).ok());
-  p = UnitParams{};
+  p = Coil();
   p.coil_diameter = 0.05e-3;  // smaller than the wire
   EXPECT_FALSE(UnitModel::Create(p).ok());
 }
