@@ -236,7 +236,9 @@ TEST(SmaBundle, IsometricStepMatchesPaperFigure4WithinDatasheetLimits) {
   std::vector<double> t, f;
   double peak_temp = 0, peak_stress = 0;
   for (int i = 1; i <= 12000; ++i) {
-    if (i == 1001) ASSERT_TRUE(b.Broadcast(state.data(), 1, 0, stretch).ok());  // t = 1 s
+    if (i == 1001) {
+      ASSERT_TRUE(b.Broadcast(state.data(), 1, 0, stretch).ok());  // t = 1 s
+    }
     b.Advance(state.data(), stretch, 1e-3);
     t.push_back(i * 1e-3);
     f.push_back(b.Tension(state.data(), stretch));
