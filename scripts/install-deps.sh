@@ -9,7 +9,7 @@ MUJOCO_VERSION=4.0.0  # keep in step with RECRUIT_MUJOCO_VERSION in CMakeLists.t
 PY_PACKAGES=("mujoco==${MUJOCO_VERSION}" "numpy" "pytest" "filterpy")
 
 PACKAGES=(
-  build-essential cmake ninja-build pkg-config clang-format
+  build-essential cmake ninja-build pkg-config clang-format ccache
   python3 python3-venv python3-dev
   libosmesa6-dev libcairo2-dev
   libeigen3-dev libcli11-dev nlohmann-json3-dev libfmt-dev libtbb-dev
