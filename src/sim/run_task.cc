@@ -14,6 +14,7 @@
 #include "sim/force_sensor.h"
 
 #if RECRUIT_CONTROL_AVAILABLE && RECRUIT_SMA_AVAILABLE
+#include "control/plant_record.h"
 #include "control/recruitment_controller.h"
 #include "plugin/sma_host.h"
 #define RECRUIT_SIM_CLOSED_LOOP 1
@@ -217,7 +218,10 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
     p.unit_force = plugin.SettledUnitForce(b);
     p.dT = settings.dT;
     p.lambda = settings.lambda;
-    auto c = control::RecruitmentController::Create(p, *spec);
+    // A model identified on another plant (unit, geometry) is refused with both named.
+    control::EstimatorSpec bundle_spec = *spec;
+    bundle_spec.plant = control::PlantRecord(plugin, b, task.model_path);
+    auto c = control::RecruitmentController::Create(p, bundle_spec);
     if (!c.ok()) return Error{where + ".controller: " + c.error()};
     controllers.push_back(std::move(c).value());
   }
