@@ -221,6 +221,12 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
     // A model identified on another plant (unit, geometry) is refused with both named.
     control::EstimatorSpec bundle_spec = *spec;
     bundle_spec.plant = control::PlantRecord(plugin, b, task.model_path);
+    // "{bundle}" in the model file name stands for the bundle's actuator name, so that each
+    // bundle of a limb gets the model identified on it.
+    const std::string key = "{bundle}";
+    for (size_t at; (at = bundle_spec.model_file.find(key)) != std::string::npos;) {
+      bundle_spec.model_file.replace(at, key.size(), plugin.bundle_name(b));
+    }
     auto c = control::RecruitmentController::Create(p, bundle_spec);
     if (!c.ok()) return Error{where + ".controller: " + c.error()};
     controllers.push_back(std::move(c).value());
