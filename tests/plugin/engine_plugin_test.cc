@@ -21,11 +21,11 @@ namespace recruit::sma {
 namespace {
 
 using ::testing::AllOf;
-using ::testing::HasSubstr;
 using testing::Bench;
 using testing::BenchXml;
 using testing::ConfigXml;
 using testing::DataPtr;
+using ::testing::HasSubstr;
 using testing::Load;
 using testing::ModelPtr;
 using testing::PluginState;
@@ -53,7 +53,7 @@ double Truth(const mjModel* m, const mjData* d, int sensor, int value) {
 
 // Steps d to time t_end, setting ctrl[0] = ctrl(time) before each step; returns force trace.
 std::vector<double> RunForce(const mjModel* m, mjData* d, double t_end,
-                        const std::function<double(double)>& ctrl) {
+                             const std::function<double(double)>& ctrl) {
   std::vector<double> f;
   while (d->time < t_end - 0.5 * m->opt.timestep) {
     d->ctrl[0] = ctrl(d->time);
@@ -144,8 +144,8 @@ TEST(EnginePlugin, CtrlHeldAtOneGivesTheFig4TraceOfTheMujocoFreeBundle) {
 TEST(EnginePlugin, IsometricBenchFileFollowsTheRigidReferenceWithinOnePercent) {
   testing::LoadPluginLibrary();
   char err[1000] = "";
-  ModelPtr m(mj_loadXML(RECRUIT_SOURCE_DIR "/models/isometric_bench.xml", nullptr, err,
-                        sizeof err));
+  ModelPtr m(
+      mj_loadXML(RECRUIT_SOURCE_DIR "/models/isometric_bench.xml", nullptr, err, sizeof err));
   ASSERT_NE(m, nullptr) << err;
   DataPtr d(mj_makeData(m.get()));
   const double dt = m->opt.timestep;
@@ -220,14 +220,17 @@ TEST(EnginePlugin, CompileErrorNamesActuatorKeyAndValue) {
     return Bench{config, "biceps", target, extra, "Euler", false};
   };
   const std::vector<BadCase> cases = {
-      {"bad number", bench(ConfigXml("units", "sixty")),
+      {"bad number",
+       bench(ConfigXml("units", "sixty")),
        {"biceps", "units=sixty", "not a finite number"}},
-      {"out of range", bench(ConfigXml("current", "-0.1")),
+      {"out of range",
+       bench(ConfigXml("current", "-0.1")),
        {"biceps", "current=-0.1", "[0, 100] A"}},
       {"not whole", bench(ConfigXml("series", "1.5")), {"biceps", "series=1.5", "whole number"}},
       {"bad law", bench(ConfigXml("law", "rope")), {"biceps", "law=rope", "wire, spring"}},
       {"bad seed", bench(ConfigXml("seed", "-3")), {"biceps", "seed=-3", "whole number"}},
-      {"bad period", bench(ConfigXml("broadcast_period", "soon")),
+      {"bad period",
+       bench(ConfigXml("broadcast_period", "soon")),
        {"biceps", "broadcast_period=soon", "[0, 1e6]"}},
       {"joint transmission", bench("", "joint=\"load_cell\""), {"biceps", "tendon"}},
       {"gear", bench("", "tendon=\"bundle\"", "gear=\"2\""), {"biceps", "gear=2", "must be 1"}},
@@ -249,11 +252,16 @@ TEST(EnginePlugin, CompileErrorNamesActuatorKeyAndValue) {
 double Schedule(double t, double phase) {
   const int k = static_cast<int>(std::floor((t + phase) / 0.05));
   switch (k % 7) {
-    case 0: return 0.3;
-    case 2: return -0.2;
-    case 4: return 0.6;
-    case 5: return -0.5;
-    default: return 0.0;
+    case 0:
+      return 0.3;
+    case 2:
+      return -0.2;
+    case 4:
+      return 0.6;
+    case 5:
+      return -0.5;
+    default:
+      return 0.0;
   }
 }
 
@@ -283,9 +291,9 @@ std::vector<Snapshot> Continue(const mjModel* m, mjData* d, int steps, double ph
 }
 
 std::string SwitchingBench() {
-  return BenchXml({ConfigXml("units", "60") + ConfigXml("seed", "11") +
-                       ConfigXml("broadcast_period", "0.01"),
-                   "bundle", "tendon=\"bundle\"", "", "Euler", false});
+  return BenchXml(
+      {ConfigXml("units", "60") + ConfigXml("seed", "11") + ConfigXml("broadcast_period", "0.01"),
+       "bundle", "tendon=\"bundle\"", "", "Euler", false});
 }
 
 // (c) mj_copyData mid-run forks the run: both continuations are bit-identical, including a
@@ -354,7 +362,8 @@ TEST(EnginePlugin, BundlesAndModelsNeverShareState) {
   ASSERT_NE(m, nullptr);
   const int n = SmaBundle::StateSize(40);
   DataPtr d(mj_makeData(m.get()));
-  const std::vector<double> b0(Block(m.get(), d.get(), 1, 0, n), Block(m.get(), d.get(), 1, 0, n) + n);
+  const std::vector<double> b0(Block(m.get(), d.get(), 1, 0, n),
+                               Block(m.get(), d.get(), 1, 0, n) + n);
   d->ctrl[0] = 0.5;
   for (int i = 0; i < 300; ++i) mj_step(m.get(), d.get());
   mj_forward(m.get(), d.get());
@@ -368,8 +377,8 @@ TEST(EnginePlugin, BundlesAndModelsNeverShareState) {
   mj_resetData(m.get(), d.get());
   d->ctrl[0] = d->ctrl[1] = 0.3;
   mj_step(m.get(), d.get());
-  EXPECT_FALSE(SameBits(Block(m.get(), d.get(), 0, 0, n) + 1, Block(m.get(), d.get(), 1, 0, n) + 1,
-                        4));
+  EXPECT_FALSE(
+      SameBits(Block(m.get(), d.get(), 0, 0, n) + 1, Block(m.get(), d.get(), 1, 0, n) + 1, 4));
   EXPECT_FALSE(SameBits(Block(m.get(), d.get(), 0, 0, n) + kHeader + 7 * 40,
                         Block(m.get(), d.get(), 1, 0, n) + kHeader + 7 * 40, 40));
 
@@ -436,8 +445,8 @@ TEST(EnginePlugin, GetStateSetStateRoundTrips) {
 
 // (h) The signed convention: ctrl = -1 switches every on unit off at the next broadcast.
 TEST(EnginePlugin, CtrlMinusOneSwitchesEveryUnitOff) {
-  ModelPtr m = MustLoad(BenchXml({ConfigXml("units", "60"), "bundle", "tendon=\"bundle\"", "",
-                                  "Euler", true}));
+  ModelPtr m = MustLoad(
+      BenchXml({ConfigXml("units", "60"), "bundle", "tendon=\"bundle\"", "", "Euler", true}));
   ASSERT_NE(m, nullptr);
   DataPtr d(mj_makeData(m.get()));
   d->ctrl[0] = 1;
@@ -463,9 +472,10 @@ TEST(EnginePlugin, HeldCtrlBroadcastsAtThePeriodWithBinomialCounts) {
   constexpr int kSeeds = 200, kUnits = 60;
   std::vector<double> c1, c3;
   for (int seed = 1; seed <= kSeeds; ++seed) {
-    ModelPtr m = MustLoad(BenchXml({ConfigXml("units", "60") + ConfigXml("seed", std::to_string(seed)) +
-                                        ConfigXml("broadcast_period", "0.5"),
-                                    "bundle", "tendon=\"bundle\"", "", "Euler", true}));
+    ModelPtr m =
+        MustLoad(BenchXml({ConfigXml("units", "60") + ConfigXml("seed", std::to_string(seed)) +
+                               ConfigXml("broadcast_period", "0.5"),
+                           "bundle", "tendon=\"bundle\"", "", "Euler", true}));
     ASSERT_NE(m, nullptr);
     DataPtr d(mj_makeData(m.get()));
     int last = 0, changes = 0;

@@ -34,18 +34,17 @@ inline std::string ConfigXml(const std::string& key, const std::string& value) {
 // from a fixed anchor to a load cell on a stiff slide joint, or, with `fixed`, to a second
 // world site (no degree of freedom: the tendon length never changes).
 struct Bench {
-  std::string config;                             // <config> elements of the instance
-  std::string name = "bundle";                    // actuator name
-  std::string target = "tendon=\"bundle\"";       // the actuator's transmission
+  std::string config;                                 // <config> elements of the instance
+  std::string name = "bundle";                        // actuator name
+  std::string target = "tendon=\"bundle\"";           // the actuator's transmission
   std::string actuator_extra = "ctrlrange=\"-1 1\"";  // more actuator attributes
   std::string integrator = "Euler";
   bool fixed = false;
 };
 
 inline std::string BenchXml(const Bench& b) {
-  const std::string hook =
-      b.fixed ? R"(<site name="hook" pos="0.1 0 0.2"/>)"
-              : R"(<body name="load_cell" pos="0.1 0 0.2">
+  const std::string hook = b.fixed ? R"(<site name="hook" pos="0.1 0 0.2"/>)"
+                                   : R"(<body name="load_cell" pos="0.1 0 0.2">
       <joint name="load_cell" type="slide" axis="1 0 0" stiffness="1e6" damping="4000"/>
       <geom type="box" size="0.01 0.02 0.02" mass="5"/>
       <site name="hook"/>
@@ -58,7 +57,8 @@ inline std::string BenchXml(const Bench& b) {
          b.config + R"(</instance></plugin></extension>
   <worldbody>
     <site name="anchor" pos="0 0 0.2"/>
-    )" + hook + R"(
+    )" + hook +
+         R"(
   </worldbody>
   <tendon><spatial name="bundle"><site site="anchor"/><site site="hook"/></spatial></tendon>
   <actuator>
