@@ -232,7 +232,8 @@ TEST(EnginePlugin, CompileErrorNamesActuatorKeyAndValue) {
       {"bad period",
        bench(ConfigXml("broadcast_period", "soon")),
        {"biceps", "broadcast_period=soon", "[0, 1e6]"}},
-      {"joint transmission", bench("", "joint=\"load_cell\""),
+      {"joint transmission",
+       bench("", "joint=\"load_cell\""),
        {"biceps", "joint='load_cell'", "must act on a tendon"}},
       {"gear", bench("", "tendon=\"bundle\"", "gear=\"2\""), {"biceps", "gear=2", "must be 1"}},
   };
