@@ -134,8 +134,9 @@ std::vector<int> TendonJoints(const mjModel* m, mjData* d, int t) {
   return joints;
 }
 
-// Tendon t's length range over the joints' ranges: a grid of up to ~4096 points (at least the
-// limits and the middle of each joint), or 4096 seeded random points beyond 6 joints.
+// Tendon t's length range over the joints' ranges: a grid with an odd number of points per joint
+// (so the limits and the middle are on it), 257 for one joint, 65 x 65 for two, up to ~4096 in
+// all; beyond 6 joints 4096 seeded random points plus the all-low and all-high corners.
 std::pair<double, double> LengthRange(const mjModel* m, mjData* d, int t,
                                       const std::vector<int>& joints) {
   const int n = static_cast<int>(joints.size());
@@ -155,7 +156,7 @@ std::pair<double, double> LengthRange(const mjModel* m, mjData* d, int t,
   };
   std::vector<double> f(n, 0.0);
   if (n <= 6) {
-    const int points = std::max(3, static_cast<int>(std::pow(4096.0, 1.0 / n)) | 1);
+    const int points = std::clamp(static_cast<int>(std::pow(4096.0, 1.0 / n)) | 1, 3, 257);
     std::vector<int> idx(n, 0);
     while (true) {
       for (int i = 0; i < n; ++i) f[i] = idx[i] / double(points - 1);
