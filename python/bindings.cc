@@ -157,10 +157,9 @@ class PyKalmanFilter {
   PyKalmanFilter(const FilterModel& model, const std::string& mode, const py::object& x0,
                  const py::object& P0)
       : model_(model),
-        f_(Take(PopulationKalmanFilter::Create(
-            model, Take(recruit::ParseCovarianceMode(mode)),
-            x0.is_none() ? model.x0 : ToVector(x0, "x0"),
-            P0.is_none() ? model.P0 : ToMatrix(P0, "P0")))) {}
+        f_(Take(PopulationKalmanFilter::Create(model, Take(recruit::ParseCovarianceMode(mode)),
+                                               x0.is_none() ? model.x0 : ToVector(x0, "x0"),
+                                               P0.is_none() ? model.P0 : ToMatrix(P0, "P0")))) {}
 
   void Predict(const py::object& A) { Check(f_.PredictChecked(ToMatrix(A, "A"))); }
 
@@ -193,8 +192,9 @@ class PyKalmanFilter {
     const Eigen::Index T = Y.rows();
     const int m = f_.num_states();
     if (Y.cols() != f_.num_outputs()) {
-      Fail("ys: must be T x " + std::to_string(f_.num_outputs()) + " (one column per output), got " +
-           std::to_string(Y.rows()) + " x " + std::to_string(Y.cols()));
+      Fail("ys: must be T x " + std::to_string(f_.num_outputs()) +
+           " (one column per output), got " + std::to_string(Y.rows()) + " x " +
+           std::to_string(Y.cols()));
     }
     Eigen::VectorXd pon, poff;
     std::vector<Eigen::MatrixXd> Ak;
@@ -209,8 +209,8 @@ class PyKalmanFilter {
         Fail("run: p_on and p_off need at least T - 1 = " + std::to_string(T - 1) + " entries");
       }
       for (Eigen::Index k = 0; k + 1 < T; ++k) {
-        Check(recruit::BroadcastTransitionModel::ValidateInputs(
-            pon(k), poff(k), "run: step " + std::to_string(k)));
+        Check(recruit::BroadcastTransitionModel::ValidateInputs(pon(k), poff(k),
+                                                                "run: step " + std::to_string(k)));
       }
     } else if (!As.is_none()) {
       DoubleArray a = AsArray(As, "A");
@@ -347,7 +347,7 @@ class PyController {
       : c_(Take(recruit::control::RecruitmentController::Create(
             Params(num_units, unit_force, dT, lambda),
             Take(recruit::control::EstimatorSpec::Parse(estimator, covariance, model_file,
-                                                         num_states, force_noise_std))))) {}
+                                                        num_states, force_noise_std))))) {}
 
   py::tuple Step(double reference, double measured) {
     if (!std::isfinite(reference)) Fail("step: reference force must be finite");
@@ -381,14 +381,18 @@ std::string LibraryOf(const void* symbol) {
 PYBIND11_MODULE(_recruit, mod) {
   mod.doc() = "Recruit's C++ core (see the recruit package for documentation).";
 
-  mod.def("mujoco_version", [] { return std::string(mj_versionString()); },
-          "Version of the libmujoco this module runs with.");
-  mod.def("mujoco_header_version", [] { return static_cast<int>(mjVERSION_HEADER); },
-          "mjVERSION_HEADER of the MuJoCo headers this module was compiled against.");
-  mod.def("plugin_library", [] { return LibraryOf(reinterpret_cast<void*>(&SmaHost::Create)); },
-          "Path of the librecruit_sma.so this module uses (the one that registered recruit.sma).");
-  mod.def("mujoco_library", [] { return LibraryOf(reinterpret_cast<void*>(&mj_step)); },
-          "Path of the libmujoco this module uses.");
+  mod.def(
+      "mujoco_version", [] { return std::string(mj_versionString()); },
+      "Version of the libmujoco this module runs with.");
+  mod.def(
+      "mujoco_header_version", [] { return static_cast<int>(mjVERSION_HEADER); },
+      "mjVERSION_HEADER of the MuJoCo headers this module was compiled against.");
+  mod.def(
+      "plugin_library", [] { return LibraryOf(reinterpret_cast<void*>(&SmaHost::Create)); },
+      "Path of the librecruit_sma.so this module uses (the one that registered recruit.sma).");
+  mod.def(
+      "mujoco_library", [] { return LibraryOf(reinterpret_cast<void*>(&mj_step)); },
+      "Path of the libmujoco this module uses.");
 
   // Filter models.
   py::class_<FilterModel>(mod, "FilterModel")
@@ -404,9 +408,9 @@ PYBIND11_MODULE(_recruit, mod) {
           },
           py::arg("N"), py::arg("dt"), py::arg("unit_force"), py::arg("noise_std"))
       .def_static("linear", &LinearModel, py::arg("H"), py::arg("R"), py::arg("N"),
-                  py::arg("x0") = py::none(), py::arg("P0") = py::none(),
-                  py::arg("A") = py::none(), py::arg("G") = py::none(),
-                  py::arg("Qw") = py::none(), py::arg("state_names") = py::none())
+                  py::arg("x0") = py::none(), py::arg("P0") = py::none(), py::arg("A") = py::none(),
+                  py::arg("G") = py::none(), py::arg("Qw") = py::none(),
+                  py::arg("state_names") = py::none())
       .def("save", [](const FilterModel& f, const std::string& path) { Check(f.Save(path)); })
       .def("with_population",
            [](const FilterModel& f, int64_t N) {
@@ -416,8 +420,8 @@ PYBIND11_MODULE(_recruit, mod) {
       .def("broadcast_matrix",
            [](const FilterModel& f, double p_on, double p_off) {
              if (f.transition != recruit::TransitionSource::kBroadcast) {
-               Fail("broadcast_matrix: the model's transition is '" +
-                    TransitionName(f.transition) + "'");
+               Fail("broadcast_matrix: the model's transition is '" + TransitionName(f.transition) +
+                    "'");
              }
              Check(recruit::BroadcastTransitionModel::ValidateInputs(p_on, p_off,
                                                                      "broadcast_matrix"));
@@ -461,8 +465,8 @@ PYBIND11_MODULE(_recruit, mod) {
       .def("run", &PyKalmanFilter::Run, py::arg("ys"), py::arg("p_on") = py::none(),
            py::arg("p_off") = py::none(), py::arg("A") = py::none())
       .def("reset", &PyKalmanFilter::Reset, py::arg("x0") = py::none(), py::arg("P0") = py::none())
-      .def_property_readonly("x",
-                             [](const PyKalmanFilter& k) { return FromVector(k.filter().estimate()); })
+      .def_property_readonly(
+          "x", [](const PyKalmanFilter& k) { return FromVector(k.filter().estimate()); })
       .def_property_readonly(
           "P", [](const PyKalmanFilter& k) { return FromMatrix(k.filter().covariance()); })
       .def_property_readonly(
@@ -610,8 +614,7 @@ PYBIND11_MODULE(_recruit, mod) {
                     const std::string&, int, double>(),
            py::arg("num_units"), py::arg("unit_force"), py::arg("dT"), py::arg("lam") = 0.2,
            py::arg("estimator") = "kalman-augmented", py::arg("covariance") = "extended",
-           py::arg("model_file") = "", py::arg("num_states") = 20,
-           py::arg("force_noise_std") = 0.0)
+           py::arg("model_file") = "", py::arg("num_states") = 20, py::arg("force_noise_std") = 0.0)
       .def("step", &PyController::Step, py::arg("reference_force"), py::arg("measured_force"))
       .def("reset", [](PyController& c) { c.c().Reset(); })
       .def_property_readonly("target_on", [](PyController& c) { return c.c().target_on(); })
@@ -632,9 +635,9 @@ PYBIND11_MODULE(_recruit, mod) {
   // Runs.
   mod.def(
       "simulate_json",
-      [](const std::string& task_path, const py::object& estimator,
-         const py::object& filter_model, const py::object& dT, const py::object& lambda,
-         const py::object& force_noise_std, const py::object& duration, uint64_t seed) {
+      [](const std::string& task_path, const py::object& estimator, const py::object& filter_model,
+         const py::object& dT, const py::object& lambda, const py::object& force_noise_std,
+         const py::object& duration, uint64_t seed) {
         recruit::sim::Task task = Take(recruit::sim::Task::FromFile(task_path));
         recruit::sim::RunOptions opt;
         if (!estimator.is_none()) opt.estimator = estimator.cast<std::string>();
@@ -648,8 +651,10 @@ PYBIND11_MODULE(_recruit, mod) {
         {
           py::gil_scoped_release release;
           auto r = recruit::sim::RunTask(task, opt);
-          if (r.ok()) json = r->ToJson().dump();
-          else json = "\x01" + r.error();  // raised below, with the GIL held
+          if (r.ok())
+            json = r->ToJson().dump();
+          else
+            json = "\x01" + r.error();  // raised below, with the GIL held
         }
         if (!json.empty() && json[0] == '\x01') Fail(json.substr(1));
         return json;
