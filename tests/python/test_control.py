@@ -85,3 +85,26 @@ def test_simulate_bad_inputs():
         recruit.simulate(TASK, estimator="nope", duration=1.0)
     with pytest.raises(ValueError):
         recruit.simulate(TASK, lam=-1.0, duration=1.0)
+
+
+def _cli():
+    import os
+    path = os.environ.get("RECRUIT_CLI", str(ROOT / "build" / "src" / "cli" / "recruit"))
+    return path if os.path.exists(path) else None
+
+
+@pytest.mark.skipif(_cli() is None, reason="no recruit CLI (set RECRUIT_CLI or build build/)")
+def test_simulate_equals_the_cli_bit_for_bit(tmp_path):
+    # The same task and seed through `recruit simulate` and recruit.simulate: every number of
+    # the summary is the same double (JSON keeps 17 digits). Keys only one side has (a newer
+    # CLI) are ignored.
+    import json
+    import subprocess
+    out = subprocess.run([_cli(), "simulate", "--task", TASK, "--duration", "10", "--seed", "3",
+                          "--out", str(tmp_path)], capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr
+    cli = json.loads((tmp_path / "isometric_steps_summary.json").read_text())
+    py = recruit.simulate(TASK, duration=10.0, seed=3)
+    common = (set(cli) & set(py)) - {"wall_seconds"}
+    assert {"metrics", "steps", "physics_steps", "seed"} <= common
+    assert {k: py[k] for k in common} == {k: cli[k] for k in common}
