@@ -41,6 +41,7 @@ int RunIdentify(const IdentifyArgs& a, const std::string& command_line) {
   }
   SwitchingLog log;
   double unit_force = 0;
+  nlohmann::json plant;  // the bench bundle (null for --log)
   std::string source;
   if (!a.log_in.empty()) {
     auto r = SwitchingLog::FromCsv(a.log_in, a.units);
@@ -67,6 +68,7 @@ int RunIdentify(const IdentifyArgs& a, const std::string& command_line) {
     }
     log = std::move(r->log);
     unit_force = r->unit_force;
+    plant = r->plant;
     source = a.bench;
   }
   if (!a.save_log.empty()) {
@@ -108,6 +110,7 @@ int RunIdentify(const IdentifyArgs& a, const std::string& command_line) {
       {"holdout", metrics(fit->holdout)},
       {"two_state_holdout", metrics(fit->two_state_holdout)},
       {"R_N2", fit->force_noise_var}};
+  if (!plant.is_null()) j["identification"]["plant"] = plant;
   const std::string out = a.output.empty() ? DefaultModelFile(log.dT, a.states) : a.output;
   if (Status s = WriteFileAtomically(out, j.dump(2) + "\n"); !s) {
     std::cerr << "recruit identify: " << s.error() << "\n";

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "common/mujoco_ptr.h"
+#include "control/plant_record.h"
 #include "plugin/sma_host.h"
 
 namespace recruit::control {
@@ -35,6 +36,7 @@ Result<BenchRecording> RecordBench(const std::string& model_path, const std::str
   BenchRecording rec;
   rec.unit_force = p.SettledUnitForce(b);
   rec.timestep = h;
+  rec.plant = PlantRecord(p, b, model_path);
   SwitchingLog& log = rec.log;
   log.num_units = p.num_units(b);
   log.dT = dT;

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <nlohmann/json.hpp>
 #include <string>
 
 #include "common/result.h"
@@ -16,6 +17,7 @@ struct BenchRecording {
   SwitchingLog log;
   double unit_force = 0;  // N, the plugin's settled force of one unit (SettledUnitForce)
   double timestep = 0;    // s, the model's physics timestep
+  nlohmann::json plant;   // the bundle it was recorded on (control/plant_record.h)
 };
 
 // `actuator`: the bundle's actuator name; empty for the model's first bundle.

@@ -8,6 +8,7 @@
 #include "control/kalman_estimator.h"
 #include "control/on_count_estimator.h"
 #include "control/output_estimator.h"
+#include "control/plant_record.h"
 #include "estimation/filter_model.h"
 #include "estimation/population_kalman_filter.h"
 
@@ -142,6 +143,9 @@ Result<std::unique_ptr<OnCountEstimator>> MakeEstimator(const EstimatorSpec& spe
                         : "")};
     }
     model = std::move(loaded).value();
+    if (!spec.plant.is_null()) {
+      if (Status s = CheckModelPlant(file, spec.plant); !s) return Error{"estimator: " + s.error()};
+    }
     if (model.transition != TransitionSource::kBroadcast) {
       return Error{"estimator: " + file + ": transition.type must be \"broadcast\""};
     }

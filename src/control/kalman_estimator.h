@@ -40,7 +40,6 @@ class KalmanOnCountEstimator final : public OnCountEstimator {
   FilterModel model_;
   PopulationKalmanFilter filter_;
   Eigen::VectorXd on_mask_;  // 1 for the "on" states
-  Eigen::MatrixXd A_;        // workspace
   Eigen::VectorXd y_;        // workspace (one output)
 };
 

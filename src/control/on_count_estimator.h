@@ -15,7 +15,7 @@
 
 #include <Eigen/Core>
 #include <memory>
-#include <nlohmann/json_fwd.hpp>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -55,6 +55,9 @@ struct EstimatorSpec {
   // R for kalman-augmented and one settled unit's force for kalman2 (the two-state model's error
   // while units are in transient is of that size).
   double force_noise_std = 0;
+  // kalman-augmented: the plant the model will run on (control/plant_record.h, PlantRecord);
+  // null = unchecked. A model file recording another plant is refused (CheckModelPlant).
+  nlohmann::json plant;
 
   static Result<EstimatorSpec> Parse(const std::string& kind,
                                      const std::string& covariance = "extended",

@@ -10,8 +10,11 @@
 #include <memory>
 
 #include "common/mujoco_ptr.h"
+#include "common/rng.h"
+#include "sim/force_sensor.h"
 
 #if RECRUIT_CONTROL_AVAILABLE && RECRUIT_SMA_AVAILABLE
+#include "control/plant_record.h"
 #include "control/recruitment_controller.h"
 #include "plugin/sma_host.h"
 #define RECRUIT_SIM_CLOSED_LOOP 1
@@ -19,6 +22,10 @@
 
 namespace recruit::sim {
 namespace {
+
+// Index of the load cells' noise streams in Rng::DeriveSeed(run seed, index): apart from any
+// stream the plugin or the sweep derives.
+constexpr std::uint64_t kSensorStream = 0x5E750000;
 
 // Outer loop state of an angle task (PI with anti-windup, derivative on the measured velocity).
 struct AngleLoop {
@@ -85,6 +92,20 @@ nlohmann::json RunSummary::ToJson() const {
                           {"settled", s.settled}});
   }
   j["steps"] = steps_json;
+  nlohmann::json bundles_json = nlohmann::json::array();
+  for (const auto& b : bundles) {
+    bundles_json.push_back({{"actuator", b.actuator},
+                            {"estimator_rmse", b.estimator_rmse},
+                            {"mean_nees", b.mean_nees},
+                            {"estimator_within3", b.estimator_within3},
+                            {"peak_temperature", b.peak_temperature},
+                            {"peak_wire_stress", b.peak_wire_stress},
+                            {"max_temperature", b.max_temperature},
+                            {"max_wire_stress", b.max_wire_stress}});
+  }
+  j["bundles"] = bundles_json;
+  j["sensor"] = sensor.ToJson();
+  j["warnings"] = warnings;
   return j;
 }
 
@@ -197,10 +218,41 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
     p.unit_force = plugin.SettledUnitForce(b);
     p.dT = settings.dT;
     p.lambda = settings.lambda;
-    auto c = control::RecruitmentController::Create(p, *spec);
+    // A model identified on another plant (unit, geometry) is refused with both named.
+    control::EstimatorSpec bundle_spec = *spec;
+    bundle_spec.plant = control::PlantRecord(plugin, b, task.model_path);
+    // "{bundle}" in the model file name stands for the bundle's actuator name, so that each
+    // bundle of a limb gets the model identified on it.
+    const std::string key = "{bundle}";
+    for (size_t at; (at = bundle_spec.model_file.find(key)) != std::string::npos;) {
+      bundle_spec.model_file.replace(at, key.size(), plugin.bundle_name(b));
+    }
+    auto c = control::RecruitmentController::Create(p, bundle_spec);
     if (!c.ok()) return Error{where + ".controller: " + c.error()};
     controllers.push_back(std::move(c).value());
   }
+  // One load cell per bundle, each with its own noise stream derived from the run seed (the
+  // plugin's unit streams use the seed itself).
+  std::vector<ForceSensor> sensors;
+  for (int i = 0; i < nb; ++i) {
+    auto sensor =
+        ForceSensor::Create(task.sensor, Rng::DeriveSeed(options.seed, kSensorStream + i));
+    if (!sensor.ok()) return Error{where + ".sensor: " + sensor.error()};
+    sensors.push_back(std::move(sensor).value());
+  }
+  // Peaks of the units against their wire's datasheet limits.
+  std::vector<double> peak_temperature(nb, -std::numeric_limits<double>::infinity());
+  std::vector<double> peak_stress(nb, 0.0);
+  auto track_peaks = [&]() {
+    for (int i = 0; i < nb; ++i) {
+      const sma::SmaBundle& bundle = plugin.bundle(bundles[i]);
+      const double* state = plugin.State(d, bundles[i]);
+      peak_temperature[i] = std::max(peak_temperature[i], bundle.MaxTemperature(state));
+      peak_stress[i] =
+          std::max(peak_stress[i], bundle.MaxWireStress(state, plugin.Stretch(d, bundles[i])));
+    }
+  };
+  track_peaks();
   AngleLoop angle_loop;
   if (task.outer) angle_loop.gains = *task.outer;
 
@@ -226,7 +278,8 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
     on_counts[i].reserve(static_cast<size_t>(duration / settings.dT) + 2);
     on_counts[i].push_back(plugin.OnCount(d, bundles[i]));
   }
-  std::vector<double> est_on, true_on, est_var;  // agonist, at control instants
+  // Per bundle, at control instants: the estimate, its variance and the true count.
+  std::vector<std::vector<double> > est_on(nb), true_on(nb), est_var(nb);
 
   auto measured = [&]() {
     return task.tracked == Tracked::kForce ? plugin.Force(d, bundles[0]) : d->qpos[qadr];
@@ -263,19 +316,22 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
         const int b = bundles[i];
         // The a-posteriori estimate is of the state at this instant, before its broadcast.
         const int on_before = plugin.OnCount(d, b);
-        const control::Broadcast bc = controllers[i].Step(force_ref[i], plugin.Force(d, b));
+        // The controller reads the load cell, not the plugin's exact tension.
+        const double sensed = sensors[i].SampleAndHold(plugin.Force(d, b));
+        const control::Broadcast bc = controllers[i].Step(force_ref[i], sensed);
         Status st = plugin.Broadcast(d, b, bc.p_on, bc.p_off);
         if (!st.ok()) return Error{where + ": " + st.error()};
         BundleTelemetry& bt = sample.bundles[i];
         bt.estimated_on = controllers[i].estimated_on();
+        const double var = controllers[i].estimated_on_variance();
+        bt.estimated_on_std = std::isfinite(var) ? std::sqrt(std::max(var, 0.0))
+                                                 : std::numeric_limits<double>::quiet_NaN();
         bt.p_on = bc.p_on;
         bt.p_off = bc.p_off;
         bt.force_reference = force_ref[i];
-        if (i == 0) {
-          est_on.push_back(controllers[i].estimated_on());
-          est_var.push_back(controllers[i].estimated_on_variance());
-          true_on.push_back(on_before);
-        }
+        est_on[i].push_back(controllers[i].estimated_on());
+        est_var[i].push_back(var);
+        true_on[i].push_back(on_before);
       }
       sample.p_on = sample.bundles[0].p_on;
       sample.p_off = sample.bundles[0].p_off;
@@ -296,6 +352,7 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
     }
 
     mj_step(m, d);
+    track_peaks();
 
     const double y = measured();
     const double r = task.reference(d->time);
@@ -385,10 +442,38 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
     units += n;
   }
   mt.switching_rate = units > 0 ? rate / units : 0;
-  const EstimatorScore es = ScoreEstimator(est_on, true_on, est_var);
-  mt.estimator_rmse = es.rmse;
-  mt.mean_nees = es.mean_nees;
-  mt.estimator_within3 = es.within3;
+  s.sensor = task.sensor;
+  for (int i = 0; i < nb; ++i) {
+    const EstimatorScore es = ScoreEstimator(est_on[i], true_on[i], est_var[i]);
+    const sma::UnitLimits& lim = plugin.bundle(bundles[i]).limits();
+    BundleSummary bs;
+    bs.actuator = plugin.bundle_name(bundles[i]);
+    bs.estimator_rmse = es.rmse;
+    bs.mean_nees = es.mean_nees;
+    bs.estimator_within3 = es.within3;
+    bs.peak_temperature = peak_temperature[i];
+    bs.peak_wire_stress = peak_stress[i];
+    bs.max_temperature = lim.max_temperature;
+    bs.max_wire_stress = lim.max_wire_stress;
+    s.bundles.push_back(bs);
+    if (i == 0) {
+      mt.estimator_rmse = es.rmse;
+      mt.mean_nees = es.mean_nees;
+      mt.estimator_within3 = es.within3;
+    }
+    char buf[200];
+    if (bs.peak_temperature > lim.max_temperature) {
+      std::snprintf(buf, sizeof buf, "%s: peak unit temperature %.1f C exceeds the limit %.1f C",
+                    bs.actuator.c_str(), bs.peak_temperature, lim.max_temperature);
+      s.warnings.push_back(buf);
+    }
+    if (bs.peak_wire_stress > lim.max_wire_stress) {
+      std::snprintf(buf, sizeof buf, "%s: peak wire stress %.1f MPa exceeds the limit %.1f MPa",
+                    bs.actuator.c_str(), bs.peak_wire_stress / 1e6, lim.max_wire_stress / 1e6);
+      s.warnings.push_back(buf);
+    }
+  }
+  for (const std::string& w : s.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
   s.wall_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   return s;

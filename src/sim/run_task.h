@@ -43,6 +43,19 @@ struct RunMetrics {
   int num_steps = 0;
 };
 
+// One bundle's scores: its estimate against the ground-truth count at the control instants, and
+// its units' peaks against the datasheet limits of its wire (SmaBundle::limits()).
+struct BundleSummary {
+  std::string actuator;
+  double estimator_rmse = 0;     // units
+  double mean_nees = 0;          // NaN: the estimator gives no variance
+  double estimator_within3 = 0;  // fraction of control instants with |n^ - n| <= 3
+  double peak_temperature = 0;   // C, hottest unit over the run
+  double peak_wire_stress = 0;   // Pa, most stressed wire over the run
+  double max_temperature = 0;    // C, the limit
+  double max_wire_stress = 0;    // Pa, the limit
+};
+
 struct RunSummary {
   std::string task;
   std::string estimator;
@@ -52,8 +65,11 @@ struct RunSummary {
   double wall_seconds = 0;  // s
   long physics_steps = 0;
   long control_instants = 0;
-  std::string unit;  // "N" or "rad"
-  RunMetrics metrics;
+  std::string unit;                    // "N" or "rad"
+  RunMetrics metrics;                  // estimator scores here are the agonist's
+  std::vector<BundleSummary> bundles;  // every bundle (agonist first)
+  SensorParams sensor;                 // the load cell the controllers read
+  std::vector<std::string> warnings;   // limits exceeded, also printed on stderr
   std::vector<StepResponse> steps;
 
   nlohmann::json ToJson() const;

@@ -102,11 +102,11 @@ Result<Task> Task::FromJsonText(const std::string& text, const std::string& sour
     return Error{file + ": not valid JSON: " + e.what()};
   }
   if (!j.is_object()) return Error{file + ": the task must be a JSON object"};
-  RECRUIT_TRY(CheckKeys(
-      j,
-      {"name", "description", "model", "tracked", "agonist", "antagonist", "joint", "duration",
-       "timestep", "reference", "controller", "outer_loop", "pushes", "payloads", "settle_band"},
-      file));
+  RECRUIT_TRY(CheckKeys(j,
+                        {"name", "description", "model", "tracked", "agonist", "antagonist",
+                         "joint", "duration", "timestep", "reference", "controller", "sensor",
+                         "outer_loop", "pushes", "payloads", "settle_band"},
+                        file));
   Task task;
   task.source = source;
   RECRUIT_TRY(String(j, "name", file, &task.name, true));
@@ -180,6 +180,12 @@ Result<Task> Task::FromJsonText(const std::string& text, const std::string& sour
                        "seconds, 0 < dT <= 1000"));
     RECRUIT_TRY(
         Number(c, "lambda", where, &task.controller.lambda, false, 0, 1, true, "0 < lambda <= 1"));
+  }
+
+  if (j.contains("sensor")) {
+    auto sensor = SensorParams::FromJson(j["sensor"], file + ".sensor");
+    if (!sensor.ok()) return Error{sensor.error()};
+    task.sensor = *sensor;
   }
 
   if (j.contains("outer_loop")) {

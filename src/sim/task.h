@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "common/result.h"
+#include "sim/force_sensor.h"
 #include "sim/reference.h"
 
 namespace recruit::sim {
@@ -67,6 +68,9 @@ struct Task {
   double timestep = 0;     // s, physics step override (0 = the model's)
   Reference reference;     // N for force tasks, rad for angle tasks
   ControllerSettings controller;
+  // The load cell every bundle's force is read through (noise, resolution, held over dT); the
+  // default is an exact sensor. Separate from the filter's own R (controller.force_noise_std).
+  SensorParams sensor;
   std::optional<OuterLoop> outer;
   std::vector<Push> pushes;
   std::vector<Payload> payloads;

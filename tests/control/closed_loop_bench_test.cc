@@ -87,10 +87,12 @@ TEST(ClosedLoopBench, AugmentedFilterConvergesAtHalfSecondForLambdasUpToOne) {
   for (double lambda : {0.2, 0.5, 1.0}) {
     const LoopResult r = RunBench(Spec("kalman-augmented"), 0.5, lambda, 1);
     // Within 1.5 units' force (0.7 N) of the reference over the last 20 s (the target, 33.1
-    // units, is not a whole number, so the count dithers), no more than 8 % overshoot, and the
-    // filter's on-count within about one unit of the truth on average.
+    // units, is not a whole number, so the count dithers), no more than 10 % overshoot, and the
+    // filter's on-count within about one unit of the truth on average. (The datasheet unit's
+    // force rises as a delayed ramp, docs/sma-units.md: at lambda 0.5 the random recruitment
+    // overshoots the count by 3-4 units, 7-8 % of the force, with the count estimate right.)
     EXPECT_LT(r.late_error, 0.7) << "lambda " << lambda;
-    EXPECT_LT(r.max_force, 1.08 * 15.0) << "lambda " << lambda;
+    EXPECT_LT(r.max_force, 1.10 * 15.0) << "lambda " << lambda;
     EXPECT_LT(r.count_rmse, 1.5) << "lambda " << lambda;
     EXPECT_LE(r.max_on, std::ceil(r.target_on) + 4) << "lambda " << lambda;
   }
@@ -128,7 +130,9 @@ TEST(ClosedLoopBench, OutputOnlyCountingOverRecruitsAtHalfSecond) {
     EXPECT_GT(out.max_force, 1.10 * 15.0) << "seed " << seed;
     EXPECT_GT(out.max_on, out.target_on + 8) << "seed " << seed;
     EXPECT_GT(out.count_rmse, 3.0) << "seed " << seed;
-    EXPECT_LT(kf.max_force, 1.06 * 15.0) << "seed " << seed;
+    EXPECT_LT(kf.max_force, 1.10 * 15.0) << "seed " << seed;
+    // The filter's overshoot is less than half the output-only loop's.
+    EXPECT_LT(kf.max_force - 15.0, 0.5 * (out.max_force - 15.0)) << "seed " << seed;
     EXPECT_LT(kf.count_rmse, out.count_rmse / 2) << "seed " << seed;
   }
 }

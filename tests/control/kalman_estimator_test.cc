@@ -8,6 +8,7 @@
 #include <cmath>
 #include <nlohmann/json.hpp>
 
+#include "common/rng.h"
 #include "control/model_export.h"
 #include "control/on_count_estimator.h"
 #include "control/transient_chain.h"
@@ -63,6 +64,39 @@ TEST(KalmanAugmented, OnCountIsTheSumOverTheHeaterOnStates) {
   EXPECT_NEAR(est.EstimatedOn(), sum_on, 1e-9);
   EXPECT_NEAR(est.EstimatedOn(), 30.0, 1e-9);
   EXPECT_NEAR(x.sum(), 60.0, 1e-9);
+}
+
+TEST(KalmanAugmented, SparseBroadcastPredictionEqualsTheDenseFilter) {
+  // The estimator predicts with PredictBroadcast (sparse A); the reference is the same filter
+  // driven densely (FillMatrix + Predict(A)), over a sequence of broadcasts and measurements.
+  const std::string file = "models/identified/bench_n60_dt0.5_m20.json";
+  auto spec = EstimatorSpec::Parse("kalman-augmented", "extended", file);
+  ASSERT_TRUE(spec.ok());
+  auto e = MakeEstimator(*spec, 60, 0.45, 0.5);
+  ASSERT_TRUE(e.ok()) << e.error();
+  const auto& est = dynamic_cast<const KalmanOnCountEstimator&>(**e);
+  FilterModel model = est.model();
+  auto dense = PopulationKalmanFilter::Create(model, CovarianceMode::kExtended);
+  ASSERT_TRUE(dense.ok()) << dense.error();
+  const int m = model.num_states();
+  Eigen::MatrixXd A(m, m);
+  Eigen::VectorXd y(1);
+  Rng rng(17);
+  for (int k = 0; k < 200; ++k) {
+    const double p_on = rng.Uniform() < 0.3 ? 0.0 : 0.5 * rng.Uniform();
+    const double p_off = rng.Uniform() < 0.3 ? 0.0 : 0.5 * rng.Uniform();
+    y[0] = 30.0 * rng.Uniform();
+    (*e)->Observe(y[0]);
+    dense->Update(y);
+    (*e)->Broadcasted({p_on, p_off});
+    model.broadcast.FillMatrix(p_on, p_off, A);
+    dense->Predict(A);
+    // Relative 1e-12 of the scales, N units and N^2 units^2 (round-off of the two orders of
+    // summation, about 1e-14 relative per step, accumulates over the run).
+    ASSERT_LE((est.filter().estimate() - dense->estimate()).cwiseAbs().maxCoeff(), 1e-12 * 60) << k;
+    ASSERT_LE((est.filter().covariance() - dense->covariance()).cwiseAbs().maxCoeff(), 1e-12 * 3600)
+        << k;
+  }
 }
 
 TEST(KalmanAugmented, ModelIsRescaledToTheBundlesUnits) {

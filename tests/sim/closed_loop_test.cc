@@ -168,6 +168,49 @@ TEST(ClosedLoop, ArmLiftsTowardTheReferenceAngle) {
   EXPECT_LT(r->metrics.tracking_rmse, 20 * M_PI / 180);
 }
 
+TEST(ClosedLoop, ArmScoresEveryBundleAndKeepsItsUnitsWithinTheirLimits) {
+  Task task = LoadTask("arm_reach_hold.json");
+  RunOptions o;
+  o.duration = 28;
+  auto r = RunTask(task, o);
+  ASSERT_TRUE(r.ok()) << r.error();
+  ASSERT_EQ(r->bundles.size(), 2u);
+  EXPECT_EQ(r->bundles[0].actuator, "flexor");
+  EXPECT_EQ(r->bundles[1].actuator, "extensor");
+  EXPECT_EQ(r->metrics.estimator_rmse, r->bundles[0].estimator_rmse);
+  for (const BundleSummary& b : r->bundles) {
+    // Both bundles recruit (the extensor carries the tone), so both have heated units, within
+    // the datasheet limits of their 0.1 mm wire (120 C, 172 MPa).
+    EXPECT_GT(b.peak_temperature, 68.0) << b.actuator;  // above As: units did transform
+    EXPECT_LE(b.peak_temperature, b.max_temperature) << b.actuator;
+    EXPECT_GT(b.peak_wire_stress, 0.0) << b.actuator;
+    EXPECT_LE(b.peak_wire_stress, b.max_wire_stress) << b.actuator;
+    EXPECT_TRUE(std::isnan(b.mean_nees)) << b.actuator;  // output only: no variance
+  }
+  EXPECT_TRUE(r->warnings.empty());
+  const nlohmann::json j = r->ToJson();
+  EXPECT_EQ(j["bundles"].size(), 2u);
+  EXPECT_TRUE(j["warnings"].is_array());
+}
+
+TEST(ClosedLoop, TheControllerReadsTheSeededLoadCell) {
+  Task task = LoadTask("isometric_steps.json");
+  RunOptions o;
+  o.duration = 20;
+  o.dT = 0.5;
+  task.sensor = {0, 0};
+  auto exact = RunTask(task, o);
+  task.sensor = {0.3, 0.05};
+  auto noisy = RunTask(task, o), again = RunTask(task, o);
+  ASSERT_TRUE(exact.ok() && noisy.ok() && again.ok());
+  // The output-only count is the sensor reading over the unit force, so the sensor's noise
+  // shows in the count error; the same seed reproduces the run exactly.
+  EXPECT_NE(exact->metrics.estimator_rmse, noisy->metrics.estimator_rmse);
+  EXPECT_EQ(noisy->metrics.estimator_rmse, again->metrics.estimator_rmse);
+  EXPECT_EQ(noisy->metrics.tracking_rmse, again->metrics.tracking_rmse);
+  EXPECT_EQ(noisy->ToJson()["sensor"]["noise_std"], 0.3);
+}
+
 TEST(ClosedLoop, TaskFieldsThatDoNotMatchTheModelAreNamed) {
   Task task = LoadTask("isometric_steps.json");
   task.agonist = "biceps";

@@ -1,0 +1,72 @@
+#include "sim/force_sensor.h"
+
+#include <cmath>
+
+namespace recruit::sim {
+namespace {
+
+std::string Short(const nlohmann::json& v) {
+  std::string s = v.dump();
+  return s.size() > 40 ? s.substr(0, 37) + "..." : s;
+}
+
+}  // namespace
+
+Result<SensorParams> SensorParams::Create(double noise_std, double resolution) {
+  if (!(noise_std >= 0 && std::isfinite(noise_std))) {
+    return Error{"noise_std must be a finite number >= 0 N, got " + std::to_string(noise_std)};
+  }
+  if (!(resolution >= 0 && std::isfinite(resolution))) {
+    return Error{"resolution must be a finite number >= 0 N, got " + std::to_string(resolution)};
+  }
+  return SensorParams{noise_std, resolution};
+}
+
+Result<SensorParams> SensorParams::FromJson(const nlohmann::json& j, const std::string& where) {
+  if (!j.is_object()) {
+    return Error{where + ": must be an object {\"noise_std\": N, \"resolution\": N}, got " +
+                 Short(j)};
+  }
+  SensorParams p;
+  for (const auto& [key, value] : j.items()) {
+    double* field = key == "noise_std"    ? &p.noise_std
+                    : key == "resolution" ? &p.resolution
+                                          : nullptr;
+    if (!field) {
+      return Error{where + "." + key + ": unknown key; allowed: noise_std, resolution"};
+    }
+    if (!value.is_number() || !(value.get<double>() >= 0) || !std::isfinite(value.get<double>())) {
+      return Error{where + "." + key + ": must be a number >= 0 (N), got " + Short(value)};
+    }
+    *field = value.get<double>();
+  }
+  return p;
+}
+
+nlohmann::json SensorParams::ToJson() const {
+  return {{"noise_std", noise_std}, {"resolution", resolution}};
+}
+
+Result<ForceSensor> ForceSensor::Create(const SensorParams& params, std::uint64_t seed) {
+  auto p = SensorParams::Create(params.noise_std, params.resolution);
+  if (!p.ok()) return Error{"sensor: " + p.error()};
+  return ForceSensor(*p, seed);
+}
+
+// Box-Muller on the sensor's own stream (std::normal_distribution's algorithm is not fixed by
+// the standard, so its numbers would differ between standard libraries).
+double ForceSensor::Gaussian() {
+  const double u1 = 1.0 - rng_.Uniform();  // (0, 1]
+  const double u2 = rng_.Uniform();
+  return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * M_PI * u2);
+}
+
+double ForceSensor::SampleAndHold(double true_force) {
+  double y = true_force;
+  if (params_.noise_std > 0) y += params_.noise_std * Gaussian();
+  if (params_.resolution > 0) y = params_.resolution * std::round(y / params_.resolution);
+  held_ = y;
+  return y;
+}
+
+}  // namespace recruit::sim
