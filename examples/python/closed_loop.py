@@ -6,7 +6,7 @@ filter estimates how many units are on, the expectation law picks (p_on, p_off),
 bundle receives the broadcast. The filter is the identified 20-state model
 (models/identified/bench_n60_dt0.5_m20.json); recruit.Controller packages the same steps.
 
-    python examples/python/closed_loop.py [--duration 30] [--seed 1]
+    python examples/python/closed_loop.py [--duration 40] [--seed 1]
 """
 import argparse
 import pathlib
@@ -21,7 +21,7 @@ ROOT = pathlib.Path(__file__).resolve().parents[2]
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--duration", type=float, default=30.0, help="simulated seconds")
+    ap.add_argument("--duration", type=float, default=40.0, help="simulated seconds")
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--lam", type=float, default=0.3, help="expectation-law gain")
     args = ap.parse_args()

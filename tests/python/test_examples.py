@@ -20,9 +20,9 @@ def _run(name, *args, tmp_path=None):
 
 
 def test_closed_loop_tracks_the_reference():
-    text = _run("closed_loop.py", "--duration", "30", "--seed", "2")
+    text = _run("closed_loop.py", "--duration", "40", "--seed", "2")
     err = float(re.search(r"mean \|force - ref\| = ([0-9.]+) N", text).group(1))
-    assert err < 2.0  # 8 N held for the last 5 s: within 25 %
+    assert err < 1.5  # 8 N held from 22 s: within 20 % over 35-40 s (seeds 1-4: 0.1-0.6 N)
 
 
 def test_filter_log_writes_the_estimates(tmp_path):
