@@ -4,7 +4,8 @@
 #   scripts/build.sh recruit        # only the command-line program and what it links
 set -euo pipefail
 cd "$(dirname "$0")/.."
-cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
+# The Python package is built too, so that ctest runs its pytest suite (python_pytest).
+cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DRECRUIT_BUILD_PYTHON=ON >/dev/null
 if [ $# -eq 0 ]; then
   cmake --build build -j"$(nproc)"
 else
