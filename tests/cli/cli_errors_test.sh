@@ -12,7 +12,7 @@ cd "$WORK" || exit 1
 TASK=$SRC/models/tasks/isometric_steps.json
 MODEL=$SRC/models/isometric_bench.xml
 
-fail() { echo "FAIL [$CASE]: $*"; echo "--- stderr:"; cat err 2>/dev/null; exit 1; }
+fail() { echo "FAIL [$CASE]: $*"; echo "--- stderr:"; head -c 2000 err 2>/dev/null; exit 1; }
 # expect CODE COMMAND...: runs the command, stderr into ./err, checks the exit code.
 expect() {
   want=$1; shift
