@@ -82,6 +82,10 @@ int main(int argc, char** argv) {
     return exit_code::kInternal;
   }
   // filter and plot report every failure as 1: map it to the class their message names.
-  if (exit_code == 1) exit_code = exit_code::FromMessage(tee.text());
+  if (exit_code == 1) {
+    exit_code = tee.text().find("refusing to overwrite an input") != std::string::npos
+                    ? exit_code::kUsage
+                    : exit_code::FromMessage(tee.text());
+  }
   return exit_code;
 }
