@@ -70,7 +70,8 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     std::string where = "recruit";
     for (const auto* sub : app.get_subcommands()) where += " " + sub->get_name();
-    std::cerr << where << ": " << ShortenLongTokens(e.what()) << "\nRun with --help for more "
+    // Paths stay readable (200 characters); a 2 MB value does not come back whole.
+    std::cerr << where << ": " << ShortenLongTokens(e.what(), 200) << "\nRun with --help for more "
               << "information.\n";
     return exit_code::kUsage;
   } catch (const std::bad_alloc&) {
