@@ -3,8 +3,14 @@
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
+#include <functional>
+#include <mutex>
+#include <set>
 #include <string>
+#include <string_view>
+#include <tuple>
 #include <utility>
 
 #include "common/rng.h"
@@ -57,12 +63,29 @@ int BundleIndexOf(const mjModel* m, int a) {
   return b;
 }
 
+std::string Fmt(const char* format, double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, format, v);
+  return buf;
+}
+
+// "joint='elbow'" for the actuator's transmission target, to quote it in messages.
+std::string Transmission(const mjModel* m, int a) {
+  static const char* kinds[] = {"joint", "jointinparent", "slidercrank", "tendon", "site", "body"};
+  const int t = m->actuator_trntype[a];
+  const char* kind = t >= 0 && t < 6 ? kinds[t] : "transmission";
+  const int types[] = {mjOBJ_JOINT, mjOBJ_JOINT, mjOBJ_SITE, mjOBJ_TENDON, mjOBJ_SITE, mjOBJ_BODY};
+  const char* name = t >= 0 && t < 6 ? mj_id2name(m, types[t], m->actuator_trnid[2 * a]) : nullptr;
+  return std::string(kind) + "='" + (name != nullptr ? name : "?") + "'";
+}
+
 Status CheckActuator(const mjModel* m, int a, const std::string& where) {
   if (m->actuator_trntype[a] != mjTRN_TENDON) {
-    return Error{where + "must act on a tendon (tendon=\"...\"): a bundle pulls a tendon"};
+    return Error{where + Transmission(m, a) +
+                 " is invalid: must act on a tendon (tendon=\"...\"): a bundle pulls a tendon"};
   }
   if (m->actuator_gear[6 * a] != 1) {
-    return Error{where + "gear=" + std::to_string(m->actuator_gear[6 * a]) +
+    return Error{where + "gear=" + Fmt("%g", m->actuator_gear[6 * a]) +
                  " is invalid: must be 1 (the bundle's tension is the actuator force)"};
   }
   if (m->actuator_dyntype[a] != mjDYN_NONE || m->actuator_actnum[a] != 0) {
@@ -71,6 +94,98 @@ Status CheckActuator(const mjModel* m, int a, const std::string& where) {
                  "plugin_state"};
   }
   return Status::Ok();
+}
+
+// --- Fit check (issue 9 item 8) ---
+
+// True while this thread builds a scratch mjData for a fit check: mj_makeData runs every
+// plugin instance's init, which must not start another check.
+thread_local bool in_fit_check = false;
+
+struct FitGuard {
+  FitGuard() { in_fit_check = true; }
+  ~FitGuard() { in_fit_check = false; }
+};
+
+// Limited hinge and slide joints whose motion changes tendon t's length (probed at both limits
+// and the middle, every other joint at qpos0).
+std::vector<int> TendonJoints(const mjModel* m, mjData* d, int t) {
+  auto length = [&] {
+    mj_kinematics(m, d);
+    mj_comPos(m, d);
+    mj_tendon(m, d);
+    return d->ten_length[t];
+  };
+  mju_copy(d->qpos, m->qpos0, m->nq);
+  const double l0 = length();
+  std::vector<int> joints;
+  for (int j = 0; j < m->njnt; ++j) {
+    const int type = m->jnt_type[j];
+    if ((type != mjJNT_HINGE && type != mjJNT_SLIDE) || !m->jnt_limited[j]) continue;
+    const int q = m->jnt_qposadr[j];
+    bool moves = false;
+    for (double f : {0.0, 0.5, 1.0}) {
+      d->qpos[q] = m->jnt_range[2 * j] + f * (m->jnt_range[2 * j + 1] - m->jnt_range[2 * j]);
+      moves = moves || std::abs(length() - l0) > 1e-9;
+    }
+    d->qpos[q] = m->qpos0[q];
+    if (moves) joints.push_back(j);
+  }
+  return joints;
+}
+
+// Tendon t's length range over the joints' ranges: a grid with an odd number of points per joint
+// (so the limits and the middle are on it), 257 for one joint, 65 x 65 for two, up to ~4096 in
+// all; beyond 6 joints 4096 seeded random points plus the all-low and all-high corners.
+std::pair<double, double> LengthRange(const mjModel* m, mjData* d, int t,
+                                      const std::vector<int>& joints) {
+  const int n = static_cast<int>(joints.size());
+  double lo = INFINITY, hi = -INFINITY;
+  auto sample = [&](const std::vector<double>& f) {
+    mju_copy(d->qpos, m->qpos0, m->nq);
+    for (int i = 0; i < n; ++i) {
+      const int j = joints[i];
+      d->qpos[m->jnt_qposadr[j]] =
+          m->jnt_range[2 * j] + f[i] * (m->jnt_range[2 * j + 1] - m->jnt_range[2 * j]);
+    }
+    mj_kinematics(m, d);
+    mj_comPos(m, d);
+    mj_tendon(m, d);
+    lo = std::min(lo, d->ten_length[t]);
+    hi = std::max(hi, d->ten_length[t]);
+  };
+  std::vector<double> f(n, 0.0);
+  if (n <= 6) {
+    const int points = std::clamp(static_cast<int>(std::pow(4096.0, 1.0 / n)) | 1, 3, 257);
+    std::vector<int> idx(n, 0);
+    while (true) {
+      for (int i = 0; i < n; ++i) f[i] = idx[i] / double(points - 1);
+      sample(f);
+      int i = 0;
+      while (i < n && ++idx[i] == points) idx[i++] = 0;
+      if (i == n) break;
+    }
+  } else {
+    Rng rng(1);
+    for (int s = 0; s < 4096; ++s) {
+      for (int i = 0; i < n; ++i) f[i] = s < 2 ? double(s) : rng.Uniform();
+      sample(f);
+    }
+  }
+  return {lo, hi};
+}
+
+std::string JointRanges(const mjModel* m, const std::vector<int>& joints) {
+  std::string s;
+  for (int j : joints) {
+    const bool hinge = m->jnt_type[j] == mjJNT_HINGE;
+    const double k = hinge ? 180 / mjPI : 1000;
+    const char* name = mj_id2name(m, mjOBJ_JOINT, j);
+    s += (s.empty() ? "" : ", ") + std::string(name != nullptr ? name : "#" + std::to_string(j)) +
+         " " + Fmt("%.4g", k * m->jnt_range[2 * j]) + ".." +
+         Fmt("%.4g", k * m->jnt_range[2 * j + 1]) + (hinge ? " deg" : " mm");
+  }
+  return s;
 }
 
 }  // namespace
@@ -86,8 +201,79 @@ bool IsSmaInstance(const mjModel* m, int instance) {
   return instance >= 0 && instance < m->nplugin && s >= 0 && m->plugin[instance] == s;
 }
 
+// True the first time (m, instance) is seen with this content: init runs for every mjData, the
+// check needs thousands of kinematics passes, so it runs once per distinct compiled model.
+static bool FirstCheck(const mjModel* m, int instance) {
+  static std::mutex mu;
+  static std::set<std::pair<std::size_t, int>> seen;
+  const std::size_t h = std::hash<std::string_view>()(
+      std::string_view(static_cast<const char*>(m->buffer), static_cast<std::size_t>(m->nbuffer)));
+  std::lock_guard<std::mutex> lock(mu);
+  return seen.insert({h, instance}).second;
+}
+
 Result<std::unique_ptr<SmaInstance>> SmaInstance::Create(const mjModel* m, int instance) {
-  return Build(m, instance, true);
+  auto p = Build(m, instance, true);
+  if (p.ok() && !in_fit_check && FirstCheck(m, instance)) {
+    const std::vector<TendonFit> fits = (*p)->Fit(m);
+    for (int k = 0; k < static_cast<int>(fits.size()); ++k) {
+      const std::string w = (*p)->FitWarning(m, k, fits[k]);
+      if (!w.empty()) mju_warning("%s", w.c_str());
+    }
+  }
+  return p;
+}
+
+std::vector<TendonFit> SmaInstance::Fit(const mjModel* m) const {
+  FitGuard guard;
+  mjData* d = mj_makeData(m);
+  std::vector<TendonFit> fits;
+  if (d == nullptr) return fits;
+  for (const SmaActuator& a : actuators_) {
+    TendonFit f;
+    const UnitModel& unit = a.model.unit();
+    const int n = a.model.num_units();
+    const std::vector<int> joints = TendonJoints(m, d, a.tendon);
+    f.joints = static_cast<int>(joints.size());
+    f.stroke = unit.recoverable_stretch();
+    f.on_force = n * a.settled_force;
+    f.rated_stress = a.model.limits().max_wire_stress;
+    if (f.joints > 0) {
+      std::tie(f.length_min, f.length_max) = LengthRange(m, d, a.tendon, joints);
+      f.joint_ranges = JointRanges(m, joints);
+      const double prestretch = a.model.config().unit.prestretch;
+      f.stretch_min = prestretch + (f.length_min - a.ref_length);
+      f.stretch_max = prestretch + (f.length_max - a.ref_length);
+      const double off = unit.Tension(1.0, f.stretch_max);
+      f.off_force = n * off;
+      f.off_stress = unit.WireStress(off);
+      const double segment = f.stroke / a.model.config().unit.series;
+      f.series_needed = std::max(1, static_cast<int>(std::ceil(f.excursion() / segment - 1e-9)));
+      f.prestretch_needed = f.series_needed * segment - (f.length_max - a.ref_length);
+    }
+    fits.push_back(f);
+  }
+  mj_deleteData(d);
+  return fits;
+}
+
+std::string SmaInstance::FitWarning(const mjModel* m, int k, const TendonFit& f) const {
+  if (f.fits()) return "";
+  const SmaActuator& a = actuators_[k];
+  auto mm = [](double v) { return Fmt("%.1f", 1000 * v); };
+  // Short: mj_loadXML keeps about 500 characters of warnings for all bundles together.
+  std::string w = "recruit.sma actuator '" + ActuatorName(m, a.actuator) + "': tendon excursion " +
+                  mm(f.excursion()) + " mm over " + f.joint_ranges.substr(0, 40) +
+                  ", unit stroke " + mm(f.stroke) + " mm, extension " + mm(f.stretch_min) + ".." +
+                  mm(f.stretch_max) + " mm:";
+  if (f.blocks()) {
+    w += " off units pull " + Fmt("%.3g", f.off_force) + " N (" + Fmt("%.0f", f.off_stress / 1e6) +
+         " MPa): will block the joint;";
+  }
+  if (f.slack()) w += " on units slack over " + mm(-f.stretch_min) + " mm;";
+  w += " fit: series=" + std::to_string(f.series_needed) +
+       " prestretch=" + Fmt("%.3g", f.prestretch_needed);
+  return w;
 }
 
 Result<std::unique_ptr<SmaInstance>> SmaInstance::Build(const mjModel* m, int instance,

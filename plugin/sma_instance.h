@@ -40,6 +40,32 @@ struct SmaActuator {
   SmaBundle model;
 };
 
+// How a bundle fits its tendon over the joint limits (issue 9 item 8): the tendon's length
+// range when the limited hinge and slide joints that move it are sampled over their ranges
+// (other joints at qpos0), against the units' stroke and forces.
+struct TendonFit {
+  int joints = 0;            // limited hinge/slide joints that move the tendon (0: no check)
+  std::string joint_ranges;  // e.g. "elbow 0..120 deg", for messages
+  double length_min = 0;     // tendon length range (m)
+  double length_max = 0;
+  double stretch_min = 0;  // unit extension at length_min / length_max (m)
+  double stretch_max = 0;
+  double stroke = 0;             // a unit's recoverable stretch (m, whole unit)
+  double on_force = 0;           // all units on, settled at the prestretch (N)
+  double off_force = 0;          // all units off (martensite) at stretch_max (N)
+  double off_stress = 0;         // wire stress of an off unit at stretch_max (Pa)
+  double rated_stress = 0;       // datasheet limit (Pa)
+  int series_needed = 0;         // smallest series whose stroke covers the excursion
+  double prestretch_needed = 0;  // with it: off units just taut at length_max (m)
+  double excursion() const { return length_max - length_min; }
+  // Off units stretched past their stroke at the longest tendon (they resist the joint), or on
+  // units slack before the shortest (they cannot pull the joint to that end); 5 % of the
+  // stroke tolerated.
+  bool blocks() const { return joints > 0 && stretch_max > 1.05 * stroke; }
+  bool slack() const { return joints > 0 && stretch_min < -0.05 * stroke; }
+  bool fits() const { return !blocks() && !slack(); }
+};
+
 class SmaInstance {
  public:
   static constexpr int kSlots = 2;  // per actuator, before the bundle's block
@@ -57,6 +83,12 @@ class SmaInstance {
   const std::vector<SmaActuator>& actuators() const { return actuators_; }
   std::uint64_t seed() const { return seed_; }
   double broadcast_period() const { return broadcast_period_; }
+
+  // The fit of each actuator's bundle to its tendon (in actuator order). Builds a scratch mjData
+  // (mj_makeData runs every plugin's init: a thread_local flag keeps this from recursing).
+  std::vector<TendonFit> Fit(const mjModel* m) const;
+  // The warning text for actuator k, or "" when it fits.
+  std::string FitWarning(const mjModel* m, int k, const TendonFit& fit) const;
 
   // The engine's callbacks. `block` is the instance's plugin_state.
   void Reset(const mjModel* m, double* block) const;  // every unit off at actuator_length0

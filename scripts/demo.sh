@@ -4,6 +4,6 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ./scripts/install-deps.sh
-./scripts/build.sh
+./scripts/build.sh recruit   # only what the demo runs
 ./scripts/render_demo.sh --progress
 echo "demo: wrote renders/demo.mp4, renders/demo.gif and renders/demo_t0031.000.png"

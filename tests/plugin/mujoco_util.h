@@ -1,12 +1,15 @@
-// Loading MJCF from strings and owning MuJoCo objects in the plugin's tests.
+// Helpers of the engine-plugin tests: loading the plugin library, inline bundle models, copies
+// of plugin_state, and capturing mju_warning.
 #pragma once
 
 #include <mujoco/mujoco.h>
 
 #include <cstring>
-#include <memory>
+#include <mutex>
 #include <string>
+#include <vector>
 
+#include "common/mujoco_load.h"
 #include "common/mujoco_ptr.h"
 
 namespace recruit::sma::testing {
@@ -14,56 +17,94 @@ namespace recruit::sma::testing {
 using ::recruit::DataPtr;
 using ::recruit::ModelPtr;
 
-// Compiles `xml`; on failure returns null and puts MuJoCo's message in *error.
-inline ModelPtr LoadXmlString(const std::string& xml, std::string* error = nullptr) {
-  auto vfs = std::make_unique<mjVFS>();  // about 2 MB: not on the stack
-  mj_defaultVFS(vfs.get());
-  mj_makeEmptyFileVFS(vfs.get(), "model.xml", static_cast<int>(xml.size()));
-  std::memcpy(vfs->filedata[0], xml.data(), xml.size());
-  char err[1000] = "";
-  ModelPtr m(mj_loadXML("model.xml", vfs.get(), err, sizeof err));
-  mj_deleteVFS(vfs.get());
-  if (error != nullptr) *error = err;
-  return m;
+// Loads librecruit_sma.so the way any MuJoCo program would (once per process). Programs that
+// link the library need not call it (its constructor registers the plugin).
+inline void LoadPluginLibrary() {
+#ifdef RECRUIT_SMA_LIBRARY
+  static std::once_flag once;
+  std::call_once(once, [] { mj_loadPluginLibrary(RECRUIT_SMA_LIBRARY); });
+#endif
 }
 
-inline ModelPtr LoadXmlFile(const std::string& path, std::string* error = nullptr) {
-  char err[1000] = "";
-  ModelPtr m(mj_loadXML(path.c_str(), nullptr, err, sizeof err));
-  if (error != nullptr) *error = err;
-  return m;
+inline std::string ConfigXml(const std::string& key, const std::string& value) {
+  return "<config key=\"" + key + "\" value=\"" + value + "\"/>";
 }
 
-inline DataPtr MakeData(const mjModel* m) { return DataPtr(mj_makeData(m)); }
+// An isometric bench: one bundle (explicit instance "units", actuator `name`) pulls a tendon
+// from a fixed anchor to a load cell on a stiff slide joint, or, with `fixed`, to a second
+// world site (no degree of freedom: the tendon length never changes).
+struct Bench {
+  std::string config;                                 // <config> elements of the instance
+  std::string name = "bundle";                        // actuator name
+  std::string target = "tendon=\"bundle\"";           // the actuator's transmission
+  std::string actuator_extra = "ctrlrange=\"-1 1\"";  // more actuator attributes
+  std::string integrator = "Euler";
+  bool fixed = false;
+};
 
-// The isometric bench with the given <text> data, nuserdata, extra actuator attributes and
-// integrator, for tests that vary one thing.
-inline std::string BenchXml(const std::string& data = "units=60", int nuserdata = 488,
-                            const std::string& actuator_extra = "",
-                            const std::string& integrator = "Euler") {
-  return R"(<mujoco>
-  <compiler autolimits="true"/>
-  <option timestep="0.001" integrator=")" +
-         integrator + R"("/>
-  <size nuserdata=")" +
-         std::to_string(nuserdata) + R"("/>
-  <custom><text name="recruit.sma.bundle" data=")" +
-         data + R"("/></custom>
-  <worldbody>
-    <site name="anchor" pos="0 0 0.2"/>
-    <body name="load_cell" pos="0.1 0 0.2">
+inline std::string BenchXml(const Bench& b) {
+  const std::string hook = b.fixed ? R"(<site name="hook" pos="0.1 0 0.2"/>)"
+                                   : R"(<body name="load_cell" pos="0.1 0 0.2">
       <joint name="load_cell" type="slide" axis="1 0 0" stiffness="1e6" damping="4000"/>
       <geom type="box" size="0.01 0.02 0.02" mass="5"/>
       <site name="hook"/>
-    </body>
+    </body>)";
+  return R"(<mujoco model="bench">
+  <compiler autolimits="true"/>
+  <option timestep="0.001" integrator=")" +
+         b.integrator + R"("/>
+  <extension><plugin plugin="recruit.sma"><instance name="units">)" +
+         b.config + R"(</instance></plugin></extension>
+  <worldbody>
+    <site name="anchor" pos="0 0 0.2"/>
+    )" + hook +
+         R"(
   </worldbody>
   <tendon><spatial name="bundle"><site site="anchor"/><site site="hook"/></spatial></tendon>
   <actuator>
-    <general name="bundle" tendon="bundle" dyntype="user" gaintype="user" biastype="user" )" +
-         actuator_extra + R"(/>
+    <plugin name=")" +
+         b.name + "\" instance=\"units\" " + b.target + " " + b.actuator_extra + R"(/>
   </actuator>
-  <keyframe><key name="stretched" qpos="0.0005"/></keyframe>
+  <sensor><plugin name="truth" instance="units"/></sensor>
 </mujoco>)";
 }
+
+// Compiles `xml` with MuJoCo's own loader (the plugin library must be loaded).
+inline Result<ModelPtr> Load(const std::string& xml) {
+  LoadPluginLibrary();
+  return LoadModelFromString(xml);
+}
+
+inline std::vector<double> PluginState(const mjModel* m, const mjData* d) {
+  return std::vector<double>(d->plugin_state, d->plugin_state + m->npluginstate);
+}
+
+// Bitwise equality of n doubles (NaN-safe, distinguishes -0 and +0).
+inline bool SameBits(const double* a, const double* b, long n) {
+  return n == 0 || std::memcmp(a, b, sizeof(double) * static_cast<size_t>(n)) == 0;
+}
+
+// Collects mju_warning texts while alive (tests in one thread only).
+class WarningCapture {
+ public:
+  WarningCapture() : old_(mju_user_warning) {
+    Texts().clear();
+    mju_user_warning = [](const char* msg) { Texts().emplace_back(msg); };
+  }
+  ~WarningCapture() { mju_user_warning = old_; }
+  const std::vector<std::string>& texts() const { return Texts(); }
+  std::string joined() const {
+    std::string s;
+    for (const std::string& t : Texts()) s += t + "\n";
+    return s;
+  }
+
+ private:
+  static std::vector<std::string>& Texts() {
+    static std::vector<std::string> t;
+    return t;
+  }
+  void (*old_)(const char*);
+};
 
 }  // namespace recruit::sma::testing

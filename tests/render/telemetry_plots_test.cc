@@ -52,7 +52,8 @@ TEST(TelemetryPlotsTest, KeepsAtMostTheFiguresPointCapacity) {
   TelemetryPlots plots(1e6);  // nothing scrolls out by time
   for (int k = 0; k < 1500; ++k) plots.Add(testing::Sample(0.001 * k, 0));
   EXPECT_EQ(plots.tracking().linepnt[0], mjMAXLINEPNT);
-  EXPECT_FLOAT_EQ(plots.tracking().linedata[0][0], 0.5f);  // the oldest 500 were dropped
+  // The oldest 1500 - mjMAXLINEPNT samples were dropped (mjMAXLINEPNT is 1001 in MuJoCo 3).
+  EXPECT_FLOAT_EQ(plots.tracking().linedata[0][0], 0.001f * (1500 - mjMAXLINEPNT));
 }
 
 }  // namespace
