@@ -7,7 +7,9 @@
 #include <string>
 
 #include "cli/commands.h"
+#include "cli/errors.h"
 #include "common/atomic_file.h"
+#include "common/output_path.h"
 #include "control/bench_recorder.h"
 #include "control/excitation.h"
 #include "control/identification.h"
@@ -36,8 +38,8 @@ struct IdentifyArgs {
 int RunIdentify(const IdentifyArgs& a, const std::string& command_line) {
   using namespace recruit::control;
   if (a.states < 4 || a.states % 2 != 0) {
-    std::cerr << "recruit identify: --states " << a.states << ": must be even and >= 4\n";
-    return 1;
+    return Fail("identify", "--states " + std::to_string(a.states) + ": must be even and >= 4",
+                exit_code::kUsage);
   }
   SwitchingLog log;
   double unit_force = 0;
@@ -46,15 +48,13 @@ int RunIdentify(const IdentifyArgs& a, const std::string& command_line) {
   if (!a.log_in.empty()) {
     auto r = SwitchingLog::FromCsv(a.log_in, a.units);
     if (!r) {
-      std::cerr << "recruit identify: " << r.error() << "\n";
-      return 1;
+      return Fail("identify", r.error());
     }
     log = std::move(r).value();
     source = a.log_in;
   } else {
     if (!(a.dT > 0) || !(a.duration > 0) || !(a.settle > 0)) {
-      std::cerr << "recruit identify: --dt, --duration and --settle must be > 0\n";
-      return 1;
+      return Fail("identify", "--dt, --duration and --settle must be > 0", exit_code::kUsage);
     }
     const int total = static_cast<int>(a.duration / a.dT + 0.5);
     const int settle = std::max(2, static_cast<int>(a.settle / a.dT + 0.5));
@@ -63,8 +63,7 @@ int RunIdentify(const IdentifyArgs& a, const std::string& command_line) {
               << a.bench << " at dT = " << a.dT << " s\n";
     auto r = RecordBench(a.bench, a.actuator, e, a.dT, a.seed);
     if (!r) {
-      std::cerr << "recruit identify: " << r.error() << "\n";
-      return 1;
+      return Fail("identify", r.error());
     }
     log = std::move(r->log);
     unit_force = r->unit_force;
@@ -72,9 +71,13 @@ int RunIdentify(const IdentifyArgs& a, const std::string& command_line) {
     source = a.bench;
   }
   if (!a.save_log.empty()) {
+    if (Status s =
+            CheckNotAnInput(a.save_log, "--save-log", {{"--log", a.log_in}, {"--bench", a.bench}});
+        !s.ok()) {
+      return Fail("identify", s.error(), exit_code::kUsage);
+    }
     if (Status s = log.SaveCsv(a.save_log); !s) {
-      std::cerr << "recruit identify: " << s.error() << "\n";
-      return 1;
+      return Fail("identify", s.error());
     }
   }
   FitOptions opt;
@@ -83,14 +86,12 @@ int RunIdentify(const IdentifyArgs& a, const std::string& command_line) {
   opt.smoothness = a.smoothness;
   auto fit = IdentifyTransientModel(log, opt);
   if (!fit) {
-    std::cerr << "recruit identify: " << fit.error() << "\n";
-    return 1;
+    return Fail("identify", fit.error());
   }
   const TransientChain& c = fit->chain;
   const FilterModel model = ToFilterModel(c, log.num_units, log.dT, fit->force_noise_var);
   if (Status s = model.Validate("identified model"); !s) {
-    std::cerr << "recruit identify: " << s.error() << "\n";
-    return 1;
+    return Fail("identify", s.error());
   }
   nlohmann::json j = model.ToJson();
   auto metrics = [](const FitMetrics& m) {
@@ -112,9 +113,12 @@ int RunIdentify(const IdentifyArgs& a, const std::string& command_line) {
       {"R_N2", fit->force_noise_var}};
   if (!plant.is_null()) j["identification"]["plant"] = plant;
   const std::string out = a.output.empty() ? DefaultModelFile(log.dT, a.states) : a.output;
+  if (Status s = CheckNotAnInput(out, "--output", {{"--log", a.log_in}, {"--bench", a.bench}});
+      !s.ok()) {
+    return Fail("identify", s.error(), exit_code::kUsage);
+  }
   if (Status s = WriteFileAtomically(out, j.dump(2) + "\n"); !s) {
-    std::cerr << "recruit identify: " << s.error() << "\n";
-    return 1;
+    return Fail("identify", s.error(), exit_code::kIo);
   }
   std::printf("identified %d-state model, N = %d, dT = %g s, from %s\n", c.num_states(),
               log.num_units, log.dT, source.c_str());
@@ -171,17 +175,22 @@ void AddIdentifyCommand(CLI::App& app, int& exit_code) {
   cmd->add_option("--units", args->units, "units in the bundle of a --log")
       ->capture_default_str()
       ->check(CLI::Range(1, 1000000));
-  cmd->add_option("--dt", args->dT, "sampling period dT, s (bench)")->capture_default_str();
-  cmd->add_option("--states", args->states, "model states m (even, >= 4)")->capture_default_str();
-  cmd->add_option("--duration", args->duration, "bench experiment length, s")
+  cmd->add_option("--dt", args->dT, "sampling period dT, s (bench), > 0")
+      ->check(Positive())
       ->capture_default_str();
-  cmd->add_option("--settle", args->settle, "hold time for a unit to settle, s")
+  cmd->add_option("--states", args->states, "model states m (even, >= 4)")->capture_default_str();
+  cmd->add_option("--duration", args->duration, "bench experiment length, s, > 0")
+      ->check(Positive())
+      ->capture_default_str();
+  cmd->add_option("--settle", args->settle, "hold time for a unit to settle, s, > 0")
+      ->check(Positive())
       ->capture_default_str();
   cmd->add_option("--holdout", args->holdout, "fraction of the log held out (its end)")
       ->capture_default_str()
-      ->check(CLI::Range(0.0, 0.9));
+      ->check(NumberIn(0, false, 0.9, "in [0, 0.9]"));
   cmd->add_option("--smoothness", args->smoothness,
-                  "weight of the neighbour-difference penalty on H (relative)")
+                  "weight of the neighbour-difference penalty on H (relative), >= 0")
+      ->check(NonNegative())
       ->capture_default_str();
   cmd->add_option("--seed", args->seed, "seed of the excitation and the bench")
       ->capture_default_str();

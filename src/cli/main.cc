@@ -1,24 +1,92 @@
-// recruit: command-line front end. Subcommands are registered from their own files.
+// recruit: command-line front end. Subcommands are registered from their own files. One error
+// policy for all of them (cli/errors.h, docs/reliability.md): exit 0 ok, 2 usage, 3 bad input,
+// 4 I/O, 5 internal; temporary files are removed on SIGINT/SIGTERM.
+#include <exception>
 #include <iostream>
+#include <new>
+#include <sstream>
 
 #include "cli/commands.h"
+#include "cli/errors.h"
+#include "common/atomic_file.h"
+
+namespace {
+
+// Keeps a copy of what a command writes to stderr, so the exit code of commands that report
+// failure as 1 (filter, plot) can be mapped to the class their message names.
+class TeeBuf : public std::streambuf {
+ public:
+  explicit TeeBuf(std::streambuf* to) : to_(to) {}
+  const std::string& text() const { return text_; }
+
+ protected:
+  int overflow(int c) override {
+    if (c != EOF && text_.size() < 65536) text_ += static_cast<char>(c);
+    return c == EOF ? 0 : to_->sputc(static_cast<char>(c));
+  }
+  std::streamsize xsputn(const char* s, std::streamsize n) override {
+    if (text_.size() < 65536) text_.append(s, static_cast<size_t>(n));
+    return to_->sputn(s, n);
+  }
+  int sync() override { return to_->pubsync(); }
+
+ private:
+  std::streambuf* to_;
+  std::string text_;
+};
+
+}  // namespace
 
 int main(int argc, char** argv) {
+  using namespace recruit;
+  InstallTempFileCleanupOnSignals();
   CLI::App app{
       "Recruit: stochastic recruitment control of SMA muscle bundles in MuJoCo, with the "
-      "population Kalman filter of Odhner and Asada (ACC 2010)."};
+      "population Kalman filter of Odhner and Asada (ACC 2010).\n"
+      "Exit codes (all commands): 0 ok, 2 usage (bad option or value), 3 bad input file content, "
+      "4 I/O (cannot read or write), 5 internal error. See docs/reliability.md."};
   app.require_subcommand(1);
   int exit_code = 0;
-  recruit::cli::AddFilterCommand(app, exit_code);
-  recruit::cli::AddIdentifyCommand(app, exit_code);
-  recruit::cli::AddSimulateCommand(app, exit_code);
-  recruit::cli::AddSweepCommand(app, exit_code);
-  recruit::cli::AddRenderCommand(app, exit_code);
-  recruit::cli::AddPlotCommand(app, exit_code);
+  cli::AddFilterCommand(app, exit_code);
+  cli::AddIdentifyCommand(app, exit_code);
+  cli::AddSimulateCommand(app, exit_code);
+  cli::AddSweepCommand(app, exit_code);
+  cli::AddRenderCommand(app, exit_code);
+  cli::AddPlotCommand(app, exit_code);
+  TeeBuf tee(std::cerr.rdbuf());
+  std::streambuf* old = std::cerr.rdbuf(&tee);
+  struct Restore {
+    std::streambuf* old;
+    ~Restore() { std::cerr.rdbuf(old); }
+  } restore{old};
   try {
     app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
+  } catch (const CLI::CallForHelp& e) {
     return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::string where = "recruit";
+    for (const auto* sub : app.get_subcommands()) where += " " + sub->get_name();
+    // Paths stay readable (200 characters); a 2 MB value does not come back whole.
+    std::cerr << where << ": " << ShortenLongTokens(e.what(), 200) << "\nRun with --help for more "
+              << "information.\n";
+    return exit_code::kUsage;
+  } catch (const std::bad_alloc&) {
+    std::cerr << "recruit: out of memory\n";
+    return exit_code::kInternal;
+  } catch (const std::exception& e) {
+    std::cerr << "recruit: internal error (please report it): " << ShortenLongTokens(e.what())
+              << "\n";
+    return exit_code::kInternal;
+  }
+  // filter and plot report every failure as 1: map it to the class their message names.
+  if (exit_code == 1) {
+    exit_code = tee.text().find("refusing to overwrite an input") != std::string::npos
+                    ? exit_code::kUsage
+                    : exit_code::FromMessage(tee.text());
   }
   return exit_code;
 }

@@ -8,7 +8,9 @@
 #include <optional>
 
 #include "cli/commands.h"
+#include "cli/errors.h"
 #include "cli/run_options.h"
+#include "common/output_path.h"
 #include "render/camera.h"
 #include "render/gl_context.h"
 #include "render/video_recorder.h"
@@ -44,8 +46,7 @@ Status CheckCamera(const std::string& model_path, const render::CameraSpec& spec
 int Run(RenderArgs& a) {
   auto task = sim::Task::FromFile(a.task);
   if (!task.ok()) {
-    std::cerr << "recruit render: " << task.error() << "\n";
-    return 1;
+    return Fail("render", task.error());
   }
   render::VideoOptions& v = a.video;
   v.mp4_path = a.out;
@@ -57,8 +58,7 @@ int Run(RenderArgs& a) {
   if (!a.lookat.empty()) cam.lookat = std::array<double, 3>{a.lookat[0], a.lookat[1], a.lookat[2]};
   auto backend = a.gl.empty() ? render::GlBackendFromEnvironment() : render::ParseGlBackend(a.gl);
   if (!backend.ok()) {
-    std::cerr << "recruit render: --gl: " << backend.error() << "\n";
-    return 1;
+    return Fail("render", "--gl: " + backend.error(), exit_code::kUsage);
   }
   v.render.backend = *backend;
   v.render.figures = !a.no_figures;
@@ -71,6 +71,18 @@ int Run(RenderArgs& a) {
     }
   }
   const sim::ControllerSettings settings = sim::EffectiveSettings(*task, a.run);
+  // Outputs never replace inputs (the task, its model, the filter model).
+  const std::vector<std::pair<std::string, std::string>> inputs = {
+      {"--task", a.task},
+      {"the task's model", task->model_path},
+      {"the filter model", settings.filter_model}};
+  for (const auto& [label, path] :
+       {std::pair{"--out", v.mp4_path}, std::pair{"--gif", v.gif_path}}) {
+    if (path.empty()) continue;
+    if (Status s = CheckNotAnInput(path, label, inputs); !s.ok()) {
+      return Fail("render", s.error(), exit_code::kUsage);
+    }
+  }
   v.label.task = task->name;
   v.label.estimator = settings.estimator;
   v.label.dT = settings.dT;
@@ -78,28 +90,23 @@ int Run(RenderArgs& a) {
   v.label.seed = a.run.seed;
 
   if (Status s = v.Validate(); !s.ok()) {
-    std::cerr << "recruit render: " << s.error() << "\n";
-    return 1;
+    return Fail("render", s.error(), exit_code::kUsage);
   }
   if (Status s = CheckCamera(task->model_path, cam); !s.ok()) {
-    std::cerr << "recruit render: " << s.error() << "\n";
-    return 1;
+    return Fail("render", s.error());
   }
   auto recorder = render::VideoRecorder::Create(v);
   if (!recorder.ok()) {
-    std::cerr << "recruit render: " << recorder.error() << "\n";
-    return 1;
+    return Fail("render", recorder.error());
   }
   sim::RunOptions run = a.run;
   run.progress = run.progress || ::isatty(STDERR_FILENO);
   auto result = sim::RunTask(*task, run, {recorder->get()});
   if (!result.ok()) {
-    std::cerr << "recruit render: " << result.error() << "\n";
-    return 1;
+    return Fail("render", result.error());
   }
   if (Status s = (*recorder)->Finish(); !s.ok()) {
-    std::cerr << "recruit render: " << s.error() << "\n";
-    return 1;
+    return Fail("render", s.error());
   }
   const render::VideoRecorder& rec = **recorder;
   std::cout << "task " << result->task << ", seed " << result->seed << ": " << rec.frames_rendered()
@@ -110,7 +117,7 @@ int Run(RenderArgs& a) {
   for (const std::string& still : rec.stills_written()) std::cout << ", " << still;
   std::cout << "\n  " << result->duration << " s simulated and rendered in " << result->wall_seconds
             << " s\n";
-  return 0;
+  return exit_code::kOk;
 }
 
 }  // namespace

@@ -1,5 +1,7 @@
 #include "cli/run_options.h"
 
+#include "cli/errors.h"
+
 namespace recruit::cli {
 
 void AddRunOptions(CLI::App* cmd, sim::RunOptions* options) {
@@ -20,25 +22,25 @@ void AddRunOptions(CLI::App* cmd, sim::RunOptions* options) {
          "--dT", [options](double v) { options->dT = v; },
          "Controller sampling period, s (> 0) [default: the task file's]")
       ->type_name("SECONDS")
-      ->check(CLI::PositiveNumber);
+      ->check(Positive());
   cmd->add_option_function<double>(
          "--lambda", [options](double v) { options->lambda = v; },
          "Gain of the expectation law, in (0, 1] [default: the task file's]")
       ->type_name("GAIN")
-      ->check(CLI::Range(1e-9, 1.0));
+      ->check(Fraction());
   cmd->add_option_function<double>(
          "--force-noise-std", [options](double v) { options->force_noise_std = v; },
          "Kalman estimators: force measurement noise std, N (0 = the estimator's default) "
          "[default: the task file's]")
       ->type_name("N")
-      ->check(CLI::NonNegativeNumber);
+      ->check(NonNegative());
   cmd->add_option("--seed", options->seed, "Seed of the units' random draws")
       ->capture_default_str();
   cmd->add_option_function<double>(
          "--duration", [options](double v) { options->duration = v; },
          "Simulated time, s (> 0) [default: the task file's]")
       ->type_name("SECONDS")
-      ->check(CLI::PositiveNumber);
+      ->check(Positive());
   cmd->add_flag("--progress", options->progress,
                 "Show progress on stderr even when it is not a terminal");
 }

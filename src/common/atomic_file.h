@@ -1,5 +1,7 @@
 // AtomicFile: write an output file through a temporary sibling and rename it into place on
-// Commit(), so a failed or interrupted run never leaves a half-written output.
+// Commit(), so a failed or interrupted run never leaves a half-written output. Temporary files
+// are removed by the destructor and, once InstallTempFileCleanupOnSignals() ran, on SIGINT /
+// SIGTERM / SIGHUP too.
 #pragma once
 
 #include <fstream>
@@ -32,7 +34,18 @@ class AtomicFile {
   std::ofstream out_;
   std::string error_;
   bool committed_ = false;
+  int slot_ = -1;  // in the signal-cleanup registry
 };
+
+// Removes every live temporary file (AtomicFile's, and paths registered below) when the process
+// gets SIGINT, SIGTERM or SIGHUP, then dies of that signal with its default action. Installed
+// once by the `recruit` front end; signals the process ignores stay ignored.
+void InstallTempFileCleanupOnSignals();
+
+// Registers a temporary path for that cleanup (for files not written through AtomicFile, e.g.
+// gnuplot's output); returns a slot for UnregisterTempFile (-1: not registered).
+int RegisterTempFile(const std::string& path);
+void UnregisterTempFile(int slot);
 
 // Writes `contents` to `path` atomically.
 Status WriteFileAtomically(const std::string& path, const std::string& contents);

@@ -3,7 +3,8 @@
 // depend on the number of threads or the order runs finish in; runs with the same seed index
 // share their random stream across grid cells (common random numbers). Every finished run is
 // recorded in its own file under `<out>/runs/` (written atomically), so an interrupted sweep
-// started again skips the runs it already has.
+// started again skips the runs it already has, if their input hash (SweepRun::input_hash) is the
+// same.
 #pragma once
 
 #include <cstdint>
@@ -33,6 +34,9 @@ struct SweepRun {
   std::string estimator;
   int seed_index = 0;
   std::uint64_t seed = 0;
+  // Hash of everything else that determines the run's result (task and model file contents,
+  // options, code version), set by the caller; a record is reused only if its hash is equal.
+  std::string input_hash;
   std::string Key() const;  // file-name-safe identity of the run, e.g. "dT0.5_l0.2_kalman_s3"
 };
 
@@ -79,7 +83,9 @@ std::vector<CellStats> Aggregate(const std::vector<RunSummary>& runs,
                                  const TrackingCriterion& criterion);
 
 // Writes table.csv, table.md, stability.dat/.gp/.png (when gnuplot is found) and
-// shortest_dT.md into `out_dir`. The files depend only on the runs' results.
+// shortest_dT.md into `out_dir`. The files depend only on the runs' results. Any failed write
+// (full disk) is an error; so is gnuplot failing or writing an empty image (gnuplot missing is
+// only a warning: the data and script are still written).
 Status WriteSweepReport(const std::vector<CellStats>& cells, const TrackingCriterion& criterion,
                         const std::string& out_dir, const std::string& title);
 

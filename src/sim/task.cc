@@ -1,5 +1,7 @@
 #include "sim/task.h"
 
+#include "common/json_file.h"
+
 #include <cmath>
 #include <filesystem>
 #include <set>
@@ -95,12 +97,9 @@ Result<Task> Task::FromFile(const std::string& path) {
 
 Result<Task> Task::FromJsonText(const std::string& text, const std::string& source) {
   const std::string file = source.empty() ? std::string("<task>") : source;
-  json j;
-  try {
-    j = json::parse(text);
-  } catch (const json::parse_error& e) {
-    return Error{file + ": not valid JSON: " + e.what()};
-  }
+  auto parsed = ParseJsonText(text, file);  // depth, size, 1e999 and BOM checked
+  if (!parsed.ok()) return Error{parsed.error()};
+  json j = std::move(parsed).value();
   if (!j.is_object()) return Error{file + ": the task must be a JSON object"};
   RECRUIT_TRY(CheckKeys(j,
                         {"name", "description", "model", "tracked", "agonist", "antagonist",

@@ -1,8 +1,11 @@
 #include "common/atomic_file.h"
 
 #include <gtest/gtest.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
+#include <csignal>
 #include <filesystem>
 
 namespace recruit {
@@ -47,6 +50,70 @@ TEST(AtomicFile, UnwritableDirectoryGivesErrorNamingPath) {
   EXPECT_FALSE(f.ok());
   EXPECT_NE(f.error().find("/nonexistent_dir_recruit/x.csv"), std::string::npos);
   EXPECT_FALSE(f.Commit().ok());
+}
+
+// Runs `body` in a forked child and returns its wait status.
+template <class F>
+int InChild(F body) {
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    body();
+    ::_exit(0);
+  }
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  return status;
+}
+
+TEST(AtomicFile, TemporaryFilesAreRemovedOnSigtermAndTheProcessDiesOfIt) {
+  const fs::path dir = TempDir();
+  for (int sig : {SIGTERM, SIGINT}) {
+    const int status = InChild([&] {
+      InstallTempFileCleanupOnSignals();
+      AtomicFile a((dir / "a.csv").string());
+      AtomicFile b((dir / "b.mp4").string(), std::ios::binary);
+      a.stream() << "partial" << std::flush;
+      b.stream() << "partial" << std::flush;
+      if (!fs::exists(a.temp_path()) || !fs::exists(b.temp_path())) ::_exit(3);
+      ::raise(sig);
+      ::_exit(4);  // not reached: the handler re-raises with the default action
+    });
+    ASSERT_TRUE(WIFSIGNALED(status)) << "status " << status;
+    EXPECT_EQ(WTERMSIG(status), sig);
+    EXPECT_TRUE(fs::is_empty(dir)) << "a temporary file survived signal " << sig;
+  }
+  fs::remove_all(dir);
+}
+
+TEST(AtomicFile, CommittedFilesAreNotTouchedBySignalCleanup) {
+  const fs::path dir = TempDir();
+  const int status = InChild([&] {
+    InstallTempFileCleanupOnSignals();
+    if (!WriteFileAtomically((dir / "done.json").string(), "{}").ok()) ::_exit(3);
+    ::raise(SIGTERM);
+  });
+  EXPECT_TRUE(WIFSIGNALED(status));
+  EXPECT_TRUE(fs::exists(dir / "done.json"));
+  fs::remove_all(dir);
+}
+
+TEST(AtomicFile, AFullDiskIsAnErrorAndLeavesNoFile) {
+  // RLIMIT_FSIZE makes writes past the limit fail (EFBIG), as a full disk does.
+  const fs::path dir = TempDir();
+  const std::string path = (dir / "big.csv").string();
+  const int status = InChild([&] {
+    std::signal(SIGXFSZ, SIG_IGN);
+    rlimit lim{1000, 1000};
+    ::setrlimit(RLIMIT_FSIZE, &lim);
+    Status s = WriteFileAtomically(path, std::string(100000, 'x'));
+    if (s.ok()) ::_exit(3);
+    if (s.error().find("cannot write") == std::string::npos) ::_exit(4);
+  });
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 0) << "3: the write reported success; 4: unclear message";
+  EXPECT_FALSE(fs::exists(path));
+  EXPECT_TRUE(fs::is_empty(dir));
+  fs::remove_all(dir);
 }
 
 TEST(ReadFile, MissingFileErrorNamesIt) {

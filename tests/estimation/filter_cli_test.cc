@@ -251,7 +251,7 @@ TEST_F(EstimationCli, OutputEqualToAnInputIsRefused) {
   for (const std::string& out : {log, other_path, (dir_ / "link.csv").string(), model}) {
     SCOPED_TRACE(out);
     const RunResult r = RunRecruit("filter --model " + model + " --log " + log + " --out " + out);
-    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_EQ(r.exit_code, 2);  // docs/reliability.md
     EXPECT_NE(r.err.find("is the same file as"), std::string::npos) << r.err;
     EXPECT_EQ(*ReadFile(log), kGoodLog);
     EXPECT_EQ(*ReadFile(model), kTwoStateModel);
@@ -265,7 +265,7 @@ TEST_F(EstimationCli, LongCellIsShortenedInTheMessage) {
   const RunResult r =
       RunRecruit("filter --model " + Write("model.json", kTwoStateModel) + " --log " +
                  Write("log.csv", "t,p_on,p_off,y\n0,0.2,0,1x" + big + "\n") + " --out " + Out());
-  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_EQ(r.exit_code, 3);  // docs/reliability.md
   EXPECT_NE(r.err.find(":2: column 'y': '1x7777"), std::string::npos) << r.err.substr(0, 300);
   EXPECT_LT(r.err.size(), 300u);
   EXPECT_TRUE(NoOutput());

@@ -80,7 +80,7 @@ TEST_F(RenderCommandTest, SameSeedSameFramesOtherSeedOtherFrames) {
 
 TEST_F(RenderCommandTest, UnknownCameraIsNamedWithTheModelsCameras) {
   Output r = Render("--out " + (dir_ / "x.mp4").string() + " --camera nope");
-  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_EQ(r.exit_code, 3);  // docs/reliability.md
   EXPECT_THAT(r.text, HasSubstr("no camera named 'nope'"));
   EXPECT_THAT(r.text, HasSubstr("isometric_bench.xml"));
   EXPECT_THAT(r.text, HasSubstr("defines no cameras"));
@@ -89,21 +89,21 @@ TEST_F(RenderCommandTest, UnknownCameraIsNamedWithTheModelsCameras) {
 
 TEST_F(RenderCommandTest, BadSizesAreRefusedWithTheAllowedRange) {
   Output odd = Render("--out " + (dir_ / "x.mp4").string() + " --width 641");
-  EXPECT_EQ(odd.exit_code, 1);
+  EXPECT_EQ(odd.exit_code, 2);  // docs/reliability.md
   EXPECT_THAT(odd.text, HasSubstr("641x480"));
   EXPECT_THAT(odd.text, HasSubstr("even width and height"));
   Output huge = Render("--out " + (dir_ / "x.mp4").string() + " --height 20000");
-  EXPECT_EQ(huge.exit_code, 1);
+  EXPECT_EQ(huge.exit_code, 2);  // docs/reliability.md
   EXPECT_THAT(huge.text, HasSubstr("[16, 8192]"));
   EXPECT_TRUE(Empty());
 }
 
 TEST_F(RenderCommandTest, UnwritableOutputIsNamed) {
   Output r = Render("--out /nonexistent-dir/x.mp4");
-  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_EQ(r.exit_code, 4);  // docs/reliability.md
   EXPECT_THAT(r.text, HasSubstr("cannot write '/nonexistent-dir/x.mp4'"));
   Output ext = Render("--out " + (dir_ / "x.avi").string());
-  EXPECT_EQ(ext.exit_code, 1);
+  EXPECT_EQ(ext.exit_code, 2);  // docs/reliability.md
   EXPECT_THAT(ext.text, HasSubstr("must end in .mp4"));
   EXPECT_TRUE(Empty());
 }

@@ -4,9 +4,13 @@
 #include "sim/sweep.h"
 
 #include <gtest/gtest.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <atomic>
 #include <chrono>
+#include <csignal>
 #include <filesystem>
 #include <set>
 #include <thread>
@@ -197,6 +201,82 @@ TEST(Sweep, ShortestDtIsTheShortestThatMeetsTheCriterion) {
   const std::string md = *ReadFile((dir / "table.md").string());
   EXPECT_NE(md.find("| output | 0.1 | 2 |"), std::string::npos) << md;
   EXPECT_NE(md.find("| kalman-augmented | 0.1 | 0.25 |"), std::string::npos) << md;
+  fs::remove_all(dir);
+}
+
+TEST(Sweep, ARecordMadeFromOtherInputsIsNotReused) {
+  // Same grid points and seeds, but the inputs changed (an edited task file): the input hash
+  // differs, so every run is made again; unchanged inputs reuse every run.
+  const auto dir = TempDir("edited");
+  auto grid = ExpandGrid(Spec());
+  for (auto& g : *grid) g.input_hash = "hash-of-task-v1";
+  ASSERT_TRUE(RunSweep(*grid, dir.string(), FakeRun, 2).ok());
+  auto same = RunSweep(*grid, dir.string(), FakeRun, 2);
+  ASSERT_TRUE(same.ok());
+  EXPECT_EQ(same->reused, static_cast<int>(grid->size()));
+  for (auto& g : *grid) g.input_hash = "hash-of-task-v2";
+  auto edited = RunSweep(*grid, dir.string(), FakeRun, 2);
+  ASSERT_TRUE(edited.ok());
+  EXPECT_EQ(edited->reused, 0);
+  EXPECT_EQ(edited->executed, static_cast<int>(grid->size()));
+  fs::remove_all(dir);
+}
+
+TEST(Sweep, AReportOnAFullDiskFails) {
+  // RLIMIT_FSIZE (inherited by gnuplot) makes writes past a size fail, as a full disk does: the
+  // report must return an error (in a child, so the limit does not leak into the test).
+  const auto dir = TempDir("full");
+  auto grid = ExpandGrid(Spec());
+  auto out = RunSweep(*grid, dir.string(), FakeRun, 2);
+  ASSERT_TRUE(out.ok());
+  const TrackingCriterion crit;
+  const auto cells = Aggregate(out->runs, crit);
+  // First with room, to size the files: the limit lets every text file through and stops the
+  // image, so this checks gnuplot's failure is seen (not only our own writes').
+  ASSERT_TRUE(WriteSweepReport(cells, crit, dir.string(), "full").ok());
+  if (!fs::exists(dir / "stability.png")) GTEST_SKIP() << "gnuplot missing";
+  std::uintmax_t text = 0;
+  for (const char* f : {"table.csv", "table.md", "stability.dat", "stability.gp"}) {
+    text = std::max(text, fs::file_size(dir / f));
+  }
+  const std::uintmax_t png = fs::file_size(dir / "stability.png");
+  ASSERT_GT(png, text + 200);
+  fs::remove(dir / "stability.png");
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    std::signal(SIGXFSZ, SIG_IGN);
+    rlimit lim{text + 100, text + 100};
+    ::setrlimit(RLIMIT_FSIZE, &lim);
+    ::_exit(WriteSweepReport(cells, crit, dir.string(), "full").ok() ? 1 : 0);
+  }
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 0) << "the report on a full disk claimed success";
+  EXPECT_FALSE(fs::exists(dir / "stability.png"));
+  for (auto& e : fs::directory_iterator(dir)) {
+    EXPECT_EQ(e.path().string().find(".tmp."), std::string::npos) << e.path();
+  }
+  fs::remove_all(dir);
+}
+
+TEST(Sweep, TheStabilityMapIsMadeOrItsFailureReported) {
+  // With room on disk the map is a non-empty PNG (gnuplot installed) or the report says why.
+  const auto dir = TempDir("png");
+  auto grid = ExpandGrid(Spec());
+  auto out = RunSweep(*grid, dir.string(), FakeRun, 2);
+  ASSERT_TRUE(out.ok());
+  const TrackingCriterion crit;
+  // A title with a quote must not break (or inject into) the gnuplot script.
+  ASSERT_TRUE(
+      WriteSweepReport(Aggregate(out->runs, crit), crit, dir.string(), "it's'; system('x").ok());
+  if (::system("command -v gnuplot > /dev/null 2>&1") == 0) {
+    ASSERT_TRUE(fs::exists(dir / "stability.png"));
+    EXPECT_GT(fs::file_size(dir / "stability.png"), 1000u);
+  }
+  for (auto& e : fs::directory_iterator(dir)) {
+    EXPECT_EQ(e.path().string().find(".tmp."), std::string::npos) << e.path();
+  }
   fs::remove_all(dir);
 }
 

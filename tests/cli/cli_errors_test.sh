@@ -1,0 +1,129 @@
+#!/bin/sh
+# End-to-end checks of the error policy of `recruit` (docs/reliability.md), one case per call:
+#   cli_errors_test.sh RECRUIT SOURCE_DIR WORK_DIR CASE
+# Each case runs the real binary and checks its exit code, its message and the files it left.
+set -u
+RECRUIT=$1
+SRC=$2
+WORK=$3/$4
+CASE=$4
+rm -rf "$WORK" && mkdir -p "$WORK" || exit 1
+cd "$WORK" || exit 1
+TASK=$SRC/models/tasks/isometric_steps.json
+MODEL=$SRC/models/isometric_bench.xml
+
+fail() { echo "FAIL [$CASE]: $*"; echo "--- stderr:"; head -c 2000 err 2>/dev/null; exit 1; }
+# expect CODE COMMAND...: runs the command, stderr into ./err, checks the exit code.
+expect() {
+  want=$1; shift
+  "$@" > out 2> err
+  got=$?
+  [ "$got" -eq "$want" ] || fail "exit $got, expected $want: $(echo "$*" | cut -c1-300)"
+}
+# A copy of the test task with one field replaced (python3 edits the JSON).
+task_with() {
+  python3 - "$TASK" "$MODEL" "$1" "$2" > "$3" <<'PY'
+import json, sys
+t = json.load(open(sys.argv[1]))
+t["model"] = sys.argv[2]
+t[sys.argv[3]] = json.loads(sys.argv[4])
+print(json.dumps(t))
+PY
+}
+
+case $CASE in
+usage_range)  # range errors: exit 2, say what is allowed, never print DBL_MAX
+  for bad in "--dT -1" "--dT nan" "--dT inf" "--lambda 2" "--duration 0"; do
+    expect 2 "$RECRUIT" simulate --task "$TASK" $bad --out o
+    grep -q "1.79769e+308\|1.7976931348623157e+308" err && fail "DBL_MAX printed for $bad"
+    grep -q "must be" err || fail "no 'must be' for $bad"
+  done
+  expect 2 "$RECRUIT" sweep --task "$TASK" --seeds 0 --out o
+  expect 2 "$RECRUIT" sweep --task "$TASK" --estimator bogus --out o
+  expect 2 "$RECRUIT" identify --dt -0.5
+  grep -q "1.79769e+308" err && fail "DBL_MAX printed by identify"
+  [ ! -e o ] || fail "a usage error created --out"
+  ;;
+usage_same_code_everywhere)  # an unknown option and a missing input: 2 for every command
+  for c in simulate sweep render identify filter plot; do
+    expect 2 "$RECRUIT" $c --no-such-option
+  done
+  expect 2 "$RECRUIT" simulate --task /no/such/task.json
+  expect 2 "$RECRUIT" filter --model /no/such.json --log /no/such.csv --out x.csv
+  expect 2 "$RECRUIT"
+  expect 0 "$RECRUIT" --help
+  ;;
+long_value_shortened)  # a huge option value is not echoed whole
+  big=$(python3 -c "print('9x' * 50000)")
+  expect 2 "$RECRUIT" simulate --task "$TASK" --dT "$big" --out o
+  [ "$(wc -c < err)" -lt 400 ] || fail "message of $(wc -c < err) bytes"
+  ;;
+bad_input_code)  # bad file content: exit 3 (task and filter model), message names the field
+  task_with controller '{"estimator": "output", "dT": 1.0, "lambda": 7}' bad.json
+  expect 3 "$RECRUIT" simulate --task bad.json --out o
+  grep -q "lambda" err || fail "field not named"
+  printf '{"states": [' > model.json
+  printf 't,y\n0,1\n' > log.csv
+  expect 3 "$RECRUIT" filter --model model.json --log log.csv --out f.csv
+  [ ! -e f.csv ] || fail "filter wrote on error"
+  ;;
+io_code)  # an output that cannot be written: exit 4
+  expect 4 "$RECRUIT" simulate --task "$TASK" --duration 2 --out o --summary /proc/nonexistent/s.json
+  ;;
+name_escape)  # a task name with .., / or an absolute path never writes outside --out
+  for name in '"../escaped"' '"/tmp/recruit_abs_escape"' '"a/b"' '"x\u001b[2J"'; do
+    task_with name "$name" t.json
+    expect 3 "$RECRUIT" simulate --task t.json --duration 2 --out od
+    grep -q "cannot be used in a file name" err || fail "unclear message for $name"
+  done
+  [ ! -e escaped_steps.csv ] && [ ! -e escaped_summary.json ] || fail "wrote outside --out"
+  [ ! -e /tmp/recruit_abs_escape_steps.csv ] || fail "wrote to an absolute path"
+  [ ! -e od ] || fail "created or wrote into --out on error"
+  ;;
+input_not_overwritten)  # --csv / --summary / render --out equal to an input are refused
+  cp "$TASK" task.json
+  sed -i "s|\"../isometric_bench.xml\"|\"$MODEL\"|" task.json
+  cp task.json before.json
+  expect 2 "$RECRUIT" simulate --task task.json --duration 2 --csv task.json
+  expect 2 "$RECRUIT" simulate --task task.json --duration 2 --summary ./task.json
+  ln -s task.json link.json
+  expect 2 "$RECRUIT" simulate --task task.json --duration 2 --csv link.json
+  grep -q "refusing to overwrite an input" err || fail "unclear message"
+  expect 2 "$RECRUIT" render --task task.json --duration 1 --out task.json
+  cmp -s task.json before.json || fail "the task file changed"
+  ;;
+sigterm_cleans_up)  # a killed simulate leaves no temporary files and dies of SIGTERM
+  "$RECRUIT" simulate --task "$TASK" --duration 3000 --out o > out 2> err &
+  pid=$!
+  i=0
+  while [ -z "$(ls o 2>/dev/null | grep '\.tmp\.')" ] && [ $i -lt 100 ]; do sleep 0.1; i=$((i+1)); done
+  [ -n "$(ls o | grep '\.tmp\.')" ] || fail "no temporary file appeared to test with"
+  kill -TERM $pid
+  wait $pid
+  rc=$?
+  [ $rc -eq 143 ] || fail "exit status $rc, expected 143 (killed by SIGTERM)"
+  [ -z "$(ls o | grep '\.tmp\.')" ] || fail "left $(ls o)"
+  ;;
+sweep_lock)  # a second sweep into a locked folder fails at once with a clear message
+  mkdir s
+  expect 4 flock s/sweep.lock "$RECRUIT" sweep --task "$TASK" --duration 4 --dT 1 \
+    --estimator output --seeds 1 --out s
+  grep -q "another sweep is writing into this folder" err || fail "unclear message"
+  [ ! -e s/runs ] || fail "the locked-out sweep wrote runs"
+  ;;
+sweep_edited_task_reruns)  # resume reuses runs only when the task content is unchanged
+  sed "s|\"../isometric_bench.xml\"|\"$MODEL\"|" "$TASK" > task.json
+  args="sweep --task task.json --duration 4 --dT 1 --estimator output --seeds 2 --out s"
+  expect 0 "$RECRUIT" $args
+  grep -q "2 runs made, 0 reused" out || fail "first sweep: $(cat out)"
+  expect 0 "$RECRUIT" $args
+  grep -q "0 runs made, 2 reused" out || fail "unchanged task not reused: $(cat out)"
+  sed -i 's/"lambda": 0.2/"lambda": 0.3/' task.json
+  expect 0 "$RECRUIT" $args
+  grep -q "2 runs made, 0 reused" out || fail "edited task served stale runs: $(cat out)"
+  [ -z "$(find s -name '*.tmp.*')" ] || fail "temporary files left"
+  ;;
+*)
+  echo "unknown case $CASE"; exit 1 ;;
+esac
+echo "ok [$CASE]"
