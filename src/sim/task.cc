@@ -1,12 +1,11 @@
 #include "sim/task.h"
 
-#include "common/json_file.h"
-
 #include <cmath>
 #include <filesystem>
 #include <set>
 
 #include "common/atomic_file.h"
+#include "common/json_file.h"
 
 namespace recruit::sim {
 namespace {
