@@ -36,10 +36,10 @@ std::string BenchWithUnits(int units, int update_ms) {
   auto replace = [&](const std::string& from, const std::string& to) {
     xml.replace(xml.find(from), from.size(), to);
   };
-  replace("<config key=\"units\" value=\"60\"/>",
-          "<config key=\"units\" value=\"" + std::to_string(units) +
-              "\"/><config key=\"update_period\" value=\"" + std::to_string(update_ms * 1e-3) +
-              "\"/>");
+  replace("<config key=\"units\" value=\"60\"/>", "<config key=\"units\" value=\"" +
+                                                      std::to_string(units) +
+                                                      "\"/><config key=\"update_period\" value=\"" +
+                                                      std::to_string(update_ms * 1e-3) + "\"/>");
   std::FILE* out = std::fopen(buf, "w");
   std::fwrite(xml.data(), 1, xml.size(), out);
   std::fclose(out);
