@@ -6,7 +6,8 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 MUJOCO_VERSION=4.0.0  # keep in step with RECRUIT_MUJOCO_VERSION in CMakeLists.txt
-PY_PACKAGES=("mujoco==${MUJOCO_VERSION}" "numpy" "pytest" "filterpy" "pybind11" "scikit-build-core")
+PY_PACKAGES=("mujoco==${MUJOCO_VERSION}" "numpy" "pytest" "filterpy" "pybind11" "scikit-build-core"
+  "matplotlib")
 
 PACKAGES=(
   build-essential cmake ninja-build pkg-config clang-format ccache
@@ -16,6 +17,8 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libavcodec-dev libavformat-dev libavutil-dev libswscale-dev ffmpeg
   liblodepng-dev libstb-dev
+  clang libclang-rt-14-dev  # libFuzzer targets (tests/fuzz)
+  slurm-wlm munge           # the single-node Slurm the sweep's job-array test runs on
 )
 
 missing=()
@@ -39,7 +42,7 @@ if [ ! -x .venv/bin/python ]; then
   python3 -m venv .venv
 fi
 if .venv/bin/python - "$MUJOCO_VERSION" <<'PY' 2>/dev/null; then
-import sys, mujoco, numpy, pytest, filterpy
+import sys, mujoco, numpy, pytest, filterpy, matplotlib
 sys.exit(0 if mujoco.__version__ == sys.argv[1] else 1)
 PY
   echo "install-deps: .venv has mujoco ${MUJOCO_VERSION} and the test tools"

@@ -89,6 +89,14 @@ class PopulationKalmanFilterT {
   // Measurement update with y(t) (eqs. 15, 17, 19, 20 in Joseph form).
   void Update(const OutVec& y);
 
+  // Replaces the output model for the next Updates: H (r x m, the force per unit in each state,
+  // which may depend on the plant's measured configuration, e.g. the tendon's length) and R
+  // (r x r, symmetric positive definite). Sizes must match (not checked); no allocation.
+  void SetOutput(const OutputMat& H, const OutMat& R) {
+    H_ = H;
+    R_ = R;
+  }
+
   // Predict / Update after checking the input (sizes, finite, column-stochastic).
   Status PredictChecked(const Eigen::MatrixXd& A);
   Status UpdateChecked(const Eigen::VectorXd& y);
