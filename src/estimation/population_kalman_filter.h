@@ -92,9 +92,9 @@ class PopulationKalmanFilterT {
   // Replaces the output model for the next Updates: H (r x m, the force per unit in each state,
   // which may depend on the plant's measured configuration, e.g. the tendon's length) and R
   // (r x r, symmetric positive definite). Sizes must match (not checked); no allocation.
-  void SetOutput(const OutputMat& H, const OutMat& R) {
+  void SetOutput(const OutputMat& H, const OutMat& noise) {
     H_ = H;
-    R_ = R;
+    R_ = noise;
   }
 
   // Predict / Update after checking the input (sizes, finite, column-stochastic).
