@@ -36,6 +36,8 @@ class SmaHost {
   const SmaBundle& bundle(int b) const { return Act(b).model; }
   // Steady tension of one unit held on at the reference length (N).
   double SettledUnitForce(int b) const { return Act(b).settled_force; }
+  // Tendon length (m) at which a unit's extension is its prestretch.
+  double ref_length(int b) const { return Act(b).ref_length; }
 
   // Every unit of every bundle off, cold, at the current tendon lengths; bundle b's stream
   // seeded with Rng::DeriveSeed(seed, b). Keeps qpos, qvel and time; ends with mj_forward.

@@ -5,7 +5,7 @@
 #include <string>
 
 #include "control/recruitment_controller.h"
-#include "control/transient_chain.h"
+#include "identification/transient_chain.h"
 
 namespace recruit::control {
 namespace {

@@ -1,7 +1,9 @@
 // recruit identify: fit the augmented transient model of an SMA unit (docs/identification.md)
 // from the bench (switching the units through the plugin) or from a recorded switching log, and
 // save it as a filter model file.
+#include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -10,11 +12,13 @@
 #include "cli/errors.h"
 #include "common/atomic_file.h"
 #include "common/output_path.h"
-#include "control/bench_recorder.h"
-#include "control/excitation.h"
-#include "control/identification.h"
-#include "control/model_export.h"
 #include "control/on_count_estimator.h"
+#include "identification/bench_recorder.h"
+#include "identification/excitation.h"
+#include "identification/identification.h"
+#include "identification/model_cache.h"
+#include "identification/model_export.h"
+#include "identification/plant_identification.h"
 
 namespace recruit::cli {
 namespace {
@@ -35,124 +39,131 @@ struct IdentifyArgs {
   std::string save_log;
 };
 
+// The fitted chain, one line per state.
+void PrintChain(const recruit::control::TransientChain& c) {
+  std::printf("%-8s %-4s %10s %10s\n", "state", "on", "H (N)", "advance");
+  const auto names = c.StateNames();
+  const auto on = c.IsOn();
+  for (int s = 0; s < c.num_states(); ++s) {
+    char adv[32] = "-";
+    if (s >= c.heat(1) && s <= c.heat(c.chain_length)) {
+      std::snprintf(adv, sizeof adv, "%.3f", c.heat_advance[s - c.heat(1)]);
+    } else if (s >= c.cool(1)) {
+      std::snprintf(adv, sizeof adv, "%.3f", c.cool_advance[s - c.cool(1)]);
+    }
+    std::printf("%-8s %-4s %10.4f %10s\n", names[s].c_str(), on[s] ? "on" : "off", c.force[s], adv);
+  }
+}
+
+void PrintFit(const recruit::control::IdentificationResult& fit) {
+  std::printf("train:   %d samples, RMSE %.3f N, R^2 %.4f\n", fit.train.samples, fit.train.rmse,
+              fit.train.r2);
+  std::printf(
+      "holdout: %d samples, RMSE %.3f N, R^2 %.4f (two-state model: RMSE %.3f N, "
+      "R^2 %.4f)\n",
+      fit.holdout.samples, fit.holdout.rmse, fit.holdout.r2, fit.two_state_holdout.rmse,
+      fit.two_state_holdout.r2);
+  std::printf("R = %.4g N^2 (sd %.3f N)\n", fit.force_noise_var, std::sqrt(fit.force_noise_var));
+}
+
+// --log: the chain fitted to a recorded switching log (plant unknown: no length model).
+Result<nlohmann::json> IdentifyFromLog(const IdentifyArgs& a, const std::string& command_line) {
+  using namespace recruit::control;
+  auto log = SwitchingLog::FromCsv(a.log_in, a.units);
+  if (!log) return Error{log.error()};
+  FitOptions opt;
+  opt.num_states = a.states;
+  opt.holdout_fraction = a.holdout;
+  opt.smoothness = a.smoothness;
+  auto fit = IdentifyTransientModel(*log, opt);
+  if (!fit) return Error{fit.error()};
+  const TransientChain& c = fit->chain;
+  const FilterModel model = ToFilterModel(c, log->num_units, log->dT, fit->force_noise_var);
+  if (Status s = model.Validate("identified model"); !s) return Error{s.error()};
+  nlohmann::json j = model.ToJson();
+  j["identification"] = {{"command", command_line},
+                         {"source", a.log_in},
+                         {"dT", log->dT},
+                         {"num_units", log->num_units},
+                         {"train", MetricsJson(fit->train)},
+                         {"holdout", MetricsJson(fit->holdout)},
+                         {"two_state_holdout", MetricsJson(fit->two_state_holdout)},
+                         {"R_N2", fit->force_noise_var}};
+  std::printf("identified %d-state model, N = %d, dT = %g s, from %s\n", c.num_states(),
+              log->num_units, log->dT, a.log_in.c_str());
+  PrintChain(c);
+  PrintFit(*fit);
+  return j;
+}
+
+// --bench: the shared pipeline on the MuJoCo plant (identification/plant_identification.h).
+Result<nlohmann::json> IdentifyFromBench(const IdentifyArgs& a, const std::string& command_line) {
+  using namespace recruit::control;
+  PlantIdentificationOptions o;
+  o.dT = a.dT;
+  o.num_states = a.states;
+  o.duration = a.duration;
+  o.settle = a.settle;
+  o.holdout = a.holdout;
+  o.smoothness = a.smoothness;
+  o.seed = a.seed;
+  std::cerr << "recruit identify: recording " << a.duration << " s on " << a.bench
+            << " at dT = " << a.dT << " s, then checks at other tendon lengths\n";
+  auto id = IdentifyOnPlant(a.bench, a.actuator, o, command_line);
+  if (!id) return Error{id.error()};
+  if (!a.save_log.empty()) {
+    if (Status s = CheckNotAnInput(a.save_log, "--save-log", {{"--bench", a.bench}}); !s.ok()) {
+      return Error{s.error()};
+    }
+    if (Status s = id->log.SaveCsv(a.save_log); !s) return Error{s.error()};
+  }
+  const nlohmann::json& ident = id->model["identification"];
+  std::printf("identified %d-state model, N = %d, dT = %g s, on %s %s (held at %s)\n",
+              id->fit.chain.num_states(), ident["num_units"].get<int>(), a.dT, a.bench.c_str(),
+              ident["plant"].value("actuator", std::string()).c_str(),
+              ident["pose"].get<std::string>().empty() ? "its fixed pose"
+                                                       : ident["pose"].get<std::string>().c_str());
+  PrintChain(id->fit.chain);
+  std::printf("settled unit force (plugin, at ref_length): %.4f N\n",
+              ident["settled_unit_force_N"].get<double>());
+  PrintFit(id->fit);
+  for (const LengthCheck& c : id->checks) {
+    std::printf("check at %s (tendon %.4f m): %d samples, RMSE %.3f N, R^2 %.4f\n", c.pose.c_str(),
+                c.tendon_length, c.fit.samples, c.fit.rmse, c.fit.r2);
+  }
+  return id->model;
+}
+
 int RunIdentify(const IdentifyArgs& a, const std::string& command_line) {
   using namespace recruit::control;
   if (a.states < 4 || a.states % 2 != 0) {
     return Fail("identify", "--states " + std::to_string(a.states) + ": must be even and >= 4",
                 exit_code::kUsage);
   }
-  SwitchingLog log;
-  double unit_force = 0;
-  nlohmann::json plant;  // the bench bundle (null for --log)
-  std::string source;
-  if (!a.log_in.empty()) {
-    auto r = SwitchingLog::FromCsv(a.log_in, a.units);
-    if (!r) {
-      return Fail("identify", r.error());
-    }
-    log = std::move(r).value();
-    source = a.log_in;
-  } else {
-    if (!(a.dT > 0) || !(a.duration > 0) || !(a.settle > 0)) {
-      return Fail("identify", "--dt, --duration and --settle must be > 0", exit_code::kUsage);
-    }
-    const int total = static_cast<int>(a.duration / a.dT + 0.5);
-    const int settle = std::max(2, static_cast<int>(a.settle / a.dT + 0.5));
-    const Excitation e = MakeExcitation(settle, total, a.seed);
-    std::cerr << "recruit identify: recording " << total << " instants (" << a.duration << " s) on "
-              << a.bench << " at dT = " << a.dT << " s\n";
-    auto r = RecordBench(a.bench, a.actuator, e, a.dT, a.seed);
-    if (!r) {
-      return Fail("identify", r.error());
-    }
-    log = std::move(r->log);
-    unit_force = r->unit_force;
-    plant = r->plant;
-    source = a.bench;
+  if (a.log_in.empty() && (!(a.dT > 0) || !(a.duration > 0) || !(a.settle > 0))) {
+    return Fail("identify", "--dt, --duration and --settle must be > 0", exit_code::kUsage);
   }
-  if (!a.save_log.empty()) {
-    if (Status s =
-            CheckNotAnInput(a.save_log, "--save-log", {{"--log", a.log_in}, {"--bench", a.bench}});
+  std::string out = a.output;
+  if (out.empty() && !a.log_in.empty()) out = DefaultModelFile(a.dT, a.states);
+  if (!out.empty()) {
+    if (Status s = CheckNotAnInput(out, "--output", {{"--log", a.log_in}, {"--bench", a.bench}});
         !s.ok()) {
       return Fail("identify", s.error(), exit_code::kUsage);
     }
-    if (Status s = log.SaveCsv(a.save_log); !s) {
-      return Fail("identify", s.error());
-    }
   }
-  FitOptions opt;
-  opt.num_states = a.states;
-  opt.holdout_fraction = a.holdout;
-  opt.smoothness = a.smoothness;
-  auto fit = IdentifyTransientModel(log, opt);
-  if (!fit) {
-    return Fail("identify", fit.error());
+  auto j = a.log_in.empty() ? IdentifyFromBench(a, command_line) : IdentifyFromLog(a, command_line);
+  if (!j) return Fail("identify", j.error());
+  if (out.empty()) {
+    // The model cache, where simulate and sweep look for it (identification/model_cache.h).
+    const auto& plant = (*j)["identification"]["plant"];
+    out = ModelSearchPath().back() + "/" + ModelFileName(plant, a.dT, a.states);
+    std::error_code ec;
+    std::filesystem::create_directories(ModelSearchPath().back(), ec);
   }
-  const TransientChain& c = fit->chain;
-  const FilterModel model = ToFilterModel(c, log.num_units, log.dT, fit->force_noise_var);
-  if (Status s = model.Validate("identified model"); !s) {
-    return Fail("identify", s.error());
-  }
-  nlohmann::json j = model.ToJson();
-  auto metrics = [](const FitMetrics& m) {
-    return nlohmann::json{{"samples", m.samples}, {"rmse_N", m.rmse}, {"r2", m.r2}};
-  };
-  j["identification"] = {
-      {"command", command_line},
-      {"source", source},
-      {"dT", log.dT},
-      {"num_units", log.num_units},
-      {"settled_unit_force_N", unit_force > 0 ? nlohmann::json(unit_force) : nlohmann::json()},
-      {"heat_advance",
-       std::vector<double>(c.heat_advance.data(), c.heat_advance.data() + c.heat_advance.size())},
-      {"cool_advance",
-       std::vector<double>(c.cool_advance.data(), c.cool_advance.data() + c.cool_advance.size())},
-      {"train", metrics(fit->train)},
-      {"holdout", metrics(fit->holdout)},
-      {"two_state_holdout", metrics(fit->two_state_holdout)},
-      {"R_N2", fit->force_noise_var}};
-  if (!plant.is_null()) j["identification"]["plant"] = plant;
-  const std::string out = a.output.empty() ? DefaultModelFile(log.dT, a.states) : a.output;
-  if (Status s = CheckNotAnInput(out, "--output", {{"--log", a.log_in}, {"--bench", a.bench}});
-      !s.ok()) {
-    return Fail("identify", s.error(), exit_code::kUsage);
-  }
-  if (Status s = WriteFileAtomically(out, j.dump(2) + "\n"); !s) {
+  if (Status s = WriteFileAtomically(out, j->dump(2) + "\n"); !s) {
     return Fail("identify", s.error(), exit_code::kIo);
   }
-  std::printf("identified %d-state model, N = %d, dT = %g s, from %s\n", c.num_states(),
-              log.num_units, log.dT, source.c_str());
-  std::printf("%-8s %-4s %10s %10s\n", "state", "on", "H (N)", "advance");
-  const auto names = c.StateNames();
-  const auto on = c.IsOn();
-  for (int s = 0; s < c.num_states(); ++s) {
-    double adv = 1.0;
-    bool has_adv = false;
-    if (s >= c.heat(1) && s <= c.heat(c.chain_length)) {
-      adv = c.heat_advance[s - c.heat(1)];
-      has_adv = true;
-    } else if (s >= c.cool(1)) {
-      adv = c.cool_advance[s - c.cool(1)];
-      has_adv = true;
-    }
-    if (has_adv) {
-      std::printf("%-8s %-4s %10.4f %10.3f\n", names[s].c_str(), on[s] ? "on" : "off", c.force[s],
-                  adv);
-    } else {
-      std::printf("%-8s %-4s %10.4f %10s\n", names[s].c_str(), on[s] ? "on" : "off", c.force[s],
-                  "-");
-    }
-  }
-  if (unit_force > 0) std::printf("settled unit force (plugin): %.4f N\n", unit_force);
-  std::printf("train:   %d samples, RMSE %.3f N, R^2 %.4f\n", fit->train.samples, fit->train.rmse,
-              fit->train.r2);
-  std::printf(
-      "holdout: %d samples, RMSE %.3f N, R^2 %.4f (two-state model: RMSE %.3f N, "
-      "R^2 %.4f)\n",
-      fit->holdout.samples, fit->holdout.rmse, fit->holdout.r2, fit->two_state_holdout.rmse,
-      fit->two_state_holdout.r2);
-  std::printf("R = %.4g N^2 (sd %.3f N)\nwrote %s\n", fit->force_noise_var,
-              std::sqrt(fit->force_noise_var), out.c_str());
+  std::printf("wrote %s\n", out.c_str());
   return 0;
 }
 
@@ -194,8 +205,10 @@ void AddIdentifyCommand(CLI::App& app, int& exit_code) {
       ->capture_default_str();
   cmd->add_option("--seed", args->seed, "seed of the excitation and the bench")
       ->capture_default_str();
-  cmd->add_option("-o,--output", args->output,
-                  "model file to write (default models/identified/bench_n60_dt<dT>_m<m>.json)");
+  cmd->add_option(
+      "-o,--output", args->output,
+      "model file to write (default for --bench: the model cache, where simulate finds it; "
+      "for --log: models/identified/bench_n60_dt<dT>_m<m>.json)");
   cmd->add_option("--save-log", args->save_log, "also write the bench's switching log (CSV)");
   cmd->callback([args, &exit_code, cmd] {
     std::string line = "recruit identify";

@@ -33,6 +33,21 @@ Result<FileLock> FileLock::TryLock(const std::string& path) {
   return FileLock(fd);
 }
 
+Result<FileLock> FileLock::Lock(const std::string& path) {
+  const int fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  if (fd < 0) return Error{"cannot open lock file '" + path + "': " + std::strerror(errno)};
+  int rc;
+  do {
+    rc = ::flock(fd, LOCK_EX);
+  } while (rc != 0 && errno == EINTR);
+  if (rc != 0) {
+    const int err = errno;
+    ::close(fd);
+    return Error{"cannot lock '" + path + "': " + std::strerror(err)};
+  }
+  return FileLock(fd);
+}
+
 FileLock& FileLock::operator=(FileLock&& o) noexcept {
   if (this != &o) {
     if (fd_ >= 0) ::close(fd_);

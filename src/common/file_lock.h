@@ -13,6 +13,9 @@ class FileLock {
   // Creates `path` if needed and takes the lock without waiting; the error says the lock is
   // held by another process (and its pid, written into the file by the holder).
   static Result<FileLock> TryLock(const std::string& path);
+  // The same, waiting for the holder to release it (e.g. one process identifies a cached model
+  // while the others wait for the file).
+  static Result<FileLock> Lock(const std::string& path);
   FileLock(FileLock&& o) noexcept : fd_(o.fd_) { o.fd_ = -1; }
   FileLock& operator=(FileLock&& o) noexcept;
   FileLock(const FileLock&) = delete;

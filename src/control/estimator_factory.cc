@@ -2,13 +2,15 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 
 #include "control/kalman_estimator.h"
+#include "control/model_plant.h"
 #include "control/on_count_estimator.h"
 #include "control/output_estimator.h"
-#include "control/plant_record.h"
 #include "estimation/filter_model.h"
 #include "estimation/population_kalman_filter.h"
 
@@ -111,8 +113,51 @@ std::string DefaultModelFile(double dT, int num_states) {
   return "models/identified/bench_n60_dt" + t + "_m" + std::to_string(num_states) + ".json";
 }
 
+namespace {
+
+// The identification record of a model file ("identification" object), {} when absent.
+nlohmann::json IdentificationOf(const std::string& file) {
+  std::ifstream in(file);
+  nlohmann::json j = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
+  if (j.is_object() && j.contains("identification") && j["identification"].is_object()) {
+    return j["identification"];
+  }
+  return nlohmann::json::object();
+}
+
+// The unit force map of an identified model: its recorded fractions, or the fractions of its H
+// at the extension it was identified at (the plant's prestretch when not recorded).
+Result<UnitForceMap> ModelForceMap(const FilterModel& model, const nlohmann::json& ident,
+                                   const UnitGeometry& g, const std::string& file) {
+  if (ident.contains("output_fractions")) {
+    const auto& f = ident["output_fractions"];
+    if (!f.is_array() || static_cast<int>(f.size()) != model.num_states()) {
+      return Error{file + ": identification.output_fractions must be an array of " +
+                   std::to_string(model.num_states()) + " numbers"};
+    }
+    Eigen::VectorXd xi(model.num_states());
+    for (int i = 0; i < model.num_states(); ++i) {
+      if (!f[i].is_number()) {
+        return Error{file + ": identification.output_fractions[" + std::to_string(i) +
+                     "] must be a number in [0, 1]"};
+      }
+      xi[i] = f[i].get<double>();
+    }
+    auto map = UnitForceMap::FromFractions(g, xi);
+    if (!map) return Error{file + ": identification.output_fractions: " + map.error()};
+    return map;
+  }
+  const double stretch = ident.contains("stretch") && ident["stretch"].is_number()
+                             ? ident["stretch"].get<double>()
+                             : g.unit.prestretch;
+  return UnitForceMap::FromForces(g, stretch, model.H.row(0).transpose());
+}
+
+}  // namespace
+
 Result<std::unique_ptr<OnCountEstimator>> MakeEstimator(const EstimatorSpec& spec, int num_units,
-                                                        double unit_force, double dT) {
+                                                        double unit_force, double dT,
+                                                        const UnitGeometry* geometry) {
   auto checked = EstimatorSpec::Parse(spec.kind, spec.covariance, spec.model_file, spec.num_states,
                                       spec.force_noise_std);
   if (!checked) return Error{checked.error()};
@@ -121,15 +166,32 @@ Result<std::unique_ptr<OnCountEstimator>> MakeEstimator(const EstimatorSpec& spe
     return Error{"estimator: unit_force must be finite and > 0 N"};
   }
   if (!std::isfinite(dT) || dT <= 0) return Error{"estimator: dT must be finite and > 0 s"};
+  // The settled on unit's force as a function of length, for the length-aware output estimator.
+  std::optional<UnitForceMap> on_force;
+  if (geometry) {
+    auto map = UnitForceMap::FromForces(*geometry, geometry->unit.prestretch,
+                                        Eigen::VectorXd::Constant(1, unit_force));
+    if (!map) return Error{"estimator: " + map.error()};
+    on_force = std::move(map).value();
+  }
   if (spec.kind == "output") {
-    return std::unique_ptr<OnCountEstimator>(new OutputOnlyEstimator(num_units, unit_force));
+    return std::unique_ptr<OnCountEstimator>(
+        new OutputOnlyEstimator(num_units, unit_force, std::move(on_force)));
   }
   auto mode = ParseCovarianceMode(spec.covariance);
   if (!mode) return Error{"estimator: " + mode.error()};
   FilterModel model;
+  std::optional<UnitForceMap> output;
+  double relative_noise = 0;
   if (spec.kind == "kalman2") {
     const double sd = spec.force_noise_std > 0 ? spec.force_noise_std : unit_force;
     model = FilterModel::TwoState(num_units, dT, unit_force, sd);
+    if (geometry) {
+      auto map = UnitForceMap::FromForces(*geometry, geometry->unit.prestretch,
+                                          Eigen::Vector2d(0.0, unit_force));
+      if (!map) return Error{"estimator: " + map.error()};
+      output = std::move(map).value();
+    }
   } else {
     const std::string file = ResolveModelPath(
         spec.model_file.empty() ? DefaultModelFile(dT, spec.num_states) : spec.model_file);
@@ -167,8 +229,25 @@ Result<std::unique_ptr<OnCountEstimator>> MakeEstimator(const EstimatorSpec& spe
     if (spec.force_noise_std > 0) {
       model.R = Eigen::MatrixXd::Constant(1, 1, spec.force_noise_std * spec.force_noise_std);
     }
+    const nlohmann::json ident = IdentificationOf(file);
+    if (geometry) {
+      auto map = ModelForceMap(model, ident, *geometry, file);
+      if (!map) return Error{"estimator: " + map.error()};
+      output = std::move(map).value();
+      // H >= 0 at the reference length, whatever the file held.
+      auto h = model.H.row(0);
+      output->Forces(geometry->ref_length, h);
+    }
+    if (spec.force_noise_std <= 0 && ident.contains("relative_noise") &&
+        ident["relative_noise"].is_number()) {
+      relative_noise = ident["relative_noise"].get<double>();
+    }
   }
-  auto est = KalmanOnCountEstimator::Create(model, *mode);
+  if (!std::isfinite(spec.sensor_variance) || spec.sensor_variance < 0) {
+    return Error{"estimator: sensor_variance must be finite and >= 0 N^2"};
+  }
+  model.R(0, 0) += spec.sensor_variance;
+  auto est = KalmanOnCountEstimator::Create(model, *mode, std::move(output), relative_noise);
   if (!est) return Error{"estimator: " + est.error()};
   return std::unique_ptr<OnCountEstimator>(std::move(est).value());
 }

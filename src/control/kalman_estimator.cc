@@ -5,7 +5,8 @@
 namespace recruit::control {
 
 Result<std::unique_ptr<KalmanOnCountEstimator>> KalmanOnCountEstimator::Create(
-    const FilterModel& model, CovarianceMode mode) {
+    const FilterModel& model, CovarianceMode mode, std::optional<UnitForceMap> output,
+    double relative_noise) {
   if (Status s = model.Validate(); !s) return Error{s.error()};
   if (model.transition != TransitionSource::kBroadcast) {
     return Error{
@@ -16,24 +17,50 @@ Result<std::unique_ptr<KalmanOnCountEstimator>> KalmanOnCountEstimator::Create(
     return Error{"estimator: the filter model must have one output (the bundle's force), has " +
                  std::to_string(model.num_outputs())};
   }
+  if (output && output->num_states() != model.num_states()) {
+    return Error{"estimator: the unit force map has " + std::to_string(output->num_states()) +
+                 " states, the model " + std::to_string(model.num_states())};
+  }
+  if (!std::isfinite(relative_noise) || relative_noise < 0) {
+    return Error{"estimator: relative_noise = " + std::to_string(relative_noise) +
+                 " must be finite and >= 0"};
+  }
   auto filter = PopulationKalmanFilter::Create(model, mode);
   if (!filter) return Error{filter.error()};
-  return std::unique_ptr<KalmanOnCountEstimator>(
-      new KalmanOnCountEstimator(model, std::move(filter).value()));
+  return std::unique_ptr<KalmanOnCountEstimator>(new KalmanOnCountEstimator(
+      model, std::move(filter).value(), std::move(output), relative_noise));
 }
 
-KalmanOnCountEstimator::KalmanOnCountEstimator(FilterModel model, PopulationKalmanFilter filter)
-    : model_(std::move(model)), filter_(std::move(filter)) {
+KalmanOnCountEstimator::KalmanOnCountEstimator(FilterModel model, PopulationKalmanFilter filter,
+                                               std::optional<UnitForceMap> output,
+                                               double relative_noise)
+    : model_(std::move(model)),
+      filter_(std::move(filter)),
+      output_(std::move(output)),
+      relative_noise_(relative_noise) {
   const int m = model_.num_states();
   on_mask_ = Eigen::VectorXd::Zero(m);
   for (int i = 0; i < m; ++i) on_mask_[i] = model_.broadcast.is_on[i] ? 1.0 : 0.0;
   y_.resize(1);
+  h_ = model_.H;
+  r_ = model_.R;
 }
 
 void KalmanOnCountEstimator::Reset() { filter_.Reset(model_.x0, model_.P0); }
 
-void KalmanOnCountEstimator::Observe(double measured_force) {
+void KalmanOnCountEstimator::Observe(double measured_force, double tendon_length) {
   if (!std::isfinite(measured_force)) return;  // a lost sample: predict only
+  if (output_ || relative_noise_ > 0) {
+    if (output_ && std::isfinite(tendon_length)) {
+      auto row = h_.row(0);
+      output_->Forces(tendon_length, row);
+    } else {
+      h_ = model_.H;
+    }
+    const double predicted = h_.row(0).dot(filter_.estimate());
+    r_(0, 0) = model_.R(0, 0) + relative_noise_ * relative_noise_ * predicted * predicted;
+    filter_.SetOutput(h_, r_);
+  }
   y_[0] = measured_force;
   filter_.Update(y_);
 }

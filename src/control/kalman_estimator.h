@@ -6,6 +6,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 
 #include "control/on_count_estimator.h"
 #include "estimation/filter_model.h"
@@ -17,11 +18,16 @@ class KalmanOnCountEstimator final : public OnCountEstimator {
  public:
   // `model` must be a single-output model with a broadcast transition; the filter starts from
   // the model's initial belief (x0, P0) and Reset returns to it.
-  static Result<std::unique_ptr<KalmanOnCountEstimator>> Create(const FilterModel& model,
-                                                                CovarianceMode mode);
+  // With `output`, the filter's H follows the measured tendon length (UnitForceMap over the
+  // model's states) and R = model R + relative_noise^2 (H x^-)^2: the unit force model's error
+  // (units of one state do not all sit at its fraction) grows with the force.
+  static Result<std::unique_ptr<KalmanOnCountEstimator>> Create(
+      const FilterModel& model, CovarianceMode mode,
+      std::optional<UnitForceMap> output = std::nullopt, double relative_noise = 0);
 
   void Reset() override;
-  void Observe(double measured_force) override;
+  using OnCountEstimator::Observe;
+  void Observe(double measured_force, double tendon_length) override;
   void Broadcasted(const Broadcast& b) override;
   double EstimatedOn() const override { return on_mask_.dot(filter_.estimate()); }
   double EstimatedOnVariance() const override {
@@ -35,12 +41,16 @@ class KalmanOnCountEstimator final : public OnCountEstimator {
   const PopulationKalmanFilter& filter() const { return filter_; }
 
  private:
-  KalmanOnCountEstimator(FilterModel model, PopulationKalmanFilter filter);
+  KalmanOnCountEstimator(FilterModel model, PopulationKalmanFilter filter,
+                         std::optional<UnitForceMap> output, double relative_noise);
 
   FilterModel model_;
   PopulationKalmanFilter filter_;
   Eigen::VectorXd on_mask_;  // 1 for the "on" states
   Eigen::VectorXd y_;        // workspace (one output)
+  std::optional<UnitForceMap> output_;
+  double relative_noise_ = 0;
+  Eigen::MatrixXd h_, r_;  // workspaces: H (1 x m) and R (1 x 1) at the measured length
 };
 
 }  // namespace recruit::control

@@ -2,7 +2,8 @@
 //
 // One estimator per bundle, called once per sampling period dT, in this order at each control
 // instant k:
-//   Observe(y_k)       update with the force sampled at instant k (before broadcasting)
+//   Observe(y_k, L_k)  update with the force and the tendon length sampled at instant k (before
+//                      broadcasting); L_k NaN = not measured (the model's reference length)
 //   EstimatedOn()      the a-posteriori on-count at instant k, which the law uses
 //   Broadcasted(b_k)   the broadcast just sent: predict to instant k + 1
 // Kinds (docs/controller.md):
@@ -14,6 +15,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <limits>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -21,6 +23,7 @@
 
 #include "common/result.h"
 #include "control/broadcast.h"
+#include "control/unit_force_map.h"
 
 namespace recruit::control {
 
@@ -29,8 +32,13 @@ class OnCountEstimator {
   virtual ~OnCountEstimator() = default;
   // Back to the initial belief: every unit off, at ambient (cold settled state).
   virtual void Reset() = 0;
-  // The force (N) sampled at this control instant.
-  virtual void Observe(double measured_force) = 0;
+  // The force (N) and the tendon length (m, from the joint encoder; NaN when not measured)
+  // sampled at this control instant. A length-aware estimator (built with a UnitGeometry) takes
+  // each state's unit force at that length; without one, at the model's reference length.
+  virtual void Observe(double measured_force, double tendon_length) = 0;
+  void Observe(double measured_force) {
+    Observe(measured_force, std::numeric_limits<double>::quiet_NaN());
+  }
   // The broadcast just sent at this instant: predict to the next instant (dT later).
   virtual void Broadcasted(const Broadcast& b) = 0;
   // Units whose heater is on.
@@ -55,6 +63,9 @@ struct EstimatorSpec {
   // R for kalman-augmented and one settled unit's force for kalman2 (the two-state model's error
   // while units are in transient is of that size).
   double force_noise_std = 0;
+  // Variance of the load cell's reading (noise and quantisation), N^2, added to the model's R
+  // (which is what the unit population and the model's error add, from identification).
+  double sensor_variance = 0;
   // kalman-augmented: the plant the model will run on (control/plant_record.h, PlantRecord);
   // null = unchecked. A model file recording another plant is refused (CheckModelPlant).
   nlohmann::json plant;
@@ -73,9 +84,12 @@ struct EstimatorSpec {
 std::string DefaultModelFile(double dT, int num_states);
 
 // Builds the estimator for a bundle of `num_units` units whose settled on-force is `unit_force`
-// (N), sampled every `dT` seconds. A kalman-augmented model identified for another N is rescaled
-// to num_units (the per-unit model does not depend on N); its dt must equal dT.
+// (N, at the reference length), sampled every `dT` seconds. A kalman-augmented model identified
+// for another N is rescaled to num_units (the per-unit model does not depend on N); its dt must
+// equal dT. With `geometry` the estimator is length-aware (UnitForceMap): each state's force
+// follows the measured tendon length.
 Result<std::unique_ptr<OnCountEstimator>> MakeEstimator(const EstimatorSpec& spec, int num_units,
-                                                        double unit_force, double dT);
+                                                        double unit_force, double dT,
+                                                        const UnitGeometry* geometry = nullptr);
 
 }  // namespace recruit::control

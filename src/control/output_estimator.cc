@@ -1,20 +1,27 @@
 #include "control/output_estimator.h"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 namespace recruit::control {
 
-OutputOnlyEstimator::OutputOnlyEstimator(int num_units, double unit_force)
-    : num_units_(num_units), unit_force_(unit_force) {}
+OutputOnlyEstimator::OutputOnlyEstimator(int num_units, double unit_force,
+                                         std::optional<UnitForceMap> on_force)
+    : num_units_(num_units), unit_force_(unit_force), on_force_(std::move(on_force)) {}
 
 void OutputOnlyEstimator::Reset() { on_ = 0; }
 
-void OutputOnlyEstimator::Observe(double measured_force) {
+void OutputOnlyEstimator::Observe(double measured_force, double tendon_length) {
   // Clamped to the feasible counts; a NaN force keeps the last count.
-  if (measured_force == measured_force) {
-    on_ = std::clamp(measured_force / unit_force_, 0.0, static_cast<double>(num_units_));
+  if (measured_force != measured_force) return;
+  double unit = unit_force_;
+  if (on_force_ && std::isfinite(tendon_length)) {
+    unit = on_force_->Force(0, tendon_length);
   }
+  // A slack tendon (no on unit can pull) says nothing about the count: keep the last one.
+  if (!(unit > 0)) return;
+  on_ = std::clamp(measured_force / unit, 0.0, static_cast<double>(num_units_));
 }
 
 double OutputOnlyEstimator::EstimatedOnVariance() const {

@@ -1,7 +1,10 @@
 // The output-only on-count: force / settled force of one unit. It is exact at steady state and
 // wrong during transients: a unit that has just turned on shows a fraction of its settled force,
-// so at short dT the controller over-recruits (the paper's Fig. 5 failure).
+// so at short dT the controller over-recruits (the paper's Fig. 5 failure). With an on-force map
+// (a single state, the settled on unit) the settled force is taken at the measured length.
 #pragma once
+
+#include <optional>
 
 #include "control/on_count_estimator.h"
 
@@ -9,9 +12,11 @@ namespace recruit::control {
 
 class OutputOnlyEstimator final : public OnCountEstimator {
  public:
-  OutputOnlyEstimator(int num_units, double unit_force);
+  OutputOnlyEstimator(int num_units, double unit_force,
+                      std::optional<UnitForceMap> on_force = std::nullopt);
   void Reset() override;
-  void Observe(double measured_force) override;
+  using OnCountEstimator::Observe;
+  void Observe(double measured_force, double tendon_length) override;
   void Broadcasted(const Broadcast& b) override {}
   double EstimatedOn() const override { return on_; }
   double EstimatedOnVariance() const override;
@@ -22,6 +27,7 @@ class OutputOnlyEstimator final : public OnCountEstimator {
  private:
   int num_units_;
   double unit_force_;
+  std::optional<UnitForceMap> on_force_;
   double on_ = 0;
 };
 

@@ -26,7 +26,14 @@ Result<RecruitmentController> RecruitmentController::Create(
     const ControllerParams& params, std::unique_ptr<OnCountEstimator> estimator) {
   if (Status s = params.Validate(); !s) return Error{s.error()};
   if (!estimator) return Error{"controller: no estimator"};
-  RecruitmentController c(params, std::move(estimator));
+  std::optional<UnitForceMap> on_force;
+  if (params.geometry) {
+    auto map = UnitForceMap::FromForces(*params.geometry, params.geometry->unit.prestretch,
+                                        Eigen::VectorXd::Constant(1, params.unit_force));
+    if (!map) return Error{"controller: " + map.error()};
+    on_force = std::move(map).value();
+  }
+  RecruitmentController c(params, std::move(estimator), std::move(on_force));
   c.Reset();
   return c;
 }
@@ -34,7 +41,8 @@ Result<RecruitmentController> RecruitmentController::Create(
 Result<RecruitmentController> RecruitmentController::Create(const ControllerParams& params,
                                                             const EstimatorSpec& spec) {
   if (Status s = params.Validate(); !s) return Error{s.error()};
-  auto est = MakeEstimator(spec, params.num_units, params.unit_force, params.dT);
+  auto est = MakeEstimator(spec, params.num_units, params.unit_force, params.dT,
+                           params.geometry ? &*params.geometry : nullptr);
   if (!est) return Error{est.error()};
   return Create(params, std::move(est).value());
 }
@@ -42,14 +50,20 @@ Result<RecruitmentController> RecruitmentController::Create(const ControllerPara
 void RecruitmentController::Reset() {
   estimator_->Reset();
   target_on_ = 0;
+  unit_force_ = params_.unit_force;
   estimated_on_ = estimator_->EstimatedOn();
   estimated_on_variance_ = estimator_->EstimatedOnVariance();
   last_ = Broadcast{};
 }
 
-Broadcast RecruitmentController::Step(double reference_force, double measured_force) {
-  estimator_->Observe(measured_force);
-  target_on_ = reference_force / params_.unit_force;
+Broadcast RecruitmentController::Step(double reference_force, double measured_force,
+                                      double tendon_length) {
+  estimator_->Observe(measured_force, tendon_length);
+  unit_force_ = on_force_ && std::isfinite(tendon_length) ? on_force_->Force(0, tendon_length)
+                                                          : params_.unit_force;
+  // Where no on unit can pull (a slack tendon) no count reaches the reference: ask for all.
+  target_on_ = unit_force_ > 0 ? reference_force / unit_force_
+                               : (reference_force > 0 ? params_.num_units : 0.0);
   estimated_on_ = estimator_->EstimatedOn();
   estimated_on_variance_ = estimator_->EstimatedOnVariance();
   last_ = ExpectationLaw(target_on_, estimated_on_, params_.num_units, params_.lambda);

@@ -3,7 +3,9 @@
 // force measured at that instant; broadcast what it returns to the bundle.
 #pragma once
 
+#include <limits>
 #include <memory>
+#include <optional>
 
 #include "common/result.h"
 #include "control/broadcast.h"
@@ -16,6 +18,9 @@ struct ControllerParams {
   double unit_force = 0;  // N, settled force of one unit whose heater is on
   double dT = 0.5;        // s, sampling period
   double lambda = 0.2;    // gain of the expectation law, in (0, 1]
+  // The bundle's unit and tendon geometry: when set, the target count and the estimator use the
+  // settled on unit's force at the measured tendon length (UnitForceMap), not at ref_length.
+  std::optional<UnitGeometry> geometry;
 
   // Checks N >= 1, unit_force > 0, dT > 0, 0 < lambda <= 1 (finite); the message names the field.
   Status Validate() const;
@@ -32,24 +37,31 @@ class RecruitmentController {
   // Back to the initial belief (all units off).
   void Reset();
 
-  // One control instant: estimator.Observe(measured), target = reference / unit_force,
-  // b = ExpectationLaw(target, estimated on, N, lambda), estimator.Broadcasted(b).
-  Broadcast Step(double reference_force, double measured_force);
+  // One control instant: estimator.Observe(measured, length), target = reference / (unit force
+  // at that length), b = ExpectationLaw(target, estimated on, N, lambda),
+  // estimator.Broadcasted(b). tendon_length NaN: not measured (the force at ref_length).
+  Broadcast Step(double reference_force, double measured_force,
+                 double tendon_length = std::numeric_limits<double>::quiet_NaN());
 
   const ControllerParams& params() const { return params_; }
   const OnCountEstimator& estimator() const { return *estimator_; }
   // Values at the last Step: the target on-count and the a-posteriori estimate the law used.
   double target_on() const { return target_on_; }
+  // Settled force of one on unit at the last Step's tendon length (N).
+  double unit_force() const { return unit_force_; }
   double estimated_on() const { return estimated_on_; }
   double estimated_on_variance() const { return estimated_on_variance_; }
   const Broadcast& last_broadcast() const { return last_; }
 
  private:
-  RecruitmentController(const ControllerParams& params, std::unique_ptr<OnCountEstimator> est)
-      : params_(params), estimator_(std::move(est)) {}
+  RecruitmentController(const ControllerParams& params, std::unique_ptr<OnCountEstimator> est,
+                        std::optional<UnitForceMap> on_force)
+      : params_(params), estimator_(std::move(est)), on_force_(std::move(on_force)) {}
 
   ControllerParams params_;
   std::unique_ptr<OnCountEstimator> estimator_;
+  std::optional<UnitForceMap> on_force_;  // one state: the settled on unit
+  double unit_force_ = 0;
   double target_on_ = 0;
   double estimated_on_ = 0;
   double estimated_on_variance_ = 0;

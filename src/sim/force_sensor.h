@@ -23,6 +23,9 @@ struct SensorParams {
   // {"noise_std": N, "resolution": N}; unknown keys and bad values are errors naming `where`.
   static Result<SensorParams> FromJson(const nlohmann::json& j, const std::string& where);
   nlohmann::json ToJson() const;
+  // Variance of a reading about the true force (N^2): noise plus the quantisation's
+  // resolution^2 / 12 (Sheppard), what an estimator adds to its own R.
+  double Variance() const { return noise_std * noise_std + resolution * resolution / 12.0; }
 };
 
 class ForceSensor {

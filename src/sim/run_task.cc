@@ -14,8 +14,9 @@
 #include "sim/force_sensor.h"
 
 #if RECRUIT_CONTROL_AVAILABLE && RECRUIT_SMA_AVAILABLE
-#include "control/plant_record.h"
 #include "control/recruitment_controller.h"
+#include "identification/model_cache.h"
+#include "identification/plant_record.h"
 #include "plugin/sma_host.h"
 #define RECRUIT_SIM_CLOSED_LOOP 1
 #endif
@@ -218,14 +219,27 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
     p.unit_force = plugin.SettledUnitForce(b);
     p.dT = settings.dT;
     p.lambda = settings.lambda;
+    // The estimator and the target follow the tendon's length (the joint encoder's reading).
+    p.geometry = control::UnitGeometry{plugin.bundle(b).config().unit, plugin.ref_length(b)};
     // A model identified on another plant (unit, geometry) is refused with both named.
     control::EstimatorSpec bundle_spec = *spec;
+    bundle_spec.sensor_variance = task.sensor.Variance();
     bundle_spec.plant = control::PlantRecord(plugin, b, task.model_path);
     // "{bundle}" in the model file name stands for the bundle's actuator name, so that each
     // bundle of a limb gets the model identified on it.
     const std::string key = "{bundle}";
     for (size_t at; (at = bundle_spec.model_file.find(key)) != std::string::npos;) {
       bundle_spec.model_file.replace(at, key.size(), plugin.bundle_name(b));
+    }
+    // No model named: the one identified on this bundle for this dT, from the model search path,
+    // else identified now and cached (identification/model_cache.h).
+    if (bundle_spec.kind == "kalman-augmented" && bundle_spec.model_file.empty()) {
+      control::ModelRequest req{task.model_path, plugin.bundle_name(b), bundle_spec.plant,
+                                settings.dT, bundle_spec.num_states};
+      auto file = control::FindOrIdentifyModel(req, options.identify_missing_models,
+                                               options.quiet ? nullptr : stderr);
+      if (!file) return Error{where + ".controller: " + file.error()};
+      bundle_spec.model_file = *file;
     }
     auto c = control::RecruitmentController::Create(p, bundle_spec);
     if (!c.ok()) return Error{where + ".controller: " + c.error()};
@@ -318,7 +332,9 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
         const int on_before = plugin.OnCount(d, b);
         // The controller reads the load cell, not the plugin's exact tension.
         const double sensed = sensors[i].SampleAndHold(plugin.Force(d, b));
-        const control::Broadcast bc = controllers[i].Step(force_ref[i], sensed);
+        // The encoder: the tendon's length follows the joint angle exactly (a known moment arm).
+        const double length = d->ten_length[plugin.tendon_id(b)];
+        const control::Broadcast bc = controllers[i].Step(force_ref[i], sensed, length);
         Status st = plugin.Broadcast(d, b, bc.p_on, bc.p_off);
         if (!st.ok()) return Error{where + ": " + st.error()};
         BundleTelemetry& bt = sample.bundles[i];

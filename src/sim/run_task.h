@@ -26,6 +26,10 @@ struct RunOptions {
   std::optional<double> duration;         // s
   std::uint64_t seed = 1;
   bool progress = false;  // progress on stderr
+  // kalman-augmented without a model file: identify (and cache) a missing model for the bundle
+  // and dT (identification/model_cache.h); false = an error naming the command that makes one.
+  bool identify_missing_models = true;
+  bool quiet = false;  // no notes on stderr (e.g. that a model is being identified)
 };
 
 struct RunMetrics {

@@ -9,9 +9,9 @@
 #include <nlohmann/json.hpp>
 
 #include "common/rng.h"
-#include "control/model_export.h"
+#include "identification/model_export.h"
 #include "control/on_count_estimator.h"
-#include "control/transient_chain.h"
+#include "identification/transient_chain.h"
 #include "estimation/filter_model.h"
 
 namespace recruit::control {

@@ -2,7 +2,7 @@
 // computed by hand in Python), the bench's and the arm's bundles get different records, the
 // shipped bench models match the bench, and a model identified on another plant is refused by
 // the estimator factory with both plants named.
-#include "control/plant_record.h"
+#include "identification/plant_record.h"
 
 #include <gtest/gtest.h>
 #include <mujoco/mujoco.h>

@@ -1,4 +1,4 @@
-#include "control/model_export.h"
+#include "identification/model_export.h"
 
 namespace recruit::control {
 

@@ -1,7 +1,7 @@
 // Transient chain structure against hand-worked edges, and identification recovering a known
 // chain from data simulated by the estimation part's aggregate population sampler (independent
 // of the mean propagation the fit uses).
-#include "control/identification.h"
+#include "identification/identification.h"
 
 #include <gtest/gtest.h>
 
@@ -11,9 +11,9 @@
 #include <iostream>
 
 #include "common/rng.h"
-#include "control/bench_recorder.h"
-#include "control/excitation.h"
-#include "control/transient_chain.h"
+#include "identification/bench_recorder.h"
+#include "identification/excitation.h"
+#include "identification/transient_chain.h"
 #include "estimation/population_chain.h"
 
 namespace recruit::control {

@@ -11,8 +11,8 @@
 #pragma once
 
 #include "common/result.h"
-#include "control/switching_log.h"
-#include "control/transient_chain.h"
+#include "identification/switching_log.h"
+#include "identification/transient_chain.h"
 
 namespace recruit::control {
 

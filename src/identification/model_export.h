@@ -3,8 +3,8 @@
 
 #include <cstdint>
 
-#include "control/transient_chain.h"
 #include "estimation/filter_model.h"
+#include "identification/transient_chain.h"
 
 namespace recruit::control {
 

@@ -1,4 +1,4 @@
-#include "control/transient_chain.h"
+#include "identification/transient_chain.h"
 
 #include <algorithm>
 

@@ -1,4 +1,4 @@
-#include "control/switching_log.h"
+#include "identification/switching_log.h"
 
 #include <cmath>
 #include <cstdlib>

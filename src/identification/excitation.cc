@@ -1,4 +1,4 @@
-#include "control/excitation.h"
+#include "identification/excitation.h"
 
 #include <algorithm>
 

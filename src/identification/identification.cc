@@ -1,4 +1,4 @@
-#include "control/identification.h"
+#include "identification/identification.h"
 
 #include <Eigen/Cholesky>
 #include <algorithm>

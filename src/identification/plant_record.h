@@ -9,6 +9,7 @@
 #include <string>
 
 #include "common/result.h"
+#include "control/model_plant.h"
 #include "plugin/sma_host.h"
 
 namespace recruit::control {
@@ -16,13 +17,5 @@ namespace recruit::control {
 // {"model": ..., "actuator": ..., "tendon": ..., "num_units": N, "settled_unit_force_N": f,
 //  "unit": {key: value, ...}, "hash": "16 hex digits"}.
 nlohmann::json PlantRecord(const sma::SmaHost& host, int bundle, const std::string& model_path);
-
-// FNV-1a 64 of the record's "unit" object as canonical JSON text.
-std::string PlantHash(const nlohmann::json& unit);
-
-// Checks a model file's "identification.plant" against `plant` (a PlantRecord). A model without
-// a record passes (e.g. fitted from a log: its plant is unknown). A different hash is an error
-// naming the model file's plant and this one and the unit parameters that differ.
-Status CheckModelPlant(const std::string& model_file, const nlohmann::json& plant);
 
 }  // namespace recruit::control

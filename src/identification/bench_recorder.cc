@@ -1,0 +1,148 @@
+#include "identification/bench_recorder.h"
+
+#include <mujoco/mujoco.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <vector>
+
+#include "common/mujoco_ptr.h"
+#include "identification/plant_record.h"
+#include "plugin/sma_host.h"
+
+namespace recruit::control {
+namespace {
+
+struct HeldPose {
+  int qadr = -1;  // -1: nothing held
+  double q = 0;
+  std::string text;
+};
+
+// The pose of the first limited 1-dof joint that moves `tendon`, sampled over its range, whose
+// tendon length is at `place` of the length range (0 shortest, 1 longest).
+HeldPose ChoosePose(const mjModel* m, mjData* d, int tendon, double place) {
+  constexpr int kSamples = 201;
+  for (int j = 0; j < m->njnt; ++j) {
+    const int type = m->jnt_type[j];
+    if ((type != mjJNT_HINGE && type != mjJNT_SLIDE) || !m->jnt_limited[j]) continue;
+    const int qadr = m->jnt_qposadr[j];
+    const double lo = m->jnt_range[2 * j], hi = m->jnt_range[2 * j + 1];
+    std::vector<double> q(kSamples), len(kSamples);
+    for (int i = 0; i < kSamples; ++i) {
+      mju_copy(d->qpos, m->qpos0, m->nq);
+      q[i] = lo + (hi - lo) * i / (kSamples - 1);
+      d->qpos[qadr] = q[i];
+      mj_kinematics(m, d);
+      mj_comPos(m, d);
+      mj_tendon(m, d);
+      len[i] = d->ten_length[tendon];
+    }
+    const auto [mn, mx] = std::minmax_element(len.begin(), len.end());
+    if (*mx - *mn < 1e-9) continue;  // does not move this tendon
+    const double want = *mn + place * (*mx - *mn);
+    int best = 0;
+    for (int i = 1; i < kSamples; ++i) {
+      if (std::abs(len[i] - want) < std::abs(len[best] - want)) best = i;
+    }
+    HeldPose p;
+    p.qadr = qadr;
+    p.q = q[best];
+    const char* name = mj_id2name(m, mjOBJ_JOINT, j);
+    char buf[160];
+    if (type == mjJNT_HINGE) {
+      std::snprintf(buf, sizeof buf, "%s %.1f deg", name ? name : "joint", q[best] * 180 / M_PI);
+    } else {
+      std::snprintf(buf, sizeof buf, "%s %.4f m", name ? name : "joint", q[best]);
+    }
+    p.text = buf;
+    mju_copy(d->qpos, m->qpos0, m->nq);
+    return p;
+  }
+  return {};
+}
+
+// Holds the pose: the joint at q and every velocity zero, before each physics step.
+void Hold(const mjModel* m, mjData* d, const HeldPose& p) {
+  if (p.qadr < 0) return;
+  d->qpos[p.qadr] = p.q;
+  mju_zero(d->qvel, m->nv);
+}
+
+}  // namespace
+
+Result<BenchRecording> RecordBench(const std::string& model_path, const std::string& actuator,
+                                   const Excitation& excitation, double dT, std::uint64_t seed,
+                                   const RecordOptions& options) {
+  char err[1000] = "";
+  ModelPtr m(mj_loadXML(model_path.c_str(), nullptr, err, sizeof err));
+  if (!m) return Error{model_path + ": " + err};
+  auto plugin = sma::SmaHost::Create(m.get());
+  if (!plugin) return Error{model_path + ": " + plugin.error()};
+  const sma::SmaHost& p = **plugin;
+  if (p.num_bundles() == 0) return Error{model_path + ": no SMA bundle (recruit.sma.* text)"};
+  const int b = actuator.empty() ? 0 : p.BundleIndex(actuator);
+  if (b < 0) return Error{model_path + ": no SMA bundle on actuator \"" + actuator + "\""};
+  const double h = m->opt.timestep;
+  const double ratio = dT / h;
+  const int steps = static_cast<int>(std::lround(ratio));
+  if (!(dT > 0) || steps < 1 || std::abs(ratio - steps) > 1e-6 * ratio) {
+    return Error{"identify: dT = " + std::to_string(dT) + " s must be a positive whole number of " +
+                 model_path + "'s timesteps (" + std::to_string(h) + " s)"};
+  }
+  if (!(options.length_place >= 0 && options.length_place <= 1)) {
+    return Error{"identify: the pose's place in the tendon's length range must be in [0, 1]"};
+  }
+  DataPtr d(mj_makeData(m.get()));
+  const HeldPose pose = ChoosePose(m.get(), d.get(), p.tendon_id(b), options.length_place);
+  Hold(m.get(), d.get(), pose);
+  mj_forward(m.get(), d.get());  // the held tendon length, which Reset reads
+  p.Reset(d.get(), seed);
+  BenchRecording rec;
+  rec.unit_force = p.SettledUnitForce(b);
+  rec.timestep = h;
+  rec.plant = PlantRecord(p, b, model_path);
+  SwitchingLog& log = rec.log;
+  log.num_units = p.num_units(b);
+  log.dT = dT;
+  // Forces and sensors at t = 0 (nothing is on yet).
+  mj_forward(m.get(), d.get());
+  rec.tendon_length = d->ten_length[p.tendon_id(b)];
+  rec.stretch = p.Stretch(d.get(), b);
+  rec.pose = pose.text;
+  rec.geometry = {p.bundle(b).config().unit, p.ref_length(b)};
+  std::vector<char> was_on(p.num_units(b));
+  for (int k = 0; k < excitation.size(); ++k) {
+    log.time.push_back(k * dT);
+    log.force.push_back(p.Force(d.get(), b));
+    log.true_on.push_back(p.OnCount(d.get(), b));
+    log.p_on.push_back(excitation.p_on[k]);
+    log.p_off.push_back(excitation.p_off[k]);
+    // Which units switched, from the per-unit debug state (the fit's realized inputs).
+    const int n = p.num_units(b);
+    for (int i = 0; i < n; ++i) was_on[i] = p.UnitOn(d.get(), b, i);
+    if (Status s = p.Broadcast(d.get(), b, excitation.p_on[k], excitation.p_off[k]); !s) {
+      return Error{"identify: broadcast " + std::to_string(k) + ": " + s.error()};
+    }
+    int on_before = 0, turned_on = 0, turned_off = 0;
+    for (int i = 0; i < n; ++i) {
+      const bool now = p.UnitOn(d.get(), b, i);
+      on_before += was_on[i];
+      turned_on += !was_on[i] && now;
+      turned_off += was_on[i] && !now;
+    }
+    log.realized_on.push_back(on_before < n ? double(turned_on) / (n - on_before) : 0.0);
+    log.realized_off.push_back(on_before > 0 ? double(turned_off) / on_before : 0.0);
+    for (int i = 0; i < steps; ++i) {
+      Hold(m.get(), d.get(), pose);
+      mj_step(m.get(), d.get());
+    }
+    Hold(m.get(), d.get(), pose);
+    mj_forward(m.get(), d.get());
+  }
+  return rec;
+}
+
+}  // namespace recruit::control

@@ -1,0 +1,82 @@
+#include "identification/model_cache.h"
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+
+#include "common/atomic_file.h"
+#include "common/file_lock.h"
+
+namespace recruit::control {
+namespace fs = std::filesystem;
+
+std::string ModelFileName(const nlohmann::json& plant, double dT, int num_states) {
+  char dt[32];
+  std::snprintf(dt, sizeof dt, "%g", dT);
+  return plant.value("actuator", std::string("bundle")) + "_" +
+         plant.value("hash", std::string("unknown")) + "_dt" + dt + "_m" +
+         std::to_string(num_states) + ".json";
+}
+
+std::vector<std::string> ModelSearchPath() {
+  std::vector<std::string> dirs;
+  if (const char* p = std::getenv("RECRUIT_MODEL_PATH"); p && *p) {
+    std::string all = p;
+    for (size_t start = 0; start <= all.size();) {
+      const size_t end = std::min(all.find(':', start), all.size());
+      if (end > start) dirs.push_back(all.substr(start, end - start));
+      start = end + 1;
+    }
+  }
+#ifdef RECRUIT_SOURCE_DIR
+  dirs.push_back(std::string(RECRUIT_SOURCE_DIR) + "/models/identified");
+#endif
+  if (const char* c = std::getenv("RECRUIT_MODEL_CACHE"); c && *c) {
+    dirs.push_back(c);
+  } else if (const char* x = std::getenv("XDG_CACHE_HOME"); x && *x) {
+    dirs.push_back(std::string(x) + "/recruit/models");
+  } else if (const char* h = std::getenv("HOME"); h && *h) {
+    dirs.push_back(std::string(h) + "/.cache/recruit/models");
+  } else {
+    dirs.push_back((fs::temp_directory_path() / "recruit-models").string());
+  }
+  return dirs;
+}
+
+Result<std::string> FindOrIdentifyModel(const ModelRequest& r, bool identify, std::FILE* log) {
+  const std::string name = ModelFileName(r.plant, r.dT, r.num_states);
+  const std::vector<std::string> dirs = ModelSearchPath();
+  std::error_code ec;
+  for (const std::string& d : dirs) {
+    const fs::path f = fs::path(d) / name;
+    if (fs::exists(f, ec)) return f.string();
+  }
+  if (!identify) {
+    return Error{"no identified model " + name + " on the model search path (" + dirs.front() +
+                 (dirs.size() > 1 ? ", ..." : "") + "); identify one: recruit identify --bench " +
+                 r.model_path + " --actuator " + r.actuator + " --dt DT"};
+  }
+  const fs::path cache = dirs.back();
+  fs::create_directories(cache, ec);
+  if (ec) return Error{"model cache " + cache.string() + ": " + ec.message()};
+  const fs::path file = cache / name;
+  auto lock = FileLock::Lock((cache / (name + ".lock")).string());
+  if (!lock) return Error{lock.error()};
+  if (fs::exists(file, ec)) return file.string();  // made while we waited
+  if (log) {
+    std::fprintf(log, "recruit: identifying the %s model for dT = %g s on %s (cached as %s)\n",
+                 r.actuator.c_str(), r.dT, r.model_path.c_str(), file.string().c_str());
+  }
+  PlantIdentificationOptions o;
+  o.dT = r.dT;
+  o.num_states = r.num_states;
+  auto id = IdentifyOnPlant(r.model_path, r.actuator, o, "identified on demand (model cache)");
+  if (!id)
+    return Error{"identifying a model for dT = " + std::to_string(r.dT) + " s: " + id.error()};
+  if (Status s = WriteFileAtomically(file.string(), id->model.dump(2) + "\n"); !s) {
+    return Error{s.error()};
+  }
+  return file.string();
+}
+
+}  // namespace recruit::control

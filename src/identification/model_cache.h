@@ -1,0 +1,38 @@
+// Where the estimator's identified models are found, and made when missing: a model is keyed
+// by the plant it describes (its unit's hash), the bundle's actuator, dT and its number of states,
+// e.g. "flexor_3f2a9c0d12ab45ef_dt0.5_m20.json". Looked up, in order, in the folders of
+// RECRUIT_MODEL_PATH (colon-separated), the shipped models/identified/ and the user's cache
+// (RECRUIT_MODEL_CACHE, else $XDG_CACHE_HOME/recruit/models, else ~/.cache/recruit/models).
+// When none holds it, it is identified on the plant (plant_identification.h) and written to the
+// cache, under a lock, so that concurrent runs identify it once.
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "common/result.h"
+#include "identification/plant_identification.h"
+
+namespace recruit::control {
+
+// "<actuator>_<hash>_dt<dT>_m<states>.json" for a PlantRecord `plant`.
+std::string ModelFileName(const nlohmann::json& plant, double dT, int num_states);
+
+// The folders searched, in order; the last is the cache.
+std::vector<std::string> ModelSearchPath();
+
+struct ModelRequest {
+  std::string model_path;  // the MJCF the plant is loaded from
+  std::string actuator;    // the bundle
+  nlohmann::json plant;    // its PlantRecord
+  double dT = 0.5;
+  int num_states = 20;
+};
+
+// The model file for the request: found on the search path, or identified and cached when
+// `identify` is true (else an error saying how to make one). `log` (may be null) is told when
+// an identification starts, as it takes a while (seconds to a minute).
+Result<std::string> FindOrIdentifyModel(const ModelRequest& request, bool identify, std::FILE* log);
+
+}  // namespace recruit::control
