@@ -18,6 +18,7 @@ namespace {
 struct HeldPose {
   int qadr = -1;  // -1: nothing held
   double q = 0;
+  double q_short = 0, q_long = 0;  // the joint where the tendon is shortest and longest
   std::string text;
 };
 
@@ -50,6 +51,8 @@ HeldPose ChoosePose(const mjModel* m, mjData* d, int tendon, double place) {
     HeldPose p;
     p.qadr = qadr;
     p.q = q[best];
+    p.q_short = q[mn - len.begin()];
+    p.q_long = q[mx - len.begin()];
     const char* name = mj_id2name(m, mjOBJ_JOINT, j);
     char buf[160];
     if (type == mjJNT_HINGE) {
@@ -64,11 +67,18 @@ HeldPose ChoosePose(const mjModel* m, mjData* d, int tendon, double place) {
   return {};
 }
 
-// Holds the pose: the joint at q and every velocity zero, before each physics step.
-void Hold(const mjModel* m, mjData* d, const HeldPose& p) {
+// Holds the pose before each physics step: the joint at q and every velocity zero; with a
+// sweep period T > 0 the joint is driven instead, q(t) = q_short + (q_long - q_short)
+// (1 - cos(2 pi t / T)) / 2, from the shortest tendon to the longest and back.
+void Hold(const mjModel* m, mjData* d, const HeldPose& p, double period) {
   if (p.qadr < 0) return;
-  d->qpos[p.qadr] = p.q;
   mju_zero(d->qvel, m->nv);
+  if (period > 0) {
+    const double w = 2 * M_PI / period, span = p.q_long - p.q_short;
+    d->qpos[p.qadr] = p.q_short + span * 0.5 * (1 - std::cos(w * d->time));
+  } else {
+    d->qpos[p.qadr] = p.q;
+  }
 }
 
 }  // namespace
@@ -92,12 +102,15 @@ Result<BenchRecording> RecordBench(const std::string& model_path, const std::str
     return Error{"identify: dT = " + std::to_string(dT) + " s must be a positive whole number of " +
                  model_path + "'s timesteps (" + std::to_string(h) + " s)"};
   }
+  if (!(options.sweep_period >= 0) || !std::isfinite(options.sweep_period)) {
+    return Error{"identify: the sweep period must be finite and >= 0 s"};
+  }
   if (!(options.length_place >= 0 && options.length_place <= 1)) {
     return Error{"identify: the pose's place in the tendon's length range must be in [0, 1]"};
   }
   DataPtr d(mj_makeData(m.get()));
   const HeldPose pose = ChoosePose(m.get(), d.get(), p.tendon_id(b), options.length_place);
-  Hold(m.get(), d.get(), pose);
+  Hold(m.get(), d.get(), pose, options.sweep_period);
   mj_forward(m.get(), d.get());  // the held tendon length, which Reset reads
   p.Reset(d.get(), seed);
   BenchRecording rec;
@@ -117,6 +130,7 @@ Result<BenchRecording> RecordBench(const std::string& model_path, const std::str
   for (int k = 0; k < excitation.size(); ++k) {
     log.time.push_back(k * dT);
     log.force.push_back(p.Force(d.get(), b));
+    rec.lengths.push_back(d->ten_length[p.tendon_id(b)]);
     log.true_on.push_back(p.OnCount(d.get(), b));
     log.p_on.push_back(excitation.p_on[k]);
     log.p_off.push_back(excitation.p_off[k]);
@@ -136,10 +150,10 @@ Result<BenchRecording> RecordBench(const std::string& model_path, const std::str
     log.realized_on.push_back(on_before < n ? double(turned_on) / (n - on_before) : 0.0);
     log.realized_off.push_back(on_before > 0 ? double(turned_off) / on_before : 0.0);
     for (int i = 0; i < steps; ++i) {
-      Hold(m.get(), d.get(), pose);
+      Hold(m.get(), d.get(), pose, options.sweep_period);
       mj_step(m.get(), d.get());
     }
-    Hold(m.get(), d.get(), pose);
+    Hold(m.get(), d.get(), pose, options.sweep_period);
     mj_forward(m.get(), d.get());
   }
   return rec;

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "common/result.h"
 #include "control/unit_force_map.h"
@@ -23,7 +24,8 @@ struct BenchRecording {
   double unit_force = 0;     // N, the plugin's settled force of one unit (SettledUnitForce)
   double timestep = 0;       // s, the model's physics timestep
   nlohmann::json plant;      // the bundle it was recorded on (identification/plant_record.h)
-  double tendon_length = 0;  // m, held (the bundle's tendon at the recorded pose)
+  double tendon_length = 0;  // m, held (the bundle's tendon at the recorded pose, at t = 0)
+  std::vector<double> lengths;  // m, the tendon's length at each sample
   double stretch = 0;        // m, the units' extension there
   std::string pose;          // e.g. "elbow 0.0 deg", empty when nothing was held
   UnitGeometry geometry;     // the bundle's unit and reference length
@@ -34,6 +36,9 @@ struct RecordOptions {
   // longest. The first limited hinge or slide joint that moves the tendon is set (others stay
   // at qpos0); a model without one (a fixed bench) is recorded as it is.
   double length_place = 1.0;
+  // > 0: instead of holding, drive the joint over its range and back with this period (s), to
+  // record the units while the tendon moves (the fit's checks; docs/identification.md).
+  double sweep_period = 0;
 };
 
 // `actuator`: the bundle's actuator name; empty for the model's first bundle.

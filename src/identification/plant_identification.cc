@@ -2,7 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <limits>
 
+#include "control/kalman_estimator.h"
 #include "control/unit_force_map.h"
 #include "identification/bench_recorder.h"
 #include "identification/excitation.h"
@@ -17,21 +20,139 @@ Excitation ExcitationFor(const PlantIdentificationOptions& o, double duration, s
   return MakeExcitation(settle, total, seed);
 }
 
-// R^2 and RMSE of the mean force the chain and the map predict for a recording held at another
-// length (the realized switching fractions as inputs, as in the fit).
-FitMetrics CheckAtLength(const TransientChain& chain, const UnitForceMap& map,
-                         const BenchRecording& rec) {
-  const SwitchingLog& log = rec.log;
+// The mean counts per state at each sample of a recording (realized switching fractions as
+// inputs, as in the fit), one row per sample.
+Eigen::MatrixXd MeanCounts(const TransientChain& chain, const SwitchingLog& log) {
   const int m = chain.num_states();
-  Eigen::RowVectorXd h(m);
-  map.Forces(rec.tendon_length, h);
-  Eigen::VectorXd x = Eigen::VectorXd::Zero(m), predicted(log.size());
+  Eigen::MatrixXd X(log.size(), m);
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(m);
   x[chain.cold()] = log.num_units;
   for (int k = 0; k < log.size(); ++k) {
-    predicted[k] = h.dot(x);
+    X.row(k) = x.transpose();
     chain.PropagateMean(log.InputOn(k), log.InputOff(k), x);
   }
-  return Score(predicted, log, 0, log.size());
+  return X;
+}
+
+// R^2 and RMSE of the mean force the chain and the map predict over samples [begin, end).
+FitMetrics CheckAtLength(const TransientChain& chain, const UnitForceMap& map,
+                         const BenchRecording& rec, int begin, int end) {
+  const Eigen::MatrixXd X = MeanCounts(chain, rec.log);
+  Eigen::RowVectorXd h(chain.num_states());
+  Eigen::VectorXd predicted(rec.log.size());
+  for (int k = 0; k < rec.log.size(); ++k) {
+    map.Forces(rec.lengths[k], h);
+    predicted[k] = h.dot(X.row(k));
+  }
+  return Score(predicted, rec.log, begin, end);
+}
+
+// The fractions that best fit the first `fraction` of every recording, the chain fixed:
+// bounded Gauss-Newton (Levenberg-Marquardt damping) on sum_k (y_k - sum_i x_ki T(xi_i, s_k))^2
+// from xi0. Recordings at several lengths and in motion pin what one length cannot: states
+// slack at the longest tendon, and the stress each state's transformation sees in use.
+Eigen::VectorXd RefineFractions(const TransientChain& chain, const UnitForceMap& map0,
+                                const std::vector<BenchRecording>& recs, double fraction) {
+  const int m = chain.num_states();
+  const sma::UnitModel& unit = map0.unit();
+  std::vector<Eigen::MatrixXd> X;
+  for (const auto& r : recs) X.push_back(MeanCounts(chain, r.log));
+  auto cost_and_normal = [&](const Eigen::VectorXd& xi, Eigen::MatrixXd* JtJ, Eigen::VectorXd* g) {
+    double cost = 0;
+    if (JtJ) JtJ->setZero(m, m), g->setZero(m);
+    Eigen::RowVectorXd row(m);
+    for (size_t r = 0; r < recs.size(); ++r) {
+      const int n = static_cast<int>(fraction * recs[r].log.size());
+      for (int k = 0; k < n; ++k) {
+        const double s = map0.Stretch(recs[r].lengths[k]);
+        double predicted = 0;
+        for (int i = 0; i < m; ++i) {
+          double slope;
+          predicted += X[r](k, i) * unit.Tension(xi[i], s, &slope);
+          row[i] = X[r](k, i) * slope;
+        }
+        const double e = recs[r].log.force[k] - predicted;
+        cost += e * e;
+        if (JtJ) {
+          JtJ->noalias() += row.transpose() * row;
+          *g -= e * row.transpose();  // gradient of cost / 2
+        }
+      }
+    }
+    return cost;
+  };
+  Eigen::VectorXd xi = map0.fractions();
+  Eigen::MatrixXd JtJ;
+  Eigen::VectorXd g;
+  double cost = cost_and_normal(xi, &JtJ, &g), damping = 1e-3;
+  for (int it = 0; it < 30; ++it) {
+    bool improved = false;
+    for (int tries = 0; tries < 10 && !improved; ++tries) {
+      Eigen::MatrixXd M = JtJ;
+      M.diagonal().array() += damping * (JtJ.diagonal().array() + 1e-9 * JtJ.trace() / m + 1e-12);
+      const Eigen::VectorXd trial = (xi - M.ldlt().solve(g)).cwiseMax(0.0).cwiseMin(1.0);
+      const double c = cost_and_normal(trial, nullptr, nullptr);
+      if (c < cost) {
+        const bool converged = cost - c < 1e-10 * cost;
+        xi = trial;
+        cost = cost_and_normal(xi, &JtJ, &g);
+        damping = std::max(damping / 3, 1e-9);
+        improved = true;
+        if (converged) return xi;
+      } else {
+        damping *= 10;
+      }
+    }
+    if (!improved) break;
+  }
+  return xi;
+}
+
+// Negative log-likelihood of recordings under the length-aware filter with
+// R = R0 + rho^2 (H x^-)^2, the filter driven by the broadcasts as in operation.
+double NegLogLikelihood(const FilterModel& model, const UnitForceMap& map,
+                        const std::vector<BenchRecording>& recs, double rho) {
+  double total = 0;
+  const double r0 = model.R(0, 0);
+  Eigen::RowVectorXd h(model.num_states());
+  for (const BenchRecording& rec : recs) {
+    auto est = KalmanOnCountEstimator::Create(model, CovarianceMode::kExtended, map, rho);
+    if (!est) return std::numeric_limits<double>::infinity();
+    KalmanOnCountEstimator& e = **est;
+    const SwitchingLog& log = rec.log;
+    for (int k = 0; k < log.size(); ++k) {
+      map.Forces(rec.lengths[k], h);
+      const Eigen::VectorXd& x = e.filter().estimate();
+      const double predicted = h.dot(x);
+      const double s = h * e.filter().covariance() * h.transpose() + r0 +
+                       rho * rho * predicted * predicted;
+      const double innovation = log.force[k] - predicted;
+      total += std::log(s) + innovation * innovation / s;
+      e.Observe(log.force[k], rec.lengths[k]);
+      e.Broadcasted({log.p_on[k], log.p_off[k]});
+    }
+  }
+  return total;
+}
+
+// The rho in [0, 0.5] of the largest likelihood (golden section): the part of the force model's
+// error that grows with the force, seen when it is carried to other lengths.
+double FitRelativeNoise(const FilterModel& model, const UnitForceMap& map,
+                        const std::vector<BenchRecording>& recs) {
+  double a = 0, b = 0.5;
+  const double g = (std::sqrt(5.0) - 1) / 2;
+  double x1 = b - g * (b - a), x2 = a + g * (b - a);
+  double f1 = NegLogLikelihood(model, map, recs, x1), f2 = NegLogLikelihood(model, map, recs, x2);
+  for (int it = 0; it < 40 && b - a > 1e-4; ++it) {
+    if (f1 < f2) {
+      b = x2, x2 = x1, f2 = f1, x1 = b - g * (b - a);
+      f1 = NegLogLikelihood(model, map, recs, x1);
+    } else {
+      a = x1, x1 = x2, f1 = f2, x2 = a + g * (b - a);
+      f2 = NegLogLikelihood(model, map, recs, x2);
+    }
+  }
+  return (a + b) / 2;
 }
 
 }  // namespace
@@ -47,6 +168,7 @@ Result<PlantIdentification> IdentifyOnPlant(const std::string& model_path,
   if (!(o.dT > 0) || !(o.duration > 0) || !(o.settle > 0) || !(o.check_duration > 0)) {
     return Error{"identify: dT, duration, settle and check duration must be > 0 s"};
   }
+  // 1-2. The chain and its forces, held at the longest tendon.
   auto rec = RecordBench(model_path, actuator, ExcitationFor(o, o.duration, o.seed), o.dT, o.seed);
   if (!rec) return Error{rec.error()};
   FitOptions fo;
@@ -59,31 +181,52 @@ Result<PlantIdentification> IdentifyOnPlant(const std::string& model_path,
   auto map = UnitForceMap::FromForces(rec->geometry, rec->stretch, c.force);
   if (!map) return Error{"identify: " + map.error()};
 
+  // 3. Recordings at other lengths and in motion (a limb only): the fractions refined on the
+  // first part of every recording, the checks scored on the rest.
+  std::vector<BenchRecording> recordings = {*rec};
+  std::vector<std::string> poses;
+  if (!rec->pose.empty()) {
+    std::vector<RecordOptions> plan;
+    for (double place : o.check_places) plan.push_back({place, 0.0});
+    plan.push_back({1.0, o.sweep_period});
+    for (size_t i = 0; i < plan.size(); ++i) {
+      const std::uint64_t seed = o.seed + 1 + i;
+      auto chk = RecordBench(model_path, actuator, ExcitationFor(o, o.check_duration, seed), o.dT,
+                             seed, plan[i]);
+      if (!chk) return Error{chk.error()};
+      char moving[80];
+      std::snprintf(moving, sizeof moving, "moving over the range, period %g s", o.sweep_period);
+      poses.push_back(plan[i].sweep_period > 0 ? moving : chk->pose);
+      recordings.push_back(std::move(chk).value());
+    }
+    const double train = 1.0 - o.holdout;
+    auto refined = UnitForceMap::FromFractions(rec->geometry,
+                                               RefineFractions(c, *map, recordings, train));
+    if (!refined) return Error{"identify: " + refined.error()};
+    map = std::move(refined);
+  }
+
   PlantIdentification out;
   out.fit = *fit;
   out.log = rec->log;
-  // The fitted forces become those of the fractions (>= 0, on the force law) at the pose.
+  nlohmann::json checks = nlohmann::json::array();
+  for (size_t i = 1; i < recordings.size(); ++i) {
+    const int n = recordings[i].log.size();
+    const int begin = static_cast<int>((1.0 - o.holdout) * n);
+    LengthCheck lc{poses[i - 1], recordings[i].tendon_length,
+                   CheckAtLength(c, *map, recordings[i], begin, n)};
+    checks.push_back({{"pose", lc.pose}, {"holdout", MetricsJson(lc.fit)}});
+    out.checks.push_back(lc);
+  }
+  // The exported H: the forces of the fractions at the recorded pose (>= 0, on the force law).
   TransientChain exported = c;
   map->Forces(rec->tendon_length, exported.force);
   const FilterModel model =
       ToFilterModel(exported, rec->log.num_units, rec->log.dT, fit->force_noise_var);
   if (Status s = model.Validate("identified model"); !s) return Error{s.error()};
+  // 4. R's part that grows with the force, by maximum likelihood over every recording.
+  const double rho = FitRelativeNoise(model, *map, recordings);
 
-  nlohmann::json checks = nlohmann::json::array();
-  if (!rec->pose.empty()) {
-    for (size_t i = 0; i < o.check_places.size(); ++i) {
-      RecordOptions ro;
-      ro.length_place = o.check_places[i];
-      const std::uint64_t seed = o.seed + 1 + i;
-      auto chk = RecordBench(model_path, actuator, ExcitationFor(o, o.check_duration, seed), o.dT,
-                             seed, ro);
-      if (!chk) return Error{chk.error()};
-      LengthCheck lc{chk->pose, chk->tendon_length, CheckAtLength(c, *map, *chk)};
-      checks.push_back(
-          {{"pose", lc.pose}, {"tendon_length_m", lc.tendon_length}, {"fit", MetricsJson(lc.fit)}});
-      out.checks.push_back(lc);
-    }
-  }
   const Eigen::VectorXd& xi = map->fractions();
   nlohmann::json j = model.ToJson();
   j["identification"] = {
@@ -105,6 +248,7 @@ Result<PlantIdentification> IdentifyOnPlant(const std::string& model_path,
       {"two_state_holdout", MetricsJson(fit->two_state_holdout)},
       {"length_checks", checks},
       {"R_N2", fit->force_noise_var},
+      {"relative_noise", rho},
       {"plant", rec->plant}};
   out.model = std::move(j);
   return out;

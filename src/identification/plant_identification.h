@@ -31,6 +31,8 @@ struct PlantIdentificationOptions {
   // Places in the tendon's length range (0 shortest, 1 longest) of the check recordings.
   std::vector<double> check_places = {0.0, 0.5};
   double check_duration = 300;  // s per check
+  // A further check with the joint driven over its range and back with this period (s).
+  double sweep_period = 20;
 };
 
 struct LengthCheck {
