@@ -77,7 +77,10 @@ Result<nlohmann::json> IdentifyFromLog(const IdentifyArgs& a, const std::string&
   opt.smoothness = a.smoothness;
   auto fit = IdentifyTransientModel(*log, opt);
   if (!fit) return Error{fit.error()};
-  const TransientChain& c = fit->chain;
+  // Forces below zero (a few hundredths of a newton in the cooling tail) are none: H >= 0. With
+  // the plant unknown, no force law carries H to other lengths (that needs --bench).
+  TransientChain c = fit->chain;
+  c.force = c.force.cwiseMax(0.0);
   const FilterModel model = ToFilterModel(c, log->num_units, log->dT, fit->force_noise_var);
   if (Status s = model.Validate("identified model"); !s) return Error{s.error()};
   nlohmann::json j = model.ToJson();

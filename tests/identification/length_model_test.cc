@@ -102,10 +102,10 @@ TEST(LengthModel, IdentificationAtTheLongestTendonRecoversEveryStatesFraction) {
   }
 }
 
-// Mean on-count NEES at instants 400, 500 and 600 (in the random switching) over 400 independent runs of 60 units, the
-// tendon moving +-1.5 mm around its reference (period 20 s) while the broadcasts excite the
-// chain. For a consistent filter each NEES is chi-square with 1 dof: the mean of 400 is within
-// 1 +- 3 sqrt(2 / 400) = [0.79, 1.21] (3 sigma).
+// Mean on-count NEES at instants 400, 500 and 600 (in the random switching) over 400 independent
+// runs of 60 units, the tendon moving +-1.5 mm around its reference (period 20 s) while the
+// broadcasts excite the chain. For a consistent filter each NEES is chi-square with 1 dof: the mean
+// of 400 is within 1 +- 3 sqrt(2 / 400) = [0.79, 1.21] (3 sigma).
 std::vector<double> MeanNees(bool length_aware) {
   const UnitGeometry g = Geometry();
   auto map = UnitForceMap::FromFractions(g, KnownFractions());

@@ -1,0 +1,143 @@
+#include "sim/plant.h"
+
+#include <algorithm>
+#include <limits>
+
+namespace recruit::sim {
+
+Result<std::unique_ptr<Plant>> Plant::Create(const Task& task) {
+  const std::string where = task.source.empty() ? task.name : task.source;
+  std::unique_ptr<Plant> p(new Plant());
+  p->task_ = &task;
+  char load_error[1000] = "";
+  p->model_.reset(mj_loadXML(task.model_path.c_str(), nullptr, load_error, sizeof load_error));
+  if (!p->model_) {
+    return Error{where + ".model: cannot load '" + task.model_path + "': " + load_error};
+  }
+  mjModel* m = p->model_.get();
+  if (task.timestep > 0) m->opt.timestep = task.timestep;
+  auto host = sma::SmaHost::Create(m);
+  if (!host.ok()) return Error{where + ".model: " + host.error()};
+  p->host_ = std::move(host).value();
+
+  for (const std::string* name : {&task.agonist, &task.antagonist}) {
+    if (name->empty()) continue;
+    const int b = p->host_->BundleIndex(*name);
+    if (b < 0) {
+      std::string have;
+      for (int i = 0; i < p->host_->num_bundles(); ++i) {
+        have += (i ? ", " : "") + p->host_->bundle_name(i);
+      }
+      return Error{where + "." + (name == &task.agonist ? "agonist" : "antagonist") + ": '" +
+                   *name + "' is not an SMA bundle of '" + task.model_path +
+                   "'; bundles: " + (have.empty() ? "none" : have)};
+    }
+    p->bundles_.push_back(b);
+  }
+  if (!task.joint.empty()) {
+    const int joint = mj_name2id(m, mjOBJ_JOINT, task.joint.c_str());
+    if (joint < 0) {
+      return Error{where + ".joint: no joint '" + task.joint + "' in '" + task.model_path + "'"};
+    }
+    if (m->jnt_type[joint] != mjJNT_HINGE) {
+      return Error{where + ".joint: '" + task.joint + "' must be a hinge"};
+    }
+    p->qadr_ = m->jnt_qposadr[joint];
+    p->dadr_ = m->jnt_dofadr[joint];
+  }
+  for (size_t i = 0; i < task.pushes.size(); ++i) {
+    const int id = mj_name2id(m, mjOBJ_BODY, task.pushes[i].body.c_str());
+    if (id < 0) {
+      return Error{where + ".pushes[" + std::to_string(i) + "].body: no body '" +
+                   task.pushes[i].body + "' in '" + task.model_path + "'"};
+    }
+    p->push_body_.push_back(id);
+  }
+  for (size_t i = 0; i < task.payloads.size(); ++i) {
+    const int id = mj_name2id(m, mjOBJ_BODY, task.payloads[i].body.c_str());
+    if (id <= 0) {
+      return Error{where + ".payloads[" + std::to_string(i) + "].body: no body '" +
+                   task.payloads[i].body + "' in '" + task.model_path + "'"};
+    }
+    p->payload_body_.push_back(id);
+  }
+  p->body_mass0_.assign(m->body_mass, m->body_mass + m->nbody);
+  p->body_inertia0_.assign(m->body_inertia, m->body_inertia + 3 * m->nbody);
+  p->data_.reset(mj_makeData(m));
+  return p;
+}
+
+void Plant::Reset(std::uint64_t seed) {
+  mjModel* m = model_.get();
+  std::copy(body_mass0_.begin(), body_mass0_.end(), m->body_mass);
+  std::copy(body_inertia0_.begin(), body_inertia0_.end(), m->body_inertia);
+  payload_done_.assign(task_->payloads.size(), false);
+  mj_resetData(m, data_.get());
+  ApplyPayloads();
+  host_->Reset(data_.get(), seed);
+  mj_forward(m, data_.get());
+  peak_temperature_.assign(bundles_.size(), -std::numeric_limits<double>::infinity());
+  peak_stress_.assign(bundles_.size(), 0.0);
+  TrackPeaks();
+}
+
+void Plant::Step() {
+  ApplyPayloads();
+  ApplyPushes();
+  mj_step(model_.get(), data_.get());
+  TrackPeaks();
+}
+
+void Plant::ApplyPayloads() {
+  mjModel* m = model_.get();
+  const double t = data_->time, h = m->opt.timestep;
+  for (size_t i = 0; i < task_->payloads.size(); ++i) {
+    if (payload_done_[i] || t + 0.5 * h < task_->payloads[i].time) continue;
+    const int id = payload_body_[i];
+    // Scale the inertia with the mass: the payload keeps its shape.
+    const double ratio = task_->payloads[i].mass / m->body_mass[id];
+    m->body_mass[id] = task_->payloads[i].mass;
+    for (int k = 0; k < 3; ++k) m->body_inertia[3 * id + k] *= ratio;
+    payload_done_[i] = true;
+  }
+}
+
+void Plant::ApplyPushes() {
+  // Pushes act through xfrc_applied while active; several may share a body, so clear all first
+  // and then add the active ones.
+  const double t = data_->time, h = model_->opt.timestep;
+  for (size_t i = 0; i < task_->pushes.size(); ++i) {
+    for (int k = 0; k < 6; ++k) data_->xfrc_applied[6 * push_body_[i] + k] = 0;
+  }
+  for (size_t i = 0; i < task_->pushes.size(); ++i) {
+    const Push& p = task_->pushes[i];
+    if (t + 0.5 * h < p.start || t + 0.5 * h >= p.start + p.duration) continue;
+    double* x = data_->xfrc_applied + 6 * push_body_[i];
+    for (int k = 0; k < 3; ++k) {
+      x[k] += p.force[k];
+      x[3 + k] += p.torque[k];
+    }
+  }
+}
+
+void Plant::TrackPeaks() {
+  for (int i = 0; i < num_bundles(); ++i) {
+    const sma::SmaBundle& bundle = host_->bundle(bundles_[i]);
+    const double* state = host_->State(data_.get(), bundles_[i]);
+    peak_temperature_[i] = std::max(peak_temperature_[i], bundle.MaxTemperature(state));
+    peak_stress_[i] = std::max(
+        peak_stress_[i], bundle.MaxWireStress(state, host_->Stretch(data_.get(), bundles_[i])));
+  }
+}
+
+Status Plant::CheckFinite() const {
+  for (int k = 0; k < model_->nq; ++k) {
+    if (!std::isfinite(data_->qpos[k])) {
+      return Error{"the simulation diverged at t = " + std::to_string(data_->time) +
+                   " s (NaN in qpos); try a smaller timestep"};
+    }
+  }
+  return Status::Ok();
+}
+
+}  // namespace recruit::sim

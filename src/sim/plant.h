@@ -1,0 +1,82 @@
+// Plant: the MuJoCo side of a task, what a lab's rig would be. The limb model with its SMA
+// bundles (the task's agonist and antagonist), the tracked joint, the payload changes and pushes
+// the task schedules, and the peaks of each bundle's units against their datasheet limits.
+// The controller side (load cells, estimators, recruitment controllers, the outer loop) only
+// reads it (forces, tendon lengths, the joint) and broadcasts to its bundles.
+#pragma once
+
+#include <mujoco/mujoco.h>
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "common/mujoco_ptr.h"
+#include "common/result.h"
+#include "plugin/sma_host.h"
+#include "sim/task.h"
+
+namespace recruit::sim {
+
+class Plant {
+ public:
+  // Loads task.model_path (timestep overridden by task.timestep when > 0) and finds the task's
+  // bundles, joint and bodies; errors name the task file's field.
+  static Result<std::unique_ptr<Plant>> Create(const Task& task);
+
+  // Every unit off and cold (the units' streams seeded by `seed`), the model at rest, forces
+  // computed; the payloads due at t = 0 applied.
+  void Reset(std::uint64_t seed);
+  // The disturbances due at the current time (payload changes, pushes), then one physics step.
+  void Step();
+  // After a step: a NaN in qpos is an error naming the time (the simulation diverged).
+  Status CheckFinite() const;
+
+  const mjModel* model() const { return model_.get(); }
+  mjData* data() const { return data_.get(); }
+  const sma::SmaHost& host() const { return *host_; }
+  double time() const { return data_->time; }
+  double timestep() const { return model_->opt.timestep; }
+
+  // Bundles: 0 the agonist, 1 the antagonist (when the task has one).
+  int num_bundles() const { return static_cast<int>(bundles_.size()); }
+  int bundle_index(int i) const { return bundles_[i]; }  // in the host
+  const std::string& bundle_name(int i) const { return host_->bundle_name(bundles_[i]); }
+  int num_units(int i) const { return host_->num_units(bundles_[i]); }
+  double Force(int i) const { return host_->Force(data_.get(), bundles_[i]); }  // exact, N
+  double TendonLength(int i) const { return data_->ten_length[host_->tendon_id(bundles_[i])]; }
+  int OnCount(int i) const { return host_->OnCount(data_.get(), bundles_[i]); }
+  Status Broadcast(int i, double p_on, double p_off) {
+    return host_->Broadcast(data_.get(), bundles_[i], p_on, p_off);
+  }
+
+  // The tracked joint (a hinge), when the task names one.
+  bool has_joint() const { return qadr_ >= 0; }
+  double angle() const { return qadr_ >= 0 ? data_->qpos[qadr_] : 0.0; }
+  double angular_velocity() const { return dadr_ >= 0 ? data_->qvel[dadr_] : 0.0; }
+
+  // Hottest unit and most stressed wire of bundle i since Reset.
+  double peak_temperature(int i) const { return peak_temperature_[i]; }
+  double peak_wire_stress(int i) const { return peak_stress_[i]; }
+
+ private:
+  Plant() = default;
+  void ApplyPayloads();
+  void ApplyPushes();
+  void TrackPeaks();
+
+  const Task* task_ = nullptr;
+  ModelPtr model_;
+  DataPtr data_;
+  std::unique_ptr<sma::SmaHost> host_;
+  std::vector<int> bundles_;
+  int qadr_ = -1, dadr_ = -1;
+  std::vector<int> push_body_, payload_body_;
+  std::vector<bool> payload_done_;
+  std::vector<double> peak_temperature_, peak_stress_;
+  // Each payload body's mass and inertia as loaded (Reset restores them).
+  std::vector<double> body_mass0_, body_inertia0_;
+};
+
+}  // namespace recruit::sim
