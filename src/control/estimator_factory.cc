@@ -17,13 +17,6 @@
 namespace recruit::control {
 namespace {
 
-bool IsKind(const std::string& k) {
-  return k == "output" || k == "kalman2" || k == "kalman-augmented";
-}
-bool IsCovariance(const std::string& c) {
-  return c == "extended" || c == "conservative" || c == "plain";
-}
-
 // A relative path is tried from the working directory, then from the source tree (so that the
 // shipped models/identified/ files are found from a build directory too).
 std::string ResolveModelPath(const std::string& path) {
@@ -39,14 +32,33 @@ std::string ResolveModelPath(const std::string& path) {
 
 }  // namespace
 
+Result<EstimatorKind> ParseEstimatorKind(const std::string& name) {
+  if (name == "output") return EstimatorKind::kOutput;
+  if (name == "kalman2") return EstimatorKind::kKalman2;
+  if (name == "kalman-augmented") return EstimatorKind::kKalmanAugmented;
+  return Error{"estimator: kind \"" + name +
+               "\" is not one of \"output\", \"kalman2\", \"kalman-augmented\""};
+}
+
+const char* EstimatorKindName(EstimatorKind kind) {
+  switch (kind) {
+    case EstimatorKind::kOutput:
+      return "output";
+    case EstimatorKind::kKalman2:
+      return "kalman2";
+    case EstimatorKind::kKalmanAugmented:
+      return "kalman-augmented";
+  }
+  return "?";
+}
+
 Result<EstimatorSpec> EstimatorSpec::Parse(const std::string& kind, const std::string& covariance,
                                            const std::string& model_file, int num_states,
                                            double force_noise_std) {
-  if (!IsKind(kind)) {
-    return Error{"estimator: kind \"" + kind +
-                 "\" is not one of \"output\", \"kalman2\", \"kalman-augmented\""};
-  }
-  if (!IsCovariance(covariance)) {
+  auto k = ParseEstimatorKind(kind);
+  if (!k) return Error{k.error()};
+  auto c = ParseCovarianceMode(covariance);
+  if (!c) {
     return Error{"estimator: covariance \"" + covariance +
                  "\" is not one of \"extended\", \"conservative\", \"plain\""};
   }
@@ -60,8 +72,8 @@ Result<EstimatorSpec> EstimatorSpec::Parse(const std::string& kind, const std::s
                  " N must be finite and >= 0 (0 = default)"};
   }
   EstimatorSpec s;
-  s.kind = kind;
-  s.covariance = covariance;
+  s.kind = *k;
+  s.covariance = *c;
   s.model_file = model_file;
   s.num_states = num_states;
   s.force_noise_std = force_noise_std;
@@ -70,7 +82,11 @@ Result<EstimatorSpec> EstimatorSpec::Parse(const std::string& kind, const std::s
 
 Result<EstimatorSpec> EstimatorSpec::FromJson(const nlohmann::json& j, const std::string& where) {
   if (!j.is_object()) return Error{where + ": estimator must be a JSON object"};
-  EstimatorSpec d;
+  struct {
+    std::string kind = "kalman-augmented", covariance = "extended", model_file;
+    int num_states = 20;
+    double force_noise_std = 0;
+  } d;
   auto str = [&](const char* key, std::string& out) -> Status {
     if (!j.contains(key)) return Status::Ok();
     if (!j[key].is_string()) return Error{where + ": estimator." + key + " must be a string"};
@@ -158,8 +174,8 @@ Result<UnitForceMap> ModelForceMap(const FilterModel& model, const nlohmann::jso
 Result<std::unique_ptr<OnCountEstimator>> MakeEstimator(const EstimatorSpec& spec, int num_units,
                                                         double unit_force, double dT,
                                                         const UnitGeometry* geometry) {
-  auto checked = EstimatorSpec::Parse(spec.kind, spec.covariance, spec.model_file, spec.num_states,
-                                      spec.force_noise_std);
+  auto checked = EstimatorSpec::Parse(EstimatorKindName(spec.kind), ToString(spec.covariance),
+                                      spec.model_file, spec.num_states, spec.force_noise_std);
   if (!checked) return Error{checked.error()};
   if (num_units < 1) return Error{"estimator: num_units must be >= 1"};
   if (!std::isfinite(unit_force) || unit_force <= 0) {
@@ -174,16 +190,15 @@ Result<std::unique_ptr<OnCountEstimator>> MakeEstimator(const EstimatorSpec& spe
     if (!map) return Error{"estimator: " + map.error()};
     on_force = std::move(map).value();
   }
-  if (spec.kind == "output") {
+  if (spec.kind == EstimatorKind::kOutput) {
     return std::unique_ptr<OnCountEstimator>(
         new OutputOnlyEstimator(num_units, unit_force, std::move(on_force)));
   }
-  auto mode = ParseCovarianceMode(spec.covariance);
-  if (!mode) return Error{"estimator: " + mode.error()};
+  const CovarianceMode mode = spec.covariance;
   FilterModel model;
   std::optional<UnitForceMap> output;
   double relative_noise = 0;
-  if (spec.kind == "kalman2") {
+  if (spec.kind == EstimatorKind::kKalman2) {
     const double sd = spec.force_noise_std > 0 ? spec.force_noise_std : unit_force;
     model = FilterModel::TwoState(num_units, dT, unit_force, sd);
     if (geometry) {
@@ -247,7 +262,7 @@ Result<std::unique_ptr<OnCountEstimator>> MakeEstimator(const EstimatorSpec& spe
     return Error{"estimator: sensor_variance must be finite and >= 0 N^2"};
   }
   model.R(0, 0) += spec.sensor_variance;
-  auto est = KalmanOnCountEstimator::Create(model, *mode, std::move(output), relative_noise);
+  auto est = KalmanOnCountEstimator::Create(model, mode, std::move(output), relative_noise);
   if (!est) return Error{"estimator: " + est.error()};
   return std::unique_ptr<OnCountEstimator>(std::move(est).value());
 }

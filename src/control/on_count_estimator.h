@@ -24,6 +24,7 @@
 #include "common/result.h"
 #include "control/broadcast.h"
 #include "control/unit_force_map.h"
+#include "estimation/population_kalman_filter.h"
 
 namespace recruit::control {
 
@@ -52,10 +53,17 @@ class OnCountEstimator {
   virtual std::vector<bool> OnStates() const = 0;
 };
 
-// What estimator to build. Validated by Parse / FromJson.
+// The estimator kinds, named "output", "kalman2", "kalman-augmented" in task files, sweeps and
+// on the command line (ParseEstimatorKind, EstimatorKindName).
+enum class EstimatorKind { kOutput, kKalman2, kKalmanAugmented };
+Result<EstimatorKind> ParseEstimatorKind(const std::string& name);
+const char* EstimatorKindName(EstimatorKind kind);
+
+// What estimator to build: the one typed value the task file, the command line and a sweep all
+// produce (Parse / FromJson validate the names and values).
 struct EstimatorSpec {
-  std::string kind = "kalman-augmented";  // "output", "kalman2", "kalman-augmented"
-  std::string covariance = "extended";    // "extended", "conservative", "plain" (Kalman kinds)
+  EstimatorKind kind = EstimatorKind::kKalmanAugmented;
+  CovarianceMode covariance = CovarianceMode::kExtended;  // Kalman kinds
   // kalman-augmented: the FilterModel file. Empty: DefaultModelFile(dT, num_states).
   std::string model_file;
   int num_states = 20;  // kalman-augmented: states of the model (checked against the file)

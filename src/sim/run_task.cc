@@ -156,7 +156,8 @@ Result<std::vector<Channel> > MakeChannels(const Task& task, const ControllerSet
     }
     // No model named: the one identified on this bundle for this dT, from the model search path,
     // else identified now and cached (identification/model_cache.h).
-    if (bundle_spec.kind == "kalman-augmented" && bundle_spec.model_file.empty()) {
+    if (bundle_spec.kind == control::EstimatorKind::kKalmanAugmented &&
+        bundle_spec.model_file.empty()) {
       control::ModelRequest req{task.model_path, host.bundle_name(b), bundle_spec.plant,
                                 settings.dT, bundle_spec.num_states};
       auto file = control::FindOrIdentifyModel(req, options.identify_missing_models,

@@ -71,8 +71,9 @@ LoopResult RunBench(const EstimatorSpec& spec, double dT, double lambda, std::ui
   std::printf(
       "  %-16s %-12s dT %.1f lambda %.1f seed %llu: max force %.2f N (ref %.1f), max on %d "
       "(target %.1f), late |err| %.3f N, on-count RMSE %.2f\n",
-      spec.kind.c_str(), spec.covariance.c_str(), dT, lambda, static_cast<unsigned long long>(seed),
-      r.max_force, reference, r.max_on, r.target_on, r.late_error, r.count_rmse);
+      EstimatorKindName(spec.kind), ToString(spec.covariance), dT, lambda,
+      static_cast<unsigned long long>(seed), r.max_force, reference, r.max_on, r.target_on,
+      r.late_error, r.count_rmse);
   return r;
 }
 

@@ -73,8 +73,8 @@ TEST(EstimatorSpec, FromJsonNamesTheFileAndField) {
   auto ok = EstimatorSpec::FromJson(
       nlohmann::json::parse(R"({"kind":"kalman2","covariance":"conservative"})"), "task.json");
   ASSERT_TRUE(ok.ok()) << ok.error();
-  EXPECT_EQ(ok->kind, "kalman2");
-  EXPECT_EQ(ok->covariance, "conservative");
+  EXPECT_EQ(ok->kind, EstimatorKind::kKalman2);
+  EXPECT_EQ(ok->covariance, CovarianceMode::kConservative);
   auto bad =
       EstimatorSpec::FromJson(nlohmann::json::parse(R"({"num_states":"many"})"), "task.json");
   ASSERT_FALSE(bad.ok());

@@ -9,10 +9,10 @@
 #include <nlohmann/json.hpp>
 
 #include "common/rng.h"
-#include "identification/model_export.h"
 #include "control/on_count_estimator.h"
-#include "identification/transient_chain.h"
 #include "estimation/filter_model.h"
+#include "identification/model_export.h"
+#include "identification/transient_chain.h"
 
 namespace recruit::control {
 namespace {
