@@ -18,6 +18,7 @@
 #include "identification/model_cache.h"
 #include "identification/plant_record.h"
 #include "plugin/sma_host.h"
+#include "sim/metrics_stream.h"
 #include "sim/plant.h"
 #define RECRUIT_SIM_CLOSED_LOOP 1
 #endif
@@ -124,7 +125,8 @@ namespace {
 struct Channel {
   ForceSensor sensor;
   control::RecruitmentController controller;
-  std::vector<double> estimated, variance, truth;  // per control instant
+  EstimatorScoreAccumulator score;  // the estimate against the truth at the control instants
+  SwitchingCounter switches;        // on-count after each broadcast
 };
 
 Result<std::vector<Channel> > MakeChannels(const Task& task, const ControllerSettings& settings,
@@ -172,7 +174,8 @@ Result<std::vector<Channel> > MakeChannels(const Task& task, const ControllerSet
     auto sensor =
         ForceSensor::Create(task.sensor, Rng::DeriveSeed(options.seed, kSensorStream + i));
     if (!sensor.ok()) return Error{where + ".sensor: " + sensor.error()};
-    channels.push_back({std::move(sensor).value(), std::move(c).value(), {}, {}, {}});
+    channels.push_back({std::move(sensor).value(), std::move(c).value(), {}, {}});
+    channels.back().switches.Add(plant.OnCount(i));
   }
   return channels;
 }
@@ -212,15 +215,13 @@ Status ControlBundle(Channel& ch, Plant& plant, int i, double force_ref, BundleT
   bt.p_on = bc.p_on;
   bt.p_off = bc.p_off;
   bt.force_reference = force_ref;
-  ch.estimated.push_back(bt.estimated_on);
-  ch.variance.push_back(var);
-  ch.truth.push_back(on_before);
+  ch.score.Add(bt.estimated_on, on_before, var);
   return Status::Ok();
 }
 
 // The per-step telemetry observers see.
 void FillTelemetry(const Plant& plant, double reference, double measured,
-                   const std::vector<std::vector<int> >& on_counts, TelemetrySample& sample) {
+                   const std::vector<Channel>& channels, TelemetrySample& sample) {
   sample.time = plant.time();
   sample.reference = reference;
   sample.measured = measured;
@@ -229,29 +230,20 @@ void FillTelemetry(const Plant& plant, double reference, double measured,
     const int b = plant.bundle_index(i);
     BundleTelemetry& bt = sample.bundles[i];
     bt.force = plant.Force(i);
-    bt.true_on = on_counts[i].back();
+    bt.true_on = channels[i].switches.last();
     bt.on_fraction = static_cast<double>(bt.true_on) / plant.num_units(i);
     bt.mean_temperature = plant.host().MeanTemperature(plant.data(), b);
     bt.heat = plant.host().Heat(plant.data(), b);
   }
 }
 
-// The tracked signal at every physics step, for the metrics.
-struct Signals {
-  std::vector<double> t, reference, measured;
-};
-
-void Summarize(const Task& task, const ControllerSettings& settings, const RunOptions& options,
-               const Plant& plant, const Signals& sig,
-               const std::vector<std::vector<int> >& on_counts,
+void Summarize(const Task& task, const Plant& plant, const SignalMetrics& sig,
                const std::vector<Channel>& channels, RunSummary& s) {
   const double duration = plant.time(), h = plant.timestep();
   RunMetrics& mt = s.metrics;
-  mt.tracking_rmse = TrackingRmse(sig.reference, sig.measured);
-  mt.iae = IntegralAbsoluteError(sig.t, sig.reference, sig.measured, duration + h);
-  s.steps = StepResponses(
-      sig.t, sig.measured,
-      task.reference.Steps(options.duration ? *options.duration : task.duration), task.settle_band);
+  mt.tracking_rmse = sig.TrackingRmse();
+  mt.iae = sig.IntegralAbsoluteError(duration + h);
+  s.steps = sig.StepResponses();
   mt.num_steps = static_cast<int>(s.steps.size());
   int settled = 0;
   for (const auto& st : s.steps) {
@@ -262,19 +254,19 @@ void Summarize(const Task& task, const ControllerSettings& settings, const RunOp
   }
   // A ratio of counts, so that "all settled" is exactly 1.
   if (!s.steps.empty()) mt.settled_fraction = static_cast<double>(settled) / s.steps.size();
-  mt.oscillation = ExcessTotalVariation(sig.reference, sig.measured);
+  mt.oscillation = sig.ExcessTotalVariation();
   long units = 0;
   double rate = 0;
   for (int i = 0; i < plant.num_bundles(); ++i) {
     const int n = plant.num_units(i);
-    rate += SwitchingRate(on_counts[i], n, duration) * n;
+    rate += channels[i].switches.Rate(n, duration) * n;
     units += n;
   }
   mt.switching_rate = units > 0 ? rate / units : 0;
   s.sensor = task.sensor;
   for (int i = 0; i < plant.num_bundles(); ++i) {
     const Channel& ch = channels[i];
-    const EstimatorScore es = ScoreEstimator(ch.estimated, ch.truth, ch.variance);
+    const EstimatorScore es = ch.score.Score();
     const sma::UnitLimits& lim = plant.host().bundle(plant.bundle_index(i)).limits();
     BundleSummary bs;
     bs.actuator = plant.bundle_name(i);
@@ -372,14 +364,8 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
   std::vector<double> force_ref(nb, 0.0);
   const double h = plant.timestep();
   const long num_steps = std::lround(duration / h);
-  Signals sig;
-  sig.t.reserve(num_steps);
-  sig.reference.reserve(num_steps);
-  sig.measured.reserve(num_steps);
-  // Units switch only when a broadcast reaches them, so the on-counts change only at control
-  // instants: sampled there (after the broadcast took effect) for the switching rate.
-  std::vector<std::vector<int> > on_counts(nb);
-  for (int i = 0; i < nb; ++i) on_counts[i].push_back(plant.OnCount(i));
+  // The metrics accumulate as the run goes: memory does not grow with its length.
+  SignalMetrics sig(task.reference.Steps(duration), task.settle_band);
   auto measured = [&]() {
     return task.tracked == Tracked::kForce ? plant.Force(0) : plant.angle();
   };
@@ -407,14 +393,14 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
 
     const double y = measured();
     const double r = task.reference(plant.time());
-    sig.t.push_back(plant.time());
-    sig.reference.push_back(r);
-    sig.measured.push_back(y);
+    sig.Add(plant.time(), r, y);
+    // Units switch only when a broadcast reaches them, so the on-counts change only at control
+    // instants: counted there (after the broadcast took effect) for the switching rate.
     if (sample.control_instant) {
-      for (int i = 0; i < nb; ++i) on_counts[i].push_back(plant.OnCount(i));
+      for (int i = 0; i < nb; ++i) channels[i].switches.Add(plant.OnCount(i));
     }
     if (!observers.empty()) {
-      FillTelemetry(plant, r, y, on_counts, sample);
+      FillTelemetry(plant, r, y, channels, sample);
       for (StepObserver* o : observers) {
         if (Status st = o->OnStep(plant.model(), plant.data(), sample); !st.ok()) {
           return Error{st.error()};
@@ -439,7 +425,7 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
   s.physics_steps = num_steps;
   s.control_instants = control_instants;
   s.unit = sample.reference_unit;
-  Summarize(task, settings, options, plant, sig, on_counts, channels, s);
+  Summarize(task, plant, sig, channels, s);
   for (const std::string& w : s.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
   s.wall_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();

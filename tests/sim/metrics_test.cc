@@ -5,6 +5,9 @@
 
 #include <cmath>
 
+#include "common/rng.h"
+#include "sim/metrics_stream.h"
+
 namespace recruit::sim {
 namespace {
 
@@ -134,6 +137,68 @@ TEST(Metrics, NeesOfGaussianErrorsWithTrueVarianceIsNearOne) {
     var.push_back(9.0);
   }
   EXPECT_NEAR(ScoreEstimator(est, truth, var).mean_nees, 1.0, 0.01);
+}
+
+}  // namespace
+}  // namespace recruit::sim
+
+namespace recruit::sim {
+namespace {
+
+// The streaming accumulators against the pure functions on the same signals, to the bit: noisy
+// step responses that ring through the band (so settling is decided late), a step with no
+// samples, a zero-size step, and estimator samples with NaN estimates and zero variances.
+TEST(MetricsStream, AccumulatorsEqualThePureFunctionsExactly) {
+  Rng rng(42);
+  for (int trial = 0; trial < 20; ++trial) {
+    const double h = 0.01 + 0.01 * rng.Uniform();
+    std::vector<ReferenceStep> steps = {{1.0, 0.0, 2.0, 6.0},
+                                        {6.0, 2.0, 0.5, 11.0},
+                                        {11.0, 0.5, 0.5, 14.0},
+                                        {30.0, 0.5, 1.0, 31.0}};  // after the end: no samples
+    std::vector<double> t, r, y;
+    SignalMetrics stream(steps, 0.1);
+    double state = 0, vel = 0;
+    for (double time = 0; time < 14.0; time += h) {
+      double ref = 0;
+      for (const auto& s : steps) ref = time >= s.time ? s.to : ref;
+      vel += h * (40 * (ref - state) - (2 + 4 * rng.Uniform()) * vel);
+      state += h * vel;
+      const double meas = state + 0.05 * (rng.Uniform() - 0.5);
+      t.push_back(time), r.push_back(ref), y.push_back(meas);
+      stream.Add(time, ref, meas);
+    }
+    EXPECT_EQ(stream.TrackingRmse(), TrackingRmse(r, y));
+    EXPECT_EQ(stream.IntegralAbsoluteError(14.0), IntegralAbsoluteError(t, r, y, 14.0));
+    EXPECT_EQ(stream.ExcessTotalVariation(), ExcessTotalVariation(r, y));
+    const auto a = stream.StepResponses(), b = StepResponses(t, y, steps, 0.1);
+    ASSERT_EQ(a.size(), b.size());
+    ASSERT_EQ(a.size(), 2u);
+    for (size_t i = 0; i < a.size(); ++i) {
+      EXPECT_EQ(a[i].overshoot, b[i].overshoot);
+      EXPECT_EQ(a[i].settling_time, b[i].settling_time);
+      EXPECT_EQ(a[i].settled, b[i].settled);
+      EXPECT_EQ(a[i].step.time, b[i].step.time);
+    }
+  }
+  EstimatorScoreAccumulator acc;
+  SwitchingCounter sw;
+  std::vector<double> est, truth, var;
+  std::vector<int> on;
+  for (int k = 0; k < 500; ++k) {
+    const double n = std::floor(60 * rng.Uniform());
+    const double e = k % 97 == 0 ? std::nan("") : n + 4 * (rng.Uniform() - 0.5);
+    const double v = k % 13 == 0 ? 0.0 : rng.Uniform();
+    est.push_back(e), truth.push_back(n), var.push_back(v), on.push_back(static_cast<int>(n));
+    acc.Add(e, n, v);
+    sw.Add(static_cast<int>(n));
+  }
+  const EstimatorScore a = acc.Score(), b = ScoreEstimator(est, truth, var);
+  EXPECT_EQ(a.rmse, b.rmse);
+  EXPECT_EQ(a.mean_nees, b.mean_nees);
+  EXPECT_EQ(a.within3, b.within3);
+  EXPECT_EQ(a.samples, b.samples);
+  EXPECT_EQ(sw.Rate(60, 250.0), SwitchingRate(on, 60, 250.0));
 }
 
 }  // namespace
