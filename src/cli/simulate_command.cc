@@ -63,7 +63,14 @@ int RunSimulate(const SimulateArgs& a) {
   auto result = sim::RunTask(*task, run, {&writer});
   if (!result.ok()) return Fail(cmd, result.error());
   summary_file.stream() << result->ToJson().dump(2) << "\n";
+  // Both or neither: the summary first (a failure leaves the CSV's temporary file, removed with
+  // the writer), then the CSV (a failure removes the summary just written).
   if (Status s = summary_file.Commit(); !s.ok()) return Fail(cmd, s.error(), exit_code::kIo);
+  if (Status s = writer.Commit(); !s.ok()) {
+    std::error_code ec;
+    std::filesystem::remove(summary, ec);
+    return Fail(cmd, s.error(), exit_code::kIo);
+  }
   const auto& m = result->metrics;
   std::cout << "task " << result->task << ", estimator " << result->estimator << ", dT "
             << result->dT << " s, lambda " << result->lambda << ", seed " << result->seed

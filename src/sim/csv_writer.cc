@@ -46,6 +46,11 @@ Status CsvStepWriter::Finish() {
   if (!file_.ok()) return Error{file_.error()};
   file_.stream() << buffer_;
   buffer_.clear();
+  return Status::Ok();
+}
+
+Status CsvStepWriter::Commit() {
+  if (!file_.ok()) return Error{file_.error()};
   return file_.Commit();
 }
 

@@ -1,5 +1,6 @@
 // CsvStepWriter: the per-step CSV of `recruit simulate` (docs/formats/task.md lists the columns).
-// It writes through an AtomicFile, so the CSV appears only when the run finishes.
+// It writes through an AtomicFile, so the CSV appears only when Commit is called: after the run
+// and after the run's other outputs are written (a failed summary leaves no CSV behind).
 #pragma once
 
 #include <string>
@@ -14,7 +15,8 @@ class CsvStepWriter : public StepObserver {
   // Writes every `every`-th physics step (1 = all).
   explicit CsvStepWriter(std::string path, int every = 1);
   Status OnStep(const mjModel* m, const mjData* d, const TelemetrySample& s) override;
-  Status Finish() override;
+  Status Finish() override;  // writes what is buffered (the file stays temporary)
+  Status Commit();           // the CSV appears under its name
 
  private:
   AtomicFile file_;

@@ -52,6 +52,8 @@ TEST(ClosedLoop, SimulateWritesCsvWhoseSignalsReproduceTheSummary) {
   CsvStepWriter writer(csv);
   auto r = RunTask(task, o, {&writer});
   ASSERT_TRUE(r.ok()) << r.error();
+  EXPECT_FALSE(fs::exists(csv)) << "the CSV appears only on Commit";
+  ASSERT_TRUE(writer.Commit().ok());
   const auto rows = ReadCsv(csv);
   ASSERT_GT(rows.size(), 1u);
   const auto& h = rows[0];
