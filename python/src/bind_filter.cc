@@ -49,37 +49,6 @@ FilterModel LinearModel(const py::object& H, const py::object& R, int64_t N, con
   return f;
 }
 
-// The step and run methods every filter object shares (PyFilter).
-template <class T>
-void DefSteps(py::class_<T, PyFilter>& c) {
-  c.def("predict", &T::Predict, py::arg("A"),
-        "Time update with an m x m column-stochastic transition matrix A.")
-      .def("predict_broadcast", &T::PredictBroadcast, py::arg("p_on"), py::arg("p_off"),
-           "Time update with the model's broadcast transition A(p_on, p_off).")
-      .def("update", &T::Update, py::arg("y"),
-           "Measurement update with y (r entries). None or all-NaN is a missing sample: nothing "
-           "changes and False is returned; otherwise True.")
-      .def("run", &T::Run, py::arg("ys"), py::arg("p_on") = py::none(),
-           py::arg("p_off") = py::none(), py::arg("A") = py::none(),
-           "Runs a whole log -> (X, V), the T x m estimates and covariance diagonals. For k = "
-           "0..T-1: predict with input k-1 (k > 0: p_on[k-1], p_off[k-1], or A / A[k-1], or the "
-           "model's constant A), then update with ys[k] unless the row is all-NaN. The GIL is "
-           "released meanwhile.")
-      .def_property_readonly(
-          "x", [](const T& f) { return FromVector(f.Mean()); }, "The estimate, counts per state.")
-      .def_property_readonly(
-          "P", [](const T& f) { return FromMatrix(f.Covariance()); },
-          "The covariance of the estimate (m x m).")
-      .def_property_readonly(
-          "model", [](const T& f) { return f.model(); }, "The FilterModel (a copy).")
-      .def_property_readonly(
-          "N", [](const T& f) { return f.model().N; }, "The population size.")
-      .def_property_readonly(
-          "num_states", [](const T& f) { return f.model().num_states(); }, "m.")
-      .def_property_readonly(
-          "num_outputs", [](const T& f) { return f.model().num_outputs(); }, "r.");
-}
-
 std::string FilterLog(const std::string& model_path, const std::string& log_path,
                       const std::string& estimator, int particles, uint64_t seed) {
   FilterModel model = Take(FilterModel::FromJson(model_path));
@@ -102,7 +71,36 @@ std::string FilterLog(const std::string& model_path, const std::string& log_path
 }  // namespace
 
 void BindFilter(py::module_& mod) {
-  py::class_<PyFilter>(mod, "_Filter", "Base of the filter objects (not constructible).");
+  // The step and run methods every filter object shares, bound once on the base (they
+  // dispatch to the C++ filter through PyFilter's virtual functions).
+  py::class_<PyFilter>(mod, "_Filter", "Base of the filter objects (not constructible).")
+      .def("predict", &PyFilter::Predict, py::arg("A"),
+           "Time update with an m x m column-stochastic transition matrix A.")
+      .def("predict_broadcast", &PyFilter::PredictBroadcast, py::arg("p_on"), py::arg("p_off"),
+           "Time update with the model's broadcast transition A(p_on, p_off).")
+      .def("update", &PyFilter::Update, py::arg("y"),
+           "Measurement update with y (r entries). None or all-NaN is a missing sample: nothing "
+           "changes and False is returned; otherwise True.")
+      .def("run", &PyFilter::Run, py::arg("ys"), py::arg("p_on") = py::none(),
+           py::arg("p_off") = py::none(), py::arg("A") = py::none(),
+           "Runs a whole log -> (X, V), the T x m estimates and covariance diagonals. For k = "
+           "0..T-1: predict with input k-1 (k > 0: p_on[k-1], p_off[k-1], or A / A[k-1], or the "
+           "model's constant A), then update with ys[k] unless the row is all-NaN. The GIL is "
+           "released meanwhile.")
+      .def_property_readonly(
+          "x", [](const PyFilter& f) { return FromVector(f.Mean()); },
+          "The estimate, counts per state.")
+      .def_property_readonly(
+          "P", [](const PyFilter& f) { return FromMatrix(f.Covariance()); },
+          "The covariance of the estimate (m x m).")
+      .def_property_readonly(
+          "model", [](const PyFilter& f) { return f.model(); }, "The FilterModel (a copy).")
+      .def_property_readonly(
+          "N", [](const PyFilter& f) { return f.model().N; }, "The population size.")
+      .def_property_readonly(
+          "num_states", [](const PyFilter& f) { return f.model().num_states(); }, "m.")
+      .def_property_readonly(
+          "num_outputs", [](const PyFilter& f) { return f.model().num_outputs(); }, "r.");
 
   py::class_<FilterModel>(mod, "FilterModel")
       .def_static(
@@ -209,7 +207,6 @@ void BindFilter(py::module_& mod) {
       .def_property_readonly(
           "fixed_size", [](const PyKalmanFilter& k) { return k.core().fixed_size(); },
           "True when the fixed-size C++ filter runs (m = 2, 3 or 20 with r = 1).");
-  DefSteps(kf);
 
   py::class_<PyExactFilter, PyFilter> ex(mod, "ExactFilter");
   ex.def(py::init<const FilterModel&, uint64_t, uint64_t>(), py::arg("model"),
@@ -242,7 +239,6 @@ void BindFilter(py::module_& mod) {
           "num_count_vectors",
           [](const PyExactFilter& f) { return f.filter().num_count_vectors(); },
           "S = C(N + m - 1, m - 1).");
-  DefSteps(ex);
 
   py::class_<PyParticleFilter, PyFilter> pf(mod, "ParticleFilter");
   pf.def(py::init<const FilterModel&, int, double, uint64_t>(), py::arg("model"),
@@ -262,7 +258,6 @@ void BindFilter(py::module_& mod) {
             return FromMatrix(X);
           },
           "The particles' counts, num_particles x m.");
-  DefSteps(pf);
 
   mod.def("filter_log", &FilterLog, py::arg("model_path"), py::arg("log_path"),
           py::arg("estimator") = "extended", py::arg("particles") = 1000, py::arg("seed") = 1,
