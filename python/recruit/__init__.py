@@ -27,6 +27,7 @@ import io as _io
 import json as _json
 import os as _os
 import tempfile as _tempfile
+from typing import Any, Dict, Mapping, Optional, Sequence, Tuple, Union
 
 # One libmujoco per process: the official bindings load the wheel's libmujoco.so.<version>
 # first; the plugin library and the extension link it by soname, so the loader reuses it.
@@ -59,6 +60,8 @@ if _recruit.mujoco_version() != _mujoco.mj_versionString():
         "built with")
 
 __version__ = "0.2.0"
+
+PathLike = Union[str, "_os.PathLike[str]"]
 
 FilterModel = _recruit.FilterModel
 KalmanFilter = _recruit.KalmanFilter
@@ -171,7 +174,8 @@ Controller.__doc__ = """One bundle's broadcast recruitment controller (docs/cont
     """
 
 
-def expectation_law(target_on, estimated_on, num_units, lam):
+def expectation_law(target_on: float, estimated_on: float, num_units: float,
+                    lam: float) -> Tuple[float, float]:
     """The expectation law -> (p_on, p_off) (docs/controller.md).
 
     recruit: p_on = lam (target - est) / (N - est), p_off = 0;
@@ -182,7 +186,8 @@ def expectation_law(target_on, estimated_on, num_units, lam):
                                     float(lam))
 
 
-def filter_log(model_path, log_path, estimator="extended", particles=1000, seed=1):
+def filter_log(model_path: PathLike, log_path: PathLike, estimator: str = "extended",
+               particles: int = 1000, seed: int = 1) -> Dict[str, _np.ndarray]:
     """Runs an estimator over a recorded log (docs/formats/filter.md) like `recruit filter`.
 
     estimator: "extended", "conservative", "plain", "exact" or "particle".
@@ -195,8 +200,11 @@ def filter_log(model_path, log_path, estimator="extended", particles=1000, seed=
     return {name: data[:, i] for i, name in enumerate(header)}
 
 
-def simulate(task_path, *, estimator=None, filter_model=None, dT=None, lam=None,
-             force_noise_std=None, duration=None, seed=1, trace_every=1):
+def simulate(task_path: PathLike, *, estimator: Optional[str] = None,
+             filter_model: Optional[PathLike] = None, dT: Optional[float] = None,
+             lam: Optional[float] = None, force_noise_std: Optional[float] = None,
+             duration: Optional[float] = None, seed: int = 1,
+             trace_every: int = 1) -> Dict[str, Any]:
     """One closed-loop run of a task file (models/tasks/*.json), as `recruit simulate`.
 
     Unset options keep the task's values. Returns the run summary as a dict (the CLI's summary
@@ -226,8 +234,11 @@ def _as_list(x, kind):
     return [kind(v) for v in (x if isinstance(x, (list, tuple, _np.ndarray)) else [x])]
 
 
-def sweep(task_path, *, dT, lam=(0.2,), estimator=("output", "kalman-augmented"), seeds=1,
-          base_seed=1, duration=None, filter_model=None, threads=0):
+def sweep(task_path: PathLike, *, dT: Union[float, Sequence[float]],
+          lam: Union[float, Sequence[float]] = (0.2,),
+          estimator: Union[str, Sequence[str]] = ("output", "kalman-augmented"), seeds: int = 1,
+          base_seed: int = 1, duration: Optional[float] = None,
+          filter_model: Optional[PathLike] = None, threads: int = 0) -> Dict[str, Any]:
     """A grid of closed-loop runs (dT x lam x estimator x seeds), as `recruit sweep`.
 
     Runs on `threads` threads (0: all cores) with the GIL released. Seed index s runs with seed
@@ -268,7 +279,8 @@ def sweep(task_path, *, dT, lam=(0.2,), estimator=("output", "kalman-augmented")
     return out
 
 
-def aggregate(runs, max_overshoot=0.10, min_settled=0.90):
+def aggregate(runs: Mapping[str, Any], max_overshoot: float = 0.10,
+              min_settled: float = 0.90) -> Dict[str, Any]:
     """The runs of sweep(...) (or any subset of its rows) per grid cell (dT, lambda, estimator).
 
     Returns a column dict with the columns of `recruit sweep`'s table.csv: dT, lambda,
