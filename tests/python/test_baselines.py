@@ -186,3 +186,26 @@ def test_baseline_errors_are_value_errors():
         f.predict(np.array([[0.5, 0.5], [0.6, 0.5]]))  # not column-stochastic
     with pytest.raises(ValueError):
         f.set_probabilities(np.ones(3))
+
+
+@pytest.mark.parametrize("fixed", [True, False])
+def test_set_output_is_a_model_with_that_output(fixed):
+    # Predictions do not read H or R: a filter whose output model is replaced before an update
+    # equals, bit for bit, one built with that output model from the start.
+    m1 = recruit.FilterModel.two_state(30, 0.5, 0.45, 0.5)
+    m2 = recruit.FilterModel.linear([[0.0, 0.41]], [[0.36]], 30, A=np.eye(2))
+    a = recruit.KalmanFilter(m1, fixed_size=fixed, x0=[20.0, 10.0], P0=np.diag([4.0, 4.0]))
+    b = recruit.KalmanFilter(m2, fixed_size=fixed, x0=[20.0, 10.0], P0=np.diag([4.0, 4.0]))
+    A = m1.broadcast_matrix(0.2, 0.1)
+    for f in (a, b):
+        f.predict(A)
+    a.set_output([[0.0, 0.41]], [[0.36]])
+    for f in (a, b):
+        f.update([5.0])
+    np.testing.assert_array_equal(a.x, b.x)
+    np.testing.assert_array_equal(a.P, b.P)
+    np.testing.assert_array_equal(a.H, [[0.0, 0.41]])
+    with pytest.raises(ValueError, match="1 x 2"):
+        a.set_output([[1.0, 2.0, 3.0]], [[1.0]])
+    with pytest.raises(ValueError, match="positive definite"):
+        a.set_output([[0.0, 1.0]], [[-1.0]])
