@@ -69,6 +69,10 @@ def main():
         ax2.plot(cells["dT"][sel], cells["tracking_rmse_mean"][sel], "o-", label=e)
     ax1.set(xscale="log", xlabel="dT (s)", ylabel="mean step overshoot (%)")
     ax2.set(xscale="log", xlabel="dT (s)", ylabel="tracking RMSE (N)")
+    for ax in (ax1, ax2):
+        ax.set_xticks(dTs)
+        ax.set_xticklabels([f"{d:g}" for d in dTs])
+        ax.minorticks_off()
     ax1.legend()
     fig.tight_layout()
     fig.savefig(out / "sweep.png", dpi=100)
