@@ -5,7 +5,8 @@ noise G Qw G^T with zero column sums, known total N), timed in one process with 
 figure is the median over repeats of the per-step time, and the ratio is filterpy / recruit.
 Rows: recruit.KalmanFilter.predict(A) + update(y), one Python call each per step (mode plain,
 the same equations as filterpy, and mode extended), and KalmanFilter.run over the whole log
-(one call, per-step time).
+(one call, per-step time), each with the fixed-size C++ filter (the default for m = 2 and 20
+with r = 1) and with the dynamic-size one (fixed_size=False).
 
     .venv/bin/python examples/python/bench_filter.py [--steps 2000] [--repeats 7]
 """
@@ -60,18 +61,21 @@ def main():
                 fp.update(ys[k % len(ys)])
 
         results = {}
-        for mode in ("plain", "extended"):
-            kf = recruit.KalmanFilter(model, mode)
-
-            def run_recruit(kf=kf):
-                for k in range(S):
-                    kf.predict(A)
-                    kf.update(ys[k % len(ys)])
-
-            results[f"recruit predict+update ({mode})"] = run_recruit
-        kf_run = recruit.KalmanFilter(model, "plain")
         ys_run = ys[np.arange(S) % len(ys)]
-        results["recruit run() (plain, one call)"] = lambda: kf_run.run(ys_run)
+        for fixed in (True, False):
+            size = "fixed" if fixed else "dyn"
+            for mode in ("plain", "extended"):
+                kf = recruit.KalmanFilter(model, mode, fixed_size=fixed)
+                assert kf.fixed_size == fixed
+
+                def run_recruit(kf=kf):
+                    for k in range(S):
+                        kf.predict(A)
+                        kf.update(ys[k % len(ys)])
+
+                results[f"recruit p+u ({mode}, {size})"] = run_recruit
+            kf_run = recruit.KalmanFilter(model, "plain", fixed_size=fixed)
+            results[f"recruit run() (plain, {size})"] = lambda kf_run=kf_run: kf_run.run(ys_run)
         t_ref = per_step(run_filterpy, S, args.repeats)
         print(f"{m:>3} {'filterpy predict+update':<34} {t_ref * 1e6:9.2f} {1.0:14.2f}")
         for name, fn in results.items():

@@ -6,12 +6,18 @@ plugin ``recruit.sma`` (the shipped ``librecruit_sma.so``), after which
 
 Contents:
     FilterModel        filter model files (docs/formats/filter.md) and models from arrays
-    KalmanFilter       the population Kalman filter (dynamic size, all covariance modes)
+    KalmanFilter       the population Kalman filter (all covariance modes; the fixed-size
+                       C++ filter for m = 2, 3, 20 with r = 1, the dynamic one otherwise)
+    ExactFilter        the exact Bayesian filter over every count vector (the reference)
+    ParticleFilter     the bootstrap particle filter over count vectors (seeded)
     filter_log         an offline run of any estimator over a recorded log -> column arrays
     Bundles            the SMA bundles of a user's mujoco.MjModel / MjData
     Controller         the broadcast recruitment controller (estimator + expectation law)
     expectation_law    the law alone
-    simulate           one closed-loop run of a task file -> summary dict
+    simulate           one closed-loop run of a task file -> summary dict with the per-step
+                       trace (a column dict of NumPy arrays)
+    sweep              a grid of runs on all cores -> column dict, one row per run
+    aggregate          a sweep's runs per grid cell -> column dict (`recruit sweep`'s table)
 
 Errors in arguments or files raise ValueError carrying the C++ message.
 """
@@ -20,6 +26,8 @@ import ctypes as _ctypes
 import io as _io
 import json as _json
 import os as _os
+import tempfile as _tempfile
+from typing import Any, Dict, Mapping, Optional, Sequence, Tuple, Union
 
 # One libmujoco per process: the official bindings load the wheel's libmujoco.so.<version>
 # first; the plugin library and the extension link it by soname, so the loader reuses it.
@@ -53,8 +61,12 @@ if _recruit.mujoco_version() != _mujoco.mj_versionString():
 
 __version__ = "0.2.0"
 
+PathLike = Union[str, "_os.PathLike[str]"]
+
 FilterModel = _recruit.FilterModel
 KalmanFilter = _recruit.KalmanFilter
+ExactFilter = _recruit.ExactFilter
+ParticleFilter = _recruit.ParticleFilter
 Bundles = _recruit.Bundles
 Controller = _recruit.Controller
 
@@ -74,12 +86,7 @@ FilterModel.__doc__ = """What a population filter knows about the units and the 
     Methods: save(path), with_population(N), broadcast_matrix(p_on, p_off).
     """
 
-KalmanFilter.__doc__ = """The population Kalman filter (Odhner and Asada 2010, eqs. 15-27).
-
-    KalmanFilter(model, mode="extended", x0=None, P0=None)
-        mode: "extended" (Qz at the estimate), "conservative" (Qz at N 1) or "plain" (no Qz:
-        the standard Kalman filter). x0, P0 default to the model's initial belief.
-
+_STEPS = """
     predict(A)                  time update with an m x m column-stochastic A
     predict_broadcast(p_on, p_off)
                                 time update with the model's broadcast transition
@@ -89,10 +96,44 @@ KalmanFilter.__doc__ = """The population Kalman filter (Odhner and Asada 2010, e
                                 the whole log: for k = 0..T-1 predict with input k-1 (k > 0)
                                 and update with ys[k] unless missing; X, V are T x m (estimates
                                 and covariance diagonals). The GIL is released meanwhile.
-    reset(x0=None, P0=None)     back to a belief (default: the model's)
+    Properties: x (m,), P (m, m), model, N, num_states, num_outputs.
+"""
 
-    Properties: x (m,), P (m, m), innovation (r,), K (m, r), mode, N, num_states,
-    num_outputs, model.
+KalmanFilter.__doc__ = """The population Kalman filter (Odhner and Asada 2010, eqs. 15-27).
+
+    KalmanFilter(model, mode="extended", x0=None, P0=None, fixed_size=True)
+        mode: "extended" (Qz at the estimate), "conservative" (Qz at N 1) or "plain" (no Qz:
+        the standard Kalman filter). x0, P0 default to the model's initial belief.
+        fixed_size: the fixed-size C++ filter PopulationKalmanFilterT<m, 1> for m = 2, 3 or 20
+        states with r = 1 output (what `recruit filter` runs; no heap in the steps), else the
+        dynamic-size one. The property fixed_size says which one runs.
+""" + _STEPS + """
+    reset(x0=None, P0=None)     back to a belief (default: the model's)
+    set_output(H, R)            a new output model for the next updates (e.g. H at the
+                                measured tendon length)
+    Also: innovation (r,), K (m, r), H (r, m), mode, fixed_size.
+    """
+
+ExactFilter.__doc__ = """The exact Bayesian filter over every count vector (the accuracy reference).
+
+    ExactFilter(model, max_states=200000, cache_bytes=256 MiB)
+        The belief is one probability per count vector X (sum X = N): C(N + m - 1, m - 1) of
+        them, refused above max_states. Prediction is the exact multinomial transition, the
+        update the Gaussian likelihood. The model must have no process noise (G empty).
+        Prior: a point mass at x0 when P0 = 0, else N(x0, P0) on the count vectors.
+""" + _STEPS + """
+    Also: probabilities (S,), states (S x m), num_count_vectors, set_probabilities(p).
+    """
+
+ParticleFilter.__doc__ = """The bootstrap particle filter over integer count vectors.
+
+    ParticleFilter(model, particles=1000, resample_threshold=0.5, seed=1)
+        Particles move by the chain itself (multinomial draws) and are weighted by the Gaussian
+        likelihood; systematic resampling when ESS < resample_threshold * particles. One
+        random stream seeded with `seed` draws the initial particles, then every step: the same
+        seed and inputs give the same estimates as `recruit filter --estimator particle`.
+""" + _STEPS + """
+    Also: ess, num_particles, particles (num_particles x m).
     """
 
 Bundles.__doc__ = """The recruit.sma bundles of a mujoco.MjModel (actuator order).
@@ -106,7 +147,11 @@ Bundles.__doc__ = """The recruit.sma bundles of a mujoco.MjModel (actuator order
     b.force(data, bundle) -> float        tension (N) at the current tendon length
     b.mean_temperature(data, bundle), b.heat(data, bundle)
     b.unit_temperatures(data, bundle), b.unit_xi(data, bundle), b.units_on(data, bundle)
-                                          per-unit ndarrays
+                                          per-unit ndarrays (ground truth)
+    b.state_counts(data, bundle) -> ndarray [off, on]
+                                          true counts, in FilterModel.two_state's state order
+    b.cohorts(data, bundle) -> dict       the units grouped by identical state: count, on,
+                                          temperature, xi arrays; b.num_cohorts(data, bundle)
     b.num_bundles, b.names, b.index(name), b.num_units(bundle), b.settled_unit_force(bundle),
     b.actuator_id(bundle), b.tendon_id(bundle)
 
@@ -129,7 +174,8 @@ Controller.__doc__ = """One bundle's broadcast recruitment controller (docs/cont
     """
 
 
-def expectation_law(target_on, estimated_on, num_units, lam):
+def expectation_law(target_on: float, estimated_on: float, num_units: float,
+                    lam: float) -> Tuple[float, float]:
     """The expectation law -> (p_on, p_off) (docs/controller.md).
 
     recruit: p_on = lam (target - est) / (N - est), p_off = 0;
@@ -140,7 +186,8 @@ def expectation_law(target_on, estimated_on, num_units, lam):
                                     float(lam))
 
 
-def filter_log(model_path, log_path, estimator="extended", particles=1000, seed=1):
+def filter_log(model_path: PathLike, log_path: PathLike, estimator: str = "extended",
+               particles: int = 1000, seed: int = 1) -> Dict[str, _np.ndarray]:
     """Runs an estimator over a recorded log (docs/formats/filter.md) like `recruit filter`.
 
     estimator: "extended", "conservative", "plain", "exact" or "particle".
@@ -153,19 +200,98 @@ def filter_log(model_path, log_path, estimator="extended", particles=1000, seed=
     return {name: data[:, i] for i, name in enumerate(header)}
 
 
-def simulate(task_path, *, estimator=None, filter_model=None, dT=None, lam=None,
-             force_noise_std=None, duration=None, seed=1):
+def simulate(task_path: PathLike, *, estimator: Optional[str] = None,
+             filter_model: Optional[PathLike] = None, dT: Optional[float] = None,
+             lam: Optional[float] = None, force_noise_std: Optional[float] = None,
+             duration: Optional[float] = None, seed: int = 1,
+             trace_every: int = 1) -> Dict[str, Any]:
     """One closed-loop run of a task file (models/tasks/*.json), as `recruit simulate`.
 
-    Unset options keep the task's values. Returns the run summary as a dict: task, estimator,
-    dT, lambda, seed, duration, unit, physics_steps, control_instants, wall_seconds,
-    metrics (dict) and steps (list of dicts). Same seed -> same result. The GIL is released
-    during the run.
+    Unset options keep the task's values. Returns the run summary as a dict (the CLI's summary
+    JSON: task, estimator, dT, lambda, seed, duration, unit, physics_steps, control_instants,
+    wall_seconds, metrics, bundles, steps, ...) plus "trace": the columns of the CLI's per-step
+    CSV (the same names and rows as `--csv-every trace_every`: every trace_every-th physics step
+    and every control instant) as a dict of NumPy arrays at full precision;
+    pandas.DataFrame(result["trace"]) takes it directly. trace_every=0: no trace.
+    Same seed -> same result. The GIL is released during the run.
     """
-    text = _recruit.simulate_json(str(task_path), estimator, filter_model, dT, lam,
-                                  force_noise_std, duration, int(seed))
-    return _json.loads(text)
+    text, trace = _recruit.simulate_run(str(task_path), estimator,
+                                        None if filter_model is None else str(filter_model), dT,
+                                        lam, force_noise_std, duration, int(seed),
+                                        int(trace_every))
+    summary = _json.loads(text)
+    if trace is not None:
+        summary["trace"] = trace
+    return summary
 
 
-__all__ = ["FilterModel", "KalmanFilter", "Bundles", "Controller", "expectation_law",
-           "filter_log", "simulate", "PLUGIN_LIBRARY"]
+_METRICS = ("tracking_rmse", "iae", "overshoot", "max_overshoot", "settling_time",
+            "settled_fraction", "oscillation", "switching_rate", "estimator_rmse", "mean_nees",
+            "estimator_within3", "num_steps")
+
+
+def _as_list(x, kind):
+    return [kind(v) for v in (x if isinstance(x, (list, tuple, _np.ndarray)) else [x])]
+
+
+def sweep(task_path: PathLike, *, dT: Union[float, Sequence[float]],
+          lam: Union[float, Sequence[float]] = (0.2,),
+          estimator: Union[str, Sequence[str]] = ("output", "kalman-augmented"), seeds: int = 1,
+          base_seed: int = 1, duration: Optional[float] = None,
+          filter_model: Optional[PathLike] = None, threads: int = 0) -> Dict[str, Any]:
+    """A grid of closed-loop runs (dT x lam x estimator x seeds), as `recruit sweep`.
+
+    Runs on `threads` threads (0: all cores) with the GIL released. Seed index s runs with seed
+    Rng::DeriveSeed(base_seed, s), as the CLI: the same arguments give the same results.
+    Returns a column dict, one row per run in grid order (dT outermost, then lam, estimator,
+    seed index): dT, lambda, estimator, seed_index, seed, duration, wall_seconds, physics_steps
+    and the metrics (tracking_rmse, iae, overshoot, max_overshoot, settling_time,
+    settled_fraction, oscillation, switching_rate, estimator_rmse, mean_nees (NaN without a
+    variance), estimator_within3, num_steps). pandas.DataFrame(...) takes it directly;
+    aggregate(...) gives the per-cell table. Not resumable: every call runs every point.
+    """
+    with _tempfile.TemporaryDirectory(prefix="recruit-sweep-") as out:
+        text = _recruit.sweep_json(str(task_path), _as_list(dT, float), _as_list(lam, float),
+                                   _as_list(estimator, str), int(seeds), int(base_seed),
+                                   None if duration is None else float(duration),
+                                   None if filter_model is None else str(filter_model),
+                                   int(threads), out)
+    runs = _json.loads(text)
+
+    def col(key, dtype=float, get=None):
+        get = get or (lambda r: r[key])
+        return _np.array([get(r) for r in runs], dtype=dtype)
+
+    out = {
+        "dT": col("dT"),
+        "lambda": col("lambda"),
+        "estimator": [r["estimator"] for r in runs],
+        "seed_index": col("seed_index", _np.int64),
+        "seed": col("seed", _np.uint64),
+        "duration": col("duration"),
+        "wall_seconds": col("wall_seconds"),
+        "physics_steps": col("physics_steps", _np.int64),
+    }
+    for k in _METRICS:
+        # JSON has no NaN: a missing value (mean_nees of an estimator without variance) is null.
+        out[k] = col(k, _np.int64 if k == "num_steps" else float,
+                     lambda r, k=k: _np.nan if r["metrics"][k] is None else r["metrics"][k])
+    return out
+
+
+def aggregate(runs: Mapping[str, Any], max_overshoot: float = 0.10,
+              min_settled: float = 0.90) -> Dict[str, Any]:
+    """The runs of sweep(...) (or any subset of its rows) per grid cell (dT, lambda, estimator).
+
+    Returns a column dict with the columns of `recruit sweep`'s table.csv: dT, lambda,
+    estimator, seeds, overshoot_mean, overshoot_sd, settling_time_mean, settled_fraction,
+    tracking_rmse_mean, iae_mean, oscillation_mean, switching_rate_mean, estimator_rmse_mean,
+    mean_nees_mean, estimator_within3_mean, meets_criterion, margin. A cell meets the criterion
+    when its mean overshoot <= max_overshoot and its settled fraction >= min_settled.
+    """
+    return _recruit.aggregate(dict(runs), float(max_overshoot), float(min_settled))
+
+
+__all__ = ["FilterModel", "KalmanFilter", "ExactFilter", "ParticleFilter", "Bundles",
+           "Controller", "expectation_law", "filter_log", "simulate", "sweep", "aggregate",
+           "PLUGIN_LIBRARY"]

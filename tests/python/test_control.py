@@ -1,6 +1,7 @@
 """The expectation law, the controller object and simulate()."""
 import math
 
+import numpy as np
 import pytest
 
 import recruit
@@ -73,7 +74,11 @@ def test_simulate_summary_and_reproducibility():
     assert a["control_instants"] == 10  # dT = 1 s over 10 s
     assert a["physics_steps"] == 5000  # timestep 0.002 s
     a.pop("wall_seconds"), b.pop("wall_seconds")
+    ta, tb = a.pop("trace"), b.pop("trace")
     assert a == b
+    assert ta.keys() == tb.keys()
+    for k in ta:
+        np.testing.assert_array_equal(ta[k], tb[k])
     c = recruit.simulate(TASK, duration=10.0, seed=4)
     assert c["metrics"] != a["metrics"]
 

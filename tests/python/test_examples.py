@@ -5,6 +5,7 @@ import subprocess
 import sys
 
 import numpy as np
+import pytest
 
 from conftest import ROOT
 
@@ -35,3 +36,19 @@ def test_filter_log_writes_the_estimates(tmp_path):
     exact = [float(v) for v in re.search(r"exact filter: +\[([^\]]+)\]", text).group(1).split()]
     # The Kalman filter is within 25 % of the exact Bayesian filter's error per state.
     assert all(k < 1.25 * e + 0.05 for k, e in zip(kalman, exact))
+
+
+def test_sweep_plot_writes_the_pngs(tmp_path):
+    pytest.importorskip("matplotlib")
+    out = tmp_path / "figs"
+    text = _run("sweep_plot.py", str(out), "--seeds", "1", "--duration", "20", tmp_path=tmp_path)
+    assert "8 runs" in text  # 4 dT x 2 estimators x 1 seed
+    import matplotlib.image as mpimg
+    for name, (w, h) in (("sweep.png", (900, 350)), ("trace.png", (800, 500))):
+        img = mpimg.imread(out / name)
+        assert img.shape[:2] == (h, w)
+        assert img[..., :3].std() > 0.05  # something is drawn
+    # The table printed: one row per cell (8), with the dT values of the grid.
+    rows = [line.split() for line in text.splitlines() if line.split()[:1] in
+            (["0.25"], ["0.5"], ["1"], ["2"])]
+    assert len(rows) == 8

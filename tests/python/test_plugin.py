@@ -139,3 +139,32 @@ def test_bad_inputs_raise_value_error():
         "<mujoco><worldbody><body><joint/><geom size='.1'/></body></worldbody></mujoco>")
     with pytest.raises(ValueError):
         recruit.Bundles(plain)
+
+
+def test_state_counts_and_cohorts_agree_with_the_units():
+    # The per-state counts and the cohorts are two views of the per-unit ground truth.
+    m, d, b = _bench()
+    b.reset(d, 3)
+    c = b.cohorts(d, 0)
+    assert list(c["count"]) == [60] and not c["on"][0]  # one cohort: all off and cold
+    np.testing.assert_array_equal(b.state_counts(d, 0), [60, 0])
+    b.broadcast(d, 0, 0.4, 0.0)
+    for _ in range(300):
+        mujoco.mj_step(m, d)
+    b.broadcast(d, 0, 0.3, 0.5)  # on units of two ages, off units cooling and cold
+    for _ in range(200):
+        mujoco.mj_step(m, d)
+    on = b.units_on(d, 0)
+    np.testing.assert_array_equal(b.state_counts(d, 0), [60 - on.sum(), on.sum()])
+    assert b.state_counts(d, "bundle")[1] == b.on_count(d, 0)
+    c = b.cohorts(d, 0)
+    assert len(c["count"]) == b.num_cohorts(d, 0) >= 3
+    assert c["count"].sum() == 60
+    assert c["count"][c["on"]].sum() == on.sum()
+    # Each cohort's temperature is carried by exactly `count` units.
+    T = b.unit_temperatures(d, 0)
+    for n, t in zip(c["count"], c["temperature"]):
+        assert np.sum(T == t) >= n
+    assert np.dot(c["count"], c["temperature"]) / 60 == pytest.approx(T.mean(), rel=1e-12)
+    np.testing.assert_allclose(np.dot(c["count"], c["xi"]) / 60, b.unit_xi(d, 0).mean(),
+                               rtol=1e-12)

@@ -1,0 +1,269 @@
+// Runs from Python: simulate (one closed-loop run of a task, with its per-step trace), sweep (a
+// grid of runs on all cores) and aggregate (a sweep's runs per grid cell, as `recruit sweep`'s
+// table.csv). Long runs release the GIL.
+#include <pybind11/numpy.h>
+#include <pybind11/stl.h>
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "bindings.h"
+#include "common/step_observer.h"
+#include "convert.h"
+#include "sim/run_task.h"
+#include "sim/sweep.h"
+#include "sim/task.h"
+
+namespace recruit::py_bind {
+namespace {
+
+// Collects the per-step CSV's columns (sim/csv_writer.cc: same rows, same names) at full
+// precision: every `every`-th physics step and every control instant.
+class TraceRecorder : public StepObserver {
+ public:
+  explicit TraceRecorder(int every) : every_(every < 1 ? 1 : every) {}
+
+  Status OnStep(const mjModel*, const mjData*, const TelemetrySample& s) override {
+    if (names_.empty()) {
+      names_ = {"time", "reference", "measured", "angle"};
+      for (const auto& b : s.bundles) {
+        for (const char* col : {"force", "force_reference", "true_on", "estimated_on",
+                                "estimated_on_std", "p_on", "p_off", "mean_temperature"}) {
+          names_.push_back(b.actuator + "." + col);
+        }
+      }
+      names_.push_back("control_instant");
+      cols_.resize(names_.size());
+    }
+    if (count_++ % every_ != 0 && !s.control_instant) return Status::Ok();
+    size_t c = 0;
+    for (double v : {s.time, s.reference, s.measured, s.angle}) cols_[c++].push_back(v);
+    for (const auto& b : s.bundles) {
+      for (double v : {b.force, b.force_reference, static_cast<double>(b.true_on), b.estimated_on,
+                       b.estimated_on_std, b.p_on, b.p_off, b.mean_temperature}) {
+        if (c + 1 >= cols_.size()) return Error{"trace: the number of bundles changed"};
+        cols_[c++].push_back(v);
+      }
+    }
+    cols_[c].push_back(s.control_instant ? 1.0 : 0.0);
+    return Status::Ok();
+  }
+
+  // Column dict; true_on as int64, control_instant as bool, the rest float64.
+  py::dict Columns() const {
+    py::dict out;
+    for (size_t c = 0; c < names_.size(); ++c) {
+      const std::string& n = names_[c];
+      const auto& v = cols_[c];
+      const bool is_int = n.size() > 8 && n.compare(n.size() - 8, 8, ".true_on") == 0;
+      if (n == "control_instant") {
+        py::array_t<bool> a(v.size());
+        for (size_t i = 0; i < v.size(); ++i) a.mutable_data()[i] = v[i] != 0.0;
+        out[n.c_str()] = a;
+      } else if (is_int) {
+        py::array_t<int64_t> a(v.size());
+        for (size_t i = 0; i < v.size(); ++i) a.mutable_data()[i] = static_cast<int64_t>(v[i]);
+        out[n.c_str()] = a;
+      } else {
+        py::array_t<double> a(v.size());
+        std::copy(v.begin(), v.end(), a.mutable_data());
+        out[n.c_str()] = a;
+      }
+    }
+    return out;
+  }
+
+ private:
+  int every_;
+  long count_ = 0;
+  std::vector<std::string> names_;
+  std::vector<std::vector<double>> cols_;
+};
+
+template <class T>
+std::optional<T> Opt(const py::object& o) {
+  if (o.is_none()) return std::nullopt;
+  return o.cast<T>();
+}
+
+// -> (summary JSON text, trace column dict or None).
+py::tuple Simulate(const std::string& task_path, const py::object& estimator,
+                   const py::object& filter_model, const py::object& dT, const py::object& lambda,
+                   const py::object& force_noise_std, const py::object& duration, uint64_t seed,
+                   int trace_every) {
+  if (trace_every < 0) Fail("trace_every: must be >= 0 (0: no trace)");
+  sim::Task task = Take(sim::Task::FromFile(task_path));
+  sim::RunOptions opt;
+  opt.estimator = Opt<std::string>(estimator);
+  opt.filter_model = Opt<std::string>(filter_model);
+  opt.dT = Opt<double>(dT);
+  opt.lambda = Opt<double>(lambda);
+  opt.force_noise_std = Opt<double>(force_noise_std);
+  opt.duration = Opt<double>(duration);
+  opt.seed = seed;
+  TraceRecorder trace(trace_every);
+  std::vector<StepObserver*> observers;
+  if (trace_every > 0) observers.push_back(&trace);
+  std::optional<Result<sim::RunSummary>> r;
+  {
+    py::gil_scoped_release release;
+    r.emplace(sim::RunTask(task, opt, observers));
+  }
+  const sim::RunSummary s = Take(std::move(*r));
+  return py::make_tuple(s.ToJson().dump(),
+                        trace_every > 0 ? py::object(trace.Columns()) : py::object(py::none()));
+}
+
+// The runs of a sweep as one JSON array text; each run's summary gets its grid position
+// (seed_index). `out_dir` holds the per-run records (RunSweep's resume files).
+std::string Sweep(const std::string& task_path, const std::vector<double>& dTs,
+                  const std::vector<double>& lambdas, const std::vector<std::string>& estimators,
+                  int seeds, uint64_t base_seed, const py::object& duration,
+                  const py::object& filter_model, int threads, const std::string& out_dir) {
+  if (threads < 0) Fail("threads: must be >= 0 (0: all cores)");
+  const sim::Task task = Take(sim::Task::FromFile(task_path));
+  sim::SweepSpec spec;
+  spec.dTs = dTs;
+  spec.lambdas = lambdas;
+  spec.estimators = estimators;
+  spec.seeds = seeds;
+  spec.base_seed = base_seed;
+  spec.duration = Opt<double>(duration);
+  spec.filter_model = Opt<std::string>(filter_model);
+  const std::vector<sim::SweepRun> grid = Take(sim::ExpandGrid(spec));
+  // As `recruit sweep` runs each grid point (src/cli/sweep_command.cc).
+  auto run = [&task, &spec](const sim::SweepRun& g) {
+    sim::RunOptions o;
+    o.estimator = g.estimator;
+    o.dT = g.dT;
+    o.lambda = g.lambda;
+    o.seed = g.seed;
+    o.duration = spec.duration;
+    o.filter_model = spec.filter_model;
+    return sim::RunTask(task, o);
+  };
+  std::optional<Result<sim::SweepOutcome>> outcome;
+  {
+    py::gil_scoped_release release;
+    outcome.emplace(sim::RunSweep(grid, out_dir, run, threads));
+  }
+  const sim::SweepOutcome o = Take(std::move(*outcome));
+  nlohmann::json runs = nlohmann::json::array();
+  for (size_t i = 0; i < o.runs.size(); ++i) {
+    nlohmann::json j = o.runs[i].ToJson();
+    j["seed_index"] = grid[i].seed_index;
+    runs.push_back(std::move(j));
+  }
+  return runs.dump();
+}
+
+// Cells of a run column dict (sweep's): per (dT, lambda, estimator), as table.csv.
+py::dict AggregateColumns(const py::dict& runs, double max_overshoot, double min_settled) {
+  auto column = [&runs](const char* name) {
+    if (!runs.contains(name)) Fail(std::string("aggregate: runs has no column '") + name + "'");
+    return ToVector(runs[name], name);
+  };
+  if (!runs.contains("estimator")) Fail("aggregate: runs has no column 'estimator'");
+  const auto est = runs["estimator"].cast<std::vector<std::string>>();
+  const Eigen::VectorXd dT = column("dT"), lambda = column("lambda"),
+                        tracking_rmse = column("tracking_rmse"), iae = column("iae"),
+                        overshoot = column("overshoot"), settling = column("settling_time"),
+                        settled = column("settled_fraction"), osc = column("oscillation"),
+                        sw = column("switching_rate"), er = column("estimator_rmse"),
+                        nees = column("mean_nees"), w3 = column("estimator_within3");
+  const Eigen::Index n = static_cast<Eigen::Index>(est.size());
+  for (const Eigen::VectorXd* v : {&dT, &lambda, &tracking_rmse, &iae, &overshoot, &settling,
+                                   &settled, &osc, &sw, &er, &nees, &w3}) {
+    if (v->size() != n) Fail("aggregate: the columns of runs differ in length");
+  }
+  std::vector<sim::RunSummary> rs(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    sim::RunSummary& r = rs[i];
+    r.dT = dT(i);
+    r.lambda = lambda(i);
+    r.estimator = est[i];
+    r.metrics.tracking_rmse = tracking_rmse(i);
+    r.metrics.iae = iae(i);
+    r.metrics.overshoot = overshoot(i);
+    r.metrics.settling_time = settling(i);
+    r.metrics.settled_fraction = settled(i);
+    r.metrics.oscillation = osc(i);
+    r.metrics.switching_rate = sw(i);
+    r.metrics.estimator_rmse = er(i);
+    r.metrics.mean_nees = nees(i);
+    r.metrics.estimator_within3 = w3(i);
+  }
+  sim::TrackingCriterion criterion;
+  criterion.max_overshoot = max_overshoot;
+  criterion.min_settled = min_settled;
+  const std::vector<sim::CellStats> cells = sim::Aggregate(rs, criterion);
+  // Column names as table.csv (sim/sweep.cc WriteSweepReport).
+  std::vector<std::string> estimators;
+  std::vector<bool> meets;
+  std::vector<int> nseeds;
+  std::vector<std::vector<double>> v(14);
+  for (const auto& c : cells) {
+    estimators.push_back(c.estimator);
+    meets.push_back(c.meets);
+    nseeds.push_back(c.seeds);
+    const double row[14] = {c.dT,
+                            c.lambda,
+                            c.overshoot_mean,
+                            c.overshoot_sd,
+                            c.settling_mean,
+                            c.settled_fraction,
+                            c.rmse_mean,
+                            c.iae_mean,
+                            c.oscillation_mean,
+                            c.switching_mean,
+                            c.estimator_rmse_mean,
+                            c.nees_mean,
+                            c.within3_mean,
+                            c.margin};
+    for (int k = 0; k < 14; ++k) v[k].push_back(row[k]);
+  }
+  auto arr = [](const std::vector<double>& x) {
+    return FromVector(Eigen::Map<const Eigen::VectorXd>(x.data(), x.size()));
+  };
+  py::dict out;
+  out["dT"] = arr(v[0]);
+  out["lambda"] = arr(v[1]);
+  out["estimator"] = estimators;
+  out["seeds"] = py::array_t<int>(nseeds.size(), nseeds.data());
+  out["overshoot_mean"] = arr(v[2]);
+  out["overshoot_sd"] = arr(v[3]);
+  out["settling_time_mean"] = arr(v[4]);
+  out["settled_fraction"] = arr(v[5]);
+  out["tracking_rmse_mean"] = arr(v[6]);
+  out["iae_mean"] = arr(v[7]);
+  out["oscillation_mean"] = arr(v[8]);
+  out["switching_rate_mean"] = arr(v[9]);
+  out["estimator_rmse_mean"] = arr(v[10]);
+  out["mean_nees_mean"] = arr(v[11]);
+  out["estimator_within3_mean"] = arr(v[12]);
+  py::array_t<bool> m(meets.size());
+  for (size_t i = 0; i < meets.size(); ++i) m.mutable_data()[i] = meets[i];
+  out["meets_criterion"] = m;
+  out["margin"] = arr(v[13]);
+  return out;
+}
+
+}  // namespace
+
+void BindSim(py::module_& mod) {
+  mod.def("simulate_run", &Simulate, py::arg("task_path"), py::arg("estimator") = py::none(),
+          py::arg("filter_model") = py::none(), py::arg("dT") = py::none(),
+          py::arg("lam") = py::none(), py::arg("force_noise_std") = py::none(),
+          py::arg("duration") = py::none(), py::arg("seed") = 1, py::arg("trace_every") = 1,
+          "One closed-loop run -> (summary JSON text, trace column dict or None).");
+  mod.def("sweep_json", &Sweep, py::arg("task_path"), py::arg("dT"), py::arg("lam"),
+          py::arg("estimator"), py::arg("seeds"), py::arg("base_seed"), py::arg("duration"),
+          py::arg("filter_model"), py::arg("threads"), py::arg("out_dir"),
+          "A grid of runs -> JSON array text of the run summaries (with seed_index).");
+  mod.def("aggregate", &AggregateColumns, py::arg("runs"), py::arg("max_overshoot") = 0.10,
+          py::arg("min_settled") = 0.90,
+          "A sweep's run columns -> cell columns (as `recruit sweep`'s table.csv).");
+}
+
+}  // namespace recruit::py_bind
