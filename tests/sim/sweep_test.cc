@@ -329,6 +329,22 @@ TEST(SweepSampling, SobolFirstTwoDimensionsFormAZeroMTwoNet) {
   EXPECT_FALSE(sweep::Sobol(4, sweep::MaxSobolDims() + 1, 1).ok());
 }
 
+TEST(SweepSampling, SobolWithoutShiftEqualsSciPysJoeKuoSequence) {
+  // Reference: scipy 1.17 `qmc.Sobol(d=12, scramble=False).random(64)` (Joe-Kuo 6.21201 direction
+  // numbers, Gray-code order), rows 5, 38 and 63. The whole 64 x 12 block was compared once too.
+  const std::vector<std::pair<int, std::vector<double>>> ref = {
+      {5, {0.875, 0.875, 0.125, 0.375, 0.875, 0.625, 0.875, 0.375, 0.375, 0.125, 0.375, 0.875}},
+      {38,
+       {0.671875, 0.390625, 0.328125, 0.171875, 0.515625, 0.046875, 0.921875, 0.546875, 0.859375,
+        0.421875, 0.265625, 0.328125}},
+      {63,
+       {0.015625, 0.796875, 0.359375, 0.453125, 0.859375, 0.140625, 0.578125, 0.140625, 0.828125,
+        0.578125, 0.421875, 0.671875}}};
+  auto pts = sweep::Sobol(64, 12, 0);
+  ASSERT_TRUE(pts.ok());
+  for (const auto& [row, values] : ref) EXPECT_EQ((*pts)[row], values) << "row " << row;
+}
+
 // --- Sweep files and plant points.
 
 const char* kTaskText = R"({"name": "t", "model": "m.xml", "tracked": "force", "agonist": "b",
