@@ -3,7 +3,7 @@
 # munged, slurmctld and slurmd (Debian's slurm-wlm + munge) with a minimal slurm.conf in a
 # temporary folder, run as root. It submits a small sweep as a 3-shard job array, breaks one
 # shard and checks merge names it, resubmits that shard (it resumes), merges, and compares the
-# merged table.csv, table.md and report.md byte for byte with an unsharded local run. The daemons
+# merged table, report and figures byte for byte with an unsharded local run. The daemons
 # are stopped and the folder removed on exit, also when interrupted.
 #
 #   scripts/slurm/test_slurm.sh RECRUIT_BINARY [SOURCE_DIR]
@@ -43,7 +43,11 @@ cleanup() {
     for _ in $(seq 20); do kill -0 "$p" 2> /dev/null || break; sleep 0.25; done
     kill -9 "$p" 2> /dev/null
   done
-  [ -f "$tmp/munged.pid" ] && kill "$(cat "$tmp/munged.pid")" 2> /dev/null
+  if [ -f "$tmp/munged.pid" ]; then  # munged writes its seed file as it exits: wait for it
+    m=$(cat "$tmp/munged.pid")
+    kill "$m" 2> /dev/null
+    for _ in $(seq 20); do kill -0 "$m" 2> /dev/null || break; sleep 0.25; done
+  fi
   if [ "${keep:-0}" = 1 ]; then echo "kept $tmp"; else rm -rf "$tmp"; fi
 }
 trap cleanup EXIT
@@ -117,12 +121,13 @@ done
 [ "$state" = idle ] || fail "the node did not come up (state '$state')"
 echo "slurm up: node $node idle, ports $port1/$port2"
 
-# The sweep: 3 plant points (N) x 2 dT x 1 seed of 6 s on the isometric bench.
+# The sweep: dT x N x load-cell noise (2 x 2 x 2, 1 seed, 6 s) on the isometric bench.
 cat > "$tmp/sweep.json" << JSON
 {"task": "$src/models/tasks/isometric_steps.json", "duration": 6,
  "controller": {"dT": [0.5, 1], "estimator": "output", "seeds": 1},
- "plant": {"axes": [{"name": "N", "path": "model:bundle_units/units", "values": [30, 60, 90],
-   "integer": true}]}}
+ "plant": {"axes": [
+   {"name": "N", "path": "model:bundle_units/units", "values": [30, 90], "integer": true},
+   {"name": "noise_std", "path": "/sensor/noise_std", "values": [0.01, 0.2]}]}}
 JSON
 args=(--sweep "$tmp/sweep.json")
 "$recruit" sweep "${args[@]}" --out "$tmp/local" --threads 1 > /dev/null \
@@ -159,7 +164,8 @@ grep -q "1 runs made" "$out/shard_2.retry.log" || fail "the resubmitted shard di
 job=$(sbatch --parsable --chdir="$tmp" --output="$out/merge.log" \
   --export="ALL,RECRUIT=$recruit" "$here/merge_job.sh" "$out" "${args[@]}")
 wait_job "${job%%;*}"
-for f in table.csv table.md report.md; do
+for f in table.csv table.md report.md report.html margin.png critical_dt.svg; do
   cmp "$tmp/local/$f" "$out/merged/$f" || fail "$f differs between the Slurm shards and the local run"
 done
-echo "PASS: 3 Slurm array shards (one failed and resubmitted) merge to the local table byte for byte"
+echo "PASS: 3 Slurm array shards of a dT x N x noise sweep (one failed and resubmitted) merge to" \
+  "the local table, report and figures byte for byte"
