@@ -141,17 +141,30 @@ wait_job() {  # sbatch --wait without holding a terminal: poll until the job lea
   done
   fail "job $1 did not finish in 60 s"
 }
-job=$(sbatch --parsable --array=1-3 --chdir="$tmp" --output="$out/shard_%a.log" \
-  --export="ALL,SHARDS=3,RECRUIT=$recruit" "$here/sweep_array.sh" "$out" "${args[@]}")
-echo "submitted array job $job"
-wait_job "${job%%;*}"
+compare() {
+  for f in table.csv table.md report.md report.html margin.png critical_dt.svg; do
+    cmp "$tmp/local/$f" "$out/merged/$f" || fail "$f differs between the Slurm shards and the local run"
+  done
+}
+
+# submit.sh: the 3-task array and the merge job that waits for it (afterany).
+ids=$(RECRUIT="$recruit" "$here/submit.sh" 3 "$out" "${args[@]}") || fail "submit.sh failed: $ids"
+ids=${ids%%$'\n'*}
+echo "$ids"
+array=$(sed -n 's/^array job \([0-9]*\) .*/\1/p' <<< "$ids")
+merge=$(sed -n 's/.*merge job \([0-9]*\);.*/\1/p' <<< "$ids")
+[ -n "$array" ] && [ -n "$merge" ] || fail "submit.sh printed no job ids: $ids"
+wait_job "$array"
+wait_job "$merge"
 for k in 1 2 3; do
   [ -f "$out/shard_$k/shard.json" ] || fail "shard $k did not finish"
 done
+[ -f "$out/merged/table.csv" ] || fail "the merge job wrote no table"
+compare
 
 # A failed task: shard 2 loses a run and its manifest; merge must name it, a resubmission of just
-# that task resumes (one run made), and the merge then succeeds.
-rm "$out/shard_2/shard.json" "$(ls "$out"/shard_2/runs/*.json | head -n 1)"
+# that task resumes (one run made), and the merge job then succeeds again.
+rm -r "$out/merged" "$out/shard_2/shard.json" "$(ls "$out"/shard_2/runs/*.json | head -n 1)"
 if "$recruit" sweep merge "${args[@]}" --out "$out/merged" "$out"/shard_* 2> "$tmp/merge.err"; then
   fail "merge accepted an incomplete shard"
 fi
@@ -160,12 +173,10 @@ job=$(sbatch --parsable --array=2 --chdir="$tmp" --output="$out/shard_%a.retry.l
   --export="ALL,SHARDS=3,RECRUIT=$recruit" "$here/sweep_array.sh" "$out" "${args[@]}")
 wait_job "${job%%;*}"
 grep -q "1 runs made" "$out/shard_2.retry.log" || fail "the resubmitted shard did not resume"
-
-job=$(sbatch --parsable --chdir="$tmp" --output="$out/merge.log" \
+rm -r "$out/merged"
+job=$(sbatch --parsable --chdir="$tmp" --output="$out/merge2.log" \
   --export="ALL,RECRUIT=$recruit" "$here/merge_job.sh" "$out" "${args[@]}")
 wait_job "${job%%;*}"
-for f in table.csv table.md report.md report.html margin.png critical_dt.svg; do
-  cmp "$tmp/local/$f" "$out/merged/$f" || fail "$f differs between the Slurm shards and the local run"
-done
-echo "PASS: 3 Slurm array shards of a dT x N x noise sweep (one failed and resubmitted) merge to" \
-  "the local table, report and figures byte for byte"
+compare
+echo "PASS: 3 Slurm array shards of a dT x N x noise sweep (submit.sh; one failed and resubmitted)" \
+  "merge to the local table, report and figures byte for byte"

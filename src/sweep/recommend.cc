@@ -34,8 +34,10 @@ std::vector<Recommendation> Recommend(const std::vector<sim::CellStats>& cells) 
       r.dT = c.dT;
       r.margin = c.margin;
       r.margin_se = c.margin_se;
-      r.confidence = c.margin_se > 0 ? 0.5 * std::erfc(-c.margin / (c.margin_se * std::sqrt(2.0)))
-                                     : (c.margin >= 0 ? 1.0 : 0.0);
+      // One seed has no spread to judge by: no confidence then.
+      r.confidence = c.seeds < 2       ? std::nan("")
+                     : c.margin_se > 0 ? 0.5 * std::erfc(-c.margin / (c.margin_se * std::sqrt(2.0)))
+                                       : (c.margin >= 0 ? 1.0 : 0.0);
       r.seeds_meeting = c.seeds_meeting;
       r.seeds = c.seeds;
       if (i == 0) {

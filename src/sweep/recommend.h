@@ -17,11 +17,12 @@ struct Recommendation {
   std::vector<std::pair<std::string, double>> plant_values;
   std::string estimator;
   double lambda = 0;
-  bool found = false;     // some dT tried meets the criterion
-  double dT = 0;          // recommended: the shortest dT tried that meets it
-  double margin = 0;      // its cell margin
-  double margin_se = 0;   // standard error of the per-seed margins
-  double confidence = 0;  // P(margin >= 0) ~ Phi(margin / margin_se) (1 or 0 when se = 0)
+  bool found = false;    // some dT tried meets the criterion
+  double dT = 0;         // recommended: the shortest dT tried that meets it
+  double margin = 0;     // its cell margin
+  double margin_se = 0;  // standard error of the per-seed margins
+  // P(margin >= 0) ~ Phi(margin / margin_se); 1 or 0 when se = 0; NaN with one seed.
+  double confidence = 0;
   int seeds_meeting = 0, seeds = 0;
   double critical_dT = 0;  // where the margin crosses 0 (NaN when not found)
   bool censored = false;   // the shortest dT tried already meets: critical_dT <= dT

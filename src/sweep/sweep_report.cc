@@ -251,10 +251,10 @@ std::string ReportMarkdown(const ReportInput& in, const std::vector<Recommendati
     std::string row = fmt::format("| {} ", r.plant);
     for (const auto& [name, v] : r.plant_values) row += fmt::format("| {:.6g} ", v);
     if (r.found) {
-      row += fmt::format("| {} | {:g} | {:g} | {:+.3f} ± {:.3f} | {:.0f} % | {}/{} | {}{} |\n",
-                         r.estimator, r.lambda, r.dT, r.margin, r.margin_se, 100 * r.confidence,
-                         r.seeds_meeting, r.seeds, r.censored ? "<= " : "",
-                         Fmt(r.critical_dT, "{:.3g}"));
+      row += fmt::format("| {} | {:g} | {:g} | {:+.3f} ± {:.3f} | {} | {}/{} | {}{} |\n",
+                         r.estimator, r.lambda, r.dT, r.margin, r.margin_se,
+                         Fmt(100 * r.confidence, "{:.0f} %"), r.seeds_meeting, r.seeds,
+                         r.censored ? "<= " : "", Fmt(r.critical_dT, "{:.3g}"));
     } else {
       row += fmt::format("| {} | {:g} | none of the dT tried | - | - | - | - |\n", r.estimator,
                          r.lambda);

@@ -286,6 +286,25 @@ TEST(Sweep, TheStabilityMapIsMadeOrItsFailureReported) {
   fs::remove_all(dir);
 }
 
+TEST(Sweep, EveryRunMadeAppendsOneLineToTheProgressLog) {
+  const auto dir = TempDir("log");
+  auto grid = ExpandGrid(Spec());
+  ASSERT_TRUE(ShardOf(*grid, 1, 2).size() > 0);
+  ASSERT_TRUE(RunSweep(ShardOf(*grid, 1, 2), dir.string(), FakeRun, 2).ok());
+  ASSERT_TRUE(RunSweep(*grid, dir.string(), FakeRun, 2).ok());  // resumes: the other half only
+  const std::string log = *ReadFile((dir / "progress.log").string());
+  size_t pos = 0, lines = 0;
+  while ((pos = log.find('\n', pos)) != std::string::npos) ++pos, ++lines;
+  for (const auto& g : *grid) {
+    const size_t at = log.find(" " + g.Key() + " ");
+    EXPECT_NE(at, std::string::npos) << g.Key();
+    EXPECT_EQ(log.find(" " + g.Key() + " ", at + 1), std::string::npos) << "twice: " << g.Key();
+  }
+  EXPECT_EQ(lines, grid->size());
+  EXPECT_NE(log.find(" eta="), std::string::npos);
+  fs::remove_all(dir);
+}
+
 // --- Samples: the defining properties, not stored numbers.
 
 TEST(SweepSampling, LatinHypercubePutsOnePointInEveryStratumOfEveryAxis) {
