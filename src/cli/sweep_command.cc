@@ -4,9 +4,12 @@
 // to join shards into the table an unsharded sweep writes. Writes table.csv/.md, report.md/.html
 // with the recommended dT per plant point, sensitivities and figures (docs/sweep.md).
 #include <fmt/format.h>
+#include <tbb/parallel_for.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <iostream>
 #include <map>
@@ -23,6 +26,7 @@
 #include "common/output_path.h"
 #include "control/on_count_estimator.h"
 #include "sim/sweep.h"
+#include "sweep/latency.h"
 #include "sweep/sweep_file.h"
 #include "sweep/sweep_report.h"
 
@@ -257,7 +261,17 @@ int WriteReports(const std::string& cmd, const Prepared& p,
   if (Status s = sim::WriteSweepReport(cells, p.criterion, out, p.task.name); !s.ok()) {
     return Fail(cmd, s.error(), exit_code::kIo);
   }
-  sweep::ReportInput in{p.task.name, p.description, p.criterion, cells};
+  sweep::ReportInput in{p.task.name, p.description, p.criterion, cells, {}};
+  // The output-only loop's latency bound needs each plant point's force latency (one open-loop
+  // step of its model, ~0.1 s each); a point whose model cannot do it gets none (NaN).
+  if (std::find(p.spec.estimators.begin(), p.spec.estimators.end(), "output") !=
+      p.spec.estimators.end()) {
+    in.latency.assign(p.plant.size(), std::nan(""));
+    tbb::parallel_for(size_t{0}, p.plant.size(), [&](size_t i) {
+      auto tau = sweep::ForceLatency(p.plant[i].task);
+      if (tau.ok()) in.latency[i] = *tau;
+    });
+  }
   if (Status s = sweep::WriteReport(in, out); !s.ok()) return Fail(cmd, s.error(), exit_code::kIo);
   return exit_code::kOk;
 }

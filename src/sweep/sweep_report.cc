@@ -10,6 +10,7 @@
 #include "common/atomic_file.h"
 #include "plot/figure.h"
 #include "plot/render.h"
+#include "sweep/latency.h"
 
 namespace recruit::sweep {
 namespace {
@@ -131,8 +132,16 @@ std::string MarkdownToHtml(const std::string& md, const std::map<std::string, st
   return html + "</body></html>\n";
 }
 
-// Margin against dT, one panel per estimator (and lambda), one series per plant point.
-plot::Figure MarginFigure(const ReportInput& in) {
+// The output-only loop's latency bound on dT for a plant point (NaN: none).
+double LatencyBound(const ReportInput& in, int plant, const std::string& estimator, double lambda,
+                    double c) {
+  if (estimator != "output" || plant >= static_cast<int>(in.latency.size())) return std::nan("");
+  return lambda * in.latency[plant] / c;
+}
+
+// Margin against dT, one panel per estimator (and lambda), one series per plant point; for output
+// only, each plant point's latency bound as a dotted vertical line of its colour.
+plot::Figure MarginFigure(const ReportInput& in, double c) {
   plot::Figure fig;
   fig.title = in.title + ": criterion margin against dT (>= 0 meets)";
   std::vector<std::pair<std::string, double>> groups;
@@ -145,15 +154,17 @@ plot::Figure MarginFigure(const ReportInput& in) {
     ax.x_label = fmt::format("dT (s), estimator {}, lambda {:g}", est, lambda);
     ax.y_label = "margin";
     std::map<int, plot::Series> by_plant;
-    double lo = 1e300, hi = -1e300;
-    for (const auto& c : in.cells) {
-      if (c.estimator != est || c.lambda != lambda) continue;
-      plot::Series& s = by_plant[c.plant];
-      s.x.push_back(c.dT);
-      s.y.push_back(c.margin);
-      lo = std::min(lo, c.dT);
-      hi = std::max(hi, c.dT);
-      if (s.label.empty()) s.label = PlantLabel(c.plant_values);
+    double lo = 1e300, hi = -1e300, ylo = 0, yhi = 0;
+    for (const auto& cell : in.cells) {
+      if (cell.estimator != est || cell.lambda != lambda) continue;
+      plot::Series& s = by_plant[cell.plant];
+      s.x.push_back(cell.dT);
+      s.y.push_back(cell.margin);
+      lo = std::min(lo, cell.dT);
+      hi = std::max(hi, cell.dT);
+      ylo = std::min(ylo, cell.margin);
+      yhi = std::max(yhi, cell.margin);
+      if (s.label.empty()) s.label = PlantLabel(cell.plant_values);
     }
     size_t i = 0;
     for (auto& [plant, s] : by_plant) {
@@ -167,8 +178,20 @@ plot::Figure MarginFigure(const ReportInput& in) {
       }
       sorted.color = Palette(i);
       if (i >= 10) sorted.label.clear();  // a legend of ten is already long
-      ++i;
       ax.series.push_back(sorted);
+      const double bound = LatencyBound(in, plant, est, lambda, c);
+      if (std::isfinite(bound)) {
+        plot::Series b;
+        b.label = i == 0 ? "latency bound lambda tau / c" : "";
+        b.x = {bound, bound};
+        b.y = {ylo, yhi};
+        b.color = Palette(i);
+        b.style = plot::LineStyle::kDotted;
+        ax.series.push_back(b);
+        lo = std::min(lo, bound);
+        hi = std::max(hi, bound);
+      }
+      ++i;
     }
     plot::Series zero;
     zero.x = {lo, hi};
@@ -227,15 +250,24 @@ std::string Fmt(double x, const char* spec) {
 
 std::string ReportMarkdown(const ReportInput& in, const std::vector<Recommendation>& recs,
                            const std::vector<Sensitivity>& sens, bool with_figures) {
+  const double c = DelayLoopGainForOvershoot(in.criterion.max_overshoot);
+  const bool bound = !in.latency.empty();
   std::string md = fmt::format(
       "# Sampling-period report: {}\n\n{}\n\nCriterion: mean step overshoot <= {:.0f} % and at "
       "least {:.0f} % of steps settled within the band, over all seeds of a cell. Margin = "
       "min(overshoot limit - overshoot, settled fraction - required fraction). Recommended dT = "
       "the shortest dT tried that meets the criterion; confidence = Phi(margin / se), se = the "
       "standard error of the seeds' own margins; critical dT = where the margin crosses 0, "
-      "interpolated in log dT (<= when the shortest dT tried already meets).\n\n"
+      "interpolated in log dT (<= when the shortest dT tried already meets).{}\n\n"
       "## Recommended dT per plant point\n\n",
-      in.title, in.description, 100 * in.criterion.max_overshoot, 100 * in.criterion.min_settled);
+      in.title, in.description, 100 * in.criterion.max_overshoot, 100 * in.criterion.min_settled,
+      bound ? fmt::format(
+                  " Latency bound (output only, docs/sweep.md): dT >= lambda tau / c, tau = the "
+                  "bundle's force latency (time to half force after every unit switches on, from "
+                  "rest), c = {:.3f} (the delay loop y' = K (r - y(t - tau)) overshoots by {:.0f} "
+                  "% at K tau = c).",
+                  c, 100 * in.criterion.max_overshoot)
+            : std::string());
   const auto& axes =
       recs.empty() ? std::vector<std::pair<std::string, double>>{} : recs.front().plant_values;
   std::string head = "| plant ", rule = "|---";
@@ -245,21 +277,28 @@ std::string ReportMarkdown(const ReportInput& in, const std::vector<Recommendati
   }
   md += head +
         "| estimator | lambda | recommended dT (s) | margin ± se | confidence | seeds meeting | "
-        "critical dT (s) |\n" +
-        rule + "|---|---|---|---|---|---|---|\n";
+        "critical dT (s) |" +
+        (bound ? " tau (s) | latency bound dT (s) |" : "") + "\n" + rule +
+        "|---|---|---|---|---|---|---|" + (bound ? "---|---|" : "") + "\n";
   for (const auto& r : recs) {
     std::string row = fmt::format("| {} ", r.plant);
     for (const auto& [name, v] : r.plant_values) row += fmt::format("| {:.6g} ", v);
     if (r.found) {
-      row += fmt::format("| {} | {:g} | {:g} | {:+.3f} ± {:.3f} | {} | {}/{} | {}{} |\n",
-                         r.estimator, r.lambda, r.dT, r.margin, r.margin_se,
-                         Fmt(100 * r.confidence, "{:.0f} %"), r.seeds_meeting, r.seeds,
-                         r.censored ? "<= " : "", Fmt(r.critical_dT, "{:.3g}"));
+      row += fmt::format("| {} | {:g} | {:g} | {:+.3f} ± {:.3f} | {} | {}/{} | {}{} |", r.estimator,
+                         r.lambda, r.dT, r.margin, r.margin_se, Fmt(100 * r.confidence, "{:.0f} %"),
+                         r.seeds_meeting, r.seeds, r.censored ? "<= " : "",
+                         Fmt(r.critical_dT, "{:.3g}"));
     } else {
-      row += fmt::format("| {} | {:g} | none of the dT tried | - | - | - | - |\n", r.estimator,
+      row += fmt::format("| {} | {:g} | none of the dT tried | - | - | - | - |", r.estimator,
                          r.lambda);
     }
-    md += row;
+    if (bound) {
+      const double tau =
+          r.plant < static_cast<int>(in.latency.size()) ? in.latency[r.plant] : std::nan("");
+      row += fmt::format(" {} | {} |", Fmt(tau, "{:.3g}"),
+                         Fmt(LatencyBound(in, r.plant, r.estimator, r.lambda, c), "{:.3g}"));
+    }
+    md += row + "\n";
   }
   if (!sens.empty()) {
     md +=
@@ -295,7 +334,8 @@ Status WriteReport(const ReportInput& in, const std::string& out_dir) {
   const auto recs = Recommend(in.cells);
   const auto sens = Sensitivities(recs);
   std::map<std::string, std::string> pngs;
-  std::vector<std::pair<std::string, plot::Figure>> figs = {{"margin", MarginFigure(in)}};
+  const double c = DelayLoopGainForOvershoot(in.criterion.max_overshoot);
+  std::vector<std::pair<std::string, plot::Figure>> figs = {{"margin", MarginFigure(in, c)}};
   if (!recs.empty() && !recs.front().plant_values.empty()) {
     figs.emplace_back("critical_dt", CriticalFigure(in.title, recs));
   }

@@ -19,6 +19,8 @@
 
 #include "common/atomic_file.h"
 #include "common/rng.h"
+#include "sim/task.h"
+#include "sweep/latency.h"
 #include "sweep/recommend.h"
 #include "sweep/sampling.h"
 #include "sweep/sweep_file.h"
@@ -303,6 +305,33 @@ TEST(Sweep, EveryRunMadeAppendsOneLineToTheProgressLog) {
   EXPECT_EQ(lines, grid->size());
   EXPECT_NE(log.find(" eta="), std::string::npos);
   fs::remove_all(dir);
+}
+
+// --- The latency bound.
+
+TEST(SweepLatency, DelayLoopMatchesItsClosedFormThreshold) {
+  // y' = a (1 - y(t - 1)) has a non-oscillating (overshoot-free) step response iff a <= 1/e.
+  EXPECT_NEAR(sweep::DelayLoopGainForOvershoot(0.0), 1 / M_E, 3e-3);
+  EXPECT_LT(sweep::DelayLoopOvershoot(0.9 / M_E), 1e-9);
+  EXPECT_GT(sweep::DelayLoopOvershoot(1.1 / M_E), 1e-4);
+  // A larger allowed overshoot allows a larger loop gain, below the stability limit pi/2.
+  const double c10 = sweep::DelayLoopGainForOvershoot(0.10);
+  EXPECT_NEAR(sweep::DelayLoopOvershoot(c10), 0.10, 1e-6);
+  EXPECT_GT(c10, 1 / M_E);
+  EXPECT_LT(c10, sweep::DelayLoopGainForOvershoot(0.20));
+  EXPECT_LT(sweep::DelayLoopGainForOvershoot(0.20), M_PI / 2);
+}
+
+TEST(SweepLatency, BenchForceLatencyEqualsTheOfficialBindingsMeasurement) {
+  // Reference: MuJoCo's Python bindings with the plugin library, models/isometric_bench.xml at
+  // timestep 0.002, ctrl = 1 held from rest: the tension first reaches half its 8 s value
+  // (26.66 N, the same at 30 s) at t = 1.742 s.
+  auto task =
+      Task::FromFile(std::string(RECRUIT_SOURCE_DIR) + "/models/tasks/isometric_steps.json");
+  ASSERT_TRUE(task.ok()) << task.error();
+  auto tau = sweep::ForceLatency(*task);
+  ASSERT_TRUE(tau.ok()) << tau.error();
+  EXPECT_NEAR(*tau, 1.742, 0.0041);
 }
 
 // --- Samples: the defining properties, not stored numbers.
