@@ -24,7 +24,6 @@
 #include "common/json_file.h"
 #include "common/mujoco_load.h"
 #include "common/output_path.h"
-#include "control/on_count_estimator.h"
 #include "sim/sweep.h"
 #include "sweep/latency.h"
 #include "sweep/sweep_file.h"
@@ -72,8 +71,10 @@ struct PlantTask {
 };
 
 // The resume key of one run: a hash of everything that determines its result (the plant
-// point's task document and model text, the filter model file's content, the run's options and
-// the code version), so an edited input or a new build is never served an old result.
+// point's task document and model text, the filter model file's content when one is given, the
+// run's options and the code version), so an edited input or a new build is never served an old
+// result. Without a filter model file, kalman-augmented finds or identifies the model of the
+// plant and dT (identification/model_cache.h): both are in the hash already.
 std::string RunInputHash(const PlantTask& p, const sim::SweepSpec& spec, const sim::SweepRun& g,
                          std::map<std::string, std::string>& cache) {
   sim::RunOptions o;
@@ -82,17 +83,13 @@ std::string RunInputHash(const PlantTask& p, const sim::SweepSpec& spec, const s
   o.lambda = g.lambda;
   o.filter_model = spec.filter_model;
   const sim::ControllerSettings c = sim::EffectiveSettings(p.task, o);
-  std::string filter_model = c.filter_model;
-  if (filter_model.empty() && c.estimator == "kalman-augmented") {
-    filter_model = control::DefaultModelFile(c.dT, 20);
-  }
   auto content = [&cache](const std::string& path) -> const std::string& {
     auto it = cache.find(path);
     if (it == cache.end()) it = cache.emplace(path, ContentOf(path)).first;
     return it->second;
   };
   ContentHash h;
-  h.Add(CodeVersion()).Add(p.task_text).Add(p.model_text).Add(content(filter_model));
+  h.Add(CodeVersion()).Add(p.task_text).Add(p.model_text).Add(content(c.filter_model));
   h.Add(c.estimator).Add(fmt::format("{:.17g} {:.17g} {:.17g}", c.dT, c.lambda, c.force_noise_std));
   h.Add(fmt::format("{:.17g} {}", spec.duration ? *spec.duration : p.task.duration, g.seed));
   return h.Hex();
