@@ -273,7 +273,9 @@ int WriteReports(const std::string& cmd, const Prepared& p,
   return exit_code::kOk;
 }
 
-Result<FileLock> OpenOut(const std::string& out, const Prepared& p, const SweepArgs& a) {
+// Checks the outputs replace no input (exit 2), creates `out` and takes its lock (exit 4).
+Result<FileLock> OpenOut(const std::string& out, const Prepared& p, const SweepArgs& a, int* code) {
+  *code = exit_code::kUsage;
   // The outputs must not replace the inputs (a task file kept in the output folder).
   for (const char* name :
        {"sweep.json", "table.csv", "table.md", "stability.dat", "stability.gp", "stability.png",
@@ -285,6 +287,7 @@ Result<FileLock> OpenOut(const std::string& out, const Prepared& p, const SweepA
                                 {"the task's model", p.task.model_path}});
     if (!s.ok()) return Error{s.error()};
   }
+  *code = exit_code::kIo;
   std::error_code ec;
   fs::create_directories(out, ec);
   if (ec) return Error{"cannot create --out '" + ShortText(out) + "': " + ec.message()};
@@ -307,8 +310,9 @@ int RunSweepCommand(const SweepArgs& a) {
       a.shard.empty() ? p.grid : sim::ShardOf(p.grid, shard_k, shard_n);
 
   // One sweep per folder at a time: the lock is held until the process ends.
-  auto lock = OpenOut(a.out, p, a);
-  if (!lock.ok()) return Fail(cmd, lock.error(), exit_code::FromMessage(lock.error()));
+  int lock_code = 0;
+  auto lock = OpenOut(a.out, p, a, &lock_code);
+  if (!lock.ok()) return Fail(cmd, lock.error(), lock_code);
   // A folder holds one sweep (or one shard of it): its id must match to resume. Which runs can
   // be reused is decided per run by its input hash (an edited task reruns everything).
   const std::string id_path = (fs::path(a.out) / "sweep.json").string();
@@ -452,8 +456,9 @@ int RunMergeCommand(const SweepArgs& a) {
   for (int k = 1; k <= n; ++k) {
     if (!dirs.count(k)) missing.push_back(k);
   }
-  auto lock = OpenOut(a.out, p, a);
-  if (!lock.ok()) return Fail(cmd, lock.error(), exit_code::FromMessage(lock.error()));
+  int lock_code = 0;
+  auto lock = OpenOut(a.out, p, a, &lock_code);
+  if (!lock.ok()) return Fail(cmd, lock.error(), lock_code);
   const fs::path runs_dir = fs::path(a.out) / "runs";
   std::error_code ec;
   fs::create_directories(runs_dir, ec);
