@@ -10,16 +10,19 @@
 #include <algorithm>
 #include <atomic>
 #include <cerrno>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <ctime>
 #include <filesystem>
 #include <map>
 #include <mutex>
 #include <set>
 
 #include "common/atomic_file.h"
+#include "common/content_hash.h"
 #include "common/json_file.h"
 #include "common/rng.h"
 
@@ -30,7 +33,8 @@ using nlohmann::json;
 std::string SweepRun::Key() const {
   std::string est;
   for (char c : estimator) est += std::isalnum(static_cast<unsigned char>(c)) ? c : '-';
-  return fmt::format("dT{:g}_l{:g}_{}_s{}", dT, lambda, est, seed_index);
+  const std::string key = fmt::format("dT{:g}_l{:g}_{}_s{}", dT, lambda, est, seed_index);
+  return plant_values.empty() ? key : fmt::format("p{:04d}_{}", plant, key);
 }
 
 Result<std::vector<SweepRun>> ExpandGrid(const SweepSpec& spec) {
@@ -44,19 +48,25 @@ Result<std::vector<SweepRun>> ExpandGrid(const SweepSpec& spec) {
   for (double x : spec.lambdas) {
     if (!(x > 0 && x <= 1)) return Error{fmt::format("sweep: lambda {} must be in (0, 1]", x)};
   }
+  const std::vector<PlantPoint> plant =
+      spec.plant.empty() ? std::vector<PlantPoint>{PlantPoint{}} : spec.plant;
   std::vector<SweepRun> grid;
-  for (double dT : spec.dTs) {
-    for (double lambda : spec.lambdas) {
-      for (const auto& est : spec.estimators) {
-        for (int s = 0; s < spec.seeds; ++s) {
-          SweepRun r;
-          r.index = static_cast<int>(grid.size());
-          r.dT = dT;
-          r.lambda = lambda;
-          r.estimator = est;
-          r.seed_index = s;
-          r.seed = Rng::DeriveSeed(spec.base_seed, static_cast<std::uint64_t>(s));
-          grid.push_back(r);
+  for (size_t p = 0; p < plant.size(); ++p) {
+    for (double dT : spec.dTs) {
+      for (double lambda : spec.lambdas) {
+        for (const auto& est : spec.estimators) {
+          for (int s = 0; s < spec.seeds; ++s) {
+            SweepRun r;
+            r.index = static_cast<int>(grid.size());
+            r.plant = static_cast<int>(p);
+            r.plant_values = plant[p].values;
+            r.dT = dT;
+            r.lambda = lambda;
+            r.estimator = est;
+            r.seed_index = s;
+            r.seed = Rng::DeriveSeed(spec.base_seed, static_cast<std::uint64_t>(s));
+            grid.push_back(r);
+          }
         }
       }
     }
@@ -66,6 +76,39 @@ Result<std::vector<SweepRun>> ExpandGrid(const SweepSpec& spec) {
     if (!keys.insert(r.Key()).second) return Error{"sweep: grid point repeated: " + r.Key()};
   }
   return grid;
+}
+
+std::vector<SweepRun> ShardOf(const std::vector<SweepRun>& grid, int k, int n) {
+  std::vector<SweepRun> out;
+  for (const auto& r : grid) {
+    if (r.index % n == k - 1) out.push_back(r);
+  }
+  return out;
+}
+
+Result<std::pair<int, int>> ParseShard(const std::string& text) {
+  const auto slash = text.find('/');
+  int k = 0, n = 0;
+  try {
+    size_t used = 0;
+    if (slash == std::string::npos) throw std::invalid_argument("no slash");
+    k = std::stoi(text.substr(0, slash), &used);
+    if (used != slash) throw std::invalid_argument("K");
+    n = std::stoi(text.substr(slash + 1), &used);
+    if (used != text.size() - slash - 1) throw std::invalid_argument("N");
+  } catch (const std::exception&) {
+    return Error{"--shard '" + text + "': must be K/N with whole numbers, e.g. 3/8"};
+  }
+  if (n < 1 || n > 100000 || k < 1 || k > n) {
+    return Error{"--shard '" + text + "': need 1 <= K <= N <= 100000"};
+  }
+  return std::make_pair(k, n);
+}
+
+std::string SweepId(const std::vector<SweepRun>& grid) {
+  ContentHash h;
+  for (const auto& r : grid) h.Add(r.Key()).Add(r.input_hash);
+  return h.Hex();
 }
 
 Result<RunSummary> RunSummaryFromJson(const json& j) {
@@ -147,6 +190,9 @@ Result<SweepOutcome> RunSweep(const std::vector<SweepRun>& grid, const std::stri
     }
   }
 
+  // One line per finished run, appended and flushed so `tail -f progress.log` follows the sweep.
+  std::FILE* log = std::fopen((fs::path(out_dir) / "progress.log").c_str(), "a");
+  const auto t0 = std::chrono::steady_clock::now();
   std::mutex mu;
   std::string first_error;
   std::atomic<bool> failed{false};
@@ -172,6 +218,22 @@ Result<SweepOutcome> RunSweep(const std::vector<SweepRun>& grid, const std::stri
     outcome.runs[todo[t]] = std::move(s).value();
     ++outcome.executed;
     ++done;
+    if (log) {
+      const RunSummary& r = outcome.runs[todo[t]];
+      const std::time_t now = std::time(nullptr);
+      char stamp[32];
+      std::strftime(stamp, sizeof stamp, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
+      const double elapsed =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      const double eta = elapsed / outcome.executed * (total - done);
+      std::fprintf(log,
+                   "%s %d/%d %s rmse=%.4g overshoot=%.4f settled=%.2f est_rmse=%.3g wall=%.2fs "
+                   "eta=%.0fs\n",
+                   stamp, done, total, g.Key().c_str(), r.metrics.tracking_rmse,
+                   r.metrics.overshoot, r.metrics.settled_fraction, r.metrics.estimator_rmse,
+                   r.wall_seconds, eta);
+      std::fflush(log);
+    }
     if (progress) progress(done, total);
   };
   const int n = threads > 0 ? threads : tbb::this_task_arena::max_concurrency();
@@ -182,6 +244,7 @@ Result<SweepOutcome> RunSweep(const std::vector<SweepRun>& grid, const std::stri
                         for (size_t t = r.begin(); t != r.end(); ++t) body(t);
                       });
   });
+  if (log) std::fclose(log);
   if (failed) return Error{first_error};
   return outcome;
 }
@@ -254,20 +317,34 @@ int RunGnuplot(const std::string& script) {
 
 std::vector<CellStats> Aggregate(const std::vector<RunSummary>& runs,
                                  const TrackingCriterion& criterion) {
+  std::vector<SweepRun> grid(runs.size());
+  return Aggregate(grid, runs, criterion);
+}
+
+std::vector<CellStats> Aggregate(const std::vector<SweepRun>& grid,
+                                 const std::vector<RunSummary>& runs,
+                                 const TrackingCriterion& criterion) {
   std::vector<CellStats> cells;
-  std::map<std::tuple<double, double, std::string>, std::vector<const RunSummary*>> groups;
-  std::vector<std::tuple<double, double, std::string>> order;
-  for (const auto& r : runs) {
-    auto key = std::make_tuple(r.dT, r.lambda, r.estimator);
-    if (!groups.count(key)) order.push_back(key);
+  using Key = std::tuple<int, double, double, std::string>;
+  std::map<Key, std::vector<const RunSummary*>> groups;
+  std::map<Key, const SweepRun*> first;
+  std::vector<Key> order;
+  for (size_t i = 0; i < runs.size(); ++i) {
+    const RunSummary& r = runs[i];
+    auto key = std::make_tuple(grid.at(i).plant, r.dT, r.lambda, r.estimator);
+    if (!groups.count(key)) {
+      order.push_back(key);
+      first[key] = &grid[i];
+    }
     groups[key].push_back(&r);
   }
   for (const auto& key : order) {
     const auto& g = groups[key];
     CellStats c;
-    std::tie(c.dT, c.lambda, c.estimator) = key;
+    std::tie(c.plant, c.dT, c.lambda, c.estimator) = key;
+    c.plant_values = first[key]->plant_values;
     c.seeds = static_cast<int>(g.size());
-    std::vector<double> os, st, sf, rmse, iae, osc, sw, er, nees, w3;
+    std::vector<double> os, st, sf, rmse, iae, osc, sw, er, nees, w3, margins;
     for (const RunSummary* r : g) {
       os.push_back(r->metrics.overshoot);
       st.push_back(r->metrics.settling_time);
@@ -279,6 +356,9 @@ std::vector<CellStats> Aggregate(const std::vector<RunSummary>& runs,
       er.push_back(r->metrics.estimator_rmse);
       if (std::isfinite(r->metrics.mean_nees)) nees.push_back(r->metrics.mean_nees);
       w3.push_back(r->metrics.estimator_within3);
+      margins.push_back(std::min(criterion.max_overshoot - r->metrics.overshoot,
+                                 r->metrics.settled_fraction - criterion.min_settled));
+      if (margins.back() >= 0) ++c.seeds_meeting;
     }
     c.overshoot_mean = Mean(os);
     c.overshoot_sd = Sd(os);
@@ -294,6 +374,7 @@ std::vector<CellStats> Aggregate(const std::vector<RunSummary>& runs,
     c.margin = std::min(criterion.max_overshoot - c.overshoot_mean,
                         c.settled_fraction - criterion.min_settled);
     c.meets = c.margin >= 0;
+    c.margin_se = Sd(margins) / std::sqrt(static_cast<double>(margins.size()));
     cells.push_back(c);
   }
   return cells;
@@ -302,7 +383,30 @@ std::vector<CellStats> Aggregate(const std::vector<RunSummary>& runs,
 Status WriteSweepReport(const std::vector<CellStats>& cells, const TrackingCriterion& criterion,
                         const std::string& out_dir, const std::string& title) {
   const fs::path dir(out_dir);
+  // Plant axes, when the sweep has them, lead each row (from the first cell: all share them).
+  const auto& axes =
+      cells.empty() ? std::vector<std::pair<std::string, double>>{} : cells.front().plant_values;
+  std::string plant_head, plant_md_head, plant_md_rule;
+  for (const auto& [name, v] : axes) {
+    plant_head += name + ",";
+    plant_md_head += "| " + name + " ";
+    plant_md_rule += "|---";
+  }
+  if (!axes.empty()) {
+    plant_head = "plant," + plant_head;
+    plant_md_head = "| plant " + plant_md_head;
+    plant_md_rule = "|---" + plant_md_rule;
+  }
+  auto plant_cols = [](const CellStats& c, bool md) {
+    if (c.plant_values.empty()) return std::string();
+    std::string out = md ? fmt::format("| {} ", c.plant) : fmt::format("{},", c.plant);
+    for (const auto& [name, v] : c.plant_values) {
+      out += md ? fmt::format("| {:.6g} ", v) : fmt::format("{:.17g},", v);
+    }
+    return out;
+  };
   std::string csv =
+      plant_head +
       "dT,lambda,estimator,seeds,overshoot_mean,overshoot_sd,settling_time_mean,"
       "settled_fraction,tracking_rmse_mean,iae_mean,oscillation_mean,switching_rate_mean,"
       "estimator_rmse_mean,mean_nees_mean,estimator_within3_mean,meets_criterion,margin\n";
@@ -310,55 +414,62 @@ Status WriteSweepReport(const std::vector<CellStats>& cells, const TrackingCrite
       "# Sweep: {}\n\nCriterion: mean step overshoot <= {:.0f} % and at least {:.0f} % of "
       "steps settled within the 10 % band, over all seeds of a cell. Margin = min(overshoot "
       "limit - overshoot, settled fraction - required fraction).\n\n"
-      "| dT (s) | lambda | estimator | seeds | overshoot (%) | settling (s) | settled (%) | "
+      "{}| dT (s) | lambda | estimator | seeds | overshoot (%) | settling (s) | settled (%) | "
       "RMSE | oscillation | switching (1/unit/s) | est. RMSE (units) | NEES | within 3 (%) | "
-      "meets | margin |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
-      title, 100 * criterion.max_overshoot, 100 * criterion.min_settled);
+      "meets | margin |\n{}|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+      title, 100 * criterion.max_overshoot, 100 * criterion.min_settled, plant_md_head,
+      plant_md_rule);
   for (const auto& c : cells) {
-    csv += fmt::format(
-        "{:g},{:g},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},"
-        "{:.6g},{:.6g},{:.6g},{},{:.6g}\n",
-        c.dT, c.lambda, c.estimator, c.seeds, c.overshoot_mean, c.overshoot_sd, c.settling_mean,
-        c.settled_fraction, c.rmse_mean, c.iae_mean, c.oscillation_mean, c.switching_mean,
-        c.estimator_rmse_mean, c.nees_mean, c.within3_mean, c.meets ? 1 : 0, c.margin);
-    md += fmt::format(
-        "| {:g} | {:g} | {} | {} | {:.1f} ± {:.1f} | {:.2f} | {:.0f} | {:.3g} | {:.3f} | {:.4f} "
-        "| {:.2f} | {:.2f} | {:.0f} | {} | {:+.3f} |\n",
-        c.dT, c.lambda, c.estimator, c.seeds, 100 * c.overshoot_mean, 100 * c.overshoot_sd,
-        c.settling_mean, 100 * c.settled_fraction, c.rmse_mean, c.oscillation_mean,
-        c.switching_mean, c.estimator_rmse_mean, c.nees_mean, 100 * c.within3_mean,
-        c.meets ? "yes" : "no", c.margin);
+    csv +=
+        plant_cols(c, false) +
+        fmt::format(
+            "{:g},{:g},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},"
+            "{:.6g},{:.6g},{:.6g},{},{:.6g}\n",
+            c.dT, c.lambda, c.estimator, c.seeds, c.overshoot_mean, c.overshoot_sd, c.settling_mean,
+            c.settled_fraction, c.rmse_mean, c.iae_mean, c.oscillation_mean, c.switching_mean,
+            c.estimator_rmse_mean, c.nees_mean, c.within3_mean, c.meets ? 1 : 0, c.margin);
+    md += (c.plant_values.empty() ? "" : plant_cols(c, true)) +
+          fmt::format(
+              "| {:g} | {:g} | {} | {} | {:.1f} ± {:.1f} | {:.2f} | {:.0f} | {:.3g} | {:.3f} | "
+              "{:.4f} "
+              "| {:.2f} | {:.2f} | {:.0f} | {} | {:+.3f} |\n",
+              c.dT, c.lambda, c.estimator, c.seeds, 100 * c.overshoot_mean, 100 * c.overshoot_sd,
+              c.settling_mean, 100 * c.settled_fraction, c.rmse_mean, c.oscillation_mean,
+              c.switching_mean, c.estimator_rmse_mean, c.nees_mean, 100 * c.within3_mean,
+              c.meets ? "yes" : "no", c.margin);
   }
 
-  // Shortest sampling period meeting the criterion, per estimator and lambda.
-  std::string shortest =
+  // Shortest sampling period meeting the criterion, per plant point, estimator and lambda.
+  std::string shortest = fmt::format(
       "\n## Shortest sampling period meeting the criterion\n\n"
-      "| estimator | lambda | shortest dT (s) | margin | next shorter dT tried "
-      "|\n|---|---|---|---|---|\n";
-  std::vector<std::pair<std::string, double>> el;
+      "{}| estimator | lambda | shortest dT (s) | margin | next shorter dT tried "
+      "|\n{}|---|---|---|---|---|\n",
+      plant_md_head, plant_md_rule);
+  std::vector<std::tuple<int, std::string, double>> el;
   for (const auto& c : cells) {
-    auto key = std::make_pair(c.estimator, c.lambda);
+    auto key = std::make_tuple(c.plant, c.estimator, c.lambda);
     if (std::find(el.begin(), el.end(), key) == el.end()) el.push_back(key);
   }
-  for (const auto& [est, lambda] : el) {
+  for (const auto& [plant, est, lambda] : el) {
     std::vector<const CellStats*> col;
     for (const auto& c : cells) {
-      if (c.estimator == est && c.lambda == lambda) col.push_back(&c);
+      if (c.plant == plant && c.estimator == est && c.lambda == lambda) col.push_back(&c);
     }
     std::sort(col.begin(), col.end(), [](auto* a, auto* b) { return a->dT < b->dT; });
+    const std::string lead = plant_cols(*col.front(), true);
     // The shortest dT tried that meets it (a long dT can fail too: too slow to settle).
     int best = -1;
     for (int i = 0; i < static_cast<int>(col.size()) && best < 0; ++i) {
       if (col[i]->meets) best = i;
     }
     if (best < 0) {
-      shortest += fmt::format("| {} | {:g} | none of the dT tried | - | - |\n", est, lambda);
+      shortest += lead + fmt::format("| {} | {:g} | none of the dT tried | - | - |\n", est, lambda);
     } else {
       const std::string next =
           best > 0 ? fmt::format("{:g} (margin {:+.3f})", col[best - 1]->dT, col[best - 1]->margin)
                    : std::string("none shorter tried");
-      shortest += fmt::format("| {} | {:g} | {:g} | {:+.3f} | {} |\n", est, lambda, col[best]->dT,
-                              col[best]->margin, next);
+      shortest += lead + fmt::format("| {} | {:g} | {:g} | {:+.3f} | {} |\n", est, lambda,
+                                     col[best]->dT, col[best]->margin, next);
     }
   }
   md += shortest;
@@ -367,6 +478,9 @@ Status WriteSweepReport(const std::vector<CellStats>& cells, const TrackingCrite
   if (!s.ok()) return s;
   s = WriteFileAtomically((dir / "table.md").string(), md);
   if (!s.ok()) return s;
+  // With plant axes the dT x lambda map would overlay plant points: the sweep report
+  // (src/sweep/sweep_report.h) draws per-plant-point figures instead.
+  if (!axes.empty()) return Status::Ok();
 
   // Stability map: one panel per estimator, dT (log) x lambda, colour = mean overshoot,
   // a ring around cells that meet the criterion.

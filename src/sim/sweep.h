@@ -18,6 +18,12 @@
 
 namespace recruit::sim {
 
+// One point of the plant axes (hardware and sensor parameters set through the task or its model,
+// src/sweep/sweep_file.h): (axis name, value) in axis order. No values: the task as it is.
+struct PlantPoint {
+  std::vector<std::pair<std::string, double>> values;
+};
+
 struct SweepSpec {
   std::vector<double> dTs;
   std::vector<double> lambdas;
@@ -26,10 +32,13 @@ struct SweepSpec {
   std::uint64_t base_seed = 1;
   std::optional<double> duration;  // override of the task's
   std::optional<std::string> filter_model;
+  std::vector<PlantPoint> plant;  // outermost loop of the grid; empty = one point, no axes
 };
 
 struct SweepRun {
-  int index = 0;  // position in the grid (dT outermost, then lambda, estimator, seed)
+  int index = 0;  // position in the grid (plant point outermost, then dT, lambda, estimator, seed)
+  int plant = 0;  // index into SweepSpec::plant
+  std::vector<std::pair<std::string, double>> plant_values;
   double dT = 0, lambda = 0;
   std::string estimator;
   int seed_index = 0;
@@ -37,10 +46,21 @@ struct SweepRun {
   // Hash of everything else that determines the run's result (task and model file contents,
   // options, code version), set by the caller; a record is reused only if its hash is equal.
   std::string input_hash;
-  std::string Key() const;  // file-name-safe identity of the run, e.g. "dT0.5_l0.2_kalman_s3"
+  // File-name-safe identity of the run, e.g. "dT0.5_l0.2_kalman_s3"; with plant axes prefixed by
+  // the plant point's index, "p0007_dT0.5_l0.2_kalman_s3".
+  std::string Key() const;
 };
 
 Result<std::vector<SweepRun>> ExpandGrid(const SweepSpec& spec);
+
+// Shard k of n (1 <= k <= n): the runs whose grid index i has i % n == k - 1. Round-robin, so
+// every shard gets a like mix of plant points and dT; the shards partition the grid.
+std::vector<SweepRun> ShardOf(const std::vector<SweepRun>& grid, int k, int n);
+// Parses "K/N" (1 <= K <= N <= 100000).
+Result<std::pair<int, int>> ParseShard(const std::string& text);
+// Identity of a whole sweep (every run's key and input hash, in grid order): shards of the same
+// sweep carry the same id, and merge refuses shards of another.
+std::string SweepId(const std::vector<SweepRun>& grid);
 
 // What the sweep runs for one grid point (RunTask in production, a fake in tests).
 using SweepRunFn = std::function<Result<RunSummary>(const SweepRun&)>;
@@ -53,6 +73,7 @@ struct SweepOutcome {
 
 // Runs every grid point not yet recorded under `out_dir`/runs on `threads` threads (0 = all
 // cores). `progress(done, total)` is called from worker threads (serialised) after each run.
+// Each finished run also appends one summary line to `out_dir`/progress.log (tail -f it).
 Result<SweepOutcome> RunSweep(const std::vector<SweepRun>& grid, const std::string& out_dir,
                               const SweepRunFn& run, int threads,
                               const std::function<void(int, int)>& progress = {});
@@ -65,6 +86,8 @@ struct TrackingCriterion {
 
 // One grid cell aggregated over seeds.
 struct CellStats {
+  int plant = 0;
+  std::vector<std::pair<std::string, double>> plant_values;
   double dT = 0, lambda = 0;
   std::string estimator;
   int seeds = 0;
@@ -77,15 +100,25 @@ struct CellStats {
   double estimator_rmse_mean = 0, nees_mean = 0, within3_mean = 0;
   bool meets = false;
   double margin = 0;  // min(max_overshoot - overshoot, settled - min_settled); >= 0 iff meets
+  // Over seeds: each seed's own margin (same formula on its run alone), how many meet, and the
+  // standard error of their mean (the spread the confidence in the report comes from).
+  int seeds_meeting = 0;
+  double margin_se = 0;
 };
 
+// Cells in grid order; runs are told apart by (dT, lambda, estimator).
 std::vector<CellStats> Aggregate(const std::vector<RunSummary>& runs,
                                  const TrackingCriterion& criterion);
+// The same with plant points: runs[i] was made for grid[i].
+std::vector<CellStats> Aggregate(const std::vector<SweepRun>& grid,
+                                 const std::vector<RunSummary>& runs,
+                                 const TrackingCriterion& criterion);
 
-// Writes table.csv, table.md, stability.dat/.gp/.png (when gnuplot is found) and
-// shortest_dT.md into `out_dir`. The files depend only on the runs' results. Any failed write
-// (full disk) is an error; so is gnuplot failing or writing an empty image (gnuplot missing is
-// only a warning: the data and script are still written).
+// Writes table.csv, table.md (with a column per plant axis when there are plant points),
+// stability.dat/.gp/.png (when gnuplot is found, and no plant axes) into `out_dir`. The files
+// depend only on the runs' results. Any failed write (full disk) is an error; so is gnuplot failing
+// or writing an empty image (gnuplot missing is only a warning: the data and script are still
+// written).
 Status WriteSweepReport(const std::vector<CellStats>& cells, const TrackingCriterion& criterion,
                         const std::string& out_dir, const std::string& title);
 

@@ -1,0 +1,487 @@
+#include "sweep/sweep_file.h"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <filesystem>
+#include <set>
+
+#include "common/atomic_file.h"
+#include "common/json_file.h"
+#include "common/short_text.h"
+#include "sweep/sampling.h"
+
+namespace recruit::sweep {
+namespace {
+
+using nlohmann::json;
+namespace fs = std::filesystem;
+
+std::string Resolve(const std::string& path, const std::string& source) {
+  if (path.empty() || fs::path(path).is_absolute() || source.empty()) return path;
+  return (fs::path(source).parent_path() / path).lexically_normal().string();
+}
+
+// Values of an axis: [v, ...] or {"values": [...]} or {"range": [lo, hi], "steps": k,
+// "scale": "lin"|"log"}; `where` names the axis in errors.
+struct Values {
+  std::vector<double> values;
+  double lo = 0, hi = 0;
+  bool has_range = false, log = false;
+};
+
+Result<Values> ParseValues(const json& j, const std::string& where, bool need_steps) {
+  Values v;
+  const json* list = nullptr;
+  if (j.is_array()) {
+    list = &j;
+  } else if (j.is_object() && j.contains("values")) {
+    list = &j.at("values");
+  }
+  if (list) {
+    if (!list->is_array() || list->empty()) {
+      return Error{where + ".values: must be a non-empty array of numbers, got " +
+                   ShortText(list->dump())};
+    }
+    for (const json& x : *list) {
+      if (!x.is_number() || !std::isfinite(x.get<double>())) {
+        return Error{where + ": value " + ShortText(x.dump()) + " is not a finite number"};
+      }
+      v.values.push_back(x.get<double>());
+    }
+    return v;
+  }
+  if (!j.is_object() || !j.contains("range")) {
+    return Error{where + ": give \"values\": [..] or \"range\": [lo, hi] (with \"steps\"), got " +
+                 ShortText(j.dump())};
+  }
+  const json& r = j.at("range");
+  if (!r.is_array() || r.size() != 2 || !r[0].is_number() || !r[1].is_number()) {
+    return Error{where + ".range: must be [lo, hi], got " + ShortText(r.dump())};
+  }
+  v.lo = r[0].get<double>();
+  v.hi = r[1].get<double>();
+  v.has_range = true;
+  if (!std::isfinite(v.lo) || !std::isfinite(v.hi) || !(v.lo <= v.hi)) {
+    return Error{where + ".range: " + r.dump() + " must be finite with lo <= hi"};
+  }
+  if (j.contains("scale")) {
+    const json& s = j.at("scale");
+    if (s == "log") {
+      v.log = true;
+    } else if (s != "lin") {
+      return Error{where + ".scale: " + ShortText(s.dump()) + "; allowed: \"lin\", \"log\""};
+    }
+  }
+  if (v.log && !(v.lo > 0)) return Error{where + ".range: a log scale needs lo > 0"};
+  int steps = 0;
+  if (j.contains("steps")) {
+    const json& s = j.at("steps");
+    if (!s.is_number_integer() || s.get<long>() < 1 || s.get<long>() > 100000) {
+      return Error{where + ".steps: " + ShortText(s.dump()) +
+                   "; allowed: a whole number 1..100000"};
+    }
+    steps = s.get<int>();
+  } else if (need_steps) {
+    return Error{where + ": a range on a grid needs \"steps\" (number of values, >= 1)"};
+  }
+  for (int i = 0; i < steps; ++i) {
+    const double f = steps == 1 ? 0.0 : static_cast<double>(i) / (steps - 1);
+    v.values.push_back(v.log ? v.lo * std::pow(v.hi / v.lo, f) : v.lo + f * (v.hi - v.lo));
+  }
+  return v;
+}
+
+Status CheckKeys(const json& j, const std::set<std::string>& allowed, const std::string& where) {
+  for (auto it = j.begin(); it != j.end(); ++it) {
+    if (!allowed.count(it.key())) {
+      std::string list;
+      for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
+      return Error{where + ": unknown field '" + it.key() + "'; allowed: " + list};
+    }
+  }
+  return Status::Ok();
+}
+
+std::string FormatValue(double v, bool integer) {
+  return integer ? fmt::format("{}", static_cast<long long>(std::llround(v)))
+                 : fmt::format("{:.17g}", v);
+}
+
+}  // namespace
+
+double PlantAxis::FromUnit(double u) const {
+  double x;
+  if (has_range) {
+    x = log ? lo * std::pow(hi / lo, u) : lo + u * (hi - lo);
+  } else {
+    const size_t i = std::min(values.size() - 1, static_cast<size_t>(u * values.size()));
+    x = values[i];
+  }
+  return integer ? std::round(x) : x;
+}
+
+Result<SweepFile> SweepFile::FromFile(const std::string& path) {
+  auto text = ReadFile(path);
+  if (!text.ok()) return Error{"sweep file: " + text.error()};
+  return FromJsonText(*text, path);
+}
+
+Result<SweepFile> SweepFile::FromJsonText(const std::string& text, const std::string& source) {
+  const std::string file = "sweep file '" + (source.empty() ? "<sweep>" : source) + "'";
+  auto parsed = ParseJsonText(text, source.empty() ? "<sweep>" : source);
+  if (!parsed.ok()) return Error{parsed.error()};
+  const json j = std::move(parsed).value();
+  if (!j.is_object()) return Error{file + ": must be a JSON object"};
+  if (Status s =
+          CheckKeys(j, {"task", "duration", "controller", "plant", "criterion", "comment"}, file);
+      !s.ok())
+    return Error{s.error()};
+  SweepFile f;
+  f.source = source;
+  if (j.contains("task")) {
+    if (!j["task"].is_string()) return Error{file + ".task: must be a path (string)"};
+    f.task = Resolve(j["task"].get<std::string>(), source);
+  }
+  if (j.contains("duration")) {
+    const json& d = j["duration"];
+    if (!d.is_number() || !(d.get<double>() > 0) || d.get<double>() > 1e6) {
+      return Error{file + ".duration: " + ShortText(d.dump()) + "; allowed: seconds, 0 < d <= 1e6"};
+    }
+    f.duration = d.get<double>();
+  }
+  if (j.contains("controller")) {
+    const json& c = j["controller"];
+    const std::string where = file + ".controller";
+    if (!c.is_object()) return Error{where + ": must be an object"};
+    if (Status s = CheckKeys(c, {"dT", "lambda", "estimator", "seeds", "base_seed"}, where);
+        !s.ok())
+      return Error{s.error()};
+    if (c.contains("dT")) {
+      auto v = ParseValues(c["dT"], where + ".dT", true);
+      if (!v.ok()) return Error{v.error()};
+      for (double x : v->values) {
+        if (!(x > 0 && x <= 1000)) {
+          return Error{fmt::format("{}.dT: value {:g} is out of range; allowed: 0 < dT <= 1000 s",
+                                   where, x)};
+        }
+      }
+      f.dTs = v->values;
+    }
+    if (c.contains("lambda")) {
+      auto v = ParseValues(c["lambda"], where + ".lambda", true);
+      if (!v.ok()) return Error{v.error()};
+      for (double x : v->values) {
+        if (!(x > 0 && x <= 1)) {
+          return Error{fmt::format(
+              "{}.lambda: value {:g} is out of range; allowed: 0 < lambda <= 1", where, x)};
+        }
+      }
+      f.lambdas = v->values;
+    }
+    if (c.contains("estimator")) {
+      const json& e = c["estimator"];
+      const json list = e.is_string() ? json::array({e}) : e;
+      if (!list.is_array() || list.empty()) {
+        return Error{where + ".estimator: must be a name or a non-empty array of names"};
+      }
+      for (const json& x : list) {
+        static const std::set<std::string> kKnown = {"output", "kalman2", "kalman-augmented"};
+        if (!x.is_string() || !kKnown.count(x.get<std::string>())) {
+          return Error{where + ".estimator: " + ShortText(x.dump()) +
+                       "; allowed: output, kalman2, kalman-augmented"};
+        }
+        f.estimators.push_back(x.get<std::string>());
+      }
+    }
+    if (c.contains("seeds")) {
+      const json& s = c["seeds"];
+      if (!s.is_number_integer() || s.get<long>() < 1 || s.get<long>() > 100000) {
+        return Error{where + ".seeds: " + ShortText(s.dump()) + "; allowed: 1..100000"};
+      }
+      f.seeds = s.get<int>();
+    }
+    if (c.contains("base_seed")) {
+      const json& s = c["base_seed"];
+      if (!s.is_number_unsigned()) {
+        return Error{where + ".base_seed: " + ShortText(s.dump()) +
+                     "; allowed: a whole number >= 0"};
+      }
+      f.base_seed = s.get<std::uint64_t>();
+    }
+  }
+  if (j.contains("criterion")) {
+    const json& c = j["criterion"];
+    const std::string where = file + ".criterion";
+    if (!c.is_object()) return Error{where + ": must be an object"};
+    if (Status s = CheckKeys(c, {"max_overshoot", "min_settled"}, where); !s.ok())
+      return Error{s.error()};
+    sim::TrackingCriterion crit;
+    if (c.contains("max_overshoot")) {
+      if (!c["max_overshoot"].is_number() || !(c["max_overshoot"].get<double>() >= 0)) {
+        return Error{where + ".max_overshoot: must be a number >= 0"};
+      }
+      crit.max_overshoot = c["max_overshoot"];
+    }
+    if (c.contains("min_settled")) {
+      const json& m = c["min_settled"];
+      if (!m.is_number() || !(m.get<double>() >= 0 && m.get<double>() <= 1)) {
+        return Error{where + ".min_settled: must be a number in [0, 1]"};
+      }
+      crit.min_settled = m;
+    }
+    f.criterion = crit;
+  }
+  if (j.contains("plant")) {
+    const json& p = j["plant"];
+    const std::string where = file + ".plant";
+    if (!p.is_object()) return Error{where + ": must be an object"};
+    if (Status s = CheckKeys(p, {"sampling", "samples", "seed", "axes"}, where); !s.ok())
+      return Error{s.error()};
+    if (p.contains("sampling")) {
+      const json& s = p["sampling"];
+      if (s == "grid") {
+        f.sampling = Sampling::kGrid;
+      } else if (s == "lhs") {
+        f.sampling = Sampling::kLatinHypercube;
+      } else if (s == "sobol") {
+        f.sampling = Sampling::kSobol;
+      } else {
+        return Error{where + ".sampling: " + ShortText(s.dump()) +
+                     "; allowed: \"grid\", \"lhs\", \"sobol\""};
+      }
+    }
+    if (f.sampling != Sampling::kGrid) {
+      const json s = p.value("samples", json());
+      if (!s.is_number_integer() || s.get<long>() < 1 || s.get<long>() > 1000000) {
+        return Error{where + ".samples: " + ShortText(s.dump()) +
+                     "; a sample needs a whole number of points, 1..1000000"};
+      }
+      f.samples = s.get<int>();
+      if (p.contains("seed")) {
+        if (!p["seed"].is_number_unsigned()) return Error{where + ".seed: a whole number >= 0"};
+        f.sample_seed = p["seed"].get<std::uint64_t>();
+      }
+    }
+    const json axes = p.value("axes", json::array());
+    if (!axes.is_array()) return Error{where + ".axes: must be an array of axes"};
+    std::set<std::string> names, paths;
+    for (size_t i = 0; i < axes.size(); ++i) {
+      const json& a = axes[i];
+      std::string aw = fmt::format("{}.axes[{}]", where, i);
+      if (!a.is_object()) return Error{aw + ": must be an object {name, path, values | range}"};
+      if (Status s =
+              CheckKeys(a, {"name", "path", "values", "range", "steps", "scale", "integer"}, aw);
+          !s.ok())
+        return Error{s.error()};
+      PlantAxis ax;
+      if (!a.contains("path") || !a["path"].is_string() || a["path"].get<std::string>().empty()) {
+        return Error{aw +
+                     ".path: missing; a JSON pointer into the task (\"/sensor/noise_std\") "
+                     "or \"model:INSTANCE/KEY\""};
+      }
+      ax.path = a["path"];
+      ax.name = a.value("name", ax.path);
+      if (!a.value("name", json("")).is_string()) return Error{aw + ".name: must be a string"};
+      aw = fmt::format("{} (axis '{}')", aw, ax.name);
+      if (ax.path.rfind("model:", 0) == 0) {
+        const std::string rest = ax.path.substr(6);
+        const auto slash = rest.find('/');
+        if (slash == std::string::npos || slash == 0 || slash + 1 == rest.size()) {
+          return Error{aw + ".path: '" + ax.path + "' must be model:INSTANCE/KEY"};
+        }
+        ax.instance = rest.substr(0, slash);
+        ax.key = rest.substr(slash + 1);
+      } else if (ax.path[0] != '/') {
+        return Error{aw + ".path: '" + ShortText(ax.path) +
+                     "' is neither a JSON pointer (starts with '/') nor model:INSTANCE/KEY"};
+      } else if (ax.path == "/controller/dT" || ax.path == "/controller/lambda" ||
+                 ax.path == "/controller/estimator") {
+        return Error{aw + ".path: '" + ax.path +
+                     "' is a controller axis; set it in \"controller\" (the sweep's own axes)"};
+      } else {
+        try {
+          (void)json::json_pointer(ax.path);
+        } catch (const json::exception& e) {
+          return Error{aw + ".path: '" + ShortText(ax.path) +
+                       "' is not a JSON pointer: " + e.what()};
+        }
+      }
+      if (!names.insert(ax.name).second) return Error{aw + ".name: repeated axis name"};
+      if (!paths.insert(ax.path).second) return Error{aw + ".path: repeated path " + ax.path};
+      if (a.contains("integer")) {
+        if (!a["integer"].is_boolean()) return Error{aw + ".integer: must be true or false"};
+        ax.integer = a["integer"];
+      }
+      auto v = ParseValues(a, aw, f.sampling == Sampling::kGrid);
+      if (!v.ok()) return Error{v.error()};
+      ax.values = v->values;
+      ax.lo = v->lo;
+      ax.hi = v->hi;
+      ax.has_range = v->has_range;
+      ax.log = v->log;
+      if (ax.integer) {
+        for (double& x : ax.values) x = std::round(x);
+      }
+      f.axes.push_back(ax);
+    }
+    if (f.sampling == Sampling::kSobol && static_cast<int>(f.axes.size()) > MaxSobolDims()) {
+      return Error{fmt::format("{}.axes: {} axes; a Sobol sample takes at most {} (use \"lhs\")",
+                               where, f.axes.size(), MaxSobolDims())};
+    }
+  }
+  return f;
+}
+
+Result<std::vector<sim::PlantPoint>> PlantPoints(const SweepFile& f) {
+  std::vector<sim::PlantPoint> points;
+  if (f.axes.empty()) return std::vector<sim::PlantPoint>{sim::PlantPoint{}};
+  if (f.sampling == Sampling::kGrid) {
+    size_t total = 1;
+    for (const auto& a : f.axes) {
+      total *= a.values.size();
+      if (total > 10000000) return Error{"sweep file '" + f.source + "': the grid is too large"};
+    }
+    for (size_t i = 0; i < total; ++i) {
+      sim::PlantPoint p;
+      size_t rem = i;
+      std::vector<size_t> idx(f.axes.size());
+      for (size_t k = f.axes.size(); k-- > 0;) {  // last axis fastest
+        idx[k] = rem % f.axes[k].values.size();
+        rem /= f.axes[k].values.size();
+      }
+      for (size_t k = 0; k < f.axes.size(); ++k) {
+        p.values.emplace_back(f.axes[k].name, f.axes[k].values[idx[k]]);
+      }
+      points.push_back(p);
+    }
+    return points;
+  }
+  const int dims = static_cast<int>(f.axes.size());
+  UnitPoints u;
+  if (f.sampling == Sampling::kLatinHypercube) {
+    u = LatinHypercube(f.samples, dims, f.sample_seed);
+  } else {
+    auto s = Sobol(f.samples, dims, f.sample_seed);
+    if (!s.ok()) return Error{"sweep file '" + f.source + "': " + s.error()};
+    u = std::move(s).value();
+  }
+  for (const auto& row : u) {
+    sim::PlantPoint p;
+    for (int k = 0; k < dims; ++k)
+      p.values.emplace_back(f.axes[k].name, f.axes[k].FromUnit(row[k]));
+    points.push_back(p);
+  }
+  return points;
+}
+
+Result<std::string> SetPluginConfig(const std::string& xml, const std::string& instance,
+                                    const std::string& key, const std::string& value) {
+  std::vector<std::string> seen;
+  size_t pos = 0;
+  while ((pos = xml.find("<instance", pos)) != std::string::npos) {
+    const size_t tag_end = xml.find('>', pos);
+    if (tag_end == std::string::npos) break;
+    const std::string tag = xml.substr(pos, tag_end - pos);
+    const size_t n = tag.find("name=");
+    std::string name;
+    if (n != std::string::npos && n + 6 < tag.size()) {
+      const char q = tag[n + 5];
+      const size_t e = tag.find(q, n + 6);
+      if (e != std::string::npos) name = tag.substr(n + 6, e - n - 6);
+    }
+    if (name != instance) {
+      seen.push_back(name);
+      pos = tag_end;
+      continue;
+    }
+    if (tag.back() == '/') {  // <instance name="x"/>: no config lines yet
+      std::string out = xml.substr(0, pos) + tag.substr(0, tag.size() - 1) + "><config key=\"" +
+                        key + "\" value=\"" + value + "\"/></instance" + xml.substr(tag_end);
+      return out;
+    }
+    const size_t close = xml.find("</instance>", tag_end);
+    if (close == std::string::npos) return Error{"instance '" + instance + "' is not closed"};
+    for (const char q : {'"', '\''}) {
+      const std::string needle = std::string("key=") + q + key + q;
+      const size_t k = xml.find(needle, tag_end);
+      if (k == std::string::npos || k > close) continue;
+      const size_t cfg = xml.rfind("<config", k);
+      const size_t cfg_end = xml.find('>', k);
+      const size_t v = xml.find("value=", cfg);
+      if (cfg == std::string::npos || cfg < tag_end || v == std::string::npos || v > cfg_end) {
+        return Error{"config key '" + key + "' of instance '" + instance + "' has no value"};
+      }
+      const char vq = xml[v + 6];
+      const size_t ve = xml.find(vq, v + 7);
+      return xml.substr(0, v + 7) + value + xml.substr(ve);
+    }
+    return xml.substr(0, tag_end + 1) + "\n        <config key=\"" + key + "\" value=\"" + value +
+           "\"/>" + xml.substr(tag_end + 1);
+  }
+  std::string list;
+  for (const auto& s : seen) list += (list.empty() ? "" : ", ") + s;
+  return Error{
+      "the model has no plugin instance '" + instance + "'" +
+      (list.empty() ? std::string(" (it has no named instances)") : "; instances: " + list)};
+}
+
+Result<PlantInputs> ApplyPlantPoint(const std::string& task_text, const std::string& model_text,
+                                    const std::vector<PlantAxis>& axes,
+                                    const sim::PlantPoint& point, const std::string& where) {
+  PlantInputs out;
+  out.model_text = model_text;
+  json doc;
+  try {
+    doc = json::parse(task_text);
+  } catch (const json::exception& e) {
+    return Error{where + ": the task is not JSON: " + e.what()};
+  }
+  for (size_t k = 0; k < axes.size(); ++k) {
+    const PlantAxis& a = axes[k];
+    const double v = point.values.at(k).second;
+    const std::string label = fmt::format("{}: axis '{}' ({}) value {}", where, a.name, a.path,
+                                          FormatValue(v, a.integer));
+    if (a.is_model()) {
+      auto xml = SetPluginConfig(out.model_text, a.instance, a.key, FormatValue(v, a.integer));
+      if (!xml.ok()) return Error{label + ": " + xml.error()};
+      out.model_text = std::move(xml).value();
+      out.model_edited = true;
+      continue;
+    }
+    const json::json_pointer ptr(a.path);
+    const json::json_pointer parent = ptr.parent_pointer();
+    if (!doc.contains(parent)) {
+      return Error{label + ": the task has no '" + parent.to_string() + "'"};
+    }
+    json& p = doc.at(parent);
+    const std::string last = ptr.back();
+    if (p.is_array()) {
+      std::size_t i = 0;
+      try {
+        i = std::stoul(last);
+      } catch (...) {
+        return Error{label + ": '" + last + "' is not an index of the array " + parent.to_string()};
+      }
+      if (i >= p.size()) {
+        return Error{fmt::format("{}: index {} is past the end of {} ({} elements)", label, i,
+                                 parent.to_string(), p.size())};
+      }
+    } else if (!p.is_object()) {
+      return Error{label + ": '" + parent.to_string() + "' is not an object or array"};
+    }
+    if (doc.contains(ptr) && !doc.at(ptr).is_number()) {
+      return Error{label + ": the task's value there is " + ShortText(doc.at(ptr).dump()) +
+                   ", not a number"};
+    }
+    if (a.integer) {
+      doc[ptr] = static_cast<long long>(std::llround(v));
+    } else {
+      doc[ptr] = v;
+    }
+  }
+  out.task_text = doc.dump(1);
+  return out;
+}
+
+}  // namespace recruit::sweep
