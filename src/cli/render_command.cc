@@ -141,8 +141,9 @@ void AddRenderCommand(CLI::App& app, int& exit_code) {
       ->capture_default_str();
   cmd->add_option("--height", a->video.render.height, "Frame height, pixels (even)")
       ->capture_default_str();
-  auto* camera =
-      cmd->add_option("--camera", a->camera, "A camera the model names [default: the free camera]");
+  auto* camera = cmd->add_option("--camera", a->camera,
+                                 "A camera the model names [default: the model's camera \"render\" "
+                                 "if any, else the free camera]");
   auto* az = cmd->add_option("--azimuth", a->azimuth, "Free camera azimuth, deg");
   auto* el = cmd->add_option("--elevation", a->elevation, "Free camera elevation, deg, [-90, 90]");
   auto* di = cmd->add_option("--distance", a->distance, "Free camera distance, m (> 0)");
