@@ -2,6 +2,7 @@
 // VideoRecorder is one of RunTask's step observers): H.264 MP4, optionally a GIF and PNG stills.
 #include <unistd.h>
 
+#include <cstdio>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -32,15 +33,18 @@ struct RenderArgs {
   std::string stills_prefix;
 };
 
-// Loads the task's model only to check the camera before anything runs.
-Status CheckCamera(const std::string& model_path, const render::CameraSpec& spec) {
+// Loads the task's model only to check the camera before anything runs. A model that does not
+// load is bad input (3); a camera the model does not have is a bad option (2, usage).
+int CheckCamera(const std::string& model_path, const render::CameraSpec& spec) {
   char error[1000] = "";
   mjModel* m = mj_loadXML(model_path.c_str(), nullptr, error, sizeof(error));
-  if (!m) return Error{"model '" + model_path + "': " + error};
+  if (!m) return Fail("render", "model '" + model_path + "': " + error, exit_code::kBadInput);
   auto cam = render::ResolveCamera(m, spec);
   mj_deleteModel(m);
-  if (!cam.ok()) return Error{"model '" + model_path + "': " + cam.error()};
-  return Status::Ok();
+  if (!cam.ok()) {
+    return Fail("render", "model '" + model_path + "': " + cam.error(), exit_code::kUsage);
+  }
+  return exit_code::kOk;
 }
 
 int Run(RenderArgs& a) {
@@ -92,9 +96,18 @@ int Run(RenderArgs& a) {
   if (Status s = v.Validate(); !s.ok()) {
     return Fail("render", s.error(), exit_code::kUsage);
   }
-  if (Status s = CheckCamera(task->model_path, cam); !s.ok()) {
-    return Fail("render", s.error());
+  // Stills are taken from frames; none is rendered after the run's end.
+  const double duration = a.run.duration ? *a.run.duration : task->duration;
+  for (double t : v.still_times) {
+    if (t > duration + 1e-9) {
+      char msg[200];
+      std::snprintf(msg, sizeof(msg),
+                    "--stills: %g s is after the run's end (%g s); stills must be in [0, %g] s", t,
+                    duration, duration);
+      return Fail("render", msg, exit_code::kUsage);
+    }
   }
+  if (const int code = CheckCamera(task->model_path, cam); code != exit_code::kOk) return code;
   auto recorder = render::VideoRecorder::Create(v);
   if (!recorder.ok()) {
     return Fail("render", recorder.error());
