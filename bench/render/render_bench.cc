@@ -195,7 +195,7 @@ BENCHMARK(BM_RenderVsRenderEncode)
     ->Unit(benchmark::kMillisecond);
 // No MinTime here: a per-benchmark MinTime overrides --benchmark_min_time, so the command line
 // could not shorten a run. The figures in docs/benchmarks.md were measured with 5 s per
-// benchmark: pass --benchmark_min_time=5s to repeat them.
+// benchmark: pass --benchmark_min_time=5 to repeat them.
 
 }  // namespace
 }  // namespace recruit::render
