@@ -2,7 +2,9 @@
 #include <iostream>
 #include <memory>
 
+#include "cli/command_modules.h"
 #include "cli/commands.h"
+#include "common/exit_codes.h"
 #include "plot/plot_run.h"
 
 namespace recruit::cli {
@@ -31,13 +33,26 @@ void AddPlotCommand(CLI::App& app, int& exit_code) {
                   "per panel below 640 px wide)")
       ->capture_default_str();
   cmd->callback([o, &exit_code] {
-    auto written = plot::RunPlot(*o);
-    if (!written.ok()) {
-      std::cerr << "recruit plot: " << written.error() << "\n";
+    // The drawing code (cairo) is loaded only now (cli/command_modules.h).
+    std::string error;
+    void* module = OpenCommandModule("librecruit-plot.so", &error);
+    auto run =
+        module
+            ? reinterpret_cast<RecruitPlotRunFn>(ModuleSymbol(module, "recruit_plot_run", &error))
+            : nullptr;
+    if (!run) {
+      std::cerr << "recruit plot: " << error << "\n";
+      exit_code = exit_code::kIo;
+      return;
+    }
+    std::vector<std::string> written;
+    run(o.get(), &written, &error);
+    if (!error.empty()) {
+      std::cerr << "recruit plot: " << error << "\n";
       exit_code = 1;
       return;
     }
-    for (const auto& p : *written) std::cout << p << "\n";
+    for (const auto& p : written) std::cout << p << "\n";
     exit_code = 0;
   });
 }
