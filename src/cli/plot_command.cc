@@ -32,6 +32,14 @@ void AddPlotCommand(CLI::App& app, int& exit_code) {
                   "Height of each single figure, px (the combined figure: 0.55x per panel, 1x "
                   "per panel below 640 px wide)")
       ->capture_default_str();
+  cmd->add_option(
+         "--panel", o->panels,
+         "Column mode, for any numeric CSV: one panel per use, 'LABEL=COL[*SCALE][,COL...]' "
+         "(e.g. 'force (N)=tension,on*0.5'); writes <out>/<name>.<format>")
+      ->type_name("SPEC");
+  cmd->add_option("--x", o->x, "Column mode: the x column")->capture_default_str();
+  cmd->add_option("--x-label", o->x_label, "Column mode: the x axis label")->capture_default_str();
+  cmd->add_option("--title", o->title, "Column mode: a title line above the panels");
   cmd->callback([o, &exit_code] {
     // The drawing code (cairo) is loaded only now (cli/command_modules.h).
     std::string error;

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "common/atomic_file.h"
+#include "plot/column_figure.h"
 #include "plot/render.h"
 #include "plot/run_data.h"
 #include "plot/run_figures.h"
@@ -53,6 +54,22 @@ struct Rendered {
   std::string path, bytes;
 };
 
+// Everything rendered: only now touch the disk.
+Result<std::vector<std::string>> WriteAll(const std::string& out_dir,
+                                          const std::vector<Rendered>& files) {
+  std::error_code ec;
+  fs::create_directories(out_dir, ec);
+  if (ec)
+    return Error{
+        fmt::format("--out: cannot create directory '{}': {}", Shorten(out_dir), ec.message())};
+  std::vector<std::string> written;
+  for (const Rendered& r : files) {
+    if (Status s = WriteFileAtomically(r.path, r.bytes); !s.ok()) return Error{s.error()};
+    written.push_back(r.path);
+  }
+  return written;
+}
+
 }  // namespace
 
 Result<std::vector<std::string>> RunPlot(const PlotOptions& o) {
@@ -63,6 +80,30 @@ Result<std::vector<std::string>> RunPlot(const PlotOptions& o) {
     if (!s.ok()) return Error{s.error()};
   }
   if (o.out_dir.empty()) return Error{"--out: empty (a directory for the figures)"};
+  const std::string name = o.name.empty() ? DefaultName(o.csv) : o.name;
+  std::vector<Rendered> files;
+  if (!o.panels.empty()) {
+    std::vector<PanelSpec> specs;
+    for (const std::string& p : o.panels) {
+      auto spec = ParsePanelSpec(p);
+      if (!spec.ok()) return Error{spec.error()};
+      specs.push_back(*spec);
+    }
+    auto table = ReadCsvTable(o.csv);
+    if (!table.ok()) return Error{table.error()};
+    auto fig = MakeColumnFigure(*table, o.x, o.x_label, specs, o.title);
+    if (!fig.ok()) return Error{fig.error()};
+    const double per_panel = specs.size() == 1 ? 1.0 : o.width < 640 ? 1.0 : 0.55;
+    const int h = std::min(kMaxSide, static_cast<int>(per_panel * specs.size() * o.height));
+    for (Format fmt : *formats) {
+      auto bytes = RenderFigure(*fig, o.width, h, fmt);
+      if (!bytes.ok()) return Error{bytes.error()};
+      const char* ext = fmt == Format::kPng ? "png" : "svg";
+      files.push_back(
+          {(fs::path(o.out_dir) / fmt::format("{}.{}", name, ext)).string(), std::move(*bytes)});
+    }
+    return WriteAll(o.out_dir, files);
+  }
   auto csv = ReadRunCsv(o.csv);
   if (!csv.ok()) return Error{csv.error()};
   RunInfo info;
@@ -71,8 +112,6 @@ Result<std::vector<std::string>> RunPlot(const PlotOptions& o) {
     if (!s.ok()) return Error{s.error()};
     info = *s;
   }
-  const std::string name = o.name.empty() ? DefaultName(o.csv) : o.name;
-  std::vector<Rendered> files;
   for (const NamedFigure& f : MakeRunFigures(*csv, info)) {
     // The combined figure gives each panel 55 % of a single figure's height, or all of it on a
     // narrow canvas, where each legend goes below its panel.
@@ -87,18 +126,7 @@ Result<std::vector<std::string>> RunPlot(const PlotOptions& o) {
                        std::move(*bytes)});
     }
   }
-  // Everything rendered: only now touch the disk.
-  std::error_code ec;
-  fs::create_directories(o.out_dir, ec);
-  if (ec)
-    return Error{
-        fmt::format("--out: cannot create directory '{}': {}", Shorten(o.out_dir), ec.message())};
-  std::vector<std::string> written;
-  for (const Rendered& r : files) {
-    if (Status s = WriteFileAtomically(r.path, r.bytes); !s.ok()) return Error{s.error()};
-    written.push_back(r.path);
-  }
-  return written;
+  return WriteAll(o.out_dir, files);
 }
 
 }  // namespace recruit::plot
