@@ -32,6 +32,9 @@ void AddPlotCommand(CLI::App& app, int& exit_code) {
                   "Height of each single figure, px (the combined figure: 0.55x per panel, 1x "
                   "per panel below 640 px wide)")
       ->capture_default_str();
+  cmd->add_option("--figure", o->figure,
+                  "Only this figure (tracking, forces, count, broadcast, temperature, all), "
+                  "written as <out>/<name>.<format>");
   cmd->add_option(
          "--panel", o->panels,
          "Column mode, for any numeric CSV: one panel per use, 'LABEL=COL[*SCALE][,COL...]' "

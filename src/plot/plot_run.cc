@@ -112,7 +112,21 @@ Result<std::vector<std::string>> RunPlot(const PlotOptions& o) {
     if (!s.ok()) return Error{s.error()};
     info = *s;
   }
-  for (const NamedFigure& f : MakeRunFigures(*csv, info)) {
+  const std::vector<NamedFigure> figures = MakeRunFigures(*csv, info);
+  if (!o.figure.empty()) {
+    std::string names;
+    bool known = false;
+    for (const NamedFigure& f : figures) {
+      names += (names.empty() ? "" : ", ") + f.name;
+      known = known || f.name == o.figure;
+    }
+    if (!known) {
+      return Error{
+          fmt::format("--figure: '{}' is not a figure of this run ({})", Shorten(o.figure), names)};
+    }
+  }
+  for (const NamedFigure& f : figures) {
+    if (!o.figure.empty() && f.name != o.figure) continue;
     // The combined figure gives each panel 55 % of a single figure's height, or all of it on a
     // narrow canvas, where each legend goes below its panel.
     const double per_panel = o.width < 640 ? 1.0 : 0.55;
@@ -122,8 +136,9 @@ Result<std::vector<std::string>> RunPlot(const PlotOptions& o) {
       auto bytes = RenderFigure(f.figure, o.width, h, fmt);
       if (!bytes.ok()) return Error{fmt::format("figure '{}': {}", f.name, bytes.error())};
       const char* ext = fmt == Format::kPng ? "png" : "svg";
-      files.push_back({(fs::path(o.out_dir) / fmt::format("{}_{}.{}", name, f.name, ext)).string(),
-                       std::move(*bytes)});
+      const std::string file = o.figure.empty() ? fmt::format("{}_{}.{}", name, f.name, ext)
+                                                : fmt::format("{}.{}", name, ext);
+      files.push_back({(fs::path(o.out_dir) / file).string(), std::move(*bytes)});
     }
   }
   return WriteAll(o.out_dir, files);

@@ -22,6 +22,9 @@ struct PlotOptions {
   // Of each single figure; the combined one is 0.55 x height per panel (2.2 x for 4 panels),
   // 1 x height per panel when width < 640 px.
   int width = 1000, height = 600;
+  // Only this figure (tracking, forces, count, broadcast, temperature or all), written as
+  // `<out_dir>/<name>.<format>`; empty = every figure, `<name>_<figure>.<format>`.
+  std::string figure;
   // Column mode (any numeric CSV): one figure `<out_dir>/<name>.<format>` with a panel per
   // spec "LABEL=COL[*SCALE][,COL...]" (column_figure.h) against column `x`.
   std::vector<std::string> panels;

@@ -102,5 +102,24 @@ TEST(ColumnFigure, RunPlotWritesOneFilePerFormat) {
   EXPECT_FALSE(fs::exists(dir));
 }
 
+TEST(PlotRunFigure, OnlyTheChosenFigureIsWrittenUnderTheGivenName) {
+  const fs::path dir = fs::path(::testing::TempDir()) / "recruit_plot_one";
+  fs::remove_all(dir);
+  PlotOptions o;
+  o.csv = std::string(RECRUIT_SOURCE_DIR) + "/tests/plot/data/tiny_steps.csv";
+  o.out_dir = dir.string();
+  o.name = "repro_fig9";
+  o.figure = "all";
+  auto written = RunPlot(o);
+  ASSERT_TRUE(written.ok()) << written.error();
+  ASSERT_EQ(written->size(), 1u);
+  EXPECT_EQ((*written)[0], (dir / "repro_fig9.png").string());
+  o.figure = "nope";
+  auto bad = RunPlot(o);
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.error().find("--figure: 'nope'"), std::string::npos) << bad.error();
+  EXPECT_NE(bad.error().find("tracking"), std::string::npos) << bad.error();
+}
+
 }  // namespace
 }  // namespace recruit::plot
