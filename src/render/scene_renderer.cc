@@ -28,8 +28,10 @@ struct ModelCopy {
 }  // namespace
 
 int FontScaleFor(int width, int height) {
-  // 100 % at 640 x 480, in MuJoCo's 50 % steps, 50 % to 300 %.
-  const double s = 100.0 * std::min(width / 640.0, height / 480.0);
+  // 100 % at 560 x 400 (640 x 360 .. 640 x 480 get 100 %), in MuJoCo's 50 % steps from 50 % to
+  // 300 %: text stays about 1/20 of the frame height, readable when a 720p frame is shown at
+  // 880 px or a 640 x 360 GIF at its size.
+  const double s = 100.0 * std::min(width / 560.0, height / 400.0);
   const int steps = static_cast<int>(std::floor(s / 50.0 + 0.25));
   return std::clamp(steps, 1, 6) * 50;
 }

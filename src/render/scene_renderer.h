@@ -21,8 +21,8 @@
 
 namespace recruit::render {
 
-// MuJoCo font scale (mjtFontScale, %) for a frame: 100 at 640 x 480, proportional to the
-// smaller of width / 640 and height / 480, in 50 % steps from 50 to 300.
+// MuJoCo font scale (mjtFontScale, %) for a frame: 100 at 560 x 400, proportional to the
+// smaller of width / 560 and height / 400, in 50 % steps from 50 to 300.
 int FontScaleFor(int width, int height);
 
 struct RunLabel;

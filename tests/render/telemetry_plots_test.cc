@@ -80,8 +80,8 @@ TEST(TelemetryPlotsTest, LegendNeverOverlapsAFigureFrom320PxTo4K) {
         ++shown;
         EXPECT_TRUE(Inside(boxes[p].legend, area));
         EXPECT_TRUE(Inside(boxes[p].figure, area));
-        // Room for a title, tick labels and at least two grid intervals.
-        EXPECT_GE(boxes[p].figure.height, 7 * text.char_height);
+        // Room for a title, x tick labels, the axis label and two grid intervals of a row each.
+        EXPECT_GE(boxes[p].figure.height, 6 * text.char_height);
         for (const auto& other : boxes) {
           if (other.figure.height > 0) EXPECT_FALSE(Intersect(boxes[p].legend, other.figure));
         }
@@ -261,7 +261,9 @@ TEST(TelemetryPlotsTest, MissingEstimatesAreLeftOutAndAnglesAreInDegrees) {
 TEST(FontScaleTest, GrowsWithTheFrameFrom50To300Percent) {
   EXPECT_EQ(FontScaleFor(320, 240), 50);
   EXPECT_EQ(FontScaleFor(640, 480), 100);
+  EXPECT_EQ(FontScaleFor(640, 360), 100);
   EXPECT_EQ(FontScaleFor(1280, 720), 150);
+  EXPECT_EQ(FontScaleFor(1920, 1080), 250);
   EXPECT_EQ(FontScaleFor(3840, 2160), 300);
   int last = 0;
   for (int w = 160; w <= 4096; w += 32) {
