@@ -20,6 +20,10 @@ std::array<float, 3> Light(const float* c) {
   return {0.5f + 0.5f * c[0], 0.5f + 0.5f * c[1], 0.5f + 0.5f * c[2]};
 }
 
+// Legend geometry: a swatch 1.6 em long, entries 0.8 em apart.
+int Swatch(int ch) { return ch * 8 / 5; }
+int Spacing(int ch) { return ch * 4 / 5; }
+
 int Decimals(double step) {
   return std::max(0, static_cast<int>(-std::floor(std::log10(step) + 1e-9)));
 }
@@ -110,9 +114,9 @@ std::vector<LegendEntry> Entries(const PanelT& p) {
     }
   }
   if (first) {
-    e.push_back(
-        {first->name,
-         with_data > 1 ? std::array<float, 4>{0.6f, 0.6f, 0.6f, first->rgba[3]} : first->rgba, 2});
+    e.push_back({first->name,
+                 with_data > 1 ? std::array<float, 4>{0.85f, 0.85f, 0.85f, 0.55f} : first->rgba,
+                 2});
   }
   return e;
 }
@@ -166,7 +170,7 @@ void TelemetryPlots::Configure(const TelemetrySample& s) {
     counts.lines.push_back({name, Rgb(kBundleRgb[b]), LineStyle::kStairs, {}, {}});
     counts.lines.push_back({"est.", Light(kBundleRgb[b]), LineStyle::kDashed, {}, {}});
     const float* c = kBundleRgb[b];
-    counts.bands.push_back({"+-2 sd", {c[0], c[1], c[2], 0.3f}, {}, {}, {}});
+    counts.bands.push_back({"+-2 sd", {c[0], c[1], c[2], 0.4f}, {}, {}, {}});
   }
   panels_.push_back(std::move(counts));
 }
@@ -221,9 +225,9 @@ int TelemetryPlots::LegendRows(const Panel& p, int width, const TextMetrics& tex
   const int ch = text.char_height;
   int rows = 1, x = 0;
   for (const LegendEntry& e : Entries(p)) {
-    const int w = 2 * ch + ch / 3 + text.width(e.name);
+    const int w = Swatch(ch) + ch / 4 + text.width(e.name);
     if (x > 0 && x + w > width - ch / 2) ++rows, x = 0;
-    x += w + ch;
+    x += w + Spacing(ch);
   }
   return rows;
 }
@@ -241,11 +245,12 @@ std::vector<TelemetryPlots::PanelBoxes> TelemetryPlots::Layout(mjrRect area,
   auto legend_height = [&](const Panel& p, int h) {
     return std::min(h / 2, LegendRows(p, area.width - ch, text) * row + ch / 3);
   };
-  // Each figure needs about 7 rows: title, x labels, axis label and a few grid intervals.
+  // Three panels only when each figure gets 8 rows (title, x tick labels, axis label and
+  // about four grid intervals); the counts matter more than the bundle forces.
   auto fits = [&](const std::vector<int>& set) {
     const int h = area.height / static_cast<int>(set.size());
     for (int i : set) {
-      if (h - legend_height(panels_[i], h) < 7 * ch) return false;
+      if (h - legend_height(panels_[i], h) < 8 * ch) return false;
     }
     return true;
   };
@@ -407,7 +412,8 @@ void TelemetryPlots::DrawLegend(const Panel& p, mjrRect box, const mjrContext* c
   int x = box.left + ch / 2, y = box.bottom + box.height - row;
   for (const LegendEntry& e : Entries(p)) {
     const int tw = text.width(e.name);
-    const int w = 2 * ch + ch / 3 + tw;
+    const int sw = Swatch(ch);
+    const int w = sw + ch / 4 + tw;
     if (x > box.left + ch / 2 && x + w > box.left + box.width - ch / 2) {
       x = box.left + ch / 2;
       y -= row;
@@ -416,22 +422,21 @@ void TelemetryPlots::DrawLegend(const Panel& p, mjrRect box, const mjrContext* c
     const int mid = y + row / 2;
     const int lw = std::max(1, static_cast<int>(std::lround(line_px)));
     if (e.kind == 2) {
-      mjr_rectangle({x, y + row / 6, 2 * ch, row * 2 / 3}, e.rgba[0], e.rgba[1], e.rgba[2],
-                    e.rgba[3]);
+      mjr_rectangle({x, y + row / 6, sw, row * 2 / 3}, e.rgba[0], e.rgba[1], e.rgba[2], e.rgba[3]);
     } else if (e.kind == 1) {
-      const int dash = 2 * ch / 5;
+      const int dash = sw / 5;
       for (int k = 0; k < 3; ++k) {
-        mjr_rectangle({x + k * (2 * ch) * 2 / 5, mid - lw / 2, dash, lw}, e.rgba[0], e.rgba[1],
-                      e.rgba[2], 1.f);
+        mjr_rectangle({x + k * sw * 2 / 5, mid - lw / 2, dash, lw}, e.rgba[0], e.rgba[1], e.rgba[2],
+                      1.f);
       }
     } else {
-      mjr_rectangle({x, mid - lw / 2, 2 * ch, lw}, e.rgba[0], e.rgba[1], e.rgba[2], 1.f);
+      mjr_rectangle({x, mid - lw / 2, sw, lw}, e.rgba[0], e.rgba[1], e.rgba[2], 1.f);
     }
     // mjr_label centres the text in its rectangle: a rectangle as wide as the text aligns it
     // left; alpha 0 leaves the background.
-    mjr_label({x + 2 * ch + ch / 3, y, tw, row}, mjFONT_NORMAL, e.name.c_str(), 0, 0, 0, 0, 0.9f,
-              0.9f, 0.9f, con);
-    x += w + ch;
+    mjr_label({x + sw + ch / 4, y, tw, row}, mjFONT_NORMAL, e.name.c_str(), 0, 0, 0, 0, 0.9f, 0.9f,
+              0.9f, con);
+    x += w + Spacing(ch);
   }
 }
 
@@ -451,11 +456,18 @@ void TelemetryPlots::DrawBands(const Panel& p, const mjrContext* con) const {
     // One rectangle per 2-pixel column: the envelope of the samples in it.
     const int cols = (px1 - px0 + 1) / 2;
     std::vector<double> lo(cols, INFINITY), hi(cols, -INFINITY);
+    // Each sample holds until the next one (estimates change at control instants).
     for (size_t i = 0; i < b.t.size(); ++i) {
-      if (b.t[i] < x0 || b.t[i] > x1) continue;
-      const int c = std::clamp(static_cast<int>((to_px(b.t[i]) - px0) / 2), 0, cols - 1);
-      lo[c] = std::min(lo[c], b.lo[i]);
-      hi[c] = std::max(hi[c], b.hi[i]);
+      if (b.t[i] > x1 || (i + 1 < b.t.size() && b.t[i + 1] < x0)) continue;
+      const int c0 = std::clamp(static_cast<int>((to_px(b.t[i]) - px0) / 2), 0, cols - 1);
+      const int c1 =
+          i + 1 < b.t.size()
+              ? std::clamp(static_cast<int>((to_px(b.t[i + 1]) - px0) / 2) - 1, c0, cols - 1)
+              : c0;
+      for (int c = c0; c <= c1; ++c) {
+        lo[c] = std::min(lo[c], b.lo[i]);
+        hi[c] = std::max(hi[c], b.hi[i]);
+      }
     }
     for (int c = 0; c < cols; ++c) {
       if (!(hi[c] >= lo[c])) continue;
