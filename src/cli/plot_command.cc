@@ -16,7 +16,13 @@ void AddPlotCommand(CLI::App& app, int& exit_code) {
       "Plot a run of `recruit simulate`: force (or angle) vs reference, true vs estimated "
       "on-count with the filter's +-2 sd band, broadcast probabilities, mean unit temperature, "
       "and all panels in one figure. PNG and/or SVG (docs/plotting.md).");
-  cmd->add_option("--csv", o->csv, "The run's per-step CSV (<name>_steps.csv)")->required();
+  auto* csv = cmd->add_option("--csv", o->csv, "The run's per-step CSV (<name>_steps.csv)");
+  auto* map = cmd->add_option(
+      "--stability-map", o->stability_map,
+      "Instead of --csv: a `recruit sweep` directory's stability.dat; draws the dT x lambda map "
+      "of mean overshoot as <out>/<name>.<format> (name default: stability)");
+  csv->excludes(map);
+  map->excludes(csv);
   cmd->add_option("--summary", o->summary,
                   "The run's summary (<name>_summary.json): title line (task, estimator, dT, "
                   "lambda, seed) and the tracked unit");
@@ -44,6 +50,12 @@ void AddPlotCommand(CLI::App& app, int& exit_code) {
   cmd->add_option("--x-label", o->x_label, "Column mode: the x axis label")->capture_default_str();
   cmd->add_option("--title", o->title, "Column mode: a title line above the panels");
   cmd->callback([o, &exit_code] {
+    if (o->csv.empty() && o->stability_map.empty()) {
+      std::cerr << "recruit plot: give --csv FILE (a run or any numeric CSV) or --stability-map "
+                   "FILE\n";
+      exit_code = exit_code::kUsage;
+      return;
+    }
     // The drawing code (cairo) is loaded only now (cli/command_modules.h).
     std::string error;
     void* module = OpenCommandModule("librecruit-plot.so", &error);

@@ -10,6 +10,7 @@
 #include "plot/render.h"
 #include "plot/run_data.h"
 #include "plot/run_figures.h"
+#include "plot/stability_map.h"
 
 namespace recruit::plot {
 namespace {
@@ -80,8 +81,25 @@ Result<std::vector<std::string>> RunPlot(const PlotOptions& o) {
     if (!s.ok()) return Error{s.error()};
   }
   if (o.out_dir.empty()) return Error{"--out: empty (a directory for the figures)"};
-  const std::string name = o.name.empty() ? DefaultName(o.csv) : o.name;
   std::vector<Rendered> files;
+  if (!o.stability_map.empty()) {
+    auto text = ReadFile(o.stability_map);
+    if (!text.ok()) return Error{text.error()};
+    auto panels = ParseStabilityDat(*text, o.stability_map);
+    if (!panels.ok()) return Error{panels.error()};
+    const std::string map_name = o.name.empty() ? "stability" : o.name;
+    const std::string title =
+        o.title.empty() ? "mean step overshoot (%), ring = meets the sweep's criterion" : o.title;
+    for (Format fmt : *formats) {
+      auto bytes = RenderStabilityMap(*panels, title, o.width, o.height, fmt);
+      if (!bytes.ok()) return Error{bytes.error()};
+      const char* ext = fmt == Format::kPng ? "png" : "svg";
+      files.push_back({(fs::path(o.out_dir) / fmt::format("{}.{}", map_name, ext)).string(),
+                       std::move(*bytes)});
+    }
+    return WriteAll(o.out_dir, files);
+  }
+  const std::string name = o.name.empty() ? DefaultName(o.csv) : o.name;
   if (!o.panels.empty()) {
     std::vector<PanelSpec> specs;
     for (const std::string& p : o.panels) {

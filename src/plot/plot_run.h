@@ -30,7 +30,10 @@ struct PlotOptions {
   std::vector<std::string> panels;
   std::string x = "time";
   std::string x_label = "time (s)";
-  std::string title;  // column mode's title line; empty = none
+  std::string title;  // column mode's (and the stability map's) title line; empty = none
+  // Stability map mode: `recruit sweep`'s stability.dat instead of --csv; writes
+  // <out_dir>/<name>.<format> (stability_map.h).
+  std::string stability_map;
 };
 
 // Writes <out_dir>/<name>_<figure>.<format> for figure in tracking, forces (angle tasks),

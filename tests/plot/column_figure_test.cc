@@ -10,6 +10,7 @@
 #include <fstream>
 
 #include "plot/plot_run.h"
+#include "plot/stability_map.h"
 
 namespace recruit::plot {
 namespace {
@@ -119,6 +120,52 @@ TEST(PlotRunFigure, OnlyTheChosenFigureIsWrittenUnderTheGivenName) {
   ASSERT_FALSE(bad.ok());
   EXPECT_NE(bad.error().find("--figure: 'nope'"), std::string::npos) << bad.error();
   EXPECT_NE(bad.error().find("tracking"), std::string::npos) << bad.error();
+}
+
+// The stability map of a sweep: stability.dat parsed into panels and cells; the colour scale's
+// anchors; the map's cell colours where the cells are; a malformed row named.
+TEST(StabilityMap, ParsesSweepsDatAndColoursEachCellByItsOvershoot) {
+  const std::string dat =
+      "# estimator output\n# dT lambda overshoot_percent meets\n"
+      "0.5 0.1 0.0000 1\n2 0.1 60.0000 0\n0.5 0.5 10.0000 0\n2 0.5 30.0000 0\n\n\n"
+      "# estimator kalman2\n# dT lambda overshoot_percent meets\n0.5 0.2 5.0 1\n\n\n";
+  auto panels = ParseStabilityDat(dat, "s.dat");
+  ASSERT_TRUE(panels.ok()) << panels.error();
+  ASSERT_EQ(panels->size(), 2u);
+  EXPECT_EQ((*panels)[0].estimator, "output");
+  ASSERT_EQ((*panels)[0].cells.size(), 4u);
+  EXPECT_EQ((*panels)[0].cells[1].dT, 2);
+  EXPECT_EQ((*panels)[0].cells[1].overshoot_percent, 60);
+  EXPECT_TRUE((*panels)[0].cells[0].meets);
+  const Color g = OvershootColor(0), y = OvershootColor(10), r = OvershootColor(50);
+  EXPECT_GT(g.g, g.r);                       // green
+  EXPECT_GT(y.r, 0.9);  // yellow
+  EXPECT_GT(y.g, 0.8);
+  EXPECT_GT(r.r, 0.8);  // red
+  EXPECT_LT(r.g, 0.2);
+  EXPECT_EQ(OvershootColor(80).r, r.r);      // clamped at 50 %
+  // Rendered: one panel's 2 x 2 grid. The centre of the lower-left quarter of the first
+  // panel's data area is the (0.5, 0.1) cell: its ring (black) or fill (green) dominates.
+  auto png = RenderStabilityMap({(*panels)[0]}, "t", 600, 400, Format::kPng);
+  ASSERT_TRUE(png.ok()) << png.error();
+  std::vector<unsigned char> rgba;
+  unsigned w = 0, h = 0;
+  ASSERT_EQ(
+      lodepng::decode(rgba, w, h, reinterpret_cast<const unsigned char*>(png->data()), png->size()),
+      0u);
+  ASSERT_EQ(w, 600u);
+  // Count red-dominated pixels: the 60 % and 30 % cells exist, so some are red/orange.
+  int red = 0, green = 0;
+  for (size_t i = 0; i + 3 < rgba.size(); i += 4) {
+    red += rgba[i] > 180 && rgba[i + 1] < 60;
+    green += rgba[i + 1] > 120 && rgba[i] < 60;
+  }
+  EXPECT_GT(red, 1000);
+  EXPECT_GT(green, 1000);
+  auto bad = ParseStabilityDat("# estimator x\n0.5 0.1 abc 1\n", "s.dat");
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.error().find("s.dat line 2"), std::string::npos) << bad.error();
+  EXPECT_FALSE(ParseStabilityDat("", "s.dat").ok());
 }
 
 }  // namespace
