@@ -247,18 +247,32 @@ std::vector<TelemetryPlots::PanelBoxes> TelemetryPlots::Layout(mjrRect area,
   };
   // Three panels only when each figure gets 8 rows (title, x tick labels, axis label and
   // about four grid intervals); the counts matter more than the bundle forces.
+  // The lowest panel (the counts) carries the time labels and the longest legend: it gets 1.35
+  // shares of the height, the others one each (they show no time tick labels).
+  auto heights = [&](size_t count) {
+    std::vector<int> h(count);
+    const double total = (count - 1) + 1.35;
+    int used = 0;
+    for (size_t k = 0; k + 1 < count; ++k) {
+      h[k] = static_cast<int>(area.height / total);
+      used += h[k];
+    }
+    h[count - 1] = area.height - used;
+    return h;
+  };
   auto fits = [&](const std::vector<int>& set) {
-    const int h = area.height / static_cast<int>(set.size());
-    for (int i : set) {
-      if (h - legend_height(panels_[i], h) < 8 * ch) return false;
+    const std::vector<int> h = heights(set.size());
+    for (size_t k = 0; k < set.size(); ++k) {
+      if (h[k] - legend_height(panels_[set[k]], h[k]) < 8 * ch) return false;
     }
     return true;
   };
   if (angle_ && num_panels() == 3 && !fits(shown)) shown.erase(shown.begin() + 1);
   const int n = static_cast<int>(shown.size());
+  const std::vector<int> hs = heights(n);
   int top = area.bottom + area.height;
   for (int k = 0; k < n; ++k) {
-    const int h = k == n - 1 ? top - area.bottom : area.height / n;
+    const int h = hs[k];
     const int legend_h = legend_height(panels_[shown[k]], h);
     boxes[shown[k]].legend = {area.left, top - legend_h, area.width, legend_h};
     boxes[shown[k]].figure = {area.left, top - h, area.width, h - legend_h};
@@ -341,6 +355,8 @@ void TelemetryPlots::Prepare(mjrRect area, const TextMetrics& text) {
     for (mjvFigure* f : {fig, dash}) {
       std::snprintf(f->title, sizeof(f->title), "%s", panel.title.c_str());
       std::snprintf(f->xlabel, sizeof(f->xlabel), "%s", p == last_shown ? "time (s)" : "");
+      // Time tick labels only under the lowest panel: the panels share the time axis.
+      f->flg_ticklabel[0] = p == last_shown ? 1 : 0;
       std::snprintf(f->xformat, sizeof(f->xformat), "%s", xformat);
       // y labels are drawn by DrawYLabels (FormatTick: exact, never "-0"); mjr_figure's own
       // would print float interpolations of the range, "-0.0" where the axis crosses zero.
