@@ -2,7 +2,9 @@
 #include <iostream>
 #include <memory>
 
+#include "cli/command_modules.h"
 #include "cli/commands.h"
+#include "common/exit_codes.h"
 #include "plot/plot_run.h"
 
 namespace recruit::cli {
@@ -14,7 +16,13 @@ void AddPlotCommand(CLI::App& app, int& exit_code) {
       "Plot a run of `recruit simulate`: force (or angle) vs reference, true vs estimated "
       "on-count with the filter's +-2 sd band, broadcast probabilities, mean unit temperature, "
       "and all panels in one figure. PNG and/or SVG (docs/plotting.md).");
-  cmd->add_option("--csv", o->csv, "The run's per-step CSV (<name>_steps.csv)")->required();
+  auto* csv = cmd->add_option("--csv", o->csv, "The run's per-step CSV (<name>_steps.csv)");
+  auto* map = cmd->add_option(
+      "--stability-map", o->stability_map,
+      "Instead of --csv: a `recruit sweep` directory's stability.dat; draws the dT x lambda map "
+      "of mean overshoot as <out>/<name>.<format> (name default: stability)");
+  csv->excludes(map);
+  map->excludes(csv);
   cmd->add_option("--summary", o->summary,
                   "The run's summary (<name>_summary.json): title line (task, estimator, dT, "
                   "lambda, seed) and the tracked unit");
@@ -30,14 +38,44 @@ void AddPlotCommand(CLI::App& app, int& exit_code) {
                   "Height of each single figure, px (the combined figure: 0.55x per panel, 1x "
                   "per panel below 640 px wide)")
       ->capture_default_str();
+  cmd->add_option("--figure", o->figure,
+                  "Only this figure (tracking, forces, count, broadcast, temperature, all), "
+                  "written as <out>/<name>.<format>");
+  cmd->add_option(
+         "--panel", o->panels,
+         "Column mode, for any numeric CSV: one panel per use, 'LABEL=COL[*SCALE][,COL...]' "
+         "(e.g. 'force (N)=tension,on*0.5'); writes <out>/<name>.<format>")
+      ->type_name("SPEC");
+  cmd->add_option("--x", o->x, "Column mode: the x column")->capture_default_str();
+  cmd->add_option("--x-label", o->x_label, "Column mode: the x axis label")->capture_default_str();
+  cmd->add_option("--title", o->title, "Column mode: a title line above the panels");
   cmd->callback([o, &exit_code] {
-    auto written = plot::RunPlot(*o);
-    if (!written.ok()) {
-      std::cerr << "recruit plot: " << written.error() << "\n";
+    if (o->csv.empty() && o->stability_map.empty()) {
+      std::cerr << "recruit plot: give --csv FILE (a run or any numeric CSV) or --stability-map "
+                   "FILE\n";
+      exit_code = exit_code::kUsage;
+      return;
+    }
+    // The drawing code (cairo) is loaded only now (cli/command_modules.h).
+    std::string error;
+    void* module = OpenCommandModule("librecruit-plot.so", &error);
+    auto run =
+        module
+            ? reinterpret_cast<RecruitPlotRunFn>(ModuleSymbol(module, "recruit_plot_run", &error))
+            : nullptr;
+    if (!run) {
+      std::cerr << "recruit plot: " << error << "\n";
+      exit_code = exit_code::kIo;
+      return;
+    }
+    std::vector<std::string> written;
+    run(o.get(), &written, &error);
+    if (!error.empty()) {
+      std::cerr << "recruit plot: " << error << "\n";
       exit_code = 1;
       return;
     }
-    for (const auto& p : *written) std::cout << p << "\n";
+    for (const auto& p : written) std::cout << p << "\n";
     exit_code = 0;
   });
 }

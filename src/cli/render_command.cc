@@ -2,18 +2,17 @@
 // VideoRecorder is one of RunTask's step observers): H.264 MP4, optionally a GIF and PNG stills.
 #include <unistd.h>
 
+#include <cstdio>
 #include <filesystem>
 #include <iostream>
 #include <memory>
 #include <optional>
 
+#include "cli/command_modules.h"
 #include "cli/commands.h"
 #include "cli/errors.h"
 #include "cli/run_options.h"
 #include "common/output_path.h"
-#include "render/camera.h"
-#include "render/gl_context.h"
-#include "render/video_recorder.h"
 #include "sim/run_task.h"
 
 namespace recruit::cli {
@@ -32,17 +31,6 @@ struct RenderArgs {
   std::string stills_prefix;
 };
 
-// Loads the task's model only to check the camera before anything runs.
-Status CheckCamera(const std::string& model_path, const render::CameraSpec& spec) {
-  char error[1000] = "";
-  mjModel* m = mj_loadXML(model_path.c_str(), nullptr, error, sizeof(error));
-  if (!m) return Error{"model '" + model_path + "': " + error};
-  auto cam = render::ResolveCamera(m, spec);
-  mj_deleteModel(m);
-  if (!cam.ok()) return Error{"model '" + model_path + "': " + cam.error()};
-  return Status::Ok();
-}
-
 int Run(RenderArgs& a) {
   auto task = sim::Task::FromFile(a.task);
   if (!task.ok()) {
@@ -56,11 +44,6 @@ int Run(RenderArgs& a) {
   cam.elevation = a.elevation;
   cam.distance = a.distance;
   if (!a.lookat.empty()) cam.lookat = std::array<double, 3>{a.lookat[0], a.lookat[1], a.lookat[2]};
-  auto backend = a.gl.empty() ? render::GlBackendFromEnvironment() : render::ParseGlBackend(a.gl);
-  if (!backend.ok()) {
-    return Fail("render", "--gl: " + backend.error(), exit_code::kUsage);
-  }
-  v.render.backend = *backend;
   v.render.figures = !a.no_figures;
   v.render.text_panel = !a.no_panel;
   if (v.still_every > 0 || !v.still_times.empty()) {
@@ -89,33 +72,40 @@ int Run(RenderArgs& a) {
   v.label.lambda = settings.lambda;
   v.label.seed = a.run.seed;
 
-  if (Status s = v.Validate(); !s.ok()) {
-    return Fail("render", s.error(), exit_code::kUsage);
+  // Stills are taken from frames; none is rendered after the run's end.
+  const double duration = a.run.duration ? *a.run.duration : task->duration;
+  for (double t : v.still_times) {
+    if (t > duration + 1e-9) {
+      char msg[200];
+      std::snprintf(msg, sizeof(msg),
+                    "--stills: %g s is after the run's end (%g s); stills must be in [0, %g] s", t,
+                    duration, duration);
+      return Fail("render", msg, exit_code::kUsage);
+    }
   }
-  if (Status s = CheckCamera(task->model_path, cam); !s.ok()) {
-    return Fail("render", s.error());
-  }
-  auto recorder = render::VideoRecorder::Create(v);
-  if (!recorder.ok()) {
-    return Fail("render", recorder.error());
-  }
+  // The rendering code (OSMesa, libav) is loaded only now (cli/command_modules.h).
+  std::string error;
+  void* module = OpenCommandModule("librecruit-render.so", &error);
+  auto open = module ? reinterpret_cast<RecruitRenderOpenFn>(
+                           ModuleSymbol(module, "recruit_render_open", &error))
+                     : nullptr;
+  if (!open) return Fail("render", error, exit_code::kIo);
+  RenderOpenRequest request{v, a.gl, task->model_path};
+  RenderOpenResult opened;
+  open(&request, &opened);
+  if (!opened.session) return Fail("render", opened.error, opened.exit_code);
+  RenderSession& session = *opened.session;
   sim::RunOptions run = a.run;
   run.progress = run.progress || ::isatty(STDERR_FILENO);
-  auto result = sim::RunTask(*task, run, {recorder->get()});
+  auto result = sim::RunTask(*task, run, {&session});
   if (!result.ok()) {
     return Fail("render", result.error());
   }
-  if (Status s = (*recorder)->Finish(); !s.ok()) {
+  if (Status s = session.Finish(); !s.ok()) {
     return Fail("render", s.error());
   }
-  const render::VideoRecorder& rec = **recorder;
-  std::cout << "task " << result->task << ", seed " << result->seed << ": " << rec.frames_rendered()
-            << " frames at " << v.fps << " frames/s, " << v.render.width << "x" << v.render.height
-            << " (" << (rec.renderer() ? rec.renderer()->gl_description() : "") << ")\n  wrote "
-            << v.mp4_path;
-  if (!v.gif_path.empty()) std::cout << ", " << v.gif_path;
-  for (const std::string& still : rec.stills_written()) std::cout << ", " << still;
-  std::cout << "\n  " << result->duration << " s simulated and rendered in " << result->wall_seconds
+  std::cout << "task " << result->task << ", seed " << result->seed << ": " << session.Report()
+            << "\n  " << result->duration << " s simulated and rendered in " << result->wall_seconds
             << " s\n";
   return exit_code::kOk;
 }
@@ -141,8 +131,9 @@ void AddRenderCommand(CLI::App& app, int& exit_code) {
       ->capture_default_str();
   cmd->add_option("--height", a->video.render.height, "Frame height, pixels (even)")
       ->capture_default_str();
-  auto* camera =
-      cmd->add_option("--camera", a->camera, "A camera the model names [default: the free camera]");
+  auto* camera = cmd->add_option("--camera", a->camera,
+                                 "A camera the model names [default: the model's camera \"render\" "
+                                 "if any, else the free camera]");
   auto* az = cmd->add_option("--azimuth", a->azimuth, "Free camera azimuth, deg");
   auto* el = cmd->add_option("--elevation", a->elevation, "Free camera elevation, deg, [-90, 90]");
   auto* di = cmd->add_option("--distance", a->distance, "Free camera distance, m (> 0)");

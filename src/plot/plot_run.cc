@@ -6,9 +6,11 @@
 #include <sstream>
 
 #include "common/atomic_file.h"
+#include "plot/column_figure.h"
 #include "plot/render.h"
 #include "plot/run_data.h"
 #include "plot/run_figures.h"
+#include "plot/stability_map.h"
 
 namespace recruit::plot {
 namespace {
@@ -53,6 +55,22 @@ struct Rendered {
   std::string path, bytes;
 };
 
+// Everything rendered: only now touch the disk.
+Result<std::vector<std::string>> WriteAll(const std::string& out_dir,
+                                          const std::vector<Rendered>& files) {
+  std::error_code ec;
+  fs::create_directories(out_dir, ec);
+  if (ec)
+    return Error{
+        fmt::format("--out: cannot create directory '{}': {}", Shorten(out_dir), ec.message())};
+  std::vector<std::string> written;
+  for (const Rendered& r : files) {
+    if (Status s = WriteFileAtomically(r.path, r.bytes); !s.ok()) return Error{s.error()};
+    written.push_back(r.path);
+  }
+  return written;
+}
+
 }  // namespace
 
 Result<std::vector<std::string>> RunPlot(const PlotOptions& o) {
@@ -63,6 +81,47 @@ Result<std::vector<std::string>> RunPlot(const PlotOptions& o) {
     if (!s.ok()) return Error{s.error()};
   }
   if (o.out_dir.empty()) return Error{"--out: empty (a directory for the figures)"};
+  std::vector<Rendered> files;
+  if (!o.stability_map.empty()) {
+    auto text = ReadFile(o.stability_map);
+    if (!text.ok()) return Error{text.error()};
+    auto panels = ParseStabilityDat(*text, o.stability_map);
+    if (!panels.ok()) return Error{panels.error()};
+    const std::string map_name = o.name.empty() ? "stability" : o.name;
+    const std::string title =
+        o.title.empty() ? "mean step overshoot (%), ring = meets the sweep's criterion" : o.title;
+    for (Format fmt : *formats) {
+      auto bytes = RenderStabilityMap(*panels, title, o.width, o.height, fmt);
+      if (!bytes.ok()) return Error{bytes.error()};
+      const char* ext = fmt == Format::kPng ? "png" : "svg";
+      files.push_back({(fs::path(o.out_dir) / fmt::format("{}.{}", map_name, ext)).string(),
+                       std::move(*bytes)});
+    }
+    return WriteAll(o.out_dir, files);
+  }
+  const std::string name = o.name.empty() ? DefaultName(o.csv) : o.name;
+  if (!o.panels.empty()) {
+    std::vector<PanelSpec> specs;
+    for (const std::string& p : o.panels) {
+      auto spec = ParsePanelSpec(p);
+      if (!spec.ok()) return Error{spec.error()};
+      specs.push_back(*spec);
+    }
+    auto table = ReadCsvTable(o.csv);
+    if (!table.ok()) return Error{table.error()};
+    auto fig = MakeColumnFigure(*table, o.x, o.x_label, specs, o.title);
+    if (!fig.ok()) return Error{fig.error()};
+    const double per_panel = specs.size() == 1 ? 1.0 : o.width < 640 ? 1.0 : 0.55;
+    const int h = std::min(kMaxSide, static_cast<int>(per_panel * specs.size() * o.height));
+    for (Format fmt : *formats) {
+      auto bytes = RenderFigure(*fig, o.width, h, fmt);
+      if (!bytes.ok()) return Error{bytes.error()};
+      const char* ext = fmt == Format::kPng ? "png" : "svg";
+      files.push_back(
+          {(fs::path(o.out_dir) / fmt::format("{}.{}", name, ext)).string(), std::move(*bytes)});
+    }
+    return WriteAll(o.out_dir, files);
+  }
   auto csv = ReadRunCsv(o.csv);
   if (!csv.ok()) return Error{csv.error()};
   RunInfo info;
@@ -71,9 +130,21 @@ Result<std::vector<std::string>> RunPlot(const PlotOptions& o) {
     if (!s.ok()) return Error{s.error()};
     info = *s;
   }
-  const std::string name = o.name.empty() ? DefaultName(o.csv) : o.name;
-  std::vector<Rendered> files;
-  for (const NamedFigure& f : MakeRunFigures(*csv, info)) {
+  const std::vector<NamedFigure> figures = MakeRunFigures(*csv, info);
+  if (!o.figure.empty()) {
+    std::string names;
+    bool known = false;
+    for (const NamedFigure& f : figures) {
+      names += (names.empty() ? "" : ", ") + f.name;
+      known = known || f.name == o.figure;
+    }
+    if (!known) {
+      return Error{
+          fmt::format("--figure: '{}' is not a figure of this run ({})", Shorten(o.figure), names)};
+    }
+  }
+  for (const NamedFigure& f : figures) {
+    if (!o.figure.empty() && f.name != o.figure) continue;
     // The combined figure gives each panel 55 % of a single figure's height, or all of it on a
     // narrow canvas, where each legend goes below its panel.
     const double per_panel = o.width < 640 ? 1.0 : 0.55;
@@ -83,22 +154,12 @@ Result<std::vector<std::string>> RunPlot(const PlotOptions& o) {
       auto bytes = RenderFigure(f.figure, o.width, h, fmt);
       if (!bytes.ok()) return Error{fmt::format("figure '{}': {}", f.name, bytes.error())};
       const char* ext = fmt == Format::kPng ? "png" : "svg";
-      files.push_back({(fs::path(o.out_dir) / fmt::format("{}_{}.{}", name, f.name, ext)).string(),
-                       std::move(*bytes)});
+      const std::string file = o.figure.empty() ? fmt::format("{}_{}.{}", name, f.name, ext)
+                                                : fmt::format("{}.{}", name, ext);
+      files.push_back({(fs::path(o.out_dir) / file).string(), std::move(*bytes)});
     }
   }
-  // Everything rendered: only now touch the disk.
-  std::error_code ec;
-  fs::create_directories(o.out_dir, ec);
-  if (ec)
-    return Error{
-        fmt::format("--out: cannot create directory '{}': {}", Shorten(o.out_dir), ec.message())};
-  std::vector<std::string> written;
-  for (const Rendered& r : files) {
-    if (Status s = WriteFileAtomically(r.path, r.bytes); !s.ok()) return Error{s.error()};
-    written.push_back(r.path);
-  }
-  return written;
+  return WriteAll(o.out_dir, files);
 }
 
 }  // namespace recruit::plot

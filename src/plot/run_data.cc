@@ -78,7 +78,7 @@ const std::vector<double>* RunCsv::Find(const std::string& name) const {
 
 const std::vector<double>& RunCsv::At(const std::string& name) const { return *Find(name); }
 
-Result<RunCsv> ParseRunCsv(const std::string& text, const std::string& path) {
+Result<RunCsv> ParseCsvTable(const std::string& text, const std::string& path) {
   RunCsv csv;
   csv.path = path;
   std::istringstream in(text);
@@ -111,6 +111,13 @@ Result<RunCsv> ParseRunCsv(const std::string& text, const std::string& path) {
   if (csv.columns.empty() || csv.columns[0].empty()) {
     return Error{path + ": no data rows after the header"};
   }
+  return csv;
+}
+
+Result<RunCsv> ParseRunCsv(const std::string& text, const std::string& path) {
+  auto table = ParseCsvTable(text, path);
+  if (!table.ok()) return Error{table.error()};
+  RunCsv csv = std::move(*table);
   FindBundles(csv);
   if (csv.bundles.empty()) {
     return Error{path + ": no column '<bundle>.true_on' (not a `recruit simulate` CSV?)"};
@@ -123,6 +130,12 @@ Result<RunCsv> ParseRunCsv(const std::string& text, const std::string& path) {
   }
   if (Status s = CheckColumns(csv); !s.ok()) return Error{s.error()};
   return csv;
+}
+
+Result<RunCsv> ReadCsvTable(const std::string& path) {
+  auto text = ReadFile(path);
+  if (!text.ok()) return Error{text.error()};
+  return ParseCsvTable(*text, path);
 }
 
 Result<RunCsv> ReadRunCsv(const std::string& path) {

@@ -29,6 +29,10 @@ struct RunCsv {
 // must exist, and all but estimated_on must hold at least one finite value.
 // `<bundle>.estimated_on_std` is optional (older CSVs lack it): absent = all NaN.
 Result<RunCsv> ParseRunCsv(const std::string& text, const std::string& path);
+// Any numeric CSV table: a header and >= 1 data row, equal cell counts, cells empty (NaN) or
+// numbers; no required columns (`recruit plot --panel`).
+Result<RunCsv> ParseCsvTable(const std::string& text, const std::string& path);
+Result<RunCsv> ReadCsvTable(const std::string& path);
 Result<RunCsv> ReadRunCsv(const std::string& path);
 
 // What the title line shows, from the summary JSON (all fields optional).

@@ -17,6 +17,16 @@ std::string ListCameras(const mjModel* m) {
 Result<mjvCamera> ResolveCamera(const mjModel* m, const CameraSpec& spec) {
   mjvCamera cam;
   mjv_defaultFreeCamera(m, &cam);
+  // Nothing asked for: the model's camera named "render" when it has one (a model's framing of
+  // its own motion), else the free camera.
+  if (spec.name.empty() && !spec.has_free_parameters()) {
+    const int id = mj_name2id(m, mjOBJ_CAMERA, kDefaultCameraName);
+    if (id >= 0) {
+      cam.type = mjCAMERA_FIXED;
+      cam.fixedcamid = id;
+      return cam;
+    }
+  }
   if (!spec.name.empty()) {
     if (spec.has_free_parameters()) {
       return Error{

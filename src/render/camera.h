@@ -1,4 +1,5 @@
-// CameraSpec: which camera a render uses. Either a camera the model names (<camera name=..>),
+// CameraSpec: which camera a render uses. With nothing set, the model's camera named "render" if
+// it has one, else the free camera. Otherwise either a camera the model names (<camera name=..>),
 // or MuJoCo's free camera given by azimuth, elevation, distance and look-at point; any free
 // parameter left unset takes mjv_defaultFreeCamera's value for the model (look at the model's
 // centre from a distance that frames its extent).
@@ -23,6 +24,9 @@ struct CameraSpec {
 
   bool has_free_parameters() const { return azimuth || elevation || distance || lookat; }
 };
+
+// With no camera options, a model camera of this name is used if the model has one.
+inline constexpr const char* kDefaultCameraName = "render";
 
 // Names of the model's cameras, comma separated ("" when it has none).
 std::string ListCameras(const mjModel* m);

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "render/scene_labels.h"
 #include "render/tendon_heat.h"
 
 namespace recruit::render {
@@ -25,6 +26,24 @@ struct ModelCopy {
 };
 
 }  // namespace
+
+int FontScaleFor(int width, int height) {
+  // 100 % at 560 x 400 (640 x 360 .. 640 x 480 get 100 %), in MuJoCo's 50 % steps from 50 % to
+  // 300 %: text stays about 1/20 of the frame height, readable when a 720p frame is shown at
+  // 880 px or a 640 x 360 GIF at its size.
+  const double s = 100.0 * std::min(width / 560.0, height / 400.0);
+  const int steps = static_cast<int>(std::floor(s / 50.0 + 0.25));
+  return std::clamp(steps, 1, 6) * 50;
+}
+
+std::string TitleLine(const RunLabel& label, double time) {
+  char buf[256];
+  std::snprintf(buf, sizeof(buf), "%s   estimator %s   dT %.3g s   lambda %.3g   t %.1f s",
+                label.task.empty() ? "run" : label.task.c_str(),
+                label.estimator.empty() ? "none" : label.estimator.c_str(), label.dT, label.lambda,
+                time);
+  return buf;
+}
 
 Status RenderOptions::Validate() const {
   if (width < kMinSide || height < kMinSide || width > kMaxSide || height > kMaxSide) {
@@ -94,10 +113,7 @@ Result<std::unique_ptr<SceneRenderer>> SceneRenderer::Create(const mjModel* m,
 
   mjv_makeScene(m, &r->scene_, 2000);
   r->scene_made_ = true;
-  const int font = options.height >= 1000  ? mjFONTSCALE_200
-                   : options.height >= 700 ? mjFONTSCALE_150
-                                           : mjFONTSCALE_100;
-  mjr_makeContext(copy.m, &r->context_, font);
+  mjr_makeContext(copy.m, &r->context_, FontScaleFor(options.width, options.height));
   r->context_made_ = true;
   if (r->context_.offWidth < options.width || r->context_.offHeight < options.height) {
     return Error{"render: MuJoCo made a " + Size(r->context_.offWidth, r->context_.offHeight) +
@@ -116,10 +132,6 @@ void SceneRenderer::AddPlotPoint(const TelemetrySample& sample) {
   if (plots_) plots_->Add(sample);
 }
 
-int SceneRenderer::PanelRows(const TelemetrySample* s) const {
-  return (ShowTaskRow() ? 1 : 0) + 3 + (s ? 1 + static_cast<int>(s->bundles.size()) : 0);
-}
-
 void SceneRenderer::DrawPanel(const TelemetrySample* s, mjrRect viewport) {
   std::string titles, values;
   auto row = [&](const std::string& title, const std::string& value) {
@@ -131,12 +143,6 @@ void SceneRenderer::DrawPanel(const TelemetrySample* s, mjrRect viewport) {
     values += value;
   };
   char buf[160];
-  if (ShowTaskRow()) row("task", label_.task);
-  std::snprintf(buf, sizeof(buf), "%.2f s", s ? s->time : 0.0);
-  row("time", buf);
-  std::snprintf(buf, sizeof(buf), "%.3g s / %.3g", label_.dT, label_.lambda);
-  row("dT / lambda", buf);
-  row("estimator", label_.estimator.empty() ? "none" : label_.estimator);
   if (s) {
     if (s->reference_unit == "rad") {
       std::snprintf(buf, sizeof(buf), "%.1f deg (ref %.1f)", s->measured * 180 / M_PI,
@@ -157,7 +163,9 @@ void SceneRenderer::DrawPanel(const TelemetrySample* s, mjrRect viewport) {
       row(b.actuator, buf);
     }
   }
-  mjr_overlay(mjFONT_NORMAL, mjGRID_TOPLEFT, viewport, titles.c_str(), values.c_str(), &context_);
+  if (titles.empty()) return;
+  mjr_overlay(mjFONT_NORMAL, mjGRID_BOTTOMRIGHT, viewport, titles.c_str(), values.c_str(),
+              &context_);
 }
 
 Status SceneRenderer::Render(const mjModel* m, const mjData* d, const TelemetrySample* sample,
@@ -181,23 +189,34 @@ Status SceneRenderer::Render(const mjModel* m, const mjData* d, const TelemetryS
   }
   mjr_setBuffer(mjFB_OFFSCREEN, &context_);
   const mjrRect viewport = {0, 0, options_.width, options_.height};
-  // With plots, the scene takes the left 55 % of the frame and the right 45 % hold the text
-  // panel on top and the plots below it, so nothing covers the model.
+  const int ch = context_.charHeight;
+  // Top: the title line (task, estimator, dT, lambda, time) across the frame. Below it, with
+  // plots, the scene takes the left 55 % and the plots the right 45 %, so nothing covers the
+  // model.
+  const int title_h = options_.text_panel ? ch + ch / 2 : 0;
+  const int below = options_.height - title_h;
   const int side = plots_ ? options_.width * 9 / 20 : 0;
-  const mjrRect scene_viewport = {0, 0, options_.width - side, options_.height};
+  const mjrRect scene_viewport = {0, 0, options_.width - side, below};
   mjr_render(scene_viewport, &scene_, &context_);
+  if (sample && options_.labels) {
+    DrawTendonLabels(PlaceTendonLabels(m, d, scene_, scene_viewport, *sample), scene_viewport,
+                     &context_);
+  }
+  if (sample && options_.heat_colours && options_.heat_key) {
+    // Bottom left, over the floor: the arm and its reach stay clear.
+    DrawHeatKey(ch / 2, ch / 2 + HeatKeyHeight(&context_), 0, &context_);
+  }
+  if (options_.text_panel) {
+    const mjrRect strip = {0, below, options_.width, title_h};
+    mjr_rectangle(strip, 0.08f, 0.08f, 0.1f, 1.f);
+    const std::string title = TitleLine(label_, sample ? sample->time : 0.0);
+    mjr_label({ch / 2, below, TextWidth(title, &context_), title_h}, mjFONT_NORMAL, title.c_str(),
+              0, 0, 0, 0, 1, 1, 1, &context_);
+  }
   if (plots_) {
-    const mjrRect column = {options_.width - side, 0, side, options_.height};
-    mjr_rectangle(column, 0.f, 0.f, 0.f, 1.f);
-    // mjr_overlay's box is rows * (charHeight + 5) + 5 pixels tall, 5 pixels from the edge.
-    const int panel =
-        options_.text_panel
-            ? std::min(options_.height / 2, PanelRows(sample) * (context_.charHeight + 5) + 12)
-            : 0;
-    if (options_.text_panel) {
-      DrawPanel(sample, {column.left, options_.height - panel, side, panel});
-    }
-    plots_->Draw({column.left, 0, side, options_.height - panel}, &context_);
+    const mjrRect column = {options_.width - side, 0, side, below};
+    mjr_rectangle(column, 0.05f, 0.05f, 0.08f, 1.f);
+    plots_->Draw(column, &context_);
   } else if (options_.text_panel) {
     DrawPanel(sample, scene_viewport);
   }

@@ -1,7 +1,8 @@
-// SceneRenderer: draws one frame of a running task off-screen with MuJoCo's renderer: the scene
-// from the chosen camera with each bundle's tendon coloured by its heat, the scrolling
-// TelemetryPlots and a text panel (time, dT, lambda, estimator, per-bundle counts). It owns its
-// GL context (GlContext), mjvScene and mjrContext; frames come back as packed RGB rows,
+// SceneRenderer: draws one frame of a running task off-screen with MuJoCo's renderer: a title
+// line (task, estimator, dT, lambda, time), the scene from the chosen camera with each bundle's
+// tendon coloured by its heat, labelled with its name and temperature, a key of the heat
+// colours, and the scrolling TelemetryPlots (or, without them, a panel of counts and heat). It owns
+// its GL context (GlContext), mjvScene and mjrContext; frames come back as packed RGB rows,
 // bottom-up as GL reads them.
 #pragma once
 
@@ -20,7 +21,15 @@
 
 namespace recruit::render {
 
-// Constant facts about the run, shown in the text panel.
+// MuJoCo font scale (mjtFontScale, %) for a frame: 100 at 560 x 400, proportional to the
+// smaller of width / 560 and height / 400, in 50 % steps from 50 to 300.
+int FontScaleFor(int width, int height);
+
+struct RunLabel;
+// "task   estimator E   dT X s   lambda Y   t Z s": the frame's title line.
+std::string TitleLine(const RunLabel& label, double time);
+
+// Constant facts about the run, shown in the title line.
 struct RunLabel {
   std::string task;       // task name or file
   std::string estimator;  // e.g. "kalman", "none"
@@ -34,13 +43,18 @@ struct RenderOptions {
   int height = 480;  // pixels
   CameraSpec camera;
   GlBackend backend = GlBackend::kOsMesa;
-  bool figures = true;        // the two scrolling plots
-  bool text_panel = true;     // the mjr_overlay panel
+  bool figures = true;  // the scrolling plots (TelemetryPlots)
+  // The title line (task, estimator, dT, lambda, time); without plots also the mjr_overlay
+  // panel of counts and heat over the scene.
+  bool text_panel = true;
+  bool labels = true;         // each bundle's name and temperature next to its tendon
+  bool heat_key = true;       // the key of the tendon heat colours
   bool heat_colours = true;   // colour each bundle's tendon by its heat
   double figure_window = 20;  // s of history in the plots
-  // Draw each bundle's tendon at least this thick (m, radius); 0 = as the model says. Real SMA
+  // Draw each bundle's tendon at least this thick (m, radius); 0 = as the model says. 3.5 mm
+  // is about 4 px across in a whole-arm shot at 640 x 480. Real SMA
   // bundles are a few mm thick, a pixel or two in a whole-arm shot.
-  double min_tendon_width = 0;
+  double min_tendon_width = 0.0035;
   // Draw every geom but planes at 35 % opacity (tendons stay opaque), so tendons routed inside
   // a bone's capsule show through it. MuJoCo's own mjVIS_TRANSPARENT only affects moving bodies.
   bool transparent = false;
@@ -83,9 +97,6 @@ class SceneRenderer {
  private:
   SceneRenderer(const RenderOptions& options, const RunLabel& label);
   void DrawPanel(const TelemetrySample* sample, mjrRect viewport);
-  int PanelRows(const TelemetrySample* sample) const;
-  // The task's name gets a row only when the panel is over the scene (no plot column).
-  bool ShowTaskRow() const { return !label_.task.empty() && !plots_; }
 
   RenderOptions options_;
   RunLabel label_;

@@ -1,44 +1,114 @@
-// TelemetryPlots: two scrolling MuJoCo figures drawn beside the scene, (1) the tracked quantity
-// against its reference (force in N, or the joint angle in deg) and (2) each bundle's true
-// against estimated on-count. mjvFigure is about 800 KB (100 lines x 1000 points), so both live
-// on the heap.
+// TelemetryPlots: the scrolling plots drawn beside the scene with MuJoCo's mjvFigure, stacked
+// panels sharing the time axis:
+//   - force task: force and its reference (N); angle task: joint angle and its reference (deg),
+//     then each bundle's force with the force reference its controller tracks (N);
+//   - each bundle's true on-count (solid stairs) and the estimator's count (dashed, lighter) with
+//     the filter's estimated_on +- 2 estimated_on_std band (translucent).
+// Rules (tests/render/telemetry_plots_test.cc): the legend sits in its own strip above each
+// panel, never over data; ticks are integer multiples of a 1-2-5 x 10^k step with the units in
+// the panel title; the whole window is kept however long it is (each line is thinned to fit
+// mjvFigure's 1000-point cap, keeping every bucket's min and max); sizes follow the font.
 #pragma once
 
 #include <mujoco/mujoco.h>
 
+#include <array>
+#include <deque>
+#include <functional>
 #include <memory>
+#include <string>
+#include <vector>
 
 #include "common/telemetry.h"
 
 namespace recruit::render {
 
+enum class LineStyle { kSolid, kStairs, kDashed };
+
+struct PlotLine {
+  std::string name;  // legend entry
+  std::array<float, 3> rgb{};
+  LineStyle style = LineStyle::kSolid;
+  std::deque<double> t, y;  // the window's samples (non-finite values left out)
+};
+
+struct PlotBand {
+  std::string name;
+  std::array<float, 4> rgba{};
+  std::deque<double> t, lo, hi;
+  bool had_data = false;  // has had a sample (its legend entry stays from then on)
+};
+
+// Text measures of the font the plots are drawn with (from the mjrContext, or fixed in tests).
+struct TextMetrics {
+  int char_height = 16;
+  std::function<int(const std::string&)> width;  // pixels of a string
+  static TextMetrics FromContext(const mjrContext* con);
+};
+
 class TelemetryPlots {
  public:
-  // `window` is the time span shown, s (> 0): older points scroll out on the left.
+  // `window` is the time span shown, s (> 0): older points scroll out on the left. The axis
+  // runs between round ticks, so up to one tick step more than `window` is shown.
   explicit TelemetryPlots(double window);
 
-  // Appends one point per line at sample.time. Non-finite values (an estimate when no estimator
-  // runs) are left out of their line.
+  // Appends one sample. The panels are chosen at the first sample (its reference unit and
+  // bundles).
   void Add(const TelemetrySample& sample);
 
-  // Draws both figures, stacked, into `area` (pixels). Call between mjr_render and
-  // mjr_readPixels.
+  struct PanelBoxes {
+    mjrRect legend;  // the legend strip (may have height 0 when the panel has no lines)
+    mjrRect figure;  // the mjvFigure's rectangle (title, ticks, data)
+  };
+  // Where each panel's legend and figure go in `area` (pixels, bottom-left origin).
+  std::vector<PanelBoxes> Layout(mjrRect area, const TextMetrics& text) const;
+  // Fills every figure for drawing in `area`: x and y ranges on round ticks, thinned lines.
+  void Prepare(mjrRect area, const TextMetrics& text);
+  // Prepare, then draws the legends, the figures and the bands. Call between mjr_render and
+  // mjr_readPixels. Line widths scale with con->fontScale.
   void Draw(mjrRect area, const mjrContext* con);
 
-  const mjvFigure& tracking() const { return *tracking_; }
-  const mjvFigure& recruitment() const { return *recruitment_; }
+  int num_panels() const { return static_cast<int>(panels_.size()); }
+  const mjvFigure& figure(int panel) const { return *panels_[panel].fig; }
+  // The dashed lines are drawn by a second, overlaid figure in barplot mode (segments).
+  const mjvFigure& dashes(int panel) const { return *panels_[panel].dash; }
+  const std::vector<PlotLine>& lines(int panel) const { return panels_[panel].lines; }
+  const std::vector<PlotBand>& bands(int panel) const { return panels_[panel].bands; }
+  // Tick values of the last Prepare (x then y).
+  const std::vector<double>& x_ticks() const { return x_ticks_; }
+  const std::vector<double>& y_ticks(int panel) const { return panels_[panel].y_ticks; }
+  // The y tick labels of the last Prepare (drawn by this class).
+  const std::vector<std::string>& y_labels(int panel) const { return panels_[panel].y_labels; }
+  // The x tick labels mjr_figure prints: evenly spaced values between the range ends,
+  // interpolated in float and formatted with the figure's xformat.
+  static std::vector<std::string> XTickLabels(const mjvFigure& fig);
 
-  static constexpr int kMaxBundles = 4;  // bundles drawn in the recruitment figure
+  static constexpr int kMaxBundles = 4;  // bundles drawn
 
  private:
-  void Push(mjvFigure* fig, int line, double x, double y);
-  void Scroll(mjvFigure* fig, double now);
+  struct Panel {
+    std::string title;  // with the unit
+    std::vector<PlotLine> lines;
+    std::vector<PlotBand> bands;
+    std::unique_ptr<mjvFigure> fig, dash;
+    std::vector<double> y_ticks;
+    std::vector<std::string> y_labels;
+    bool include_zero = true;
+  };
+  void Configure(const TelemetrySample& s);
+  void Drop(double start);
+  int LegendRows(const Panel& p, int width, const TextMetrics& text) const;
+  void DrawLegend(const Panel& p, mjrRect box, const mjrContext* con, const TextMetrics& text,
+                  float line_px) const;
+  void DrawBands(const Panel& p, const mjrContext* con) const;
+  void DrawYLabels(const Panel& p, const mjrContext* con, const TextMetrics& text) const;
 
   double window_;
+  double now_ = 0;
   bool configured_ = false;
-  bool angle_ = false;  // the tracked quantity is a joint angle (plotted in deg)
-  std::unique_ptr<mjvFigure> tracking_;
-  std::unique_ptr<mjvFigure> recruitment_;
+  bool angle_ = false;
+  std::vector<Panel> panels_;
+  std::vector<double> x_ticks_;
 };
 
 }  // namespace recruit::render

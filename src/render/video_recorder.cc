@@ -42,6 +42,16 @@ Status VideoOptions::Validate() const {
                    std::to_string(render.height) +
                    ": H.264 in yuv420p (what browsers play) needs an even width and height"};
     }
+    // H.264's largest level (6.2) allows 139264 macroblocks of 16 x 16 pixels per frame: e.g.
+    // 8192 x 4352, 7680 x 4320 (8K UHD); 8192 x 8192 is twice that.
+    const long mbs = static_cast<long>((render.width + 15) / 16) * ((render.height + 15) / 16);
+    if (mbs > kMaxH264Macroblocks) {
+      return Error{"frame size " + std::to_string(render.width) + "x" +
+                   std::to_string(render.height) + " is " + std::to_string(mbs) +
+                   " macroblocks of 16x16 px; H.264 (level 6.2, its largest) allows at most " +
+                   std::to_string(kMaxH264Macroblocks) +
+                   " per frame (e.g. 7680x4320 or 8192x4352)"};
+    }
     if (Status s = h264.Validate(); !s.ok()) return s;
   }
   if (!gif_path.empty()) {
@@ -140,6 +150,7 @@ Status VideoRecorder::OnStep(const mjModel* m, const mjData* d, const TelemetryS
   Frame* first = *frame;
   first->index = next_index_++;
   first->time = d->time;
+  last_frame_time_ = d->time;
   first->still_path = StillPathFor(d->time, slack);
   if (tap_) tap_(*first);
   // Physics steps longer than a frame period: repeat the image for every frame now due.
@@ -163,7 +174,17 @@ Status VideoRecorder::Finish() {
   if (finished_) return Status::Ok();
   finished_ = true;
   if (next_index_ == 0) return Error{"video recorder: the run ended before the first frame"};
-  return pipeline_->Finish();
+  if (Status s = pipeline_->Finish(); !s.ok()) return s;
+  // A still due after the last frame cannot be taken: say so rather than drop it.
+  if (!pending_stills_.empty()) {
+    char msg[200];
+    std::snprintf(msg, sizeof(msg),
+                  "%zu still(s) not written: requested at %g s and later, after the last frame "
+                  "(t = %g s); the video and the other stills were written",
+                  pending_stills_.size(), pending_stills_.front(), last_frame_time_);
+    return Error{msg};
+  }
+  return Status::Ok();
 }
 
 std::vector<std::string> VideoRecorder::stills_written() const {

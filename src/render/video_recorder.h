@@ -17,6 +17,9 @@
 
 namespace recruit::render {
 
+// H.264 level 6.2's MaxFS: the most 16 x 16 macroblocks a frame may have.
+inline constexpr long kMaxH264Macroblocks = 139264;
+
 struct VideoOptions {
   std::string mp4_path;             // H.264 MP4 (".mp4"); empty = none
   std::string gif_path;             // animated GIF (".gif"); empty = none
@@ -46,6 +49,8 @@ class VideoRecorder final : public StepObserver {
   Status Prepare(const mjModel* m);
 
   Status OnStep(const mjModel* m, const mjData* d, const TelemetrySample& sample) override;
+  // Closes the outputs. A still requested after the last frame is an error (the outputs that
+  // were made are kept); `recruit render` refuses such times before the run.
   Status Finish() override;
 
   int64_t frames_rendered() const { return next_index_; }
@@ -66,6 +71,7 @@ class VideoRecorder final : public StepObserver {
   std::vector<double> pending_stills_;  // sorted, consumed from the front
   double next_periodic_still_ = 0;
   int64_t next_index_ = 0;
+  double last_frame_time_ = 0;
   int64_t renders_ = 0;
   bool finished_ = false;
   std::function<void(const Frame&)> tap_;

@@ -1,6 +1,7 @@
 // `recruit render` end to end on a short isometric-bench task: the video decodes with the
 // expected frame count (ffprobe), the same seed gives identical decoded frames and another seed
-// does not (ffmpeg framemd5), and bad options fail with exit code 1, a clear message and no file.
+// does not (ffmpeg framemd5), and bad options fail with the documented exit code (2 usage, 3 input,
+// 4 I/O), a clear message and no file.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <sys/wait.h>
@@ -80,7 +81,7 @@ TEST_F(RenderCommandTest, SameSeedSameFramesOtherSeedOtherFrames) {
 
 TEST_F(RenderCommandTest, UnknownCameraIsNamedWithTheModelsCameras) {
   Output r = Render("--out " + (dir_ / "x.mp4").string() + " --camera nope");
-  EXPECT_EQ(r.exit_code, 3);  // docs/reliability.md
+  EXPECT_EQ(r.exit_code, 2);  // a bad option value: usage (docs/reliability.md)
   EXPECT_THAT(r.text, HasSubstr("no camera named 'nope'"));
   EXPECT_THAT(r.text, HasSubstr("isometric_bench.xml"));
   EXPECT_THAT(r.text, HasSubstr("defines no cameras"));
@@ -95,6 +96,26 @@ TEST_F(RenderCommandTest, BadSizesAreRefusedWithTheAllowedRange) {
   Output huge = Render("--out " + (dir_ / "x.mp4").string() + " --height 20000");
   EXPECT_EQ(huge.exit_code, 2);  // docs/reliability.md
   EXPECT_THAT(huge.text, HasSubstr("[16, 8192]"));
+  // Within the side limit but beyond H.264's largest frame (level 6.2: 139264 macroblocks):
+  // refused before any rendering or allocation.
+  Output square = Render("--out " + (dir_ / "x.mp4").string() + " --width 8192 --height 8192");
+  EXPECT_EQ(square.exit_code, 2);
+  EXPECT_THAT(square.text, HasSubstr("262144 macroblocks"));
+  EXPECT_THAT(square.text, HasSubstr("139264"));
+  EXPECT_TRUE(Empty());
+}
+
+TEST_F(RenderCommandTest, StillsAfterTheEndAndBadDurationsAreUsageErrors) {
+  Output late = Render("--out " + (dir_ / "x.mp4").string() + " --duration 0.5 --stills 0.2,3");
+  EXPECT_EQ(late.exit_code, 2);
+  EXPECT_THAT(late.text, HasSubstr("--stills: 3 s is after the run's end (0.5 s)"));
+  for (const char* d : {"-1", "0", "1e400", "nan", "abc"}) {
+    Output bad = Render("--out " + (dir_ / "x.mp4").string() + " --duration " + d);
+    EXPECT_EQ(bad.exit_code, 2) << d;
+    EXPECT_THAT(bad.text, HasSubstr("--duration")) << d;
+    EXPECT_THAT(bad.text, ::testing::Not(HasSubstr("1.79769e+308"))) << d;
+    EXPECT_THAT(bad.text, ::testing::Not(HasSubstr("DBL_MAX"))) << d;
+  }
   EXPECT_TRUE(Empty());
 }
 

@@ -81,6 +81,8 @@ TEST_F(SceneRendererTest, TendonTurnsFromBlueToRedWhereThePinholeModelPutsIt) {
   RenderOptions o = Front();
   o.figures = false;  // only the tendon may differ between the two renders
   o.text_panel = false;
+  o.labels = false;
+  o.heat_key = false;
   const TelemetrySample cold = Sample(1.0, 0.0), hot = Sample(1.0, 1.0);
   const std::vector<unsigned char> a = Render(o, &cold);
   EXPECT_GT(last_recoloured_, 0);
@@ -126,6 +128,8 @@ TEST_F(SceneRendererTest, MinimumTendonWidthThickensOnlyTheTendon) {
   RenderOptions o = Front();
   o.figures = false;
   o.text_panel = false;
+  o.labels = false;
+  o.heat_key = false;
   const TelemetrySample hot = Sample(1.0, 1.0);
   auto red_pixels = [&](const std::vector<unsigned char>& rgb) {
     long n = 0;
@@ -222,6 +226,8 @@ TEST_F(SceneRendererTest, FreeCameraLooksWhereItIsTold) {
   o.height = 240;
   o.figures = false;
   o.text_panel = false;
+  o.labels = false;
+  o.heat_key = false;
   o.camera.azimuth = 70;
   o.camera.elevation = -15;
   o.camera.distance = 0.8;

@@ -1,0 +1,18 @@
+// librecruit-plot.so: `recruit plot`'s drawing (cairo), opened only when it runs (see
+// cli/command_modules.h).
+#include <string>
+#include <vector>
+
+// No MuJoCo here: the signature is RecruitPlotRunFn of cli/command_modules.h.
+#include "plot/plot_run.h"
+
+extern "C" __attribute__((visibility("default"))) void recruit_plot_run(
+    const recruit::plot::PlotOptions* options, std::vector<std::string>* written,
+    std::string* error) {
+  auto r = recruit::plot::RunPlot(*options);
+  if (r.ok()) {
+    *written = std::move(*r);
+  } else {
+    *error = r.error();
+  }
+}
