@@ -4,7 +4,8 @@
 # its checked-in seed corpus with a fixed seed. Fails if any target crashes, hangs (-timeout),
 # leaks or trips a sanitizer; the input that did it is written to build-fuzz/artifacts/.
 # Usage:
-#   scripts/fuzz.sh [target...]     targets: task filter_model filter_log bundle_config (default all)
+#   scripts/fuzz.sh [target...]     targets: task filter_model filter_log bundle_config mjcf_config
+#                                   (default: all)
 # Environment: FUZZ_SECONDS per target (default 30), FUZZ_SEED (default 1), BUILD_DIR (default
 # build-fuzz), JOBS (default: nproc). Reproduce a crash: build-fuzz/tests/fuzz/fuzz_<target> FILE.
 # Keep one found crash as a regression test: copy it to tests/fuzz/corpus/<target>/regress-<what>
@@ -16,7 +17,7 @@ JOBS=${JOBS:-$(nproc)}
 FUZZ_SECONDS=${FUZZ_SECONDS:-30}
 FUZZ_SEED=${FUZZ_SEED:-1}
 TARGETS=("$@")
-if [ ${#TARGETS[@]} -eq 0 ]; then TARGETS=(task filter_model filter_log bundle_config); fi
+if [ ${#TARGETS[@]} -eq 0 ]; then TARGETS=(task filter_model filter_log bundle_config mjcf_config); fi
 
 # fuzzer-no-link: coverage instrumentation in every library, libFuzzer's main only in fuzz_*.
 FLAGS="-O1 -g -fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=all"

@@ -21,17 +21,19 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   static const std::vector<std::string> kKeys = BundleConfig::Keys();
   if (size < 2) return 0;
   const std::string rest(reinterpret_cast<const char*>(data) + 2, size - 2);
-  recruit::Result<BundleConfig> cfg = BundleConfig::FromText("fuzz", rest);
-  if (data[0] % 2 == 1) {
+  auto parse = [&]() -> recruit::Result<BundleConfig> {
+    if (data[0] % 2 == 0) return BundleConfig::FromText("fuzz", rest);
     std::vector<std::pair<std::string, std::string>> pairs;
     size_t start = 0;
     for (const std::string& key : kKeys) {
-      const size_t end = start <= rest.size() ? rest.find('\n', start) : std::string::npos;
+      size_t end = start <= rest.size() ? rest.find('\n', start) : std::string::npos;
+      if (end == std::string::npos) end = rest.size();
       pairs.emplace_back(key, start <= rest.size() ? rest.substr(start, end - start) : "");
-      start = end == std::string::npos ? rest.size() + 1 : end + 1;
+      start = end + 1;
     }
-    cfg = BundleConfig::FromPairs("fuzz", "recruit.sma actuator 'fuzz': config ", pairs);
-  }
+    return BundleConfig::FromPairs("fuzz", "recruit.sma actuator 'fuzz': config ", pairs);
+  };
+  const recruit::Result<BundleConfig> cfg = parse();
   if (!cfg.ok()) return 0;
   static const double kTimesteps[] = {1e-4, 2e-3, 0.05};
   const double dt = kTimesteps[data[1] % 3];

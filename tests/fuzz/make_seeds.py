@@ -85,3 +85,21 @@ write("bundle_config", "no_equals.txt", b"\x00\x01units")
 write("bundle_config", "lines.txt", b"\x01\x01spring\n60\n\n\n\n\n2\n")
 write("bundle_config", "lines_wire.txt", b"\x01\x02wire\n5\n0.0001\n0.1\n")
 write("bundle_config", "lines_nan.txt", b"\x01\x01\nnan\ninf\n-0\n0x10\n 5\n")
+
+# --- mjcf_config: one value per line for law, units, ... (the 35 BundleConfig keys), then seed
+# and broadcast_period ---
+def lines(values):
+    out = [""] * 37
+    for i, v in values.items():
+        out[i] = v
+    return "\n".join(out).rstrip("\n")
+
+
+write("mjcf_config", "bench.txt", lines({1: "60"}))
+write("mjcf_config", "wire.txt", lines({0: "wire", 1: "12", 9: "0.03", 35: "7", 36: "0.01"}))
+write("mjcf_config", "spring_period.txt", lines({0: "spring", 1: "30", 34: "0.004", 36: "0.5"}))
+write("mjcf_config", "bad_seed.txt", lines({35: "-3"}))
+write("mjcf_config", "bad_period.txt", lines({36: "soon"}))
+write("mjcf_config", "huge_seed.txt", lines({35: "18446744073709551616"}))
+write("mjcf_config", "xml_chars.txt", lines({0: "<&\"'>", 1: "6\x01"}))
+write("mjcf_config", "many_units.txt", lines({1: "100000"}))
