@@ -28,13 +28,10 @@ echo "== single runs (seed 1)"
 run fig5_top output 2.0
 run fig5_bottom output 0.5
 run fig9 kalman-augmented 0.5
-gnuplot -e "csv='$OUT/fig5_top.csv'; out='docs/img/repro_fig5_top.png'; \
-  title='Fig. 5 top: output only, dT = 2.0 s, lambda = 0.2 (seed 1)'" scripts/plot_repro.gp
-gnuplot -e "csv='$OUT/fig5_bottom.csv'; out='docs/img/repro_fig5_bottom.png'; \
-  title='Fig. 5 bottom: output only, dT = 0.5 s, lambda = 0.2 (seed 1)'" scripts/plot_repro.gp
-gnuplot -e "csv='$OUT/fig9.csv'; out='docs/img/repro_fig9.png'; \
-  title='Fig. 9: Kalman filter on the augmented model, dT = 0.5 s, lambda = 0.2 (seed 1)'" \
-  scripts/plot_repro.gp
+for f in fig5_top fig5_bottom fig9; do
+  "$RECRUIT" plot --csv "$OUT/$f.csv" --summary "$OUT/$f.json" --out docs/img --name "repro_$f" \
+    --figure all --width 900 --height 640
+done
 
 echo "== $SEEDS seeds at lambda = 0.2"
 "$RECRUIT" sweep --task "$TASK" --out "$OUT/seeds_output" --dT 0.5,2.0 --lambda 0.2 \
@@ -67,14 +64,18 @@ awk -v a="$os_o05" -v b="$os_o2" -v c="$os_k05" -v s2="$st_o2" -v sk="$st_k05" -
 echo "== dT x lambda sweeps (stability maps)"
 "$RECRUIT" sweep --task "$TASK" --out "$OUT/map_output" --dT 0.25,0.5,1.0,2.0 \
   --lambda 0.1,0.2,0.35,0.5 --estimator output --seeds "${MAP_SEEDS:-5}"
-cp "$OUT/map_output/stability.png" docs/img/sweep_stability_output.png
+"$RECRUIT" plot --stability-map "$OUT/map_output/stability.dat" --out docs/img \
+  --name sweep_stability_output --width 920 --height 420 \
+  --title "isometric_paper, output only: mean step overshoot (%), ring = meets criterion"
 "$RECRUIT" sweep --task "$TASK" --out "$OUT/map_kalman" --dT 0.5,2.0 \
   --lambda 0.1,0.2,0.35,0.5 --estimator kalman-augmented --seeds "${MAP_SEEDS:-5}" "${FM[@]}"
-cp "$OUT/map_kalman/stability.png" docs/img/sweep_stability_kalman.png
-echo "== arm tasks (seed 1, output only)"
+"$RECRUIT" plot --stability-map "$OUT/map_kalman/stability.dat" --out docs/img \
+  --name sweep_stability_kalman --width 920 --height 420 \
+  --title "isometric_paper, Kalman filter: mean step overshoot (%), ring = meets criterion"
+echo "== arm tasks (seed 1, the tasks' Kalman filter)"
 for t in arm_reach_hold arm_lift arm_push; do
   "$RECRUIT" simulate --task "models/tasks/$t.json" --seed 1 --out "$OUT" --csv-every 5
-  gnuplot -e "csv='$OUT/${t}_steps.csv'; out='docs/img/repro_$t.png'; title='$t (seed 1)'" \
-    scripts/plot_arm.gp
+  "$RECRUIT" plot --csv "$OUT/${t}_steps.csv" --summary "$OUT/${t}_summary.json" --out docs/img \
+    --name "repro_$t" --figure all --width 900 --height 640
 done
 echo "done: $OUT, docs/img/repro_*.png, docs/img/sweep_*.png"
