@@ -11,12 +11,14 @@
 #include "estimation/filter_log.h"
 #include "estimation/filter_model.h"
 #include "estimation/json_matrix.h"
+#include "identification/plant_record.h"
 
 namespace recruit::cli {
 namespace {
 
 struct FilterArgs {
   std::string model, log, out;
+  std::string plant, actuator;  // the MJCF and bundle the log was recorded on (optional)
   CountFilterOptions options;
 };
 
@@ -41,6 +43,13 @@ int RunFilter(const FilterArgs& a) {
   if (Status s = CheckOutputIsNoInput(a.out, a); !s.ok()) return fail(s.error());
   auto model = FilterModel::FromJson(a.model);
   if (!model.ok()) return fail(model.error());
+  // A model identified on another plant than the log's is refused (its H and chain describe
+  // other units), as simulate and sweep refuse it.
+  if (!a.plant.empty()) {
+    auto record = control::PlantRecordOf(a.plant, a.actuator);
+    if (!record.ok()) return fail("--plant: " + record.error());
+    if (Status s = control::CheckModelPlant(a.model, *record); !s.ok()) return fail(s.error());
+  }
   auto filter = MakeCountFilter(*model, a.options);
   if (!filter.ok()) return fail(filter.error());
   // Streamed: the log is read, stepped and written row by row (memory flat in its length).
@@ -78,6 +87,11 @@ void AddFilterCommand(CLI::App& app, int& exit_code) {
                   "Output CSV: step[,t],updated,x_<state>...,var_<state>... (estimate and "
                   "diagonal of its covariance per step), written atomically")
       ->required();
+  cmd->add_option("--plant", args->plant,
+                  "MJCF model the log was recorded on: the model file must have been identified "
+                  "on that plant's bundle (its identification.plant), else it is refused")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--actuator", args->actuator, "--plant's bundle (default: its first)");
   cmd->add_option("--estimator", args->options.estimator,
                   std::string("Estimator: ") + kEstimatorNames)
       ->check(CLI::IsMember({"extended", "conservative", "plain", "exact", "particle"}))

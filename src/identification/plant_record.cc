@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <fstream>
 
+#include "common/mujoco_ptr.h"
+
 namespace recruit::control {
 
 nlohmann::json PlantRecord(const sma::SmaHost& host, int b, const std::string& model_path) {
@@ -19,6 +21,23 @@ nlohmann::json PlantRecord(const sma::SmaHost& host, int b, const std::string& m
           {"settled_unit_force_N", host.SettledUnitForce(b)},
           {"unit", unit},
           {"hash", PlantHash(unit)}};
+}
+
+Result<nlohmann::json> PlantRecordOf(const std::string& model_path, const std::string& actuator) {
+  char err[1000] = "";
+  ModelPtr m(mj_loadXML(model_path.c_str(), nullptr, err, sizeof err));
+  if (!m) return Error{model_path + ": " + err};
+  auto host = sma::SmaHost::Create(m.get());
+  if (!host) return Error{model_path + ": " + host.error()};
+  const sma::SmaHost& h = **host;
+  if (h.num_bundles() == 0) return Error{model_path + ": no SMA bundle (recruit.sma)"};
+  const int b = actuator.empty() ? 0 : h.BundleIndex(actuator);
+  if (b < 0) {
+    std::string have;
+    for (int i = 0; i < h.num_bundles(); ++i) have += (i ? ", " : "") + h.bundle_name(i);
+    return Error{model_path + ": no SMA bundle on actuator '" + actuator + "'; bundles: " + have};
+  }
+  return PlantRecord(h, b, model_path);
 }
 
 }  // namespace recruit::control

@@ -18,4 +18,8 @@ namespace recruit::control {
 //  "unit": {key: value, ...}, "hash": "16 hex digits"}.
 nlohmann::json PlantRecord(const sma::SmaHost& host, int bundle, const std::string& model_path);
 
+// The record of the bundle on actuator `actuator` (empty: the first) of the MJCF model at
+// `model_path`, loaded with MuJoCo; errors name the file and the bundles it has.
+Result<nlohmann::json> PlantRecordOf(const std::string& model_path, const std::string& actuator);
+
 }  // namespace recruit::control

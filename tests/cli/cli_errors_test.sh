@@ -53,6 +53,19 @@ usage_same_code_everywhere)  # an unknown option and a missing input: 2 for ever
   expect 2 "$RECRUIT"
   expect 0 "$RECRUIT" --help
   ;;
+filter_plant_mismatch)  # filter --plant: a model identified on another plant is refused (3)
+  BENCH_MODEL=$SRC/models/identified/bundle_903e47abb54d0604_dt0.5_m20.json
+  awk -F, 'NR==1{print "t,p_on,p_off,y"; next} NR<=200{print $1","$2","$3","$4}' \
+    "$SRC/models/identified/bench_n60_dt0.5_log.csv" > log.csv
+  expect 3 "$RECRUIT" filter --model "$BENCH_MODEL" --log log.csv --out f.csv \
+    --plant "$SRC/models/elbow_arm.xml" --actuator flexor
+  grep -q "identified on another plant" err || fail "no plant mismatch message"
+  grep -q "series 1 vs 6" err || fail "the differing unit parameters are not named"
+  [ ! -e f.csv ] || fail "filter wrote on a refused model"
+  expect 0 "$RECRUIT" filter --model "$BENCH_MODEL" --log log.csv --out f.csv \
+    --plant "$SRC/models/isometric_bench.xml"
+  [ -s f.csv ] || fail "no output on the matching plant"
+  ;;
 long_value_shortened)  # a huge option value is not echoed whole
   big=$(python3 -c "print('9x' * 50000)")
   expect 2 "$RECRUIT" simulate --task "$TASK" --dT "$big" --out o
