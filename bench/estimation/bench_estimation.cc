@@ -16,7 +16,6 @@
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
-
 #include <cmath>
 #include <map>
 #include <vector>
