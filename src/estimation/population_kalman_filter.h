@@ -78,14 +78,16 @@ class PopulationKalmanFilterT {
   // Time update with the transition A(t) (eqs. 16, 22/27). A must be column-stochastic (the
   // caller validates it, or uses PredictChecked). A step without a measurement is Predict alone.
   void Predict(const Mat& A);
-  // The same for a sparse A (column-major, compressed; e.g. BroadcastTransitionModel::
-  // SparsePattern filled by FillSparse): A (P - diag xq) A^T as 2 m nnz(A) column updates
-  // instead of two dense m x m products; O(m^2 nnz / m) instead of O(m^3). A must be m x m and
-  // column-stochastic (not checked); no allocation. Equal to Predict(Mat(A)) up to round-off.
+  // The same for a sparse A (column-major; e.g. BroadcastTransitionModel::SparsePattern filled
+  // by FillSparse), converted to compressed rows in preallocated workspaces: A (P - diag xq) A^T
+  // in about 3 m nnz(A) flops (PredictRows) instead of two dense m x m products. A must be
+  // m x m and column-stochastic (not checked); no allocation. Equal to Predict(Mat(A)) up to
+  // round-off.
   void Predict(const Eigen::SparseMatrix<double>& A);
   // The natural call for a broadcast model (model.transition == kBroadcast): fills the filter's
-  // own sparse A(p_on, p_off) in place (BroadcastTransitionModel::FillSparse on the pattern
-  // built at Create) and predicts with it, O(m nnz(A)), no allocation. p_on, p_off in [0, 1]
+  // own sparse A(p_on, p_off) in place (the arithmetic of BroadcastTransitionModel::FillSparse,
+  // into the compressed rows of the pattern built at Create) and predicts with it, O(m nnz(A)),
+  // no allocation. p_on, p_off in [0, 1]
   // (not checked; BroadcastTransitionModel::ValidateInputs). Not for other transition sources
   // (has_broadcast() is false; then this is a no-op guarded by an assertion in debug builds).
   void PredictBroadcast(double p_on, double p_off);
