@@ -9,6 +9,7 @@
 
 #include "estimation/json_matrix.h"
 #include "estimation/population_chain.h"
+#include "estimation/shortest_double.h"
 
 namespace recruit {
 namespace {
@@ -261,7 +262,11 @@ Status RunFilterStream(const FilterModel& model, FilterLogReader& log, CountFilt
                        std::ostream& out) {
   const int m = model.num_states();
   std::string buf;
-  buf.reserve(kChunk + 24 * (2 * static_cast<size_t>(m) + 3) + 4096);
+  // Room for the longest row: per number its comma and kShortestDoubleMaxChars characters, and
+  // WriteShortest's room after the last one.
+  const size_t row_room =
+      (kShortestDoubleMaxChars + 1) * (2 * static_cast<size_t>(m) + 3) + kShortestDoubleRoom + 8;
+  buf.reserve(kChunk + row_room + 4096);
   buf += "step";
   if (log.has_time()) buf += ",t";
   buf += ",updated";
@@ -299,26 +304,26 @@ Status RunFilterStream(const FilterModel& model, FilterLogReader& log, CountFilt
     if (!mean.allFinite() || !var.allFinite()) {
       return Error{log.path() + ": step " + std::to_string(k) + ": the estimate is not finite"};
     }
-    // The row is formatted straight into the buffer's tail (room for the longest row: 24
-    // characters per number), then the buffer is cut to what was written.
+    // The row is formatted straight into the buffer's tail (row_room: room for the longest
+    // row), then the buffer is cut to what was written.
     const size_t start = buf.size();
-    buf.resize(start + 24 * (2 * m + 3) + 8);
+    buf.resize(start + row_room);
     char* p = buf.data() + start;
     char* const end = buf.data() + buf.size();
     p = std::to_chars(p, end, k).ptr;
     if (log.has_time()) {
       *p++ = ',';
-      p = std::to_chars(p, end, row.t).ptr;  // shortest round-trip form
+      p = WriteShortest(p, row.t);  // shortest round-trip form, as std::to_chars
     }
     *p++ = ',';
     *p++ = row.has_y ? '1' : '0';
     for (int i = 0; i < m; ++i) {
       *p++ = ',';
-      p = std::to_chars(p, end, mean(i)).ptr;
+      p = WriteShortest(p, mean(i));
     }
     for (int i = 0; i < m; ++i) {
       *p++ = ',';
-      p = std::to_chars(p, end, var(i)).ptr;
+      p = WriteShortest(p, var(i));
     }
     *p++ = '\n';
     buf.resize(static_cast<size_t>(p - buf.data()));

@@ -22,7 +22,9 @@
 //
 // The total N is known exactly, so 1^T P = 0 and 1^T X^ = N are invariants of the equations
 // (1^T A = 1^T, 1^T Qz = 0, 1^T G Qw G^T = 0 by validation, hence 1^T K = 0). Round-off is
-// removed after every step by projecting X^ onto sum = N and P onto the subspace 1^T P = 0.
+// removed by projecting X^ onto sum = N (every step) and P onto the subspace 1^T P = 0 (every
+// dense step; every kSparseReprojectPeriod sparse predictions, since the sparse step keeps
+// 1^T P = 0 algebraically and its round-off drift is O(eps) per step).
 //
 // PopulationKalmanFilterT<M, R> is the fixed-size filter for m = M states and r = R outputs
 // (no heap allocation in Predict / Update); PopulationKalmanFilter is the dynamic-size one.
@@ -35,6 +37,10 @@
 #include <cmath>
 #include <functional>
 #include <string>
+#include <vector>
+#ifdef __SSE2__
+#include <emmintrin.h>
+#endif
 
 #include "common/result.h"
 #include "estimation/filter_model.h"
@@ -72,17 +78,21 @@ class PopulationKalmanFilterT {
   // Time update with the transition A(t) (eqs. 16, 22/27). A must be column-stochastic (the
   // caller validates it, or uses PredictChecked). A step without a measurement is Predict alone.
   void Predict(const Mat& A);
-  // The same for a sparse A (column-major, compressed; e.g. BroadcastTransitionModel::
-  // SparsePattern filled by FillSparse): A (P - diag xq) A^T as 2 m nnz(A) column updates
-  // instead of two dense m x m products; O(m^2 nnz / m) instead of O(m^3). A must be m x m and
-  // column-stochastic (not checked); no allocation. Equal to Predict(Mat(A)) up to round-off.
+  // The same for a sparse A (column-major; e.g. BroadcastTransitionModel::SparsePattern filled
+  // by FillSparse), converted to compressed rows in preallocated workspaces: A (P - diag xq) A^T
+  // in about 3 m nnz(A) flops (PredictRows) instead of two dense m x m products. A must be
+  // m x m and column-stochastic (not checked); no allocation. Equal to Predict(Mat(A)) up to
+  // round-off.
   void Predict(const Eigen::SparseMatrix<double>& A);
   // The natural call for a broadcast model (model.transition == kBroadcast): fills the filter's
-  // own sparse A(p_on, p_off) in place (BroadcastTransitionModel::FillSparse on the pattern
-  // built at Create) and predicts with it, O(m nnz(A)), no allocation. p_on, p_off in [0, 1]
+  // own sparse A(p_on, p_off) in place (the arithmetic of BroadcastTransitionModel::FillSparse,
+  // into the compressed rows of the pattern built at Create) and predicts with it, O(m nnz(A)),
+  // no allocation. p_on, p_off in [0, 1]
   // (not checked; BroadcastTransitionModel::ValidateInputs). Not for other transition sources
   // (has_broadcast() is false; then this is a no-op guarded by an assertion in debug builds).
   void PredictBroadcast(double p_on, double p_off);
+  // Sparse predictions between two projections of P onto 1^T P = 0 (see the header comment).
+  static constexpr int kSparseReprojectPeriod = 16;
   bool has_broadcast() const { return has_broadcast_; }
   // The A of the last PredictBroadcast (the broadcast pattern, values of that call).
   const Eigen::SparseMatrix<double>& broadcast_matrix() const { return As_; }
@@ -136,6 +146,9 @@ class PopulationKalmanFilterT {
   void MirrorUpperAndReproject();
   // Reproject for an exactly symmetric P.
   void ReprojectSymmetric();
+  // The sparse prediction with A in compressed-row form (row i: entries ptr[i]..ptr[i+1] - 1,
+  // columns col[], values val[]): P = A (P - diag xq) A^T + diag(A xq) + G Qw G^T, x = A x.
+  void PredictRows(const int* ptr, const int* col, const double* val);
 
   CovarianceMode mode_ = CovarianceMode::kExtended;
   double N_ = 0.0;
@@ -159,6 +172,16 @@ class PopulationKalmanFilterT {
   bool has_broadcast_ = false;
   BroadcastTransitionModel broadcast_;
   Eigen::SparseMatrix<double> As_;
+  // Its compressed-row form, built at Create: per entry the column, the value of `interior`,
+  // 1 if the row is the column's switch target (else 0), and the entry's index in As_
+  // (column-major); per column whether it is an on state. Values rewritten by PredictBroadcast.
+  std::vector<int> bc_ptr_, bc_col_, bc_src_;
+  std::vector<double> bc_base_, bc_val_, bc_target_;
+  std::vector<char> bc_on_;  // per column
+  // Predict(SparseMatrix): A converted to compressed rows (sized m^2 at Create, no allocation).
+  std::vector<int> sp_ptr_, sp_col_, sp_fill_;
+  std::vector<double> sp_val_;
+  int sparse_steps_ = 0;  // sparse predictions since P was last projected onto 1^T P = 0
 };
 
 using PopulationKalmanFilter = PopulationKalmanFilterT<Eigen::Dynamic, Eigen::Dynamic>;
@@ -185,6 +208,90 @@ void ProjectOntoSimplexInto(const V& x, double N, V& out, V& work) {
     if (work(k) - t > 0.0) theta = t;
   }
   out = (x.array() - theta).max(0.0).matrix();
+}
+
+// out[0..len) = sum_k a[k] src(0..len, c[k]) for n terms (column-major src, leading dimension
+// ld); zero for n = 0. Up to three columns per loop, so that `out` is written once per three
+// terms. Len: the length when fixed at compile time (unrolled), else Eigen::Dynamic.
+template <int Len>
+inline void RowCombination(double* __restrict out, const double* __restrict src, Eigen::Index ld,
+                           Eigen::Index len_dynamic, const int* c, const double* a, int n) {
+  const Eigen::Index len = Len == Eigen::Dynamic ? len_dynamic : Len;
+  if (n == 0) {
+    for (Eigen::Index r = 0; r < len; ++r) out[r] = 0.0;
+    return;
+  }
+  int k = 0;
+  bool first = true;
+  while (k < n) {
+    const int t = std::min(3, n - k);
+    const double* s0 = src + c[k] * ld;
+    const double a0 = a[k];
+    if (t == 1) {
+      if (first)
+        for (Eigen::Index r = 0; r < len; ++r) out[r] = a0 * s0[r];
+      else
+        for (Eigen::Index r = 0; r < len; ++r) out[r] += a0 * s0[r];
+    } else if (t == 2) {
+      const double* s1 = src + c[k + 1] * ld;
+      const double a1 = a[k + 1];
+      if (first)
+        for (Eigen::Index r = 0; r < len; ++r) out[r] = a0 * s0[r] + a1 * s1[r];
+      else
+        for (Eigen::Index r = 0; r < len; ++r) out[r] += a0 * s0[r] + a1 * s1[r];
+    } else {
+      const double* s1 = src + c[k + 1] * ld;
+      const double* s2 = src + c[k + 2] * ld;
+      const double a1 = a[k + 1], a2 = a[k + 2];
+      if (first)
+        for (Eigen::Index r = 0; r < len; ++r) out[r] = a0 * s0[r] + a1 * s1[r] + a2 * s2[r];
+      else
+        for (Eigen::Index r = 0; r < len; ++r) out[r] += a0 * s0[r] + a1 * s1[r] + a2 * s2[r];
+    }
+    first = false;
+    k += t;
+  }
+}
+
+// dst = src^T, m x m column-major; 2 x 2 blocks with SSE2 when m is even.
+inline void Transpose(const double* __restrict src, double* __restrict dst, Eigen::Index m) {
+#ifdef __SSE2__
+  if (m % 2 == 0) {
+    for (Eigen::Index j = 0; j < m; j += 2) {
+      for (Eigen::Index i = 0; i < m; i += 2) {
+        const __m128d c0 = _mm_loadu_pd(src + i + j * m);
+        const __m128d c1 = _mm_loadu_pd(src + i + (j + 1) * m);
+        _mm_storeu_pd(dst + j + i * m, _mm_unpacklo_pd(c0, c1));
+        _mm_storeu_pd(dst + j + (i + 1) * m, _mm_unpackhi_pd(c0, c1));
+      }
+    }
+    return;
+  }
+#endif
+  for (Eigen::Index j = 0; j < m; ++j) {
+    for (Eigen::Index i = 0; i < m; ++i) dst[j + i * m] = src[i + j * m];
+  }
+}
+
+// Copies the strict upper triangle of the m x m column-major P to its lower triangle.
+inline void MirrorUpper(double* P, Eigen::Index m) {
+#ifdef __SSE2__
+  if (m % 2 == 0) {
+    for (Eigen::Index j = 0; j < m; j += 2) {
+      for (Eigen::Index i = 0; i < j; i += 2) {  // the 2 x 2 block (i, j) above the diagonal
+        const __m128d c0 = _mm_loadu_pd(P + i + j * m);
+        const __m128d c1 = _mm_loadu_pd(P + i + (j + 1) * m);
+        _mm_storeu_pd(P + j + i * m, _mm_unpacklo_pd(c0, c1));
+        _mm_storeu_pd(P + j + (i + 1) * m, _mm_unpackhi_pd(c0, c1));
+      }
+      P[j + 1 + j * m] = P[j + (j + 1) * m];
+    }
+    return;
+  }
+#endif
+  for (Eigen::Index i = 0; i < m; ++i) {
+    for (Eigen::Index j = i + 1; j < m; ++j) P[j + i * m] = P[i + j * m];
+  }
 }
 
 }  // namespace kf_detail
@@ -245,10 +352,42 @@ Result<PopulationKalmanFilterT<M, R>> PopulationKalmanFilterT<M, R>::Create(
   f.innov_.setZero(r);
   f.Kt_.resize(r, m);
   f.llt_.compute(OutMat::Identity(r, r));
+  f.sp_ptr_.assign(m + 1, 0);
+  f.sp_fill_.assign(m, 0);
+  f.sp_col_.assign(static_cast<size_t>(m) * m, 0);
+  f.sp_val_.assign(static_cast<size_t>(m) * m, 0.0);
   if (model.transition == TransitionSource::kBroadcast) {
     f.has_broadcast_ = true;
     f.broadcast_ = model.broadcast;
     f.As_ = model.broadcast.SparsePattern();
+    // Compressed rows of the pattern (rows in order, columns in order within a row).
+    const Eigen::SparseMatrix<double>& A = f.As_;
+    f.bc_ptr_.assign(m + 1, 0);
+    for (int l = 0; l < m; ++l) {
+      for (Eigen::SparseMatrix<double>::InnerIterator it(A, l); it; ++it) ++f.bc_ptr_[it.row() + 1];
+    }
+    for (int i = 0; i < m; ++i) f.bc_ptr_[i + 1] += f.bc_ptr_[i];
+    const size_t nnz = static_cast<size_t>(A.nonZeros());
+    f.bc_col_.assign(nnz, 0);
+    f.bc_src_.assign(nnz, 0);
+    f.bc_base_.assign(nnz, 0.0);
+    f.bc_val_.assign(nnz, 0.0);
+    f.bc_target_.assign(nnz, 0.0);
+    f.bc_on_.assign(m, 0);
+    std::vector<int> next(f.bc_ptr_.begin(), f.bc_ptr_.end() - 1);
+    const BroadcastTransitionModel& b = model.broadcast;
+    for (int l = 0; l < m; ++l) {
+      const int target = b.is_on[l] ? b.off_target[l] : b.on_target[l];
+      for (Eigen::SparseMatrix<double>::InnerIterator it(A, l); it; ++it) {
+        const int i = static_cast<int>(it.row());
+        const int e = next[i]++;
+        f.bc_col_[e] = l;
+        f.bc_src_[e] = static_cast<int>(&it.valueRef() - A.valuePtr());
+        f.bc_base_[e] = b.interior(i, l);
+        f.bc_target_[e] = i == target ? 1.0 : 0.0;
+        f.bc_on_[l] = b.is_on[l];
+      }
+    }
   }
   f.Reproject();
   return f;
@@ -303,48 +442,91 @@ void PopulationKalmanFilterT<M, R>::Predict(const Mat& A) {
 
 template <int M, int R>
 void PopulationKalmanFilterT<M, R>::Predict(const Eigen::SparseMatrix<double>& A) {
-  using It = Eigen::SparseMatrix<double>::InnerIterator;
-  SetQzPoint();
-  const Eigen::Index m = x_.size();
-  const bool qz = mode_ != CovarianceMode::kPlain;
-  // B = (P - diag xq) A^T column by column: A(i, l) = a adds a P(:, l) to B(:, i) (contiguous
-  // columns) and -a xq_l to B(l, i); P itself is read, not copied. 2 m nnz(A) flops.
-  AM_.setZero();
-  ax_.setZero();
-  tmp_.setZero();
-  for (Eigen::Index l = 0; l < m; ++l) {
-    const double xl = x_(l), ql = xq_(l);
-    for (It it(A, l); it; ++it) {
-      const Eigen::Index i = it.row();
-      const double a = it.value();
-      AM_.col(i) += a * P_.col(l);
-      tmp_(i) += a * xl;
-      if (qz) {
-        AM_(l, i) -= a * ql;
-        ax_(i) += a * ql;
-      }
+  // Compressed columns to compressed rows (a counting sort, O(nnz + m), into the workspaces).
+  const int m = static_cast<int>(x_.size());
+  std::fill(sp_ptr_.begin(), sp_ptr_.end(), 0);
+  for (int l = 0; l < m; ++l) {
+    for (Eigen::SparseMatrix<double>::InnerIterator it(A, l); it; ++it) ++sp_ptr_[it.row() + 1];
+  }
+  for (int i = 0; i < m; ++i) {
+    sp_ptr_[i + 1] += sp_ptr_[i];
+    sp_fill_[i] = sp_ptr_[i];
+  }
+  for (int l = 0; l < m; ++l) {
+    for (Eigen::SparseMatrix<double>::InnerIterator it(A, l); it; ++it) {
+      const int e = sp_fill_[it.row()]++;
+      sp_col_[e] = l;
+      sp_val_[e] = it.value();
     }
   }
-  // P = A B: column i is sum_l A(i, l) B(l, :)^T; rows of B are made columns by one transpose
-  // (m^2 moves) so that the second pass is contiguous too. P is symmetric: only its upper
-  // triangle (rows 0..i of column i) is computed, about m nnz(A) flops.
-  M_ = AM_.transpose();
-  P_.setZero();
-  for (Eigen::Index l = 0; l < m; ++l) {
-    for (It it(A, l); it; ++it) {
-      const Eigen::Index i = it.row();
-      P_.col(i).head(i + 1) += it.value() * M_.col(l).head(i + 1);
-    }
-  }
-  FinishPredict();
+  PredictRows(sp_ptr_.data(), sp_col_.data(), sp_val_.data());
 }
 
 template <int M, int R>
 void PopulationKalmanFilterT<M, R>::PredictBroadcast(double p_on, double p_off) {
   eigen_assert(has_broadcast_ && "PredictBroadcast needs a broadcast model");
   if (!has_broadcast_) return;
-  broadcast_.FillSparse(p_on, p_off, As_);
-  Predict(As_);
+  // The values of A(p_on, p_off), the arithmetic of BroadcastTransitionModel::FillSparse, into
+  // the compressed rows and into As_ (broadcast_matrix()).
+  double* as = As_.valuePtr();
+  const int m = static_cast<int>(x_.size());
+  for (int l = 0; l < m; ++l) kw_(l) = bc_on_[l] ? p_off : p_on;  // p of column l
+  const size_t nnz = bc_val_.size();
+  for (size_t e = 0; e < nnz; ++e) {
+    const double p = kw_(bc_col_[e]);
+    const double v = (1.0 - p) * bc_base_[e] + bc_target_[e] * p;  // target: 1, else 0
+    bc_val_[e] = v;
+    as[bc_src_[e]] = v;
+  }
+  PredictRows(bc_ptr_.data(), bc_col_.data(), bc_val_.data());
+}
+
+template <int M, int R>
+void PopulationKalmanFilterT<M, R>::PredictRows(const int* ptr, const int* col, const double* val) {
+  SetQzPoint();
+  const Eigen::Index m = x_.size();
+  const bool qz = mode_ != CovarianceMode::kPlain;
+  const double* P = P_.data();
+  double* B = AM_.data();
+  // P is overwritten below: P - diag xq is formed in place.
+  if (qz) P_.diagonal() -= xq_;
+  // Pass 1, B = (P - diag xq) A^T column by column: B(:, i) = sum over row i of A of
+  // A(i, l) (P - diag xq)(:, l); each column of B written once (no zeroing), 2 m nnz(A) flops;
+  // with A x and A xq.
+  for (Eigen::Index i = 0; i < m; ++i) {
+    kf_detail::RowCombination<M>(B + i * m, P, m, m, col + ptr[i], val + ptr[i],
+                                 ptr[i + 1] - ptr[i]);
+    double ti = 0.0, ai = 0.0;
+    for (int e = ptr[i]; e < ptr[i + 1]; ++e) {
+      ti += val[e] * x_(col[e]);
+      ai += val[e] * xq_(col[e]);
+    }
+    tmp_(i) = ti;
+    ax_(i) = ai;
+  }
+  // Pass 2, P = A B, upper triangle: column j is sum over row j of A of A(j, l) B(l, 0..j)^T.
+  // Rows of B are made columns by one transposition so that this pass is contiguous too; the
+  // diagonal term and G Qw G^T are added in the same pass, then the upper triangle is mirrored
+  // (P stays exactly symmetric). About m nnz(A) flops.
+  double* Bt = M_.data();
+  kf_detail::Transpose(B, Bt, m);
+  double* Pw = P_.data();
+  for (Eigen::Index j = 0; j < m; ++j) {
+    // Rows 0..j, rounded up to an even count (the extra entry is below the diagonal).
+    const Eigen::Index len = std::min<Eigen::Index>(m, (j + 2) & ~Eigen::Index{1});
+    kf_detail::RowCombination<Eigen::Dynamic>(Pw + j * m, Bt, m, len, col + ptr[j], val + ptr[j],
+                                              ptr[j + 1] - ptr[j]);
+    if (qz) Pw[j * m + j] += ax_(j);
+    if (has_process_noise_) P_.col(j).head(j + 1) += GQG_.col(j).head(j + 1);
+  }
+  kf_detail::MirrorUpper(Pw, m);
+  x_ = tmp_;
+  if (++sparse_steps_ >= kSparseReprojectPeriod) {
+    sparse_steps_ = 0;
+    ReprojectSymmetric();
+  } else {
+    x_.array() += (N_ - x_.sum()) / static_cast<double>(m);
+  }
 }
 
 template <int M, int R>
@@ -353,7 +535,10 @@ void PopulationKalmanFilterT<M, R>::UpdateScalar(double y) {
   const auto h = H_.row(0);
   auto u = U_.col(0);
   auto k = K_.col(0);
-  u.noalias() = P_ * h.transpose();  // P h^T (P symmetric)
+  // P h^T as a combination of P's columns (no call into Eigen's general matrix-vector kernel,
+  // whose set-up dominates at these sizes).
+  u = h(0) * P_.col(0);
+  for (Eigen::Index j = 1; j < P_.cols(); ++j) u += h(j) * P_.col(j);
   const double s = h.dot(u) + R_(0, 0);
   S_(0, 0) = s;
   k = u / s;
