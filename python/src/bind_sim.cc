@@ -134,14 +134,7 @@ std::string Sweep(const std::string& task_path, const std::vector<double>& dTs,
   const std::vector<sim::SweepRun> grid = Take(sim::ExpandGrid(spec));
   // As `recruit sweep` runs each grid point (src/cli/sweep_command.cc).
   auto run = [&task, &spec](const sim::SweepRun& g) {
-    sim::RunOptions o;
-    o.estimator = g.estimator;
-    o.dT = g.dT;
-    o.lambda = g.lambda;
-    o.seed = g.seed;
-    o.duration = spec.duration;
-    o.filter_model = spec.filter_model;
-    return sim::RunTask(task, o);
+    return sim::RunTask(task, sim::RunOptionsFor(g, spec));
   };
   std::optional<Result<sim::SweepOutcome>> outcome;
   {

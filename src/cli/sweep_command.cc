@@ -336,14 +336,7 @@ int RunSweepCommand(const SweepArgs& a) {
 
   sim::SweepSpec spec = p.spec;
   auto run = [&p, &spec](const sim::SweepRun& g) {
-    sim::RunOptions o;
-    o.estimator = g.estimator;
-    o.dT = g.dT;
-    o.lambda = g.lambda;
-    o.seed = g.seed;
-    o.duration = spec.duration;
-    o.filter_model = spec.filter_model;
-    return sim::RunTask(p.plant[g.plant].task, o);
+    return sim::RunTask(p.plant[g.plant].task, sim::RunOptionsFor(g, spec));
   };
   // Progress and the remaining time on stderr: in place on a terminal, else (a batch job's log)
   // a line at most every 10 s. The estimate uses the runs made now (not those reused).

@@ -86,15 +86,11 @@ void Hold(const mjModel* m, mjData* d, const HeldPose& p, double period) {
 Result<BenchRecording> RecordBench(const std::string& model_path, const std::string& actuator,
                                    const Excitation& excitation, double dT, std::uint64_t seed,
                                    const RecordOptions& options) {
-  char err[1000] = "";
-  ModelPtr m(mj_loadXML(model_path.c_str(), nullptr, err, sizeof err));
-  if (!m) return Error{model_path + ": " + err};
-  auto plugin = sma::SmaHost::Create(m.get());
-  if (!plugin) return Error{model_path + ": " + plugin.error()};
-  const sma::SmaHost& p = **plugin;
-  if (p.num_bundles() == 0) return Error{model_path + ": no SMA bundle (recruit.sma.* text)"};
-  const int b = actuator.empty() ? 0 : p.BundleIndex(actuator);
-  if (b < 0) return Error{model_path + ": no SMA bundle on actuator \"" + actuator + "\""};
+  auto loaded = LoadBundle(model_path, actuator);
+  if (!loaded) return Error{loaded.error()};
+  const ModelPtr& m = loaded->model;
+  const sma::SmaHost& p = *loaded->host;
+  const int b = loaded->bundle;
   const double h = m->opt.timestep;
   const double ratio = dT / h;
   const int steps = static_cast<int>(std::lround(ratio));

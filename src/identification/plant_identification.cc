@@ -124,8 +124,8 @@ double NegLogLikelihood(const FilterModel& model, const UnitForceMap& map,
       map.Forces(rec.lengths[k], h);
       const Eigen::VectorXd& x = e.filter().estimate();
       const double predicted = h.dot(x);
-      const double s = h * e.filter().covariance() * h.transpose() + r0 +
-                       rho * rho * predicted * predicted;
+      const double s =
+          h * e.filter().covariance() * h.transpose() + r0 + rho * rho * predicted * predicted;
       const double innovation = log.force[k] - predicted;
       total += std::log(s) + innovation * innovation / s;
       e.Observe(log.force[k], rec.lengths[k]);
@@ -200,8 +200,8 @@ Result<PlantIdentification> IdentifyOnPlant(const std::string& model_path,
       recordings.push_back(std::move(chk).value());
     }
     const double train = 1.0 - o.holdout;
-    auto refined = UnitForceMap::FromFractions(rec->geometry,
-                                               RefineFractions(c, *map, recordings, train));
+    auto refined =
+        UnitForceMap::FromFractions(rec->geometry, RefineFractions(c, *map, recordings, train));
     if (!refined) return Error{"identify: " + refined.error()};
     map = std::move(refined);
   }

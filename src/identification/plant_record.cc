@@ -5,8 +5,6 @@
 #include <cstdio>
 #include <fstream>
 
-#include "common/mujoco_ptr.h"
-
 namespace recruit::control {
 
 nlohmann::json PlantRecord(const sma::SmaHost& host, int b, const std::string& model_path) {
@@ -23,21 +21,29 @@ nlohmann::json PlantRecord(const sma::SmaHost& host, int b, const std::string& m
           {"hash", PlantHash(unit)}};
 }
 
-Result<nlohmann::json> PlantRecordOf(const std::string& model_path, const std::string& actuator) {
+Result<LoadedBundle> LoadBundle(const std::string& model_path, const std::string& actuator) {
+  LoadedBundle out;
   char err[1000] = "";
-  ModelPtr m(mj_loadXML(model_path.c_str(), nullptr, err, sizeof err));
-  if (!m) return Error{model_path + ": " + err};
-  auto host = sma::SmaHost::Create(m.get());
+  out.model.reset(mj_loadXML(model_path.c_str(), nullptr, err, sizeof err));
+  if (!out.model) return Error{model_path + ": " + err};
+  auto host = sma::SmaHost::Create(out.model.get());
   if (!host) return Error{model_path + ": " + host.error()};
-  const sma::SmaHost& h = **host;
+  out.host = std::move(host).value();
+  const sma::SmaHost& h = *out.host;
   if (h.num_bundles() == 0) return Error{model_path + ": no SMA bundle (recruit.sma)"};
-  const int b = actuator.empty() ? 0 : h.BundleIndex(actuator);
-  if (b < 0) {
+  out.bundle = actuator.empty() ? 0 : h.BundleIndex(actuator);
+  if (out.bundle < 0) {
     std::string have;
     for (int i = 0; i < h.num_bundles(); ++i) have += (i ? ", " : "") + h.bundle_name(i);
     return Error{model_path + ": no SMA bundle on actuator '" + actuator + "'; bundles: " + have};
   }
-  return PlantRecord(h, b, model_path);
+  return out;
+}
+
+Result<nlohmann::json> PlantRecordOf(const std::string& model_path, const std::string& actuator) {
+  auto loaded = LoadBundle(model_path, actuator);
+  if (!loaded) return Error{loaded.error()};
+  return PlantRecord(*loaded->host, loaded->bundle, model_path);
 }
 
 }  // namespace recruit::control

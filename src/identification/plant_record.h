@@ -5,9 +5,11 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "common/mujoco_ptr.h"
 #include "common/result.h"
 #include "control/model_plant.h"
 #include "plugin/sma_host.h"
@@ -18,8 +20,17 @@ namespace recruit::control {
 //  "unit": {key: value, ...}, "hash": "16 hex digits"}.
 nlohmann::json PlantRecord(const sma::SmaHost& host, int bundle, const std::string& model_path);
 
-// The record of the bundle on actuator `actuator` (empty: the first) of the MJCF model at
-// `model_path`, loaded with MuJoCo; errors name the file and the bundles it has.
+// An MJCF model loaded with MuJoCo, its SMA host and the index of one of its bundles.
+struct LoadedBundle {
+  ModelPtr model;
+  std::unique_ptr<sma::SmaHost> host;
+  int bundle = -1;
+};
+// The bundle on actuator `actuator` (empty: the first) of the model at `model_path`; errors name
+// the file and the bundles it has.
+Result<LoadedBundle> LoadBundle(const std::string& model_path, const std::string& actuator);
+
+// The PlantRecord of that bundle.
 Result<nlohmann::json> PlantRecordOf(const std::string& model_path, const std::string& actuator);
 
 }  // namespace recruit::control

@@ -37,6 +37,17 @@ std::string SweepRun::Key() const {
   return plant_values.empty() ? key : fmt::format("p{:04d}_{}", plant, key);
 }
 
+RunOptions RunOptionsFor(const SweepRun& run, const SweepSpec& spec) {
+  RunOptions o;
+  o.estimator = run.estimator;
+  o.dT = run.dT;
+  o.lambda = run.lambda;
+  o.seed = run.seed;
+  o.duration = spec.duration;
+  o.filter_model = spec.filter_model;
+  return o;
+}
+
 Result<std::vector<SweepRun>> ExpandGrid(const SweepSpec& spec) {
   if (spec.dTs.empty()) return Error{"sweep: no dT values (--dT)"};
   if (spec.lambdas.empty()) return Error{"sweep: no lambda values (--lambda)"};

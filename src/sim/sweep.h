@@ -51,6 +51,10 @@ struct SweepRun {
   std::string Key() const;
 };
 
+// The run options of one grid point: its estimator, dT, lambda and seed, the spec's duration and
+// filter model (what `recruit sweep` and the Python `sweep` run each point with).
+RunOptions RunOptionsFor(const SweepRun& run, const SweepSpec& spec);
+
 Result<std::vector<SweepRun>> ExpandGrid(const SweepSpec& spec);
 
 // Shard k of n (1 <= k <= n): the runs whose grid index i has i % n == k - 1. Round-robin, so
