@@ -34,5 +34,8 @@ ctest "${args[@]}" -E '^python_pytest$'
 # tests start, e.g. gnuplot, stay as they are).
 if grep -q '^RECRUIT_BUILD_PYTHON:BOOL=ON' "$BUILD_DIR/CMakeCache.txt"; then
   cxx=$(sed -n 's/^CMAKE_CXX_COMPILER:[A-Z]*=//p' "$BUILD_DIR/CMakeCache.txt")
-  LD_PRELOAD=$("$cxx" -print-file-name=libasan.so) ctest "${args[@]}" -R '^python_pytest$'
+  # libstdc++ too: the interpreter does not link it, and ASan's __cxa_throw interceptor must find
+  # it at start-up (else the first C++ exception aborts: "real___cxa_throw != 0").
+  LD_PRELOAD="$("$cxx" -print-file-name=libasan.so) $("$cxx" -print-file-name=libstdc++.so)" \
+    ctest "${args[@]}" -R '^python_pytest$'
 fi
