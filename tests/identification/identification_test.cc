@@ -11,10 +11,10 @@
 #include <iostream>
 
 #include "common/rng.h"
+#include "estimation/population_chain.h"
 #include "identification/bench_recorder.h"
 #include "identification/excitation.h"
 #include "identification/transient_chain.h"
-#include "estimation/population_chain.h"
 
 namespace recruit::control {
 namespace {

@@ -138,12 +138,12 @@ TEST(StabilityMap, ParsesSweepsDatAndColoursEachCellByItsOvershoot) {
   EXPECT_EQ((*panels)[0].cells[1].overshoot_percent, 60);
   EXPECT_TRUE((*panels)[0].cells[0].meets);
   const Color g = OvershootColor(0), y = OvershootColor(10), r = OvershootColor(50);
-  EXPECT_GT(g.g, g.r);                       // green
+  EXPECT_GT(g.g, g.r);  // green
   EXPECT_GT(y.r, 0.9);  // yellow
   EXPECT_GT(y.g, 0.8);
   EXPECT_GT(r.r, 0.8);  // red
   EXPECT_LT(r.g, 0.2);
-  EXPECT_EQ(OvershootColor(80).r, r.r);      // clamped at 50 %
+  EXPECT_EQ(OvershootColor(80).r, r.r);  // clamped at 50 %
   // Rendered: one panel's 2 x 2 grid. The centre of the lower-left quarter of the first
   // panel's data area is the (0.5, 0.1) cell: its ring (black) or fill (green) dominates.
   auto png = RenderStabilityMap({(*panels)[0]}, "t", 600, 400, Format::kPng);
