@@ -3,7 +3,7 @@
 # task in closed loop, filmed while it runs; the video lands in renders/demo.mp4.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-./scripts/install-deps.sh
-./scripts/build.sh recruit   # only what the demo runs
+./scripts/install-deps.sh --demo   # only what the demo needs (the tests install the rest)
+./scripts/build.sh --demo          # only `recruit` and its render and plot modules
 ./scripts/render_demo.sh --progress
-echo "demo: wrote renders/demo.mp4, renders/demo.gif and renders/demo_t0031.000.png"
+echo "demo: wrote renders/demo.mp4, renders/demo.gif and renders/demo_t0038.000.png"

@@ -1,36 +1,37 @@
 #!/usr/bin/env bash
-# Builds the libFuzzer targets of the input parsers (tests/fuzz) with clang, AddressSanitizer and
-# UndefinedBehaviorSanitizer (no recovery) into build-fuzz, then runs each for a fixed time from
-# its checked-in seed corpus with a fixed seed. Fails if any target crashes, hangs (-timeout),
-# leaks or trips a sanitizer; the input that did it is written to build-fuzz/artifacts/.
+# Builds the libFuzzer targets of the input parsers (tests/fuzz) in the sanitized tree that the
+# suite uses (scripts/build-sanitized.sh: clang, AddressSanitizer + UndefinedBehaviorSanitizer with
+# no recovery, coverage instrumentation in every library; build-asan/), then runs each for a fixed
+# time from its checked-in seed corpus with a fixed seed. Fails if any target crashes, hangs
+# (-timeout), leaks or trips a sanitizer; the input that did it is written to
+# build-asan/artifacts/.
 # Usage:
 #   scripts/fuzz.sh [target...]     targets: task filter_model filter_log bundle_config mjcf_config
 #                                   (default: all)
 # Environment: FUZZ_SECONDS per target (default 30), FUZZ_SEED (default 1), BUILD_DIR (default
-# build-fuzz), JOBS (default: nproc). Reproduce a crash: build-fuzz/tests/fuzz/fuzz_<target> FILE.
+# build-asan), JOBS (default: nproc). Reproduce a crash: build-asan/tests/fuzz/fuzz_<target> FILE.
 # Keep one found crash as a regression test: copy it to tests/fuzz/corpus/<target>/regress-<what>
 # (ctest's fuzz_<target>_corpus replays every corpus file with the normal build).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-BUILD_DIR=${BUILD_DIR:-build-fuzz}
+BUILD_DIR=${BUILD_DIR:-build-asan}
 JOBS=${JOBS:-$(nproc)}
 FUZZ_SECONDS=${FUZZ_SECONDS:-30}
 FUZZ_SEED=${FUZZ_SEED:-1}
 TARGETS=("$@")
 if [ ${#TARGETS[@]} -eq 0 ]; then TARGETS=(task filter_model filter_log bundle_config mjcf_config); fi
 
-# fuzzer-no-link: coverage instrumentation in every library, libFuzzer's main only in fuzz_*.
-FLAGS="-O1 -g -fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=all"
-FLAGS="$FLAGS -fno-omit-frame-pointer"
-cmake -G Ninja -S . -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=None \
-  -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ \
-  -DCMAKE_C_FLAGS="$FLAGS" -DCMAKE_CXX_FLAGS="$FLAGS" \
-  -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" \
-  -DRECRUIT_BUILD_FUZZ=ON -DRECRUIT_BUILD_TESTS=OFF -DRECRUIT_BUILD_BENCH=OFF \
-  -DRECRUIT_BUILD_PYTHON=OFF >/dev/null
-ninja -C "$BUILD_DIR" -j "$JOBS" "${TARGETS[@]/#/fuzz_}"
+export BUILD_DIR JOBS
+if ! "${CXX:-clang++}" --version | grep -q clang; then
+  echo "fuzz: libFuzzer needs clang (CXX=${CXX:-clang++})" >&2
+  exit 2
+fi
+./scripts/build-sanitized.sh "${TARGETS[@]/#/fuzz_}"
 
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
+# libFuzzer's link puts libstdc++ before the shared ASan runtime (scripts/build-sanitized.sh), which
+# must come first: preload it.
+ASAN_RUNTIME="$("${CXX:-clang++}" -print-runtime-dir)/libclang_rt.asan-x86_64.so"
 mkdir -p "$BUILD_DIR/artifacts"
 failed=()
 for t in "${TARGETS[@]}"; do
@@ -38,7 +39,7 @@ for t in "${TARGETS[@]}"; do
   work="$BUILD_DIR/corpus/$t"
   mkdir -p "$work"
   echo "fuzz: $t for ${FUZZ_SECONDS}s (seed $FUZZ_SEED)"
-  if ! "$BUILD_DIR/tests/fuzz/fuzz_$t" -seed="$FUZZ_SEED" -max_total_time="$FUZZ_SECONDS" \
+  if ! LD_PRELOAD="$ASAN_RUNTIME" "$BUILD_DIR/tests/fuzz/fuzz_$t" -seed="$FUZZ_SEED" -max_total_time="$FUZZ_SECONDS" \
       -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
       -artifact_prefix="$BUILD_DIR/artifacts/$t-" "$work" "tests/fuzz/corpus/$t" \
       >"$BUILD_DIR/artifacts/$t.log" 2>&1; then

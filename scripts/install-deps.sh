@@ -2,24 +2,43 @@
 # Installs every build, test and render dependency of Recruit: Debian 12 packages, then a Python
 # virtual environment at .venv/ with the pinned MuJoCo wheel (the only MuJoCo the build uses) and
 # the Python test tools. Nothing else is downloaded. Safe to run again: skips what is present.
+#   scripts/install-deps.sh          everything (tests, benchmarks, Python package, fuzzers, Slurm)
+#   scripts/install-deps.sh --demo   only what `recruit` and its render and plot modules need
+#                                    (scripts/demo.sh): no test tools, clang, Slurm or ffmpeg CLI
 set -euo pipefail
 cd "$(dirname "$0")/.."
+MODE=${1:-all}
+case "$MODE" in
+  all | --demo) ;;
+  *)
+    echo "usage: scripts/install-deps.sh [--demo]" >&2
+    exit 2
+    ;;
+esac
 
 MUJOCO_VERSION=4.0.0  # keep in step with RECRUIT_MUJOCO_VERSION in CMakeLists.txt
 PY_PACKAGES=("mujoco==${MUJOCO_VERSION}" "numpy" "pytest" "filterpy" "pybind11" "scikit-build-core"
   "matplotlib")
 
-PACKAGES=(
-  build-essential cmake ninja-build pkg-config clang-format ccache
-  python3 python3-venv python3-dev
+DEMO_PACKAGES=(
+  build-essential cmake ninja-build pkg-config ccache
+  python3 python3-venv
   libosmesa6-dev libcairo2-dev
   libeigen3-dev libcli11-dev nlohmann-json3-dev libfmt-dev libtbb-dev
-  libgtest-dev libgmock-dev libbenchmark-dev
-  libavcodec-dev libavformat-dev libavutil-dev libswscale-dev ffmpeg
+  libavcodec-dev libavformat-dev libavutil-dev libswscale-dev
   liblodepng-dev libstb-dev
-  clang libclang-rt-14-dev  # libFuzzer targets (tests/fuzz)
+)
+PACKAGES=("${DEMO_PACKAGES[@]}"
+  clang-format python3-dev
+  libgtest-dev libgmock-dev libbenchmark-dev
+  ffmpeg                    # the render tests decode the videos they write
+  clang libclang-rt-14-dev  # the sanitized suite and the libFuzzer targets (tests/fuzz)
   slurm-wlm munge           # the single-node Slurm the sweep's job-array test runs on
 )
+if [ "$MODE" = --demo ]; then
+  PACKAGES=("${DEMO_PACKAGES[@]}")
+  PY_PACKAGES=("mujoco==${MUJOCO_VERSION}")
+fi
 
 missing=()
 for p in "${PACKAGES[@]}"; do
@@ -41,11 +60,14 @@ fi
 if [ ! -x .venv/bin/python ]; then
   python3 -m venv .venv
 fi
-if .venv/bin/python - "$MUJOCO_VERSION" <<'PY' 2>/dev/null; then
-import sys, mujoco, numpy, pytest, filterpy, matplotlib
+if .venv/bin/python - "$MUJOCO_VERSION" "${PY_PACKAGES[@]}" <<'PY' 2>/dev/null; then
+import importlib, sys
+import mujoco
+for package in sys.argv[3:]:
+    importlib.import_module(package.split("==")[0].replace("-", "_"))
 sys.exit(0 if mujoco.__version__ == sys.argv[1] else 1)
 PY
-  echo "install-deps: .venv has mujoco ${MUJOCO_VERSION} and the test tools"
+  echo "install-deps: .venv has mujoco ${MUJOCO_VERSION} and ${#PY_PACKAGES[@]} Python packages"
 else
   echo "install-deps: installing ${PY_PACKAGES[*]} into .venv"
   .venv/bin/python -m pip install -q --disable-pip-version-check "${PY_PACKAGES[@]}"

@@ -170,7 +170,9 @@ plot::Figure MarginFigure(const ReportInput& in, double c) {
     for (auto& [plant, s] : by_plant) {
       std::vector<size_t> idx(s.x.size());
       for (size_t k = 0; k < idx.size(); ++k) idx[k] = k;
-      std::sort(idx.begin(), idx.end(), [&](size_t a, size_t b) { return s.x[a] < s.x[b]; });
+      // C++17 lambdas cannot capture a structured binding by name (clang rejects it).
+      const std::vector<double>& x = s.x;
+      std::sort(idx.begin(), idx.end(), [&x](size_t a, size_t b) { return x[a] < x[b]; });
       plot::Series sorted = s;
       for (size_t k = 0; k < idx.size(); ++k) {
         sorted.x[k] = s.x[idx[k]];
