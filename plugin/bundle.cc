@@ -51,18 +51,21 @@ void SmaBundle::Reset(double* s, std::uint64_t seed, double stretch) const {
   StoreRng(Rng(seed), s + kRngSlot);
   s[kCohortCountSlot] = 1;
   const UnitState rest = RestState(unit_, stretch);
-  double* c = Cohort(s, 0);
-  c[kCount] = config_.units;
-  c[kOn] = 0;
-  c[kTemp] = rest.temperature;
-  c[kXi] = rest.xi;
-  c[kTeff] = rest.t_eff;
-  c[kHeatScale] = rest.heat_scale;
-  c[kCoolScale] = rest.cool_scale;
+  Field(s, kCount)[0] = config_.units;
+  Field(s, kOn)[0] = 0;
+  Field(s, kTemp)[0] = rest.temperature;
+  Field(s, kXi)[0] = rest.xi;
+  Field(s, kTeff)[0] = rest.t_eff;
+  Field(s, kHeatScale)[0] = rest.heat_scale;
+  Field(s, kCoolScale)[0] = rest.cool_scale;
   // Unit index block is already 0: every unit in cohort 0.
 }
 
 bool SmaBundle::Initialized(const double* s) { return s[kMagicSlot] == kMagic; }
+
+void SmaBundle::CopyCohort(double* s, int from, int to) const {
+  for (int f = 0; f < kFields; ++f) Field(s, f)[to] = Field(s, f)[from];
+}
 
 Status SmaBundle::Broadcast(double* s, double p_on, double p_off, double stretch) const {
   if (!(p_on >= 0 && p_on <= 1) || !(p_off >= 0 && p_off <= 1)) {
@@ -72,13 +75,15 @@ Status SmaBundle::Broadcast(double* s, double p_on, double p_off, double stretch
   Rng rng = LoadRng(s + kRngSlot);
   const int k0 = NumCohorts(s);
   double* idx = UnitIndex(s);
+  double* count = Field(s, kCount);
+  double* on = Field(s, kOn);
   // Pass 1: every unit draws, in unit order.
   std::vector<int> flips(k0, 0);
   std::vector<char> flip(config_.units, 0);
   for (int i = 0; i < config_.units; ++i) {
     const int from = static_cast<int>(idx[i]);
     const double u = rng.Uniform();
-    if (u < (Cohort(s, from)[kOn] != 0 ? p_off : p_on)) {
+    if (u < (on[from] != 0 ? p_off : p_on)) {
       flip[i] = 1;
       ++flips[from];
     }
@@ -90,17 +95,15 @@ Status SmaBundle::Broadcast(double* s, double p_on, double p_off, double stretch
   int k = k0;
   for (int j = 0; j < k0; ++j) {
     if (flips[j] == 0) continue;
-    double* c = Cohort(s, j);
-    if (flips[j] == static_cast<int>(c[kCount])) {
-      c[kOn] = c[kOn] != 0 ? 0 : 1;
+    if (flips[j] == static_cast<int>(count[j])) {
+      on[j] = on[j] != 0 ? 0 : 1;
       target[j] = j;
       continue;
     }
-    double* n = Cohort(s, k);
-    std::copy(c, c + kCohortStride, n);
-    n[kCount] = flips[j];
-    n[kOn] = c[kOn] != 0 ? 0 : 1;
-    c[kCount] -= flips[j];
+    CopyCohort(s, j, k);
+    count[k] = flips[j];
+    on[k] = on[j] != 0 ? 0 : 1;
+    count[j] -= flips[j];
     target[j] = k++;
   }
   for (int i = 0; i < config_.units; ++i) {
@@ -135,16 +138,9 @@ void SmaBundle::Integrate(double* s, double stretch, double dt) const {
     decay = unit_.DecayFactor(dt);
   }
   const int k = NumCohorts(s);
-  for (int j = 0; j < k; ++j) {
-    double* c = Cohort(s, j);
-    UnitState st{c[kTemp], c[kXi], c[kTeff], c[kHeatScale], c[kCoolScale]};
-    AdvanceUnitWithDecay(unit_, st, c[kOn] != 0, stretch, decay);
-    c[kTemp] = st.temperature;
-    c[kXi] = st.xi;
-    c[kTeff] = st.t_eff;
-    c[kHeatScale] = st.heat_scale;
-    c[kCoolScale] = st.cool_scale;
-  }
+  const UnitModel::Cohorts c{Field(s, kOn),   Field(s, kTemp),      Field(s, kXi),
+                             Field(s, kTeff), Field(s, kHeatScale), Field(s, kCoolScale)};
+  unit_.AdvanceCohorts(c, k, stretch, decay);
   s[kCounterSlot] += 1;
   if (k > 1 && std::fmod(s[kCounterSlot], kMergeEvery) == 0) Merge(s);
 }
@@ -153,33 +149,33 @@ void SmaBundle::Merge(double* s) const {
   const int k = NumCohorts(s);
   std::vector<int> order(k);
   std::iota(order.begin(), order.end(), 0);
+  const double* on = Field(s, kOn);
+  const double* temp = Field(s, kTemp);
   std::sort(order.begin(), order.end(), [&](int a, int b) {
-    const double* ca = Cohort(s, a);
-    const double* cb = Cohort(s, b);
-    if (ca[kOn] != cb[kOn]) return ca[kOn] < cb[kOn];
-    return ca[kTemp] < cb[kTemp];
+    if (on[a] != on[b]) return on[a] < on[b];
+    return temp[a] < temp[b];
   });
   bool merged = false;
   std::vector<int> forward(k, -1);  // representative that absorbed each merged cohort
   int rep = order[0];
+  auto at = [&](int f, int j) -> double& { return Field(s, f)[j]; };
   for (int j = 1; j < k; ++j) {
-    double* r = Cohort(s, rep);
-    double* c = Cohort(s, order[j]);
-    const bool same = r[kOn] == c[kOn] &&
-                      std::abs(r[kTemp] - c[kTemp]) <= config_.merge_temperature &&
-                      std::abs(r[kXi] - c[kXi]) <= config_.merge_xi &&
-                      std::abs(r[kHeatScale] - c[kHeatScale]) <= config_.merge_xi &&
-                      std::abs(r[kCoolScale] - c[kCoolScale]) <= config_.merge_xi;
+    const int r = rep, c = order[j];
+    const bool same = at(kOn, r) == at(kOn, c) &&
+                      std::abs(at(kTemp, r) - at(kTemp, c)) <= config_.merge_temperature &&
+                      std::abs(at(kXi, r) - at(kXi, c)) <= config_.merge_xi &&
+                      std::abs(at(kHeatScale, r) - at(kHeatScale, c)) <= config_.merge_xi &&
+                      std::abs(at(kCoolScale, r) - at(kCoolScale, c)) <= config_.merge_xi;
     if (!same) {
       rep = order[j];
       continue;
     }
     // Count-weighted mean keeps the bundle's mean temperature and fraction.
-    const double n = r[kCount] + c[kCount];
+    const double n = at(kCount, r) + at(kCount, c);
     for (int f : {kTemp, kXi, kTeff, kHeatScale, kCoolScale})
-      r[f] = (r[f] * r[kCount] + c[f] * c[kCount]) / n;
-    r[kCount] = n;
-    c[kCount] = 0;
+      at(f, r) = (at(f, r) * at(kCount, r) + at(f, c) * at(kCount, c)) / n;
+    at(kCount, r) = n;
+    at(kCount, c) = 0;
     forward[order[j]] = rep;
     merged = true;
   }
@@ -190,10 +186,11 @@ void SmaBundle::Compact(double* s, const std::vector<int>& forward) const {
   const int k = NumCohorts(s);
   // New index for each surviving cohort; a merged cohort forwards its units to its
   // representative.
+  const double* count = Field(s, kCount);
   std::vector<int> remap(k, -1);
   int n = 0;
   for (int j = 0; j < k; ++j) {
-    if (Cohort(s, j)[kCount] > 0) remap[j] = n++;
+    if (count[j] > 0) remap[j] = n++;
   }
   for (int j = 0; j < k; ++j) {
     if (remap[j] < 0 && j < static_cast<int>(forward.size()) && forward[j] >= 0) {
@@ -202,48 +199,40 @@ void SmaBundle::Compact(double* s, const std::vector<int>& forward) const {
   }
   double* idx = UnitIndex(s);
   for (int i = 0; i < config_.units; ++i) idx[i] = remap[static_cast<int>(idx[i])];
+  // remap[j] <= j for survivors: copying in increasing j never overwrites one not yet moved.
   for (int j = 0; j < k; ++j) {
-    if (Cohort(s, j)[kCount] > 0 && remap[j] != j) {
-      std::copy(Cohort(s, j), Cohort(s, j) + kCohortStride, Cohort(s, remap[j]));
-    }
+    if (count[j] > 0 && remap[j] != j) CopyCohort(s, j, remap[j]);
   }
   s[kCohortCountSlot] = n;
 }
 
 double SmaBundle::Tension(const double* s, double stretch) const {
-  const int k = NumCohorts(s);
-  double f = 0;
-  for (int j = 0; j < k; ++j) {
-    const double* c = Cohort(s, j);
-    f += c[kCount] * unit_.Tension(c[kXi], stretch);
-  }
-  return f;
+  return unit_.SumTension(Field(s, kCount), Field(s, kXi), NumCohorts(s), stretch);
 }
 
-int SmaBundle::OnCount(const double* s) const {
+double SmaBundle::CountWeightedSum(const double* s, int f) const {
   const int k = NumCohorts(s);
-  double n = 0;
-  for (int j = 0; j < k; ++j) {
-    const double* c = Cohort(s, j);
-    if (c[kOn] != 0) n += c[kCount];
+  const double* count = Field(s, kCount);
+  const double* v = Field(s, f);
+  double acc[4] = {0, 0, 0, 0};  // four partial sums: vectorisable, and exact for one cohort
+  int j = 0;
+  for (; j + 4 <= k; j += 4) {
+    for (int l = 0; l < 4; ++l) acc[l] += count[j + l] * v[j + l];
   }
-  return static_cast<int>(n);
+  for (int l = 0; j + l < k; ++l) acc[l] += count[j + l] * v[j + l];
+  return (acc[0] + acc[1]) + (acc[2] + acc[3]);
 }
+
+int SmaBundle::OnCount(const double* s) const { return static_cast<int>(CountWeightedSum(s, kOn)); }
 
 double SmaBundle::MeanTemperature(const double* s) const {
-  const int k = NumCohorts(s);
-  if (k == 0) return config_.unit.ambient;
-  double t = 0;
-  for (int j = 0; j < k; ++j) t += Cohort(s, j)[kCount] * Cohort(s, j)[kTemp];
-  return t / config_.units;
+  if (NumCohorts(s) == 0) return config_.unit.ambient;
+  return CountWeightedSum(s, kTemp) / config_.units;
 }
 
 double SmaBundle::MeanXi(const double* s) const {
-  const int k = NumCohorts(s);
-  if (k == 0) return 1;
-  double x = 0;
-  for (int j = 0; j < k; ++j) x += Cohort(s, j)[kCount] * Cohort(s, j)[kXi];
-  return x / config_.units;
+  if (NumCohorts(s) == 0) return 1;
+  return CountWeightedSum(s, kXi) / config_.units;
 }
 
 double SmaBundle::Heat(const double* s) const {
@@ -255,15 +244,17 @@ double SmaBundle::Heat(const double* s) const {
 
 double SmaBundle::MaxTemperature(const double* s) const {
   const int k = NumCohorts(s);
-  double t = config_.unit.ambient;
-  for (int j = 0; j < k; ++j) t = j == 0 ? Cohort(s, j)[kTemp] : std::max(t, Cohort(s, j)[kTemp]);
+  const double* temp = Field(s, kTemp);
+  double t = k > 0 ? temp[0] : config_.unit.ambient;
+  for (int j = 1; j < k; ++j) t = std::max(t, temp[j]);
   return t;
 }
 
 double SmaBundle::MaxWireStress(const double* s, double stretch) const {
   const int k = NumCohorts(s);
+  const double* xi = Field(s, kXi);
   double f = 0;
-  for (int j = 0; j < k; ++j) f = std::max(f, unit_.Tension(Cohort(s, j)[kXi], stretch));
+  for (int j = 0; j < k; ++j) f = std::max(f, unit_.Tension(xi[j], stretch));
   return unit_.WireStress(f);
 }
 
@@ -271,12 +262,12 @@ int SmaBundle::UnitCohort(const double* s, int i) const {
   return static_cast<int>(UnitIndex(s)[i]);
 }
 bool SmaBundle::UnitOn(const double* s, int i) const {
-  return Cohort(s, UnitCohort(s, i))[kOn] != 0;
+  return Field(s, kOn)[UnitCohort(s, i)] != 0;
 }
 double SmaBundle::UnitTemperature(const double* s, int i) const {
-  return Cohort(s, UnitCohort(s, i))[kTemp];
+  return Field(s, kTemp)[UnitCohort(s, i)];
 }
-double SmaBundle::UnitXi(const double* s, int i) const { return Cohort(s, UnitCohort(s, i))[kXi]; }
+double SmaBundle::UnitXi(const double* s, int i) const { return Field(s, kXi)[UnitCohort(s, i)]; }
 
 double SmaBundle::SettledOnTension(double stretch) const {
   // The fixed point of the exact thermal step and the implicit phase solve does not depend on

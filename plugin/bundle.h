@@ -22,7 +22,7 @@ class SmaBundle {
   static Result<SmaBundle> Create(const BundleConfig& config, double dt);
 
   // Doubles of state needed for `units` units.
-  static int StateSize(int units) { return kHeader + (kCohortStride + 1) * units; }
+  static int StateSize(int units) { return kHeader + (kFields + 1) * units; }
   int state_size() const { return StateSize(config_.units); }
 
   const BundleConfig& config() const { return config_; }
@@ -81,19 +81,22 @@ class SmaBundle {
   static constexpr int kHeader = 8;
   static constexpr int kMagicSlot = 0, kRngSlot = 1, kCohortCountSlot = 5, kCounterSlot = 6,
                        kPendingSlot = 7;
-  // Cohort: count, on, then the UnitState fields.
-  static constexpr int kCohortStride = 7;
+  // Cohorts as a structure of arrays: field f of cohort j at kHeader + f * N + j (N = units,
+  // the most cohorts there can be), so the batched update loads four cohorts' values at once.
+  static constexpr int kFields = 7;
   static constexpr int kCount = 0, kOn = 1, kTemp = 2, kXi = 3, kTeff = 4, kHeatScale = 5,
                        kCoolScale = 6;
   static constexpr int kMergeEvery = 8;  // steps between merge passes
 
   SmaBundle(BundleConfig c, UnitModel u, double dt);
-  double* Cohort(double* s, int k) const { return s + kHeader + kCohortStride * k; }
-  const double* Cohort(const double* s, int k) const { return s + kHeader + kCohortStride * k; }
-  double* UnitIndex(double* s) const { return s + kHeader + kCohortStride * config_.units; }
-  const double* UnitIndex(const double* s) const {
-    return s + kHeader + kCohortStride * config_.units;
-  }
+  double* Field(double* s, int f) const { return s + kHeader + f * config_.units; }
+  const double* Field(const double* s, int f) const { return s + kHeader + f * config_.units; }
+  // Copies every field of cohort `from` to cohort `to`.
+  void CopyCohort(double* s, int from, int to) const;
+  double* UnitIndex(double* s) const { return Field(s, kFields); }
+  const double* UnitIndex(const double* s) const { return Field(s, kFields); }
+  // Sum over cohorts of count * field f, in four partial sums.
+  double CountWeightedSum(const double* s, int f) const;
   void Merge(double* s) const;
   void Flush(double* s, double stretch) const;
   void Integrate(double* s, double stretch, double dt) const;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <string>
 
 namespace recruit::sma {
@@ -347,5 +348,284 @@ void AdvanceUnitWithDecay(const UnitModel& m, UnitState& s, bool on, double stre
   const double t_ss = m.SteadyTemperature(on, s.xi);
   SolvePhase(m, s, t_ss + (s.temperature - t_ss) * decay, stretch);
 }
+
+}  // namespace recruit::sma
+
+// ---- Batched cohort update (structure of arrays, four cohorts per SIMD batch) ----
+//
+// Every lane performs exactly the operations of SolvePhase and AdvanceUnitWithDecay on one
+// cohort, in the same order (no contraction: the build is ISO C++ without -ffp-contract=fast),
+// so each cohort's result is bit-identical to the scalar update. Branches become lane masks; a
+// lane whose Newton iteration has stopped keeps its values while the others continue.
+
+namespace recruit::sma {
+namespace {
+
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wpsabi"  // vectors are passed only between inlined functions
+
+// One SIMD register of doubles: 4 with AVX (x86-64-v3), 2 with the portable SSE2 baseline (wider
+// generic vectors are split by the compiler, at a cost).
+#ifdef __AVX__
+constexpr int kLanes = 4;
+#else
+constexpr int kLanes = 2;
+#endif
+using Vd = double __attribute__((vector_size(kLanes * sizeof(double))));
+using Vm = decltype(Vd{} < Vd{});  // lane mask: all bits set or clear
+
+inline Vd Load(const double* p) {
+  Vd v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+inline void Store(double* p, Vd v) { std::memcpy(p, &v, sizeof v); }
+inline Vd Splat(double x) { return Vd{} + x; }
+inline Vd Sel(Vm m, Vd a, Vd b) { return m ? a : b; }
+inline bool Any(Vm m) {
+  for (int l = 0; l < kLanes; ++l) {
+    if (m[l]) return true;
+  }
+  return false;
+}
+inline Vd Abs(Vd x) { return x < 0 ? -x : x; }
+// std::clamp(v, 0, 1) lane by lane (NaN passes through, as there).
+inline Vd Clamp01(Vd v) { return Sel(v < 0, Splat(0), Sel(1 < v, Splat(1), v)); }
+
+// A major curve (MajorHeating with t0 = As, t1 = Af or MajorCooling with Mf, Ms) per lane:
+// 1 at or below t0, 0 at or above t1, the cosine in between; slope as in the scalar overload.
+inline Vd MajorCurve(Vd te, Vd t0, Vd t1, Vd rate, Vd* slope) {
+  const Vm below = te <= t0, above = te >= t1, out = below | above;
+  Vd sn = Splat(0), cs = Splat(0);
+  if (Any(~out)) SinCosHalfTurn(rate * (te - t0), &sn, &cs);
+  *slope = Sel(out, Splat(0), (-0.5 * rate) * sn);
+  return Sel(below, Splat(1), Sel(above, Splat(0), 0.5 * (cs + 1)));
+}
+
+// The phase-solve constants of one model and extension, per lane where they depend on the
+// branch (heating: M -> A on the M+ curve; cooling: A -> M on M-).
+struct Consts {
+  double k_A, dk_w, k_s, stretch_L, stretch, latent, pn_h, pn_c;
+  double As, Af, Ms, Mf, heat_rate, cool_rate;
+};
+
+// UnitModel::Tension(x, stretch, &slope) lane by lane.
+inline Vd LaneTension(const Consts& c, Vd xi, Vd* slope) {
+  const Vd kw = c.k_A + xi * c.dk_w;
+  Vd k, dk;
+  if (c.k_s <= 0) {
+    dk = Splat(c.dk_w);
+    k = kw;
+  } else {
+    const Vd inv = 1.0 / (kw + c.k_s);
+    dk = c.k_s * c.k_s * c.dk_w * inv * inv;
+    k = kw * c.k_s * inv;
+  }
+  const Vd e = c.stretch - xi * c.stretch_L;
+  const Vd ke = k * e;
+  const Vm slack = ke <= 0;
+  *slope = Sel(slack, Splat(0), dk * e - k * c.stretch_L);
+  return Sel(slack, Splat(0), ke);
+}
+
+// UnitModel::Tension(x, stretch) lane by lane: std::max(0.0, k e).
+inline Vd TensionOnly(const Consts& c, Vd xi) {
+  const Vd kw = c.k_A + xi * c.dk_w;
+  const Vd k = c.k_s <= 0 ? kw : kw * c.k_s * (1.0 / (kw + c.k_s));
+  const Vd ke = k * (c.stretch - xi * c.stretch_L);
+  return Sel(0.0 < ke, ke, Splat(0));
+}
+
+// One branch's residual g and slope dg at x (gd_h / gd_c of SolvePhase) per lane.
+struct Lanes {
+  Vm heat;
+  Vd xi0, tth, hs, cs, pn, scale, t0, t1, rate;
+};
+
+inline void Residual(const Consts& c, const Lanes& L, Vd x, Vd* g, Vd* dg, Vd* te_out) {
+  Vd dfdx, slope;
+  const Vd te = (L.tth + c.latent * (x - L.xi0)) - L.pn * LaneTension(c, x, &dfdx);
+  const Vd mv = MajorCurve(te, L.t0, L.t1, L.rate, &slope);
+  *g = Sel(L.heat, x - L.hs * mv, x - 1 + L.cs * (1 - mv));
+  *dg = 1 - L.scale * slope * (c.latent - L.pn * dfdx);
+  if (te_out != nullptr) *te_out = te;
+}
+
+#pragma GCC diagnostic pop
+
+}  // namespace
+
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wpsabi"
+
+void UnitModel::AdvanceCohorts(const Cohorts& c, int n, double stretch, double decay) const {
+  constexpr int kChunk = 64;
+  for (int base = 0; base < n; base += kChunk) {
+    const Cohorts part{c.on + base,    c.temperature + base, c.xi + base,
+                       c.t_eff + base, c.heat_scale + base,  c.cool_scale + base};
+    AdvanceChunk(part, std::min(kChunk, n - base), stretch, decay);
+  }
+}
+
+// Up to 64 cohorts: copied into padded local arrays, then (A) thermal step, branch test and
+// residual at xi_n for all, four at a time; (B) Newton on the cohorts that transform, gathered
+// four at a time; (C) canonical loop ends and the write-back.
+void UnitModel::AdvanceChunk(const Cohorts& c, int n, double stretch, double decay) const {
+  constexpr int kMax = 64;
+  alignas(32) double on[kMax], T[kMax], xi[kMax], te[kMax], hs[kMax], cs[kMax];
+  alignas(32) double tth[kMax], g0[kMax], dg0[kMax], heat[kMax];
+  const int padded = (n + kLanes - 1) / kLanes * kLanes;
+  for (int j = 0; j < padded; ++j) {
+    const int i = j < n ? j : 0;  // padding lanes repeat cohort 0 and are not written back
+    on[j] = c.on[i];
+    T[j] = c.temperature[i];
+    xi[j] = c.xi[i];
+    te[j] = c.t_eff[i];
+    hs[j] = c.heat_scale[i];
+    cs[j] = c.cool_scale[i];
+  }
+  const Consts k{k_A_,
+                 k_M_ - k_A_,
+                 k_s_,
+                 stretch_L_,
+                 stretch,
+                 latent_rise_,
+                 heat_shift_per_newton_,
+                 cool_shift_per_newton_,
+                 p_.As,
+                 p_.Af,
+                 p_.Ms,
+                 p_.Mf,
+                 heat_rate_,
+                 cool_rate_};
+  const double amb = p_.ambient;
+  int solve[kMax];
+  int n_solve = 0;
+  // (A) Lanes beyond n are computed but never listed for a solve or written back.
+  for (int j = 0; j < padded; j += kLanes) {
+    const Vd xi0 = Load(xi + j);
+    const Vd t_ss = Sel(Load(on + j) != 0, amb + (on_rise_A_ + xi0 * on_rise_dM_), Splat(amb));
+    const Vd t_th = t_ss + (Load(T + j) - t_ss) * decay;
+    Vd dfdx0;
+    const Vd f0 = LaneTension(k, xi0, &dfdx0);
+    const Vd te_h0 = t_th - k.pn_h * f0;
+    const Vm is_heat = te_h0 >= Load(te + j);
+    const Vd te0 = Sel(is_heat, te_h0, t_th - k.pn_c * f0);
+    const Vd pn = Sel(is_heat, Splat(k.pn_h), Splat(k.pn_c));
+    Vd slope;
+    const Vd mv = MajorCurve(te0, Sel(is_heat, Splat(k.As), Splat(k.Mf)),
+                             Sel(is_heat, Splat(k.Af), Splat(k.Ms)),
+                             Sel(is_heat, Splat(k.heat_rate), Splat(k.cool_rate)), &slope);
+    const Vd h = Load(hs + j), cl = Load(cs + j);
+    const Vd g = Sel(is_heat, xi0 - h * mv, xi0 - 1 + cl * (1 - mv));
+    const Vd dg = 1 - Sel(is_heat, h, cl) * slope * (k.latent - pn * dfdx0);
+    const Vm transforms = (is_heat & (g > 1e-12)) | (~is_heat & (g < -1e-12));
+    Store(tth + j, t_th);
+    Store(te + j, te0);  // t_eff of a cohort that does not transform
+    Store(g0 + j, g);
+    Store(dg0 + j, dg);
+    Store(heat + j, Sel(is_heat, Splat(1), Splat(0)));
+    for (int l = 0; l < kLanes; ++l) {
+      if (transforms[l] && j + l < n) solve[n_solve++] = j + l;
+    }
+  }
+  // (B) Each batch of four solves runs SolveNewton lane by lane; a short batch repeats its last
+  // cohort (same inputs, same result).
+  for (int b = 0; b < n_solve; b += kLanes) {
+    int idx[kLanes];
+    for (int l = 0; l < kLanes; ++l) idx[l] = solve[std::min(b + l, n_solve - 1)];
+    auto gather = [&](const double* a) {
+      Vd v;
+      for (int l = 0; l < kLanes; ++l) v[l] = a[idx[l]];
+      return v;
+    };
+    Lanes L;
+    L.heat = gather(heat) != 0;
+    L.xi0 = gather(xi);
+    L.tth = gather(tth);
+    L.hs = gather(hs);
+    L.cs = gather(cs);
+    L.pn = Sel(L.heat, Splat(k.pn_h), Splat(k.pn_c));
+    L.scale = Sel(L.heat, L.hs, L.cs);
+    L.t0 = Sel(L.heat, Splat(k.As), Splat(k.Mf));
+    L.t1 = Sel(L.heat, Splat(k.Af), Splat(k.Ms));
+    L.rate = Sel(L.heat, Splat(k.heat_rate), Splat(k.cool_rate));
+    // SolveNewton: heating on [0, xi_n], cooling on [xi_n, 1], from x = xi_n.
+    Vd lo = Sel(L.heat, Splat(0), L.xi0), hi = Sel(L.heat, L.xi0, Splat(1)), x = L.xi0;
+    Vd g = gather(g0), dg = gather(dg0);
+    Vm active = ~Vm{};  // every lane iterates
+    for (int it = 0; it < 60; ++it) {
+      const Vm pos = g > 0;
+      hi = Sel(active & pos, x, hi);
+      lo = Sel(active & ~pos, x, lo);
+      const Vd mid = 0.5 * (lo + hi);
+      Vd next = Sel(dg > 0, x - g / dg, mid);
+      next = Sel((next > lo) & (next < hi), next, mid);
+      const Vd step = next - x;
+      x = Sel(active, next, x);
+      active &= ~((Abs(step) < 1e-10) | (hi - lo < 1e-15));
+      if (!Any(active)) break;
+      Vd gn, dgn;
+      Residual(k, L, x, &gn, &dgn, nullptr);
+      g = Sel(active, gn, g);
+      dg = Sel(active, dgn, dg);
+      active &= ~(Abs(g) < 1e-13);
+      if (!Any(active)) break;
+    }
+    // T_eff at the solution; the opposite branch's scale restarts here (proportional rule).
+    const Vd t_eff = (L.tth + k.latent * (x - L.xi0)) - L.pn * TensionOnly(k, x);
+    Vd unused;
+    const Vd other = MajorCurve(t_eff, Sel(L.heat, Splat(k.Mf), Splat(k.As)),
+                                Sel(L.heat, Splat(k.Ms), Splat(k.Af)),
+                                Sel(L.heat, Splat(k.cool_rate), Splat(k.heat_rate)), &unused);
+    const Vd cs_new = Sel(other < 1, Clamp01((1 - x) / (1 - other)), Splat(1));
+    const Vd hs_new = Sel(other > 0, Clamp01(x / other), Splat(1));
+    for (int l = 0; l < kLanes; ++l) {
+      const int j = idx[l];
+      xi[j] = x[l];
+      te[j] = t_eff[l];
+      if (L.heat[l]) {
+        cs[j] = cs_new[l];
+      } else {
+        hs[j] = hs_new[l];
+      }
+    }
+  }
+  // (C) Canonical ends of the loop, new temperature, write-back. xi still holds xi_n in lanes
+  // that did not transform; xi0 is re-read from the caller's arrays.
+  for (int j = 0; j < n; ++j) {
+    double x = xi[j], h = hs[j], cl = cs[j];
+    if (x >= 1 - 1e-12) {
+      x = 1, h = 1, cl = 0;
+    } else if (x <= 1e-12) {
+      x = 0, h = 0, cl = 1;
+    }
+    c.temperature[j] = tth[j] + latent_rise_ * (x - c.xi[j]);
+    c.xi[j] = x;
+    c.t_eff[j] = te[j];
+    c.heat_scale[j] = h;
+    c.cool_scale[j] = cl;
+  }
+}
+
+double UnitModel::SumTension(const double* count, const double* xi, int n, double stretch) const {
+  const Consts k{k_A_, k_M_ - k_A_, k_s_, stretch_L_, stretch, 0, 0, 0, 0, 0, 0, 0, 0, 0};
+  Vd acc = Splat(0);
+  int j = 0;
+  for (; j + kLanes <= n; j += kLanes) acc += Load(count + j) * TensionOnly(k, Load(xi + j));
+  if (j < n) {
+    alignas(32) double cnt[kLanes], x[kLanes];
+    for (int l = 0; l < kLanes; ++l) {
+      cnt[l] = j + l < n ? count[j + l] : 0;
+      x[l] = j + l < n ? xi[j + l] : 1;
+    }
+    acc += Load(cnt) * TensionOnly(k, Load(x));
+  }
+  double sum = 0;  // lane 0 first: exact for one cohort (the other lanes hold zeros)
+  for (int l = 0; l < kLanes; ++l) sum += acc[l];
+  return sum;
+}
+
+#pragma GCC diagnostic pop
 
 }  // namespace recruit::sma

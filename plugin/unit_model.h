@@ -121,6 +121,23 @@ class UnitModel {
   double heat_shift_per_newton() const { return heat_shift_per_newton_; }
   double cool_shift_per_newton() const { return cool_shift_per_newton_; }
 
+  // Advances n cohorts (structure of arrays, one entry per cohort) by one step with thermal decay
+  // factor `decay` at extension `stretch`: lane by lane the same operations as
+  // AdvanceUnitWithDecay, so the results are bit-identical to it (test
+  // BatchedCohortUpdateIsBitIdenticalToScalarUpdate), but four cohorts at a time in SIMD lanes,
+  // the phase solves of the transforming cohorts gathered into full batches.
+  struct Cohorts {
+    const double* on;  // 0 or 1
+    double* temperature;
+    double* xi;
+    double* t_eff;
+    double* heat_scale;
+    double* cool_scale;
+  };
+  void AdvanceCohorts(const Cohorts& c, int n, double stretch, double decay) const;
+  // Sum over n cohorts of count[j] * Tension(xi[j], stretch), four cohorts at a time.
+  double SumTension(const double* count, const double* xi, int n, double stretch) const;
+
   // Natural convection (Morgan's horizontal-cylinder correlation, air at the film temperature)
   // plus linearised radiation, for a wire of diameter d at temperature excess dT over ambient.
   static double NaturalConvectionH(double d, double ambient, double dT, double emissivity);
@@ -132,6 +149,7 @@ class UnitModel {
   double k_s_ = 0;                            // series spring of the unit (N/m), 0 = rigid
   // Unit stiffness at xi (wire in series with the coupling spring) and its xi-derivative.
   double Stiffness(double xi, double* dk) const;
+  void AdvanceChunk(const Cohorts& c, int n, double stretch, double decay) const;
   double stress_per_newton_ = 0;
   double heat_rate_ = 0, cool_rate_ = 0;  // pi / (Af - As), pi / (Ms - Mf)
   double latent_rise_ = 0, heat_shift_per_newton_ = 0, cool_shift_per_newton_ = 0;
@@ -144,10 +162,12 @@ class UnitModel {
 // b^20 and b^19. The truncation error is below (pi/2)^21 / 21! < 3e-16 and the rounding error a
 // few ulp, so both are within 1e-15 of the exact values (test
 // PolynomialSinCosMatchesLibmOverTheHalfTurn); the phase solve's tolerances are 1e-13 and above.
-// Inlined, 64 instructions against about 94 for glibc's sincos call (callgrind).
-inline void SinCosHalfTurn(double a, double* sin_a, double* cos_a) {
-  const double b = a - 0.5 * 3.14159265358979323846;
-  const double z = b * b, z2 = z * z, z4 = z2 * z2, z8 = z4 * z4;
+// Inlined, 64 instructions against about 94 for glibc's sincos call (callgrind). T is double or
+// a GCC vector of doubles (the batched cohort update): the same operations lane by lane.
+template <class T>
+inline void SinCosHalfTurn(T a, T* sin_a, T* cos_a) {
+  const T b = a - 0.5 * 3.14159265358979323846;
+  const T z = b * b, z2 = z * z, z4 = z2 * z2, z8 = z4 * z4;
   // Taylor coefficients (-1)^k / (2k)! (cosine) and (-1)^k / (2k+1)! (sine) of z^k, k = 0..10
   // and 0..9, summed by Estrin's scheme (shorter dependency chains than Horner's).
   constexpr double c0 = 1, c1 = -1.0 / 2, c2 = 1.0 / 24, c3 = -1.0 / 720, c4 = 1.0 / 40320,
@@ -157,10 +177,10 @@ inline void SinCosHalfTurn(double a, double* sin_a, double* cos_a) {
   constexpr double s0 = 1, s1 = -1.0 / 6, s2 = 1.0 / 120, s3 = -1.0 / 5040, s4 = 1.0 / 362880,
                    s5 = -1.0 / 39916800, s6 = 1.0 / 6227020800, s7 = -1.0 / 1307674368000,
                    s8 = 1.0 / 355687428096000, s9 = -1.0 / 121645100408832000;
-  const double cos_b = ((c0 + c1 * z) + (c2 + c3 * z) * z2) +
-                       ((c4 + c5 * z) + (c6 + c7 * z) * z2) * z4 + ((c8 + c9 * z) + c10 * z2) * z8;
-  const double sin_b = b * (((s0 + s1 * z) + (s2 + s3 * z) * z2) +
-                            ((s4 + s5 * z) + (s6 + s7 * z) * z2) * z4 + (s8 + s9 * z) * z8);
+  const T cos_b = ((c0 + c1 * z) + (c2 + c3 * z) * z2) + ((c4 + c5 * z) + (c6 + c7 * z) * z2) * z4 +
+                  ((c8 + c9 * z) + c10 * z2) * z8;
+  const T sin_b = b * (((s0 + s1 * z) + (s2 + s3 * z) * z2) +
+                       ((s4 + s5 * z) + (s6 + s7 * z) * z2) * z4 + (s8 + s9 * z) * z8);
   *sin_a = cos_b;
   *cos_a = -sin_b;
 }
