@@ -149,7 +149,6 @@ class UnitModel {
   double k_s_ = 0;                            // series spring of the unit (N/m), 0 = rigid
   // Unit stiffness at xi (wire in series with the coupling spring) and its xi-derivative.
   double Stiffness(double xi, double* dk) const;
-  void AdvanceChunk(const Cohorts& c, int n, double stretch, double decay) const;
   double stress_per_newton_ = 0;
   double heat_rate_ = 0, cool_rate_ = 0;  // pi / (Af - As), pi / (Ms - Mf)
   double latent_rise_ = 0, heat_shift_per_newton_ = 0, cool_shift_per_newton_ = 0;

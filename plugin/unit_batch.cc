@@ -1,0 +1,358 @@
+// The batched cohort update (UnitModel::AdvanceCohorts, SumTension): cohorts as a structure of
+// arrays, one SIMD register of cohorts per batch (2 lanes with the portable SSE2 baseline, 4 with
+// AVX). Every lane performs exactly the operations of SolvePhase and AdvanceUnitWithDecay
+// (unit_model.cc) on one cohort, in the same order and without contraction (-ffp-contract=off,
+// plugin/CMakeLists.txt), so each cohort's result is bit-identical to the scalar update.
+// Branches become lane masks; a lane whose Newton iteration has stopped keeps its values while
+// the others continue.
+#include <algorithm>
+#include <cstring>
+
+#include "plugin/unit_model.h"
+
+#if defined(__SSE2__)
+#include <immintrin.h>
+#endif
+
+namespace recruit::sma {
+namespace {
+
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wpsabi"  // vectors are passed only between inlined functions
+
+// Lane masks are vectors of doubles with all bits set or clear (the comparison instructions'
+// result), combined with bit operations.
+#if defined(__AVX__)
+constexpr int kLanes = 4;
+using Vd = __m256d;
+inline Vd Splat(double x) { return _mm256_set1_pd(x); }
+inline Vd Load(const double* p) { return _mm256_loadu_pd(p); }
+inline void Store(double* p, Vd v) { _mm256_storeu_pd(p, v); }
+inline Vd Lt(Vd a, Vd b) { return _mm256_cmp_pd(a, b, _CMP_LT_OQ); }
+inline Vd Le(Vd a, Vd b) { return _mm256_cmp_pd(a, b, _CMP_LE_OQ); }
+inline Vd Ne(Vd a, Vd b) { return _mm256_cmp_pd(a, b, _CMP_NEQ_UQ); }
+inline Vd And(Vd a, Vd b) { return _mm256_and_pd(a, b); }
+inline Vd Or(Vd a, Vd b) { return _mm256_or_pd(a, b); }
+inline Vd AndNot(Vd a, Vd b) { return _mm256_andnot_pd(b, a); }  // a & ~b
+inline Vd Sel(Vd m, Vd a, Vd b) { return _mm256_blendv_pd(b, a, m); }
+inline int Bits(Vd m) { return _mm256_movemask_pd(m); }
+#elif defined(__SSE2__)
+constexpr int kLanes = 2;
+using Vd = __m128d;
+inline Vd Splat(double x) { return _mm_set1_pd(x); }
+inline Vd Load(const double* p) { return _mm_loadu_pd(p); }
+inline void Store(double* p, Vd v) { _mm_storeu_pd(p, v); }
+inline Vd Lt(Vd a, Vd b) { return _mm_cmplt_pd(a, b); }
+inline Vd Le(Vd a, Vd b) { return _mm_cmple_pd(a, b); }
+inline Vd Ne(Vd a, Vd b) { return _mm_cmpneq_pd(a, b); }
+inline Vd And(Vd a, Vd b) { return _mm_and_pd(a, b); }
+inline Vd Or(Vd a, Vd b) { return _mm_or_pd(a, b); }
+inline Vd AndNot(Vd a, Vd b) { return _mm_andnot_pd(b, a); }  // a & ~b
+inline Vd Sel(Vd m, Vd a, Vd b) { return _mm_or_pd(_mm_and_pd(m, a), _mm_andnot_pd(m, b)); }
+inline int Bits(Vd m) { return _mm_movemask_pd(m); }
+#else  // generic vectors (GCC / Clang extension)
+constexpr int kLanes = 2;
+using Vd = double __attribute__((vector_size(16)));
+using Vi = long long __attribute__((vector_size(16)));
+inline Vd Splat(double x) { return Vd{x, x}; }
+inline Vd Load(const double* p) {
+  Vd v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+inline void Store(double* p, Vd v) { std::memcpy(p, &v, sizeof v); }
+inline Vd Lt(Vd a, Vd b) { return reinterpret_cast<Vd>(a < b); }
+inline Vd Le(Vd a, Vd b) { return reinterpret_cast<Vd>(a <= b); }
+inline Vd Ne(Vd a, Vd b) { return reinterpret_cast<Vd>(a != b); }
+inline Vd Bit(Vi x) { return reinterpret_cast<Vd>(x); }
+inline Vi Int(Vd x) { return reinterpret_cast<Vi>(x); }
+inline Vd And(Vd a, Vd b) { return Bit(Int(a) & Int(b)); }
+inline Vd Or(Vd a, Vd b) { return Bit(Int(a) | Int(b)); }
+inline Vd AndNot(Vd a, Vd b) { return Bit(Int(a) & ~Int(b)); }
+inline Vd Sel(Vd m, Vd a, Vd b) { return Or(And(m, a), AndNot(b, m)); }
+inline int Bits(Vd m) { return (Int(m)[0] != 0 ? 1 : 0) | (Int(m)[1] != 0 ? 2 : 0); }
+#endif
+
+constexpr int kAll = (1 << kLanes) - 1;
+inline Vd Gt(Vd a, Vd b) { return Lt(b, a); }
+inline Vd Ge(Vd a, Vd b) { return Le(b, a); }
+inline Vd Lt(Vd a, double b) { return Lt(a, Splat(b)); }
+inline Vd Gt(Vd a, double b) { return Lt(Splat(b), a); }
+inline Vd Le(Vd a, double b) { return Le(a, Splat(b)); }
+inline Vd Ge(Vd a, double b) { return Le(Splat(b), a); }
+// |x| by clearing the sign bit (std::abs).
+inline Vd Abs(Vd x) { return AndNot(x, Splat(-0.0)); }
+// std::clamp(v, 0, 1) lane by lane (NaN passes through, as there).
+inline Vd Clamp01(Vd v) { return Sel(Lt(v, 0.0), Splat(0), Sel(Gt(v, 1.0), Splat(1), v)); }
+
+// A major curve per lane: MajorHeating (t0 = As, t1 = Af) or MajorCooling (Mf, Ms), 1 at or
+// below t0, 0 at or above t1, the cosine in between; slope as in the scalar overloads.
+inline Vd MajorCurve(Vd te, Vd t0, Vd t1, Vd rate, Vd* slope) {
+  const Vd below = Le(te, t0), above = Ge(te, t1), out = Or(below, above);
+  Vd sn = Splat(0), cs = Splat(0);
+  if (Bits(out) != kAll) SinCosHalfTurn(rate * (te - t0), &sn, &cs);
+  *slope = AndNot((-0.5 * rate) * sn, out);
+  return Sel(below, Splat(1), AndNot(0.5 * (cs + 1.0), above));
+}
+
+// The phase-solve constants of one model and extension, broadcast to every lane once.
+struct Consts {
+  bool rigid;         // no series spring
+  Vd k_A, dk_w, k_s;  // k_A, k_M - k_A, series spring
+  Vd k_s2_dk_w;       // k_s * k_s * (k_M - k_A), grouped as the scalar code evaluates it
+  Vd stretch_L, stretch, latent, pn_h, pn_c;
+  Vd As, Af, Ms, Mf, heat_rate, cool_rate;
+};
+
+// UnitModel::Tension(x, stretch, &slope) lane by lane.
+inline Vd LaneTension(const Consts& c, Vd xi, Vd* slope) {
+  const Vd kw = c.k_A + xi * c.dk_w;
+  Vd k, dk;
+  if (c.rigid) {
+    dk = c.dk_w;
+    k = kw;
+  } else {
+    const Vd inv = 1.0 / (kw + c.k_s);
+    dk = c.k_s2_dk_w * inv * inv;
+    k = kw * c.k_s * inv;
+  }
+  const Vd e = c.stretch - xi * c.stretch_L;
+  const Vd ke = k * e;
+  const Vd slack = Le(ke, 0.0);
+  *slope = AndNot(dk * e - k * c.stretch_L, slack);
+  return AndNot(ke, slack);
+}
+
+// UnitModel::Tension(x, stretch) lane by lane: std::max(0.0, k e).
+inline Vd TensionOnly(const Consts& c, Vd xi) {
+  const Vd kw = c.k_A + xi * c.dk_w;
+  const Vd k = c.rigid ? kw : kw * c.k_s * (1.0 / (kw + c.k_s));
+  const Vd ke = k * (c.stretch - xi * c.stretch_L);
+  return And(ke, Gt(ke, 0.0));
+}
+
+// Per-lane inputs of a phase solve; heat selects gd_h (M -> A on M+) or gd_c (A -> M on M-).
+struct Lanes {
+  Vd heat, xi0, tth, hs, cs, pn, scale, t0, t1, rate;
+};
+
+// gd_h / gd_c of SolvePhase: residual g and its slope dg at x.
+inline void Residual(const Consts& c, const Lanes& L, Vd x, Vd* g, Vd* dg) {
+  Vd dfdx, slope;
+  const Vd te = (L.tth + c.latent * (x - L.xi0)) - L.pn * LaneTension(c, x, &dfdx);
+  const Vd mv = MajorCurve(te, L.t0, L.t1, L.rate, &slope);
+  *g = Sel(L.heat, x - L.hs * mv, x - 1.0 + L.cs * (1.0 - mv));
+  *dg = 1.0 - L.scale * slope * (c.latent - L.pn * dfdx);
+}
+
+// SolveNewton lane by lane from x = xi_n, where the residual is g, dg: heating on [0, xi_n],
+// cooling on [xi_n, 1].
+inline Vd Newton(const Consts& c, const Lanes& L, Vd g, Vd dg) {
+  Vd lo = AndNot(L.xi0, L.heat), hi = Sel(L.heat, L.xi0, Splat(1)), x = L.xi0;
+  Vd active = Or(Le(x, x), Ne(x, x));  // every lane
+  for (int it = 0; it < 60; ++it) {
+    const Vd pos = Gt(g, 0.0);
+    hi = Sel(And(active, pos), x, hi);
+    lo = Sel(AndNot(active, pos), x, lo);
+    const Vd mid = 0.5 * (lo + hi);
+    Vd next = Sel(Gt(dg, 0.0), x - g / dg, mid);
+    next = Sel(And(Gt(next, lo), Lt(next, hi)), next, mid);
+    const Vd step = next - x;
+    x = Sel(active, next, x);
+    active = AndNot(active, Or(Lt(Abs(step), 1e-10), Lt(hi - lo, 1e-15)));
+    if (Bits(active) == 0) break;
+    Vd gn, dgn;
+    Residual(c, L, x, &gn, &dgn);
+    g = Sel(active, gn, g);
+    dg = Sel(active, dgn, dg);
+    active = AndNot(active, Lt(Abs(g), 1e-13));
+    if (Bits(active) == 0) break;
+  }
+  return x;
+}
+
+// Canonical ends of the loop (SolvePhase), so that settled cohorts compare equal.
+inline void Canonical(Vd* xi, Vd* hs, Vd* cs) {
+  const Vd top = Ge(*xi, 1 - 1e-12), bottom = Le(*xi, 1e-12);
+  if (Bits(Or(top, bottom)) == 0) return;
+  const Vd low = AndNot(bottom, top);
+  *xi = Sel(top, Splat(1), AndNot(*xi, low));
+  *hs = Sel(top, Splat(1), AndNot(*hs, low));
+  *cs = Sel(top, Splat(0), Sel(low, Splat(1), *cs));
+}
+
+// kLanes consecutive cohorts' fields (in the caller's arrays, or a padded copy of the tail).
+struct Block {
+  const double* on;
+  double *temperature, *xi, *t_eff, *heat_scale, *cool_scale;
+};
+
+#pragma GCC diagnostic pop
+
+}  // namespace
+
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wpsabi"
+
+// Cohorts in chunks of 64: (A) the thermal step, the branch test and the residual at xi_n for
+// all, kLanes at a time; cohorts that do not transform are finished there. (B) The phase solves
+// of those that do, gathered kLanes at a time.
+void UnitModel::AdvanceCohorts(const Cohorts& c, int n, double stretch, double decay) const {
+  constexpr int kChunk = 64;
+  Consts k;
+  k.rigid = k_s_ <= 0;
+  k.k_A = Splat(k_A_);
+  k.dk_w = Splat(k_M_ - k_A_);
+  k.k_s = Splat(k_s_);
+  k.k_s2_dk_w = Splat(k_s_ * k_s_ * (k_M_ - k_A_));
+  k.stretch_L = Splat(stretch_L_);
+  k.stretch = Splat(stretch);
+  k.latent = Splat(latent_rise_);
+  k.pn_h = Splat(heat_shift_per_newton_);
+  k.pn_c = Splat(cool_shift_per_newton_);
+  k.As = Splat(p_.As);
+  k.Af = Splat(p_.Af);
+  k.Ms = Splat(p_.Ms);
+  k.Mf = Splat(p_.Mf);
+  k.heat_rate = Splat(heat_rate_);
+  k.cool_rate = Splat(cool_rate_);
+  const Vd amb = Splat(p_.ambient), rise_A = Splat(on_rise_A_), rise_dM = Splat(on_rise_dM_);
+  const Vd vdecay = Splat(decay);
+  alignas(32) double tth[kChunk], g0[kChunk], dg0[kChunk], heat[kChunk];
+  int solve[kChunk];
+  for (int base = 0; base < n; base += kChunk) {
+    const int m = std::min(kChunk, n - base);
+    int n_solve = 0;
+    // (A) on cohorts base + j .. base + j + kLanes - 1; `valid` has the bits of real lanes.
+    auto phase_a = [&](const Block& b, int j, int valid) {
+      const Vd xi0 = Load(b.xi), hs0 = Load(b.heat_scale), cs0 = Load(b.cool_scale);
+      const Vd T0 = Load(b.temperature);
+      const Vd t_ss = Sel(Ne(Load(b.on), Splat(0)), amb + (rise_A + xi0 * rise_dM), amb);
+      const Vd t_th = t_ss + (T0 - t_ss) * vdecay;
+      Vd dfdx0;
+      const Vd f0 = LaneTension(k, xi0, &dfdx0);
+      const Vd te_h0 = t_th - k.pn_h * f0;
+      const Vd is_heat = Ge(te_h0, Load(b.t_eff));
+      const Vd te0 = Sel(is_heat, te_h0, t_th - k.pn_c * f0);
+      const Vd pn = Sel(is_heat, k.pn_h, k.pn_c);
+      Vd slope;
+      const Vd mv = MajorCurve(te0, Sel(is_heat, k.As, k.Mf), Sel(is_heat, k.Af, k.Ms),
+                               Sel(is_heat, k.heat_rate, k.cool_rate), &slope);
+      const Vd g = Sel(is_heat, xi0 - hs0 * mv, xi0 - 1.0 + cs0 * (1.0 - mv));
+      const Vd dg = 1.0 - Sel(is_heat, hs0, cs0) * slope * (k.latent - pn * dfdx0);
+      const Vd tr = Sel(is_heat, Gt(g, 1e-12), Lt(g, -1e-12));
+      // Cohorts that do not transform keep xi_n and are finished here; the others keep their
+      // old values until (B).
+      Vd x = xi0, h = hs0, cl = cs0;
+      Canonical(&x, &h, &cl);
+      Store(b.temperature, Sel(tr, T0, t_th + k.latent * (x - xi0)));
+      Store(b.xi, Sel(tr, xi0, x));
+      Store(b.t_eff, te0);
+      Store(b.heat_scale, Sel(tr, hs0, h));
+      Store(b.cool_scale, Sel(tr, cs0, cl));
+      Store(tth + j, t_th);
+      Store(g0 + j, g);
+      Store(dg0 + j, dg);
+      Store(heat + j, is_heat);
+      for (int bits = Bits(tr) & valid; bits != 0; bits &= bits - 1) {
+        solve[n_solve++] = j + __builtin_ctz(bits);
+      }
+    };
+    const double* const on = c.on + base;
+    double* const T = c.temperature + base;
+    double* const xi = c.xi + base;
+    double* const te = c.t_eff + base;
+    double* const hs = c.heat_scale + base;
+    double* const cs = c.cool_scale + base;
+    int j = 0;
+    for (; j + kLanes <= m; j += kLanes) {
+      phase_a(Block{on + j, T + j, xi + j, te + j, hs + j, cs + j}, j, kAll);
+    }
+    if (j < m) {  // the tail through a padded copy (padding repeats the tail's first cohort)
+      alignas(32) double pad[6][kLanes];
+      const double* const src[6] = {on, T, xi, te, hs, cs};
+      double* const dst[5] = {T, xi, te, hs, cs};
+      for (int f = 0; f < 6; ++f) {
+        for (int l = 0; l < kLanes; ++l) pad[f][l] = src[f][j + l < m ? j + l : j];
+      }
+      phase_a(Block{pad[0], pad[1], pad[2], pad[3], pad[4], pad[5]}, j, (1 << (m - j)) - 1);
+      for (int f = 0; f < 5; ++f) {
+        for (int l = 0; j + l < m; ++l) dst[f][j + l] = pad[f + 1][l];
+      }
+    }
+    // (B) A short batch repeats its last cohort (same inputs, same result).
+    for (int b = 0; b < n_solve; b += kLanes) {
+      int idx[kLanes];
+      for (int l = 0; l < kLanes; ++l) idx[l] = solve[std::min(b + l, n_solve - 1)];
+      auto gather = [&](const double* a) {
+        alignas(32) double v[kLanes];
+        for (int l = 0; l < kLanes; ++l) v[l] = a[idx[l]];
+        return Load(v);
+      };
+      Lanes L;
+      L.heat = gather(heat);
+      L.xi0 = gather(xi);
+      L.tth = gather(tth);
+      L.hs = gather(hs);
+      L.cs = gather(cs);
+      L.pn = Sel(L.heat, k.pn_h, k.pn_c);
+      L.scale = Sel(L.heat, L.hs, L.cs);
+      L.t0 = Sel(L.heat, k.As, k.Mf);
+      L.t1 = Sel(L.heat, k.Af, k.Ms);
+      L.rate = Sel(L.heat, k.heat_rate, k.cool_rate);
+      Vd x = Newton(k, L, gather(g0), gather(dg0));
+      // T_eff at the solution; the opposite branch's scale restarts there (proportional rule).
+      const Vd t_eff = (L.tth + k.latent * (x - L.xi0)) - L.pn * TensionOnly(k, x);
+      Vd unused;
+      const Vd other = MajorCurve(t_eff, Sel(L.heat, k.Mf, k.As), Sel(L.heat, k.Ms, k.Af),
+                                  Sel(L.heat, k.cool_rate, k.heat_rate), &unused);
+      Vd cl = Sel(L.heat, Sel(Lt(other, 1.0), Clamp01((1.0 - x) / (1.0 - other)), Splat(1)), L.cs);
+      Vd h = Sel(L.heat, L.hs, Sel(Gt(other, 0.0), Clamp01(x / other), Splat(1)));
+      Canonical(&x, &h, &cl);
+      alignas(32) double out[5][kLanes];
+      Store(out[0], L.tth + k.latent * (x - L.xi0));
+      Store(out[1], x);
+      Store(out[2], t_eff);
+      Store(out[3], h);
+      Store(out[4], cl);
+      for (int l = 0; l < kLanes; ++l) {
+        const int i = idx[l];
+        T[i] = out[0][l];
+        xi[i] = out[1][l];
+        te[i] = out[2][l];
+        hs[i] = out[3][l];
+        cs[i] = out[4][l];
+      }
+    }
+  }
+}
+
+double UnitModel::SumTension(const double* count, const double* xi, int n, double stretch) const {
+  Consts k;
+  k.rigid = k_s_ <= 0;
+  k.k_A = Splat(k_A_);
+  k.dk_w = Splat(k_M_ - k_A_);
+  k.k_s = Splat(k_s_);
+  k.stretch_L = Splat(stretch_L_);
+  k.stretch = Splat(stretch);
+  Vd acc = Splat(0);
+  int j = 0;
+  for (; j + kLanes <= n; j += kLanes) acc += Load(count + j) * TensionOnly(k, Load(xi + j));
+  if (j < n) {
+    alignas(32) double cnt[kLanes], x[kLanes];
+    for (int l = 0; l < kLanes; ++l) {
+      cnt[l] = j + l < n ? count[j + l] : 0;
+      x[l] = j + l < n ? xi[j + l] : 1;
+    }
+    acc += Load(cnt) * TensionOnly(k, Load(x));
+  }
+  alignas(32) double lanes[kLanes];
+  Store(lanes, acc);
+  double sum = 0;  // lane 0 first: exact for one cohort (the other lanes hold zeros)
+  for (int l = 0; l < kLanes; ++l) sum += lanes[l];
+  return sum;
+}
+
+#pragma GCC diagnostic pop
+
+}  // namespace recruit::sma
