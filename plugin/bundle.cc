@@ -142,41 +142,52 @@ void SmaBundle::Integrate(double* s, double stretch, double dt) const {
                              Field(s, kTeff), Field(s, kHeatScale), Field(s, kCoolScale)};
   unit_.AdvanceCohorts(c, k, stretch, decay);
   s[kCounterSlot] += 1;
-  if (k > 1 && std::fmod(s[kCounterSlot], kMergeEvery) == 0) Merge(s);
+  // The counter is a whole number: integer modulo instead of a libm fmod call.
+  if (k > 1 && static_cast<long long>(s[kCounterSlot]) % kMergeEvery == 0) Merge(s);
 }
 
 void SmaBundle::Merge(double* s) const {
   const int k = NumCohorts(s);
-  std::vector<int> order(k);
-  std::iota(order.begin(), order.end(), 0);
-  const double* on = Field(s, kOn);
-  const double* temp = Field(s, kTemp);
-  std::sort(order.begin(), order.end(), [&](int a, int b) {
-    if (on[a] != on[b]) return on[a] < on[b];
-    return temp[a] < temp[b];
+  // Reused scratch (one per thread: bundles may step in parallel on their own mjData).
+  // Sorted by (on, T) as keys held by value: std::sort's moves depend only on the comparisons,
+  // so the order (ties included) is that of sorting the indices with the same comparator.
+  struct Key {
+    double on, temp;
+    int index;
+  };
+  static thread_local std::vector<Key> order;
+  static thread_local std::vector<int> forward;
+  const double *on = Field(s, kOn), *temp = Field(s, kTemp);
+  order.resize(k);
+  for (int j = 0; j < k; ++j) order[j] = {on[j], temp[j], j};
+  std::sort(order.begin(), order.end(), [](const Key& a, const Key& b) {
+    if (a.on != b.on) return a.on < b.on;
+    return a.temp < b.temp;
   });
   bool merged = false;
-  std::vector<int> forward(k, -1);  // representative that absorbed each merged cohort
-  int rep = order[0];
-  auto at = [&](int f, int j) -> double& { return Field(s, f)[j]; };
+  forward.assign(k, -1);  // representative that absorbed each merged cohort
+  double* count = Field(s, kCount);
+  double* f[kFields];
+  for (int i = 0; i < kFields; ++i) f[i] = Field(s, i);
+  int rep = order[0].index;
   for (int j = 1; j < k; ++j) {
-    const int r = rep, c = order[j];
-    const bool same = at(kOn, r) == at(kOn, c) &&
-                      std::abs(at(kTemp, r) - at(kTemp, c)) <= config_.merge_temperature &&
-                      std::abs(at(kXi, r) - at(kXi, c)) <= config_.merge_xi &&
-                      std::abs(at(kHeatScale, r) - at(kHeatScale, c)) <= config_.merge_xi &&
-                      std::abs(at(kCoolScale, r) - at(kCoolScale, c)) <= config_.merge_xi;
+    const int r = rep, c = order[j].index;
+    const bool same = on[r] == on[c] && std::abs(temp[r] - temp[c]) <= config_.merge_temperature &&
+                      std::abs(f[kXi][r] - f[kXi][c]) <= config_.merge_xi &&
+                      std::abs(f[kHeatScale][r] - f[kHeatScale][c]) <= config_.merge_xi &&
+                      std::abs(f[kCoolScale][r] - f[kCoolScale][c]) <= config_.merge_xi;
     if (!same) {
-      rep = order[j];
+      rep = c;
       continue;
     }
     // Count-weighted mean keeps the bundle's mean temperature and fraction.
-    const double n = at(kCount, r) + at(kCount, c);
-    for (int f : {kTemp, kXi, kTeff, kHeatScale, kCoolScale})
-      at(f, r) = (at(f, r) * at(kCount, r) + at(f, c) * at(kCount, c)) / n;
-    at(kCount, r) = n;
-    at(kCount, c) = 0;
-    forward[order[j]] = rep;
+    const double n = count[r] + count[c];
+    for (int i : {kTemp, kXi, kTeff, kHeatScale, kCoolScale}) {
+      f[i][r] = (f[i][r] * count[r] + f[i][c] * count[c]) / n;
+    }
+    count[r] = n;
+    count[c] = 0;
+    forward[c] = rep;
     merged = true;
   }
   if (merged) Compact(s, forward);
@@ -187,7 +198,8 @@ void SmaBundle::Compact(double* s, const std::vector<int>& forward) const {
   // New index for each surviving cohort; a merged cohort forwards its units to its
   // representative.
   const double* count = Field(s, kCount);
-  std::vector<int> remap(k, -1);
+  static thread_local std::vector<int> remap;
+  remap.assign(k, -1);
   int n = 0;
   for (int j = 0; j < k; ++j) {
     if (count[j] > 0) remap[j] = n++;
@@ -210,17 +222,52 @@ double SmaBundle::Tension(const double* s, double stretch) const {
   return unit_.SumTension(Field(s, kCount), Field(s, kXi), NumCohorts(s), stretch);
 }
 
-double SmaBundle::CountWeightedSum(const double* s, int f) const {
-  const int k = NumCohorts(s);
-  const double* count = Field(s, kCount);
-  const double* v = Field(s, f);
-  double acc[4] = {0, 0, 0, 0};  // four partial sums: vectorisable, and exact for one cohort
+namespace {
+
+// Sums over the k cohorts of count[j] * v[f][j] for nf fields, each in four partial sums (lane
+// j mod 4, in a vector: one register with AVX, two with SSE2) added as (a0 + a1) + (a2 + a3):
+// exact for one cohort.
+void CountWeightedSums(const double* count, const double* const* v, int nf, int k, double* out) {
+  using V4 = double __attribute__((vector_size(32)));
+  auto load = [](const double* p) {
+    V4 x;
+    std::memcpy(&x, p, sizeof x);
+    return x;
+  };
+  V4 acc[3] = {};
   int j = 0;
   for (; j + 4 <= k; j += 4) {
-    for (int l = 0; l < 4; ++l) acc[l] += count[j + l] * v[j + l];
+    const V4 c = load(count + j);
+    for (int f = 0; f < nf; ++f) acc[f] += c * load(v[f] + j);
   }
-  for (int l = 0; j + l < k; ++l) acc[l] += count[j + l] * v[j + l];
-  return (acc[0] + acc[1]) + (acc[2] + acc[3]);
+  for (int f = 0; f < nf; ++f) {
+    double a[4];
+    std::memcpy(a, &acc[f], sizeof a);
+    for (int l = 0; j + l < k; ++l) a[l] += count[j + l] * v[f][j + l];
+    out[f] = (a[0] + a[1]) + (a[2] + a[3]);
+  }
+}
+
+}  // namespace
+
+double SmaBundle::CountWeightedSum(const double* s, int f) const {
+  const double* v[1] = {Field(s, f)};
+  double sum;
+  CountWeightedSums(Field(s, kCount), v, 1, NumCohorts(s), &sum);
+  return sum;
+}
+
+SmaBundle::Summary SmaBundle::Summarize(const double* s, double stretch) const {
+  const int k = NumCohorts(s);
+  const double* v[3] = {Field(s, kOn), Field(s, kTemp), Field(s, kXi)};
+  double sum[3];
+  CountWeightedSums(Field(s, kCount), v, 3, k, sum);
+  Summary r;
+  r.on_count = static_cast<int>(sum[0]);
+  r.tension = Tension(s, stretch);
+  r.mean_temperature = k == 0 ? config_.unit.ambient : sum[1] / config_.units;
+  r.mean_xi = k == 0 ? 1 : sum[2] / config_.units;
+  return r;
 }
 
 int SmaBundle::OnCount(const double* s) const { return static_cast<int>(CountWeightedSum(s, kOn)); }

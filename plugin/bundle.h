@@ -52,6 +52,13 @@ class SmaBundle {
   double ActDot(const double* s) const { return 0; }
 
   int OnCount(const double* s) const;
+  // OnCount, Tension, MeanTemperature and MeanXi (the plugin's sensor) in one pass, with the
+  // same values.
+  struct Summary {
+    int on_count;
+    double tension, mean_temperature, mean_xi;
+  };
+  Summary Summarize(const double* s, double stretch) const;
   int NumCohorts(const double* s) const { return static_cast<int>(s[kCohortCountSlot]); }
   double MeanTemperature(const double* s) const;
   double MeanXi(const double* s) const;

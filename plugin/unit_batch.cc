@@ -224,7 +224,7 @@ void UnitModel::AdvanceCohorts(const Cohorts& c, int n, double stretch, double d
     const int m = std::min(kChunk, n - base);
     int n_solve = 0;
     // (A) on cohorts base + j .. base + j + kLanes - 1; `valid` has the bits of real lanes.
-    auto phase_a = [&](const Block& b, int j, int valid) {
+    auto phase_a = [&](const Block& b, int j, int valid) __attribute__((always_inline)) {
       const Vd xi0 = Load(b.xi), hs0 = Load(b.heat_scale), cs0 = Load(b.cool_scale);
       const Vd T0 = Load(b.temperature);
       const Vd t_ss = Sel(Ne(Load(b.on), Splat(0)), amb + (rise_A + xi0 * rise_dM), amb);
@@ -284,11 +284,19 @@ void UnitModel::AdvanceCohorts(const Cohorts& c, int n, double stretch, double d
     for (int b = 0; b < n_solve; b += kLanes) {
       int idx[kLanes];
       for (int l = 0; l < kLanes; ++l) idx[l] = solve[std::min(b + l, n_solve - 1)];
+#if defined(__AVX2__)
+      const __m128i vidx = _mm_loadu_si128(reinterpret_cast<const __m128i*>(idx));
+      const Vd all = Le(Splat(0), Splat(0));  // every lane
+      auto gather = [&](const double* a) {
+        return _mm256_mask_i32gather_pd(Splat(0), a, vidx, all, 8);
+      };
+#else
       auto gather = [&](const double* a) {
         alignas(32) double v[kLanes];
         for (int l = 0; l < kLanes; ++l) v[l] = a[idx[l]];
         return Load(v);
       };
+#endif
       Lanes L;
       L.heat = gather(heat);
       L.xi0 = gather(xi);
