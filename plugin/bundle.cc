@@ -229,16 +229,15 @@ namespace {
 // exact for one cohort.
 void CountWeightedSums(const double* count, const double* const* v, int nf, int k, double* out) {
   using V4 = double __attribute__((vector_size(32)));
-  auto load = [](const double* p) {
-    V4 x;
-    std::memcpy(&x, p, sizeof x);
-    return x;
-  };
   V4 acc[3] = {};
   int j = 0;
   for (; j + 4 <= k; j += 4) {
-    const V4 c = load(count + j);
-    for (int f = 0; f < nf; ++f) acc[f] += c * load(v[f] + j);
+    V4 c, x;
+    std::memcpy(&c, count + j, sizeof c);
+    for (int f = 0; f < nf; ++f) {
+      std::memcpy(&x, v[f] + j, sizeof x);
+      acc[f] += c * x;
+    }
   }
   for (int f = 0; f < nf; ++f) {
     double a[4];
