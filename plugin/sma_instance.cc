@@ -364,7 +364,7 @@ void SmaInstance::Advance(const mjModel* m, mjData* d) const {
     if (t + 0.5 * h >= next) {
       if (u != 0 && std::isfinite(u)) {
         const double p = std::min(1.0, std::abs(u));
-        act.model.Broadcast(s, u > 0 ? p : 0.0, u < 0 ? p : 0.0, stretch);
+        (void)act.model.Broadcast(s, u > 0 ? p : 0.0, u < 0 ? p : 0.0, stretch);  // p in [0, 1]
       }
       next = broadcast_period_ > 0
                  ? (std::floor((t + 0.5 * h) / broadcast_period_) + 1) * broadcast_period_

@@ -5,16 +5,22 @@
 // plugin/CMakeLists.txt), so each cohort's result is bit-identical to the scalar update.
 // Branches become lane masks; a lane whose Newton iteration has stopped keeps its values while
 // the others continue.
-#include <algorithm>
+#include "plugin/unit_batch.h"
+
 #include <cstring>
 
 #include "plugin/unit_model.h"
+
+// batch_base in the normal compile, batch_avx2 in the AVX2 clone (plugin/CMakeLists.txt).
+#ifndef RECRUIT_SMA_BATCH_NS
+#define RECRUIT_SMA_BATCH_NS batch_base
+#endif
 
 #if defined(__SSE2__)
 #include <immintrin.h>
 #endif
 
-namespace recruit::sma {
+namespace recruit::sma::RECRUIT_SMA_BATCH_NS {
 namespace {
 
 #pragma GCC diagnostic push
@@ -103,6 +109,27 @@ struct Consts {
   Vd stretch_L, stretch, latent, pn_h, pn_c;
   Vd As, Af, Ms, Mf, heat_rate, cool_rate;
 };
+
+inline Consts MakeConsts(const BatchParams& p, double stretch) {
+  Consts k;
+  k.rigid = p.k_s <= 0;
+  k.k_A = Splat(p.k_A);
+  k.dk_w = Splat(p.k_M - p.k_A);
+  k.k_s = Splat(p.k_s);
+  k.k_s2_dk_w = Splat(p.k_s * p.k_s * (p.k_M - p.k_A));
+  k.stretch_L = Splat(p.stretch_L);
+  k.stretch = Splat(stretch);
+  k.latent = Splat(p.latent);
+  k.pn_h = Splat(p.pn_h);
+  k.pn_c = Splat(p.pn_c);
+  k.As = Splat(p.As);
+  k.Af = Splat(p.Af);
+  k.Ms = Splat(p.Ms);
+  k.Mf = Splat(p.Mf);
+  k.heat_rate = Splat(p.heat_rate);
+  k.cool_rate = Splat(p.cool_rate);
+  return k;
+}
 
 // UnitModel::Tension(x, stretch, &slope) lane by lane.
 inline Vd LaneTension(const Consts& c, Vd xi, Vd* slope) {
@@ -197,31 +224,16 @@ struct Block {
 // Cohorts in chunks of 64: (A) the thermal step, the branch test and the residual at xi_n for
 // all, kLanes at a time; cohorts that do not transform are finished there. (B) The phase solves
 // of those that do, gathered kLanes at a time.
-void UnitModel::AdvanceCohorts(const Cohorts& c, int n, double stretch, double decay) const {
+void AdvanceCohorts(const BatchParams& p, const BatchCohorts& c, int n, double stretch,
+                    double decay) {
   constexpr int kChunk = 64;
-  Consts k;
-  k.rigid = k_s_ <= 0;
-  k.k_A = Splat(k_A_);
-  k.dk_w = Splat(k_M_ - k_A_);
-  k.k_s = Splat(k_s_);
-  k.k_s2_dk_w = Splat(k_s_ * k_s_ * (k_M_ - k_A_));
-  k.stretch_L = Splat(stretch_L_);
-  k.stretch = Splat(stretch);
-  k.latent = Splat(latent_rise_);
-  k.pn_h = Splat(heat_shift_per_newton_);
-  k.pn_c = Splat(cool_shift_per_newton_);
-  k.As = Splat(p_.As);
-  k.Af = Splat(p_.Af);
-  k.Ms = Splat(p_.Ms);
-  k.Mf = Splat(p_.Mf);
-  k.heat_rate = Splat(heat_rate_);
-  k.cool_rate = Splat(cool_rate_);
-  const Vd amb = Splat(p_.ambient), rise_A = Splat(on_rise_A_), rise_dM = Splat(on_rise_dM_);
+  const Consts k = MakeConsts(p, stretch);
+  const Vd amb = Splat(p.ambient), rise_A = Splat(p.rise_A), rise_dM = Splat(p.rise_dM);
   const Vd vdecay = Splat(decay);
   alignas(32) double tth[kChunk], g0[kChunk], dg0[kChunk], heat[kChunk];
   int solve[kChunk];
   for (int base = 0; base < n; base += kChunk) {
-    const int m = std::min(kChunk, n - base);
+    const int m = n - base < kChunk ? n - base : kChunk;
     int n_solve = 0;
     // (A) on cohorts base + j .. base + j + kLanes - 1; `valid` has the bits of real lanes.
     auto phase_a = [&](const Block& b, int j, int valid) __attribute__((always_inline)) {
@@ -283,7 +295,7 @@ void UnitModel::AdvanceCohorts(const Cohorts& c, int n, double stretch, double d
     // (B) A short batch repeats its last cohort (same inputs, same result).
     for (int b = 0; b < n_solve; b += kLanes) {
       int idx[kLanes];
-      for (int l = 0; l < kLanes; ++l) idx[l] = solve[std::min(b + l, n_solve - 1)];
+      for (int l = 0; l < kLanes; ++l) idx[l] = solve[b + l < n_solve ? b + l : n_solve - 1];
 #if defined(__AVX2__)
       const __m128i vidx = _mm_loadu_si128(reinterpret_cast<const __m128i*>(idx));
       const Vd all = Le(Splat(0), Splat(0));  // every lane
@@ -335,14 +347,9 @@ void UnitModel::AdvanceCohorts(const Cohorts& c, int n, double stretch, double d
   }
 }
 
-double UnitModel::SumTension(const double* count, const double* xi, int n, double stretch) const {
-  Consts k;
-  k.rigid = k_s_ <= 0;
-  k.k_A = Splat(k_A_);
-  k.dk_w = Splat(k_M_ - k_A_);
-  k.k_s = Splat(k_s_);
-  k.stretch_L = Splat(stretch_L_);
-  k.stretch = Splat(stretch);
+double SumTension(const BatchParams& p, const double* count, const double* xi, int n,
+                  double stretch) {
+  const Consts k = MakeConsts(p, stretch);
   Vd acc = Splat(0);
   int j = 0;
   for (; j + kLanes <= n; j += kLanes) acc += Load(count + j) * TensionOnly(k, Load(xi + j));
@@ -363,4 +370,4 @@ double UnitModel::SumTension(const double* count, const double* xi, int n, doubl
 
 #pragma GCC diagnostic pop
 
-}  // namespace recruit::sma
+}  // namespace recruit::sma::RECRUIT_SMA_BATCH_NS

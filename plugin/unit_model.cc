@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <string>
 
+#include "plugin/unit_batch.h"
+
 namespace recruit::sma {
 namespace {
 
@@ -346,6 +348,67 @@ void ImposeTemperature(const UnitModel& m, UnitState& s, double t, double stretc
 void AdvanceUnitWithDecay(const UnitModel& m, UnitState& s, bool on, double stretch, double decay) {
   const double t_ss = m.SteadyTemperature(on, s.xi);
   SolvePhase(m, s, t_ss + (s.temperature - t_ss) * decay, stretch);
+}
+
+namespace {
+
+BatchParams ParamsOf(double k_A, double k_M, double k_s, double stretch_L, double latent,
+                     double pn_h, double pn_c, const UnitParams& p, double heat_rate,
+                     double cool_rate, double rise_A, double rise_dM) {
+  return {k_A,  k_M,  k_s,  stretch_L, latent,    pn_h,      pn_c,   p.As,
+          p.Af, p.Ms, p.Mf, heat_rate, cool_rate, p.ambient, rise_A, rise_dM};
+}
+
+bool UseAvx2(UnitModel::Isa isa) {
+#ifdef RECRUIT_SMA_AVX2_CLONE
+  if (isa == UnitModel::Isa::kBase) return false;
+  return UnitModel::HasAvx2();
+#else
+  return false;
+#endif
+}
+
+}  // namespace
+
+bool UnitModel::HasAvx2() {
+#ifdef RECRUIT_SMA_AVX2_CLONE
+  static const bool has = __builtin_cpu_supports("avx2");
+  return has;
+#else
+  return false;
+#endif
+}
+
+int UnitModel::Lanes(Isa isa) {
+  if (UseAvx2(isa)) return 4;
+#ifdef __AVX__
+  return 4;
+#else
+  return 2;
+#endif
+}
+
+void UnitModel::AdvanceCohorts(const Cohorts& c, int n, double stretch, double decay,
+                               Isa isa) const {
+  const BatchParams bp =
+      ParamsOf(k_A_, k_M_, k_s_, stretch_L_, latent_rise_, heat_shift_per_newton_,
+               cool_shift_per_newton_, p_, heat_rate_, cool_rate_, on_rise_A_, on_rise_dM_);
+  const BatchCohorts bc{c.on, c.temperature, c.xi, c.t_eff, c.heat_scale, c.cool_scale};
+#ifdef RECRUIT_SMA_AVX2_CLONE
+  if (UseAvx2(isa)) return batch_avx2::AdvanceCohorts(bp, bc, n, stretch, decay);
+#endif
+  batch_base::AdvanceCohorts(bp, bc, n, stretch, decay);
+}
+
+double UnitModel::SumTension(const double* count, const double* xi, int n, double stretch,
+                             Isa isa) const {
+  const BatchParams bp =
+      ParamsOf(k_A_, k_M_, k_s_, stretch_L_, latent_rise_, heat_shift_per_newton_,
+               cool_shift_per_newton_, p_, heat_rate_, cool_rate_, on_rise_A_, on_rise_dM_);
+#ifdef RECRUIT_SMA_AVX2_CLONE
+  if (UseAvx2(isa)) return batch_avx2::SumTension(bp, count, xi, n, stretch);
+#endif
+  return batch_base::SumTension(bp, count, xi, n, stretch);
 }
 
 }  // namespace recruit::sma

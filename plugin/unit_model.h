@@ -125,7 +125,7 @@ class UnitModel {
   // factor `decay` at extension `stretch`: lane by lane the same operations as
   // AdvanceUnitWithDecay, so the results are bit-identical to it (test
   // BatchedCohortUpdateIsBitIdenticalToScalarUpdate), but four cohorts at a time in SIMD lanes,
-  // the phase solves of the transforming cohorts gathered into full batches.
+  // the phase solves of the transforming cohorts gathered into full batches (unit_batch.cc).
   struct Cohorts {
     const double* on;  // 0 or 1
     double* temperature;
@@ -134,9 +134,17 @@ class UnitModel {
     double* heat_scale;
     double* cool_scale;
   };
-  void AdvanceCohorts(const Cohorts& c, int n, double stretch, double decay) const;
-  // Sum over n cohorts of count[j] * Tension(xi[j], stretch), four cohorts at a time.
-  double SumTension(const double* count, const double* xi, int n, double stretch) const;
+  // Kernel: kAuto = AVX2 when this build has the AVX2 clone and the CPU runs it, else the
+  // build's own instruction set (kBase). Tests run both.
+  enum class Isa { kAuto, kBase, kAvx2 };
+  void AdvanceCohorts(const Cohorts& c, int n, double stretch, double decay,
+                      Isa isa = Isa::kAuto) const;
+  // Sum over n cohorts of count[j] * Tension(xi[j], stretch), in SIMD lanes.
+  double SumTension(const double* count, const double* xi, int n, double stretch,
+                    Isa isa = Isa::kAuto) const;
+  // Whether kAvx2 is available (built and supported by the CPU); the lanes kAuto uses.
+  static bool HasAvx2();
+  static int Lanes(Isa isa = Isa::kAuto);
 
   // Natural convection (Morgan's horizontal-cylinder correlation, air at the film temperature)
   // plus linearised radiation, for a wire of diameter d at temperature excess dT over ambient.

@@ -2,11 +2,12 @@
 // the scalar per-cohort update it replaces in the bundle (AdvanceUnitWithDecay, kept as the
 // reference): bit-identical results, cohort by cohort, for random states and along trajectories
 // with random switching, across unit models and cohort counts that leave partial SIMD batches and
-// span several 64-cohort chunks.
+// span several 64-cohort chunks; for the build's own kernel and the AVX2 clone.
 #include <gtest/gtest.h>
 
 #include <cstring>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "common/rng.h"
@@ -48,14 +49,14 @@ struct Soa {
 
 // One batched step against the scalar step of every cohort; reports the first difference.
 ::testing::AssertionResult StepMatchesScalar(const UnitModel& m, Soa& soa, double stretch,
-                                             double decay) {
+                                             double decay, UnitModel::Isa isa) {
   const int n = static_cast<int>(soa.on.size());
   std::vector<UnitState> ref(n);
   for (int j = 0; j < n; ++j) {
     ref[j] = soa.Get(j);
     AdvanceUnitWithDecay(m, ref[j], soa.on[j] != 0, stretch, decay);
   }
-  m.AdvanceCohorts(soa.View(), n, stretch, decay);
+  m.AdvanceCohorts(soa.View(), n, stretch, decay, isa);
   for (int j = 0; j < n; ++j) {
     const UnitState b = soa.Get(j);
     if (!SameBits(b.temperature, ref[j].temperature) || !SameBits(b.xi, ref[j].xi) ||
@@ -71,12 +72,21 @@ struct Soa {
   return ::testing::AssertionSuccess();
 }
 
-class BatchedCohorts : public ::testing::TestWithParam<std::string> {};
+class BatchedCohorts : public ::testing::TestWithParam<std::tuple<std::string, UnitModel::Isa>> {
+ protected:
+  void SetUp() override {
+    if (isa() == UnitModel::Isa::kAvx2 && !UnitModel::HasAvx2()) {
+      GTEST_SKIP() << "no AVX2 kernel in this build or CPU";
+    }
+  }
+  const std::string& config() const { return std::get<0>(GetParam()); }
+  UnitModel::Isa isa() const { return std::get<1>(GetParam()); }
+};
 
 // Random states anywhere in and around the loop: ends (0, 1, within 1e-12 of them), inside the
 // transformation windows, above and below them, heating or cooling relative to T_eff.
 TEST_P(BatchedCohorts, RandomStatesAreBitIdenticalToScalarUpdate) {
-  const UnitModel m = MakeModel(GetParam());
+  const UnitModel m = MakeModel(config());
   const double e0 = m.params().prestretch;
   Rng rng(2024);
   int transforming = 0;
@@ -99,7 +109,7 @@ TEST_P(BatchedCohorts, RandomStatesAreBitIdenticalToScalarUpdate) {
       const double stretch = 1.5 * e0 * rng.Uniform();
       const double dt = trial % 3 == 0 ? 1e-3 : trial % 3 == 1 ? 1e-2 : 0.3;
       const std::vector<double> xi_before = soa.xi;
-      ASSERT_TRUE(StepMatchesScalar(m, soa, stretch, m.DecayFactor(dt)))
+      ASSERT_TRUE(StepMatchesScalar(m, soa, stretch, m.DecayFactor(dt), isa()))
           << "n " << n << " trial " << trial;
       for (int j = 0; j < n; ++j) transforming += soa.xi[j] != xi_before[j];
     }
@@ -110,7 +120,7 @@ TEST_P(BatchedCohorts, RandomStatesAreBitIdenticalToScalarUpdate) {
 // Trajectories: 70 cohorts switched at random every 0.3 s for 30 s, batched and scalar updates
 // compared after every step (states stay on the physical loop, minor loops included).
 TEST_P(BatchedCohorts, SwitchingTrajectoriesAreBitIdenticalToScalarUpdate) {
-  const UnitModel m = MakeModel(GetParam());
+  const UnitModel m = MakeModel(config());
   const double stretch = m.params().prestretch;
   const int n = 70;
   Soa soa(n);
@@ -126,22 +136,26 @@ TEST_P(BatchedCohorts, SwitchingTrajectoriesAreBitIdenticalToScalarUpdate) {
       }
     }
     const std::vector<double> xi_before = soa.xi;
-    ASSERT_TRUE(StepMatchesScalar(m, soa, stretch, decay)) << "step " << step;
+    ASSERT_TRUE(StepMatchesScalar(m, soa, stretch, decay, isa())) << "step " << step;
     solved_steps += soa.xi != xi_before;
   }
   EXPECT_GT(solved_steps, 10000);
 }
 
-INSTANTIATE_TEST_SUITE_P(Units, BatchedCohorts,
-                         ::testing::Values("",                          // datasheet wire unit
-                                           "series_spring=0",           // rigid: no series spring
-                                           "law=spring current=0.235",  // coiled spring
-                                           "parallel=2 series=3", "latent_heat=0"));
+INSTANTIATE_TEST_SUITE_P(
+    Units, BatchedCohorts,
+    ::testing::Combine(::testing::Values("",                          // datasheet wire unit
+                                         "series_spring=0",           // rigid: no series spring
+                                         "law=spring current=0.235",  // coiled spring
+                                         "parallel=2 series=3", "latent_heat=0"),
+                       ::testing::Values(UnitModel::Isa::kBase, UnitModel::Isa::kAvx2)));
 
 // The tension sum over cohorts against the scalar sum of count * Tension: the same to rounding
 // of the summation order (four partial sums), exactly for one cohort.
-TEST(BatchedCohorts, SumTensionMatchesScalarSum) {
+TEST(BatchedCohortSums, SumTensionMatchesScalarSum) {
   const UnitModel m = MakeModel("");
+  std::vector<UnitModel::Isa> isas = {UnitModel::Isa::kBase};
+  if (UnitModel::HasAvx2()) isas.push_back(UnitModel::Isa::kAvx2);
   Rng rng(3);
   for (int n : {1, 2, 3, 5, 8, 33, 300}) {
     std::vector<double> count(n), xi(n);
@@ -152,11 +166,13 @@ TEST(BatchedCohorts, SumTensionMatchesScalarSum) {
     for (double stretch : {0.0, 1e-3, 4e-3, 6e-3}) {
       double ref = 0;
       for (int j = 0; j < n; ++j) ref += count[j] * m.Tension(xi[j], stretch);
-      const double got = m.SumTension(count.data(), xi.data(), n, stretch);
-      if (n == 1) {
-        EXPECT_TRUE(SameBits(got, ref)) << got << " vs " << ref;
-      } else {
-        EXPECT_NEAR(got, ref, 1e-14 * (1 + ref)) << "n " << n << " stretch " << stretch;
+      for (UnitModel::Isa isa : isas) {
+        const double got = m.SumTension(count.data(), xi.data(), n, stretch, isa);
+        if (n == 1) {
+          EXPECT_TRUE(SameBits(got, ref)) << got << " vs " << ref;
+        } else {
+          EXPECT_NEAR(got, ref, 1e-14 * (1 + ref)) << "n " << n << " stretch " << stretch;
+        }
       }
     }
   }
