@@ -222,37 +222,10 @@ double SmaBundle::Tension(const double* s, double stretch) const {
   return unit_.SumTension(Field(s, kCount), Field(s, kXi), NumCohorts(s), stretch);
 }
 
-namespace {
-
-// Sums over the k cohorts of count[j] * v[f][j] for nf fields, each in four partial sums (lane
-// j mod 4, in a vector: one register with AVX, two with SSE2) added as (a0 + a1) + (a2 + a3):
-// exact for one cohort.
-void CountWeightedSums(const double* count, const double* const* v, int nf, int k, double* out) {
-  using V4 = double __attribute__((vector_size(32)));
-  V4 acc[3] = {};
-  int j = 0;
-  for (; j + 4 <= k; j += 4) {
-    V4 c, x;
-    std::memcpy(&c, count + j, sizeof c);
-    for (int f = 0; f < nf; ++f) {
-      std::memcpy(&x, v[f] + j, sizeof x);
-      acc[f] += c * x;
-    }
-  }
-  for (int f = 0; f < nf; ++f) {
-    double a[4];
-    std::memcpy(a, &acc[f], sizeof a);
-    for (int l = 0; j + l < k; ++l) a[l] += count[j + l] * v[f][j + l];
-    out[f] = (a[0] + a[1]) + (a[2] + a[3]);
-  }
-}
-
-}  // namespace
-
 double SmaBundle::CountWeightedSum(const double* s, int f) const {
   const double* v[1] = {Field(s, f)};
   double sum;
-  CountWeightedSums(Field(s, kCount), v, 1, NumCohorts(s), &sum);
+  UnitModel::WeightedSums(Field(s, kCount), v, 1, NumCohorts(s), &sum);
   return sum;
 }
 
@@ -260,7 +233,7 @@ SmaBundle::Summary SmaBundle::Summarize(const double* s, double stretch) const {
   const int k = NumCohorts(s);
   const double* v[3] = {Field(s, kOn), Field(s, kTemp), Field(s, kXi)};
   double sum[3];
-  CountWeightedSums(Field(s, kCount), v, 3, k, sum);
+  UnitModel::WeightedSums(Field(s, kCount), v, 3, k, sum);
   Summary r;
   r.on_count = static_cast<int>(sum[0]);
   r.tension = Tension(s, stretch);

@@ -42,6 +42,12 @@ inline Vd Or(Vd a, Vd b) { return _mm256_or_pd(a, b); }
 inline Vd AndNot(Vd a, Vd b) { return _mm256_andnot_pd(b, a); }  // a & ~b
 inline Vd Sel(Vd m, Vd a, Vd b) { return _mm256_blendv_pd(b, a, m); }
 inline int Bits(Vd m) { return _mm256_movemask_pd(m); }
+// The first n < 4 lanes only (the others load as 0, are not stored; no access beyond them).
+inline __m256i FirstLanes(int n) {
+  return _mm256_castpd_si256(_mm256_cmp_pd(_mm256_setr_pd(0, 1, 2, 3), Splat(n), _CMP_LT_OQ));
+}
+inline Vd LoadN(const double* p, int n) { return _mm256_maskload_pd(p, FirstLanes(n)); }
+inline void StoreN(double* p, Vd v, int n) { _mm256_maskstore_pd(p, FirstLanes(n), v); }
 #elif defined(__SSE2__)
 constexpr int kLanes = 2;
 using Vd = __m128d;
@@ -56,6 +62,9 @@ inline Vd Or(Vd a, Vd b) { return _mm_or_pd(a, b); }
 inline Vd AndNot(Vd a, Vd b) { return _mm_andnot_pd(b, a); }  // a & ~b
 inline Vd Sel(Vd m, Vd a, Vd b) { return _mm_or_pd(_mm_and_pd(m, a), _mm_andnot_pd(m, b)); }
 inline int Bits(Vd m) { return _mm_movemask_pd(m); }
+// The first lane only (n = 1; the other loads as 0, is not stored).
+inline Vd LoadN(const double* p, int) { return _mm_load_sd(p); }
+inline void StoreN(double* p, Vd v, int) { _mm_storel_pd(p, v); }
 #else  // generic vectors (GCC / Clang extension)
 constexpr int kLanes = 2;
 using Vd = double __attribute__((vector_size(16)));
@@ -77,6 +86,8 @@ inline Vd Or(Vd a, Vd b) { return Bit(Int(a) | Int(b)); }
 inline Vd AndNot(Vd a, Vd b) { return Bit(Int(a) & ~Int(b)); }
 inline Vd Sel(Vd m, Vd a, Vd b) { return Or(And(m, a), AndNot(b, m)); }
 inline int Bits(Vd m) { return (Int(m)[0] != 0 ? 1 : 0) | (Int(m)[1] != 0 ? 2 : 0); }
+inline Vd LoadN(const double* p, int) { return Vd{p[0], 0}; }
+inline void StoreN(double* p, Vd v, int) { p[0] = v[0]; }
 #endif
 
 constexpr int kAll = (1 << kLanes) - 1;
@@ -208,7 +219,7 @@ inline void Canonical(Vd* xi, Vd* hs, Vd* cs) {
   *cs = Sel(top, Splat(0), Sel(low, Splat(1), *cs));
 }
 
-// kLanes consecutive cohorts' fields (in the caller's arrays, or a padded copy of the tail).
+// kLanes consecutive cohorts' fields in the caller's arrays (the tail: fewer, masked).
 struct Block {
   const double* on;
   double *temperature, *xi, *t_eff, *heat_scale, *cool_scale;
@@ -231,20 +242,29 @@ void AdvanceCohorts(const BatchParams& p, const BatchCohorts& c, int n, double s
   const Vd amb = Splat(p.ambient), rise_A = Splat(p.rise_A), rise_dM = Splat(p.rise_dM);
   const Vd vdecay = Splat(decay);
   alignas(32) double tth[kChunk], g0[kChunk], dg0[kChunk], heat[kChunk];
-  int solve[kChunk];
+  int solve[kChunk + kLanes];
   for (int base = 0; base < n; base += kChunk) {
     const int m = n - base < kChunk ? n - base : kChunk;
     int n_solve = 0;
     // (A) on cohorts base + j .. base + j + kLanes - 1; `valid` has the bits of real lanes.
-    auto phase_a = [&](const Block& b, int j, int valid) __attribute__((always_inline)) {
-      const Vd xi0 = Load(b.xi), hs0 = Load(b.heat_scale), cs0 = Load(b.cool_scale);
-      const Vd T0 = Load(b.temperature);
-      const Vd t_ss = Sel(Ne(Load(b.on), Splat(0)), amb + (rise_A + xi0 * rise_dM), amb);
+    // The block's `count` lanes are real cohorts (kLanes but at the tail); others are zeros.
+    auto phase_a = [&](const Block& b, int j, int count) __attribute__((always_inline)) {
+      auto load = [count](const double* p) { return count == kLanes ? Load(p) : LoadN(p, count); };
+      auto store = [count](double* p, Vd v) {
+        if (count == kLanes) {
+          Store(p, v);
+        } else {
+          StoreN(p, v, count);
+        }
+      };
+      const Vd xi0 = load(b.xi), hs0 = load(b.heat_scale), cs0 = load(b.cool_scale);
+      const Vd T0 = load(b.temperature);
+      const Vd t_ss = Sel(Ne(load(b.on), Splat(0)), amb + (rise_A + xi0 * rise_dM), amb);
       const Vd t_th = t_ss + (T0 - t_ss) * vdecay;
       Vd dfdx0;
       const Vd f0 = LaneTension(k, xi0, &dfdx0);
       const Vd te_h0 = t_th - k.pn_h * f0;
-      const Vd is_heat = Ge(te_h0, Load(b.t_eff));
+      const Vd is_heat = Ge(te_h0, load(b.t_eff));
       const Vd te0 = Sel(is_heat, te_h0, t_th - k.pn_c * f0);
       const Vd pn = Sel(is_heat, k.pn_h, k.pn_c);
       Vd slope;
@@ -257,16 +277,16 @@ void AdvanceCohorts(const BatchParams& p, const BatchCohorts& c, int n, double s
       // old values until (B).
       Vd x = xi0, h = hs0, cl = cs0;
       Canonical(&x, &h, &cl);
-      Store(b.temperature, Sel(tr, T0, t_th + k.latent * (x - xi0)));
-      Store(b.xi, Sel(tr, xi0, x));
-      Store(b.t_eff, te0);
-      Store(b.heat_scale, Sel(tr, hs0, h));
-      Store(b.cool_scale, Sel(tr, cs0, cl));
+      store(b.temperature, Sel(tr, T0, t_th + k.latent * (x - xi0)));
+      store(b.xi, Sel(tr, xi0, x));
+      store(b.t_eff, te0);
+      store(b.heat_scale, Sel(tr, hs0, h));
+      store(b.cool_scale, Sel(tr, cs0, cl));
       Store(tth + j, t_th);
       Store(g0 + j, g);
       Store(dg0 + j, dg);
       Store(heat + j, is_heat);
-      for (int bits = Bits(tr) & valid; bits != 0; bits &= bits - 1) {
+      for (int bits = Bits(tr) & ((1 << count) - 1); bits != 0; bits &= bits - 1) {
         solve[n_solve++] = j + __builtin_ctz(bits);
       }
     };
@@ -278,24 +298,13 @@ void AdvanceCohorts(const BatchParams& p, const BatchCohorts& c, int n, double s
     double* const cs = c.cool_scale + base;
     int j = 0;
     for (; j + kLanes <= m; j += kLanes) {
-      phase_a(Block{on + j, T + j, xi + j, te + j, hs + j, cs + j}, j, kAll);
+      phase_a(Block{on + j, T + j, xi + j, te + j, hs + j, cs + j}, j, kLanes);
     }
-    if (j < m) {  // the tail through a padded copy (padding repeats the tail's first cohort)
-      alignas(32) double pad[6][kLanes];
-      const double* const src[6] = {on, T, xi, te, hs, cs};
-      double* const dst[5] = {T, xi, te, hs, cs};
-      for (int f = 0; f < 6; ++f) {
-        for (int l = 0; l < kLanes; ++l) pad[f][l] = src[f][j + l < m ? j + l : j];
-      }
-      phase_a(Block{pad[0], pad[1], pad[2], pad[3], pad[4], pad[5]}, j, (1 << (m - j)) - 1);
-      for (int f = 0; f < 5; ++f) {
-        for (int l = 0; j + l < m; ++l) dst[f][j + l] = pad[f + 1][l];
-      }
-    }
+    if (j < m) phase_a(Block{on + j, T + j, xi + j, te + j, hs + j, cs + j}, j, m - j);
     // (B) A short batch repeats its last cohort (same inputs, same result).
+    for (int l = n_solve; l % kLanes != 0; ++l) solve[l] = solve[n_solve - 1];
     for (int b = 0; b < n_solve; b += kLanes) {
-      int idx[kLanes];
-      for (int l = 0; l < kLanes; ++l) idx[l] = solve[b + l < n_solve ? b + l : n_solve - 1];
+      const int* const idx = solve + b;
 #if defined(__AVX2__)
       const __m128i vidx = _mm_loadu_si128(reinterpret_cast<const __m128i*>(idx));
       const Vd all = Le(Splat(0), Splat(0));  // every lane
@@ -366,6 +375,28 @@ double SumTension(const BatchParams& p, const double* count, const double* xi, i
   double sum = 0;  // lane 0 first: exact for one cohort (the other lanes hold zeros)
   for (int l = 0; l < kLanes; ++l) sum += lanes[l];
   return sum;
+}
+
+void WeightedSums(const double* count, const double* const* v, int nf, int n, double* out) {
+  // Four partial sums per field: one register with AVX, two with SSE2.
+  constexpr int kRegs = 4 / kLanes;
+  Vd acc[3][kRegs];
+  for (int f = 0; f < 3; ++f) {
+    for (int r = 0; r < kRegs; ++r) acc[f][r] = Splat(0);
+  }
+  int j = 0;
+  for (; j + 4 <= n; j += 4) {
+    for (int r = 0; r < kRegs; ++r) {
+      const Vd c = Load(count + j + r * kLanes);
+      for (int f = 0; f < nf; ++f) acc[f][r] += c * Load(v[f] + j + r * kLanes);
+    }
+  }
+  for (int f = 0; f < nf; ++f) {
+    alignas(32) double a[4];
+    for (int r = 0; r < kRegs; ++r) Store(a + r * kLanes, acc[f][r]);
+    for (int l = 0; j + l < n; ++l) a[l] += count[j + l] * v[f][j + l];
+    out[f] = (a[0] + a[1]) + (a[2] + a[3]);
+  }
 }
 
 #pragma GCC diagnostic pop

@@ -22,11 +22,15 @@ struct BatchCohorts {
   double *temperature, *xi, *t_eff, *heat_scale, *cool_scale;
 };
 
+// Kernels: AdvanceCohorts and SumTension as UnitModel's; WeightedSums sets out[f] to the sum
+// over j < n of count[j] * v[f][j] for f < nf <= 3, in four partial sums (lane j mod 4) added as
+// (s0 + s1) + (s2 + s3): the same in both clones, exact for one cohort.
 namespace batch_base {
 void AdvanceCohorts(const BatchParams& p, const BatchCohorts& c, int n, double stretch,
                     double decay);
 double SumTension(const BatchParams& p, const double* count, const double* xi, int n,
                   double stretch);
+void WeightedSums(const double* count, const double* const* v, int nf, int n, double* out);
 }  // namespace batch_base
 
 #ifdef RECRUIT_SMA_AVX2_CLONE
@@ -35,6 +39,7 @@ void AdvanceCohorts(const BatchParams& p, const BatchCohorts& c, int n, double s
                     double decay);
 double SumTension(const BatchParams& p, const double* count, const double* xi, int n,
                   double stretch);
+void WeightedSums(const double* count, const double* const* v, int nf, int n, double* out);
 }  // namespace batch_avx2
 #endif
 

@@ -157,6 +157,22 @@ Result<UnitModel> UnitModel::Create(const UnitParams& p) {
   m.on_power_dM_ = joule * (p.resistivity_M - p.resistivity_A);
   m.on_rise_A_ = m.on_power_A_ / m.conductance_;
   m.on_rise_dM_ = m.on_power_dM_ / m.conductance_;
+  m.batch_ = {m.k_A_,
+              m.k_M_,
+              m.k_s_,
+              m.stretch_L_,
+              m.latent_rise_,
+              m.heat_shift_per_newton_,
+              m.cool_shift_per_newton_,
+              p.As,
+              p.Af,
+              p.Ms,
+              p.Mf,
+              m.heat_rate_,
+              m.cool_rate_,
+              p.ambient,
+              m.on_rise_A_,
+              m.on_rise_dM_};
   return m;
 }
 
@@ -352,13 +368,6 @@ void AdvanceUnitWithDecay(const UnitModel& m, UnitState& s, bool on, double stre
 
 namespace {
 
-BatchParams ParamsOf(double k_A, double k_M, double k_s, double stretch_L, double latent,
-                     double pn_h, double pn_c, const UnitParams& p, double heat_rate,
-                     double cool_rate, double rise_A, double rise_dM) {
-  return {k_A,  k_M,  k_s,  stretch_L, latent,    pn_h,      pn_c,   p.As,
-          p.Af, p.Ms, p.Mf, heat_rate, cool_rate, p.ambient, rise_A, rise_dM};
-}
-
 bool UseAvx2(UnitModel::Isa isa) {
 #ifdef RECRUIT_SMA_AVX2_CLONE
   if (isa == UnitModel::Isa::kBase) return false;
@@ -390,9 +399,7 @@ int UnitModel::Lanes(Isa isa) {
 
 void UnitModel::AdvanceCohorts(const Cohorts& c, int n, double stretch, double decay,
                                Isa isa) const {
-  const BatchParams bp =
-      ParamsOf(k_A_, k_M_, k_s_, stretch_L_, latent_rise_, heat_shift_per_newton_,
-               cool_shift_per_newton_, p_, heat_rate_, cool_rate_, on_rise_A_, on_rise_dM_);
+  const BatchParams& bp = batch_;
   const BatchCohorts bc{c.on, c.temperature, c.xi, c.t_eff, c.heat_scale, c.cool_scale};
 #ifdef RECRUIT_SMA_AVX2_CLONE
   if (UseAvx2(isa)) return batch_avx2::AdvanceCohorts(bp, bc, n, stretch, decay);
@@ -402,13 +409,19 @@ void UnitModel::AdvanceCohorts(const Cohorts& c, int n, double stretch, double d
 
 double UnitModel::SumTension(const double* count, const double* xi, int n, double stretch,
                              Isa isa) const {
-  const BatchParams bp =
-      ParamsOf(k_A_, k_M_, k_s_, stretch_L_, latent_rise_, heat_shift_per_newton_,
-               cool_shift_per_newton_, p_, heat_rate_, cool_rate_, on_rise_A_, on_rise_dM_);
+  const BatchParams& bp = batch_;
 #ifdef RECRUIT_SMA_AVX2_CLONE
   if (UseAvx2(isa)) return batch_avx2::SumTension(bp, count, xi, n, stretch);
 #endif
   return batch_base::SumTension(bp, count, xi, n, stretch);
+}
+
+void UnitModel::WeightedSums(const double* count, const double* const* v, int nf, int n,
+                             double* out) {
+#ifdef RECRUIT_SMA_AVX2_CLONE
+  if (UseAvx2(Isa::kAuto)) return batch_avx2::WeightedSums(count, v, nf, n, out);
+#endif
+  batch_base::WeightedSums(count, v, nf, n, out);
 }
 
 }  // namespace recruit::sma

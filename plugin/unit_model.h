@@ -6,6 +6,7 @@
 #include <string>
 
 #include "common/result.h"
+#include "plugin/unit_batch.h"
 
 namespace recruit::sma {
 
@@ -142,6 +143,9 @@ class UnitModel {
   // Sum over n cohorts of count[j] * Tension(xi[j], stretch), in SIMD lanes.
   double SumTension(const double* count, const double* xi, int n, double stretch,
                     Isa isa = Isa::kAuto) const;
+  // Sets out[f] = sum over j < n of count[j] * v[f][j] for f < nf <= 3, in four partial sums
+  // (s0 + s1) + (s2 + s3) of cohorts j mod 4: exact for one cohort.
+  static void WeightedSums(const double* count, const double* const* v, int nf, int n, double* out);
   // Whether kAvx2 is available (built and supported by the CPU); the lanes kAuto uses.
   static bool HasAvx2();
   static int Lanes(Isa isa = Isa::kAuto);
@@ -162,6 +166,7 @@ class UnitModel {
   double latent_rise_ = 0, heat_shift_per_newton_ = 0, cool_shift_per_newton_ = 0;
   double on_power_A_ = 0, on_power_dM_ = 0;  // Joule power (W) in austenite; M minus A
   double on_rise_A_ = 0, on_rise_dM_ = 0;    // the same over the conductance (K)
+  BatchParams batch_{};  // the constants above as the batched kernels take them (Create)
 };
 
 // sin and cos of an angle a in [0, pi] (the cosine curves' range), as a polynomial: with
