@@ -358,23 +358,30 @@ void AdvanceCohorts(const BatchParams& p, const BatchCohorts& c, int n, double s
 
 double SumTension(const BatchParams& p, const double* count, const double* xi, int n,
                   double stretch) {
+  // Four partial sums (cohort j mod 4; one register with AVX, two with SSE2), added as
+  // (s0 + s1) + (s2 + s3): the same value in both clones.
+  constexpr int kRegs = 4 / kLanes;
   const Consts k = MakeConsts(p, stretch);
-  Vd acc = Splat(0);
+  Vd acc[kRegs];
+  for (int r = 0; r < kRegs; ++r) acc[r] = Splat(0);
   int j = 0;
-  for (; j + kLanes <= n; j += kLanes) acc += Load(count + j) * TensionOnly(k, Load(xi + j));
-  if (j < n) {
-    alignas(32) double cnt[kLanes], x[kLanes];
-    for (int l = 0; l < kLanes; ++l) {
-      cnt[l] = j + l < n ? count[j + l] : 0;
-      x[l] = j + l < n ? xi[j + l] : 1;
+  for (; j + 4 <= n; j += 4) {
+    for (int r = 0; r < kRegs; ++r) {
+      const int i = j + r * kLanes;
+      acc[r] += Load(count + i) * TensionOnly(k, Load(xi + i));
     }
-    acc += Load(cnt) * TensionOnly(k, Load(x));
   }
-  alignas(32) double lanes[kLanes];
-  Store(lanes, acc);
-  double sum = 0;  // lane 0 first: exact for one cohort (the other lanes hold zeros)
-  for (int l = 0; l < kLanes; ++l) sum += lanes[l];
-  return sum;
+  alignas(32) double a[4];
+  for (int r = 0; r < kRegs; ++r) Store(a + r * kLanes, acc[r]);
+  if (j < n) {
+    alignas(32) double cnt[4] = {0, 0, 0, 0}, x[4] = {1, 1, 1, 1}, f[4];
+    for (int l = 0; j + l < n; ++l) cnt[l] = count[j + l], x[l] = xi[j + l];
+    for (int r = 0; r < kRegs; ++r) {
+      Store(f + r * kLanes, Load(cnt + r * kLanes) * TensionOnly(k, Load(x + r * kLanes)));
+    }
+    for (int l = 0; l < 4; ++l) a[l] += f[l];
+  }
+  return (a[0] + a[1]) + (a[2] + a[3]);
 }
 
 void WeightedSums(const double* count, const double* const* v, int nf, int n, double* out) {

@@ -399,6 +399,13 @@ int UnitModel::Lanes(Isa isa) {
 
 void UnitModel::AdvanceCohorts(const Cohorts& c, int n, double stretch, double decay,
                                Isa isa) const {
+  if (n == 1 && isa == Isa::kAuto) {  // one cohort (units switched together): the scalar update
+    UnitState s{c.temperature[0], c.xi[0], c.t_eff[0], c.heat_scale[0], c.cool_scale[0]};
+    AdvanceUnitWithDecay(*this, s, c.on[0] != 0, stretch, decay);
+    c.temperature[0] = s.temperature, c.xi[0] = s.xi, c.t_eff[0] = s.t_eff;
+    c.heat_scale[0] = s.heat_scale, c.cool_scale[0] = s.cool_scale;
+    return;
+  }
   const BatchParams& bp = batch_;
   const BatchCohorts bc{c.on, c.temperature, c.xi, c.t_eff, c.heat_scale, c.cool_scale};
 #ifdef RECRUIT_SMA_AVX2_CLONE
@@ -409,6 +416,11 @@ void UnitModel::AdvanceCohorts(const Cohorts& c, int n, double stretch, double d
 
 double UnitModel::SumTension(const double* count, const double* xi, int n, double stretch,
                              Isa isa) const {
+  if (n < 4 && isa == Isa::kAuto) {  // the kernels' four partial sums, without the kernel
+    double a[4] = {0, 0, 0, 0};
+    for (int j = 0; j < n; ++j) a[j] += count[j] * Tension(xi[j], stretch);
+    return (a[0] + a[1]) + (a[2] + a[3]);
+  }
   const BatchParams& bp = batch_;
 #ifdef RECRUIT_SMA_AVX2_CLONE
   if (UseAvx2(isa)) return batch_avx2::SumTension(bp, count, xi, n, stretch);
@@ -418,6 +430,14 @@ double UnitModel::SumTension(const double* count, const double* xi, int n, doubl
 
 void UnitModel::WeightedSums(const double* count, const double* const* v, int nf, int n,
                              double* out) {
+  if (n < 4) {  // the kernels' four partial sums, without the kernel
+    for (int f = 0; f < nf; ++f) {
+      double a[4] = {0, 0, 0, 0};
+      for (int j = 0; j < n; ++j) a[j] += count[j] * v[f][j];
+      out[f] = (a[0] + a[1]) + (a[2] + a[3]);
+    }
+    return;
+  }
 #ifdef RECRUIT_SMA_AVX2_CLONE
   if (UseAvx2(Isa::kAuto)) return batch_avx2::WeightedSums(count, v, nf, n, out);
 #endif
