@@ -13,6 +13,12 @@ namespace {
 
 constexpr double kMagic = 5318008.25;  // marks an initialised block (mj_resetData zeroes it)
 
+// A cohort's merge sort key: on/off state, then temperature.
+struct MergeKey {
+  double on, temp;
+  int index;
+};
+
 Rng LoadRng(const double* words) {
   Rng::State st;
   std::memcpy(st.data(), words, sizeof st);
@@ -148,24 +154,31 @@ void SmaBundle::Integrate(double* s, double stretch, double dt) const {
 
 void SmaBundle::Merge(double* s) const {
   const int k = NumCohorts(s);
-  // Reused scratch (one per thread: bundles may step in parallel on their own mjData).
+  // Scratch on the stack up to 64 cohorts, else reused per thread (bundles may step in
+  // parallel on their own mjData).
+  constexpr int kSmall = 64;
+  MergeKey small_order[kSmall];
+  int small_forward[kSmall], small_remap[kSmall];
+  static thread_local std::vector<MergeKey> big_order;
+  static thread_local std::vector<int> big_forward, big_remap;
+  if (k > kSmall) {
+    big_order.resize(k);
+    big_forward.resize(k);
+    big_remap.resize(k);
+  }
+  MergeKey* const order = k > kSmall ? big_order.data() : small_order;
+  int* const forward = k > kSmall ? big_forward.data() : small_forward;
+  int* const remap = k > kSmall ? big_remap.data() : small_remap;
   // Sorted by (on, T) as keys held by value: std::sort's moves depend only on the comparisons,
   // so the order (ties included) is that of sorting the indices with the same comparator.
-  struct Key {
-    double on, temp;
-    int index;
-  };
-  static thread_local std::vector<Key> order;
-  static thread_local std::vector<int> forward;
   const double *on = Field(s, kOn), *temp = Field(s, kTemp);
-  order.resize(k);
   for (int j = 0; j < k; ++j) order[j] = {on[j], temp[j], j};
-  std::sort(order.begin(), order.end(), [](const Key& a, const Key& b) {
+  std::sort(order, order + k, [](const MergeKey& a, const MergeKey& b) {
     if (a.on != b.on) return a.on < b.on;
     return a.temp < b.temp;
   });
   bool merged = false;
-  forward.assign(k, -1);  // representative that absorbed each merged cohort
+  std::fill(forward, forward + k, -1);  // representative that absorbed each merged cohort
   double* count = Field(s, kCount);
   double* f[kFields];
   for (int i = 0; i < kFields; ++i) f[i] = Field(s, i);
@@ -190,24 +203,21 @@ void SmaBundle::Merge(double* s) const {
     forward[c] = rep;
     merged = true;
   }
-  if (merged) Compact(s, forward);
+  if (merged) Compact(s, forward, remap);
 }
 
-void SmaBundle::Compact(double* s, const std::vector<int>& forward) const {
+void SmaBundle::Compact(double* s, const int* forward, int* remap) const {
   const int k = NumCohorts(s);
   // New index for each surviving cohort; a merged cohort forwards its units to its
   // representative.
   const double* count = Field(s, kCount);
-  static thread_local std::vector<int> remap;
-  remap.assign(k, -1);
+  std::fill(remap, remap + k, -1);
   int n = 0;
   for (int j = 0; j < k; ++j) {
     if (count[j] > 0) remap[j] = n++;
   }
   for (int j = 0; j < k; ++j) {
-    if (remap[j] < 0 && j < static_cast<int>(forward.size()) && forward[j] >= 0) {
-      remap[j] = remap[forward[j]];
-    }
+    if (remap[j] < 0 && forward[j] >= 0) remap[j] = remap[forward[j]];
   }
   double* idx = UnitIndex(s);
   for (int i = 0; i < config_.units; ++i) idx[i] = remap[static_cast<int>(idx[i])];

@@ -108,8 +108,8 @@ class SmaBundle {
   void Flush(double* s, double stretch) const;
   void Integrate(double* s, double stretch, double dt) const;
   // Drops cohorts with count 0 and relabels units; forward[j] >= 0 sends the units of an
-  // emptied cohort j to cohort forward[j].
-  void Compact(double* s, const std::vector<int>& forward) const;
+  // emptied cohort j to cohort forward[j] (k entries); remap: k ints of scratch.
+  void Compact(double* s, const int* forward, int* remap) const;
 
   BundleConfig config_;
   UnitModel unit_;

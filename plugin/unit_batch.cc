@@ -384,26 +384,37 @@ double SumTension(const BatchParams& p, const double* count, const double* xi, i
   return (a[0] + a[1]) + (a[2] + a[3]);
 }
 
-void WeightedSums(const double* count, const double* const* v, int nf, int n, double* out) {
+namespace {
+
+// WeightedSums for NF fields (unrolled).
+template <int NF>
+void Sums(const double* count, const double* const* v, int n, double* out) {
   // Four partial sums per field: one register with AVX, two with SSE2.
   constexpr int kRegs = 4 / kLanes;
-  Vd acc[3][kRegs];
-  for (int f = 0; f < 3; ++f) {
+  Vd acc[NF][kRegs];
+  for (int f = 0; f < NF; ++f) {
     for (int r = 0; r < kRegs; ++r) acc[f][r] = Splat(0);
   }
   int j = 0;
   for (; j + 4 <= n; j += 4) {
     for (int r = 0; r < kRegs; ++r) {
       const Vd c = Load(count + j + r * kLanes);
-      for (int f = 0; f < nf; ++f) acc[f][r] += c * Load(v[f] + j + r * kLanes);
+      for (int f = 0; f < NF; ++f) acc[f][r] += c * Load(v[f] + j + r * kLanes);
     }
   }
-  for (int f = 0; f < nf; ++f) {
+  for (int f = 0; f < NF; ++f) {
     alignas(32) double a[4];
     for (int r = 0; r < kRegs; ++r) Store(a + r * kLanes, acc[f][r]);
     for (int l = 0; j + l < n; ++l) a[l] += count[j + l] * v[f][j + l];
     out[f] = (a[0] + a[1]) + (a[2] + a[3]);
   }
+}
+
+}  // namespace
+
+void WeightedSums(const double* count, const double* const* v, int nf, int n, double* out) {
+  if (nf == 3) return Sums<3>(count, v, n, out);
+  for (int f = 0; f < nf; ++f) Sums<1>(count, v + f, n, out + f);
 }
 
 #pragma GCC diagnostic pop
