@@ -220,7 +220,7 @@ void SmaBundle::Compact(double* s, const int* forward, int* remap) const {
     if (remap[j] < 0 && forward[j] >= 0) remap[j] = remap[forward[j]];
   }
   double* idx = UnitIndex(s);
-  for (int i = 0; i < config_.units; ++i) idx[i] = remap[static_cast<int>(idx[i])];
+  UnitModel::Relabel(idx, config_.units, remap);
   // remap[j] <= j for survivors: copying in increasing j never overwrites one not yet moved.
   for (int j = 0; j < k; ++j) {
     if (count[j] > 0 && remap[j] != j) CopyCohort(s, j, remap[j]);

@@ -417,6 +417,17 @@ void WeightedSums(const double* count, const double* const* v, int nf, int n, do
   for (int f = 0; f < nf; ++f) Sums<1>(count, v + f, n, out + f);
 }
 
+void Relabel(double* idx, int n, const int* remap) {
+  int i = 0;
+#if defined(__AVX2__)
+  for (; i + 4 <= n; i += 4) {
+    const __m128i from = _mm256_cvttpd_epi32(_mm256_loadu_pd(idx + i));
+    _mm256_storeu_pd(idx + i, _mm256_cvtepi32_pd(_mm_i32gather_epi32(remap, from, 4)));
+  }
+#endif
+  for (; i < n; ++i) idx[i] = remap[static_cast<int>(idx[i])];
+}
+
 #pragma GCC diagnostic pop
 
 }  // namespace recruit::sma::RECRUIT_SMA_BATCH_NS

@@ -31,6 +31,8 @@ void AdvanceCohorts(const BatchParams& p, const BatchCohorts& c, int n, double s
 double SumTension(const BatchParams& p, const double* count, const double* xi, int n,
                   double stretch);
 void WeightedSums(const double* count, const double* const* v, int nf, int n, double* out);
+// idx[i] = remap[idx[i]] for i < n (indices held as doubles).
+void Relabel(double* idx, int n, const int* remap);
 }  // namespace batch_base
 
 #ifdef RECRUIT_SMA_AVX2_CLONE
@@ -40,6 +42,7 @@ void AdvanceCohorts(const BatchParams& p, const BatchCohorts& c, int n, double s
 double SumTension(const BatchParams& p, const double* count, const double* xi, int n,
                   double stretch);
 void WeightedSums(const double* count, const double* const* v, int nf, int n, double* out);
+void Relabel(double* idx, int n, const int* remap);
 }  // namespace batch_avx2
 #endif
 

@@ -444,4 +444,11 @@ void UnitModel::WeightedSums(const double* count, const double* const* v, int nf
   batch_base::WeightedSums(count, v, nf, n, out);
 }
 
+void UnitModel::Relabel(double* idx, int n, const int* remap) {
+#ifdef RECRUIT_SMA_AVX2_CLONE
+  if (UseAvx2(Isa::kAuto)) return batch_avx2::Relabel(idx, n, remap);
+#endif
+  batch_base::Relabel(idx, n, remap);
+}
+
 }  // namespace recruit::sma

@@ -146,6 +146,8 @@ class UnitModel {
   // Sets out[f] = sum over j < n of count[j] * v[f][j] for f < nf <= 3, in four partial sums
   // (s0 + s1) + (s2 + s3) of cohorts j mod 4: exact for one cohort.
   static void WeightedSums(const double* count, const double* const* v, int nf, int n, double* out);
+  // idx[i] = remap[idx[i]] for i < n (cohort indices of units, held as doubles).
+  static void Relabel(double* idx, int n, const int* remap);
   // Whether kAvx2 is available (built and supported by the CPU); the lanes kAuto uses.
   static bool HasAvx2();
   static int Lanes(Isa isa = Isa::kAuto);
