@@ -184,43 +184,29 @@ inline void Residual(const Consts& c, const Lanes& L, Vd x, Vd* g, Vd* dg) {
 }
 
 // SolveNewton lane by lane from x = xi_n, where the residual is g, dg: heating on [0, xi_n],
-// cooling on [xi_n, 1]. NB independent batches advance together (their dependency chains
-// interleave); a lane that has stopped keeps its values while the others iterate.
-template <int NB>
-inline void Newton(const Consts& c, const Lanes* L, Vd* g, Vd* dg, Vd* x) {
-  Vd lo[NB], hi[NB], active[NB];
-  for (int q = 0; q < NB; ++q) {
-    lo[q] = AndNot(L[q].xi0, L[q].heat);
-    hi[q] = Sel(L[q].heat, L[q].xi0, Splat(1));
-    x[q] = L[q].xi0;
-    active[q] = Or(Le(x[q], x[q]), Ne(x[q], x[q]));  // every lane
-  }
+// cooling on [xi_n, 1].
+inline Vd Newton(const Consts& c, const Lanes& L, Vd g, Vd dg) {
+  Vd lo = AndNot(L.xi0, L.heat), hi = Sel(L.heat, L.xi0, Splat(1)), x = L.xi0;
+  Vd active = Or(Le(x, x), Ne(x, x));  // every lane
   for (int it = 0; it < 60; ++it) {
-    int any = 0;
-    for (int q = 0; q < NB; ++q) {
-      const Vd pos = Gt(g[q], 0.0);
-      hi[q] = Sel(And(active[q], pos), x[q], hi[q]);
-      lo[q] = Sel(AndNot(active[q], pos), x[q], lo[q]);
-      const Vd mid = 0.5 * (lo[q] + hi[q]);
-      Vd next = Sel(Gt(dg[q], 0.0), x[q] - g[q] / dg[q], mid);
-      next = Sel(And(Gt(next, lo[q]), Lt(next, hi[q])), next, mid);
-      const Vd step = next - x[q];
-      x[q] = Sel(active[q], next, x[q]);
-      active[q] = AndNot(active[q], Or(Lt(Abs(step), 1e-10), Lt(hi[q] - lo[q], 1e-15)));
-      any |= Bits(active[q]);
-    }
-    if (any == 0) break;
-    any = 0;
-    for (int q = 0; q < NB; ++q) {
-      Vd gn, dgn;
-      Residual(c, L[q], x[q], &gn, &dgn);
-      g[q] = Sel(active[q], gn, g[q]);
-      dg[q] = Sel(active[q], dgn, dg[q]);
-      active[q] = AndNot(active[q], Lt(Abs(g[q]), 1e-13));
-      any |= Bits(active[q]);
-    }
-    if (any == 0) break;
+    const Vd pos = Gt(g, 0.0);
+    hi = Sel(And(active, pos), x, hi);
+    lo = Sel(AndNot(active, pos), x, lo);
+    const Vd mid = 0.5 * (lo + hi);
+    Vd next = Sel(Gt(dg, 0.0), x - g / dg, mid);
+    next = Sel(And(Gt(next, lo), Lt(next, hi)), next, mid);
+    const Vd step = next - x;
+    x = Sel(active, next, x);
+    active = AndNot(active, Or(Lt(Abs(step), 1e-10), Lt(hi - lo, 1e-15)));
+    if (Bits(active) == 0) break;
+    Vd gn, dgn;
+    Residual(c, L, x, &gn, &dgn);
+    g = Sel(active, gn, g);
+    dg = Sel(active, dgn, dg);
+    active = AndNot(active, Lt(Abs(g), 1e-13));
+    if (Bits(active) == 0) break;
   }
+  return x;
 }
 
 // Canonical ends of the loop (SolvePhase), so that settled cohorts compare equal.
@@ -315,10 +301,10 @@ void AdvanceCohorts(const BatchParams& p, const BatchCohorts& c, int n, double s
       phase_a(Block{on + j, T + j, xi + j, te + j, hs + j, cs + j}, j, kLanes);
     }
     if (j < m) phase_a(Block{on + j, T + j, xi + j, te + j, hs + j, cs + j}, j, m - j);
-    // (B) A short batch repeats its last cohort (same inputs, same result). Two batches at a
-    // time while there are.
+    // (B) A short batch repeats its last cohort (same inputs, same result).
     for (int l = n_solve; l % kLanes != 0; ++l) solve[l] = solve[n_solve - 1];
-    auto prepare = [&](const int* idx, Lanes* L, Vd* g, Vd* dg) __attribute__((always_inline)) {
+    for (int b = 0; b < n_solve; b += kLanes) {
+      const int* const idx = solve + b;
 #if defined(__AVX2__)
       const __m128i vidx = _mm_loadu_si128(reinterpret_cast<const __m128i*>(idx));
       const Vd all = Le(Splat(0), Splat(0));  // every lane
@@ -332,20 +318,18 @@ void AdvanceCohorts(const BatchParams& p, const BatchCohorts& c, int n, double s
         return Load(v);
       };
 #endif
-      L->heat = gather(heat);
-      L->xi0 = gather(xi);
-      L->tth = gather(tth);
-      L->hs = gather(hs);
-      L->cs = gather(cs);
-      L->pn = Sel(L->heat, k.pn_h, k.pn_c);
-      L->scale = Sel(L->heat, L->hs, L->cs);
-      L->t0 = Sel(L->heat, k.As, k.Mf);
-      L->t1 = Sel(L->heat, k.Af, k.Ms);
-      L->rate = Sel(L->heat, k.heat_rate, k.cool_rate);
-      *g = gather(g0);
-      *dg = gather(dg0);
-    };
-    auto finish = [&](const int* idx, const Lanes& L, Vd x) __attribute__((always_inline)) {
+      Lanes L;
+      L.heat = gather(heat);
+      L.xi0 = gather(xi);
+      L.tth = gather(tth);
+      L.hs = gather(hs);
+      L.cs = gather(cs);
+      L.pn = Sel(L.heat, k.pn_h, k.pn_c);
+      L.scale = Sel(L.heat, L.hs, L.cs);
+      L.t0 = Sel(L.heat, k.As, k.Mf);
+      L.t1 = Sel(L.heat, k.Af, k.Ms);
+      L.rate = Sel(L.heat, k.heat_rate, k.cool_rate);
+      Vd x = Newton(k, L, gather(g0), gather(dg0));
       // T_eff at the solution; the opposite branch's scale restarts there (proportional rule).
       const Vd t_eff = (L.tth + k.latent * (x - L.xi0)) - L.pn * TensionOnly(k, x);
       Vd unused;
@@ -368,23 +352,6 @@ void AdvanceCohorts(const BatchParams& p, const BatchCohorts& c, int n, double s
         hs[i] = out[3][l];
         cs[i] = out[4][l];
       }
-    };
-    int b = 0;
-    for (; b + kLanes < n_solve; b += 2 * kLanes) {
-      Lanes L[2];
-      Vd g[2], dg[2], x[2];
-      prepare(solve + b, &L[0], &g[0], &dg[0]);
-      prepare(solve + b + kLanes, &L[1], &g[1], &dg[1]);
-      Newton<2>(k, L, g, dg, x);
-      finish(solve + b, L[0], x[0]);
-      finish(solve + b + kLanes, L[1], x[1]);
-    }
-    if (b < n_solve) {
-      Lanes L[1];
-      Vd g[1], dg[1], x[1];
-      prepare(solve + b, &L[0], &g[0], &dg[0]);
-      Newton<1>(k, L, g, dg, x);
-      finish(solve + b, L[0], x[0]);
     }
   }
 }
