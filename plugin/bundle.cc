@@ -13,6 +13,12 @@ namespace {
 
 constexpr double kMagic = 5318008.25;  // marks an initialised block (mj_resetData zeroes it)
 
+// A cohort's merge sort key: on/off state, then temperature.
+struct MergeKey {
+  double on, temp;
+  int index;
+};
+
 Rng LoadRng(const double* words) {
   Rng::State st;
   std::memcpy(st.data(), words, sizeof st);
@@ -51,18 +57,21 @@ void SmaBundle::Reset(double* s, std::uint64_t seed, double stretch) const {
   StoreRng(Rng(seed), s + kRngSlot);
   s[kCohortCountSlot] = 1;
   const UnitState rest = RestState(unit_, stretch);
-  double* c = Cohort(s, 0);
-  c[kCount] = config_.units;
-  c[kOn] = 0;
-  c[kTemp] = rest.temperature;
-  c[kXi] = rest.xi;
-  c[kTeff] = rest.t_eff;
-  c[kHeatScale] = rest.heat_scale;
-  c[kCoolScale] = rest.cool_scale;
+  Field(s, kCount)[0] = config_.units;
+  Field(s, kOn)[0] = 0;
+  Field(s, kTemp)[0] = rest.temperature;
+  Field(s, kXi)[0] = rest.xi;
+  Field(s, kTeff)[0] = rest.t_eff;
+  Field(s, kHeatScale)[0] = rest.heat_scale;
+  Field(s, kCoolScale)[0] = rest.cool_scale;
   // Unit index block is already 0: every unit in cohort 0.
 }
 
 bool SmaBundle::Initialized(const double* s) { return s[kMagicSlot] == kMagic; }
+
+void SmaBundle::CopyCohort(double* s, int from, int to) const {
+  for (int f = 0; f < kFields; ++f) Field(s, f)[to] = Field(s, f)[from];
+}
 
 Status SmaBundle::Broadcast(double* s, double p_on, double p_off, double stretch) const {
   if (!(p_on >= 0 && p_on <= 1) || !(p_off >= 0 && p_off <= 1)) {
@@ -72,13 +81,15 @@ Status SmaBundle::Broadcast(double* s, double p_on, double p_off, double stretch
   Rng rng = LoadRng(s + kRngSlot);
   const int k0 = NumCohorts(s);
   double* idx = UnitIndex(s);
+  double* count = Field(s, kCount);
+  double* on = Field(s, kOn);
   // Pass 1: every unit draws, in unit order.
   std::vector<int> flips(k0, 0);
   std::vector<char> flip(config_.units, 0);
   for (int i = 0; i < config_.units; ++i) {
     const int from = static_cast<int>(idx[i]);
     const double u = rng.Uniform();
-    if (u < (Cohort(s, from)[kOn] != 0 ? p_off : p_on)) {
+    if (u < (on[from] != 0 ? p_off : p_on)) {
       flip[i] = 1;
       ++flips[from];
     }
@@ -90,17 +101,15 @@ Status SmaBundle::Broadcast(double* s, double p_on, double p_off, double stretch
   int k = k0;
   for (int j = 0; j < k0; ++j) {
     if (flips[j] == 0) continue;
-    double* c = Cohort(s, j);
-    if (flips[j] == static_cast<int>(c[kCount])) {
-      c[kOn] = c[kOn] != 0 ? 0 : 1;
+    if (flips[j] == static_cast<int>(count[j])) {
+      on[j] = on[j] != 0 ? 0 : 1;
       target[j] = j;
       continue;
     }
-    double* n = Cohort(s, k);
-    std::copy(c, c + kCohortStride, n);
-    n[kCount] = flips[j];
-    n[kOn] = c[kOn] != 0 ? 0 : 1;
-    c[kCount] -= flips[j];
+    CopyCohort(s, j, k);
+    count[k] = flips[j];
+    on[k] = on[j] != 0 ? 0 : 1;
+    count[j] -= flips[j];
     target[j] = k++;
   }
   for (int i = 0; i < config_.units; ++i) {
@@ -135,115 +144,124 @@ void SmaBundle::Integrate(double* s, double stretch, double dt) const {
     decay = unit_.DecayFactor(dt);
   }
   const int k = NumCohorts(s);
-  for (int j = 0; j < k; ++j) {
-    double* c = Cohort(s, j);
-    UnitState st{c[kTemp], c[kXi], c[kTeff], c[kHeatScale], c[kCoolScale]};
-    AdvanceUnitWithDecay(unit_, st, c[kOn] != 0, stretch, decay);
-    c[kTemp] = st.temperature;
-    c[kXi] = st.xi;
-    c[kTeff] = st.t_eff;
-    c[kHeatScale] = st.heat_scale;
-    c[kCoolScale] = st.cool_scale;
-  }
+  const UnitModel::Cohorts c{Field(s, kOn),   Field(s, kTemp),      Field(s, kXi),
+                             Field(s, kTeff), Field(s, kHeatScale), Field(s, kCoolScale)};
+  unit_.AdvanceCohorts(c, k, stretch, decay);
   s[kCounterSlot] += 1;
-  if (k > 1 && std::fmod(s[kCounterSlot], kMergeEvery) == 0) Merge(s);
+  // The counter is a whole number: integer modulo instead of a libm fmod call.
+  if (k > 1 && static_cast<long long>(s[kCounterSlot]) % kMergeEvery == 0) Merge(s);
 }
 
 void SmaBundle::Merge(double* s) const {
   const int k = NumCohorts(s);
-  std::vector<int> order(k);
-  std::iota(order.begin(), order.end(), 0);
-  std::sort(order.begin(), order.end(), [&](int a, int b) {
-    const double* ca = Cohort(s, a);
-    const double* cb = Cohort(s, b);
-    if (ca[kOn] != cb[kOn]) return ca[kOn] < cb[kOn];
-    return ca[kTemp] < cb[kTemp];
+  // Scratch on the stack up to 64 cohorts, else reused per thread (bundles may step in
+  // parallel on their own mjData).
+  constexpr int kSmall = 64;
+  MergeKey small_order[kSmall];
+  int small_forward[kSmall], small_remap[kSmall];
+  static thread_local std::vector<MergeKey> big_order;
+  static thread_local std::vector<int> big_forward, big_remap;
+  if (k > kSmall) {
+    big_order.resize(k);
+    big_forward.resize(k);
+    big_remap.resize(k);
+  }
+  MergeKey* const order = k > kSmall ? big_order.data() : small_order;
+  int* const forward = k > kSmall ? big_forward.data() : small_forward;
+  int* const remap = k > kSmall ? big_remap.data() : small_remap;
+  // Sorted by (on, T) as keys held by value: std::sort's moves depend only on the comparisons,
+  // so the order (ties included) is that of sorting the indices with the same comparator.
+  const double *on = Field(s, kOn), *temp = Field(s, kTemp);
+  for (int j = 0; j < k; ++j) order[j] = {on[j], temp[j], j};
+  std::sort(order, order + k, [](const MergeKey& a, const MergeKey& b) {
+    if (a.on != b.on) return a.on < b.on;
+    return a.temp < b.temp;
   });
   bool merged = false;
-  std::vector<int> forward(k, -1);  // representative that absorbed each merged cohort
-  int rep = order[0];
+  std::fill(forward, forward + k, -1);  // representative that absorbed each merged cohort
+  double* count = Field(s, kCount);
+  double* f[kFields];
+  for (int i = 0; i < kFields; ++i) f[i] = Field(s, i);
+  int rep = order[0].index;
   for (int j = 1; j < k; ++j) {
-    double* r = Cohort(s, rep);
-    double* c = Cohort(s, order[j]);
-    const bool same = r[kOn] == c[kOn] &&
-                      std::abs(r[kTemp] - c[kTemp]) <= config_.merge_temperature &&
-                      std::abs(r[kXi] - c[kXi]) <= config_.merge_xi &&
-                      std::abs(r[kHeatScale] - c[kHeatScale]) <= config_.merge_xi &&
-                      std::abs(r[kCoolScale] - c[kCoolScale]) <= config_.merge_xi;
+    const int r = rep, c = order[j].index;
+    const bool same = on[r] == on[c] && std::abs(temp[r] - temp[c]) <= config_.merge_temperature &&
+                      std::abs(f[kXi][r] - f[kXi][c]) <= config_.merge_xi &&
+                      std::abs(f[kHeatScale][r] - f[kHeatScale][c]) <= config_.merge_xi &&
+                      std::abs(f[kCoolScale][r] - f[kCoolScale][c]) <= config_.merge_xi;
     if (!same) {
-      rep = order[j];
+      rep = c;
       continue;
     }
     // Count-weighted mean keeps the bundle's mean temperature and fraction.
-    const double n = r[kCount] + c[kCount];
-    for (int f : {kTemp, kXi, kTeff, kHeatScale, kCoolScale})
-      r[f] = (r[f] * r[kCount] + c[f] * c[kCount]) / n;
-    r[kCount] = n;
-    c[kCount] = 0;
-    forward[order[j]] = rep;
+    const double n = count[r] + count[c];
+    for (int i : {kTemp, kXi, kTeff, kHeatScale, kCoolScale}) {
+      f[i][r] = (f[i][r] * count[r] + f[i][c] * count[c]) / n;
+    }
+    count[r] = n;
+    count[c] = 0;
+    forward[c] = rep;
     merged = true;
   }
-  if (merged) Compact(s, forward);
+  if (merged) Compact(s, forward, remap);
 }
 
-void SmaBundle::Compact(double* s, const std::vector<int>& forward) const {
+void SmaBundle::Compact(double* s, const int* forward, int* remap) const {
   const int k = NumCohorts(s);
   // New index for each surviving cohort; a merged cohort forwards its units to its
   // representative.
-  std::vector<int> remap(k, -1);
+  const double* count = Field(s, kCount);
+  std::fill(remap, remap + k, -1);
   int n = 0;
   for (int j = 0; j < k; ++j) {
-    if (Cohort(s, j)[kCount] > 0) remap[j] = n++;
+    if (count[j] > 0) remap[j] = n++;
   }
   for (int j = 0; j < k; ++j) {
-    if (remap[j] < 0 && j < static_cast<int>(forward.size()) && forward[j] >= 0) {
-      remap[j] = remap[forward[j]];
-    }
+    if (remap[j] < 0 && forward[j] >= 0) remap[j] = remap[forward[j]];
   }
   double* idx = UnitIndex(s);
-  for (int i = 0; i < config_.units; ++i) idx[i] = remap[static_cast<int>(idx[i])];
+  UnitModel::Relabel(idx, config_.units, remap);
+  // remap[j] <= j for survivors: copying in increasing j never overwrites one not yet moved.
   for (int j = 0; j < k; ++j) {
-    if (Cohort(s, j)[kCount] > 0 && remap[j] != j) {
-      std::copy(Cohort(s, j), Cohort(s, j) + kCohortStride, Cohort(s, remap[j]));
-    }
+    if (count[j] > 0 && remap[j] != j) CopyCohort(s, j, remap[j]);
   }
   s[kCohortCountSlot] = n;
 }
 
 double SmaBundle::Tension(const double* s, double stretch) const {
-  const int k = NumCohorts(s);
-  double f = 0;
-  for (int j = 0; j < k; ++j) {
-    const double* c = Cohort(s, j);
-    f += c[kCount] * unit_.Tension(c[kXi], stretch);
-  }
-  return f;
+  return unit_.SumTension(Field(s, kCount), Field(s, kXi), NumCohorts(s), stretch);
 }
 
-int SmaBundle::OnCount(const double* s) const {
-  const int k = NumCohorts(s);
-  double n = 0;
-  for (int j = 0; j < k; ++j) {
-    const double* c = Cohort(s, j);
-    if (c[kOn] != 0) n += c[kCount];
-  }
-  return static_cast<int>(n);
+double SmaBundle::CountWeightedSum(const double* s, int f) const {
+  const double* v[1] = {Field(s, f)};
+  double sum;
+  UnitModel::WeightedSums(Field(s, kCount), v, 1, NumCohorts(s), &sum);
+  return sum;
 }
+
+SmaBundle::Summary SmaBundle::Summarize(const double* s, double stretch) const {
+  const int k = NumCohorts(s);
+  const double* v[3] = {Field(s, kOn), Field(s, kTemp), Field(s, kXi)};
+  double sum[3];
+  UnitModel::WeightedSums(Field(s, kCount), v, 3, k, sum);
+  Summary r;
+  r.on_count = static_cast<int>(sum[0]);
+  r.tension = Tension(s, stretch);
+  r.mean_temperature = k == 0 ? config_.unit.ambient : sum[1] / config_.units;
+  r.mean_xi = k == 0 ? 1 : sum[2] / config_.units;
+  return r;
+}
+
+int SmaBundle::OnCount(const double* s) const { return static_cast<int>(CountWeightedSum(s, kOn)); }
 
 double SmaBundle::MeanTemperature(const double* s) const {
-  const int k = NumCohorts(s);
-  if (k == 0) return config_.unit.ambient;
-  double t = 0;
-  for (int j = 0; j < k; ++j) t += Cohort(s, j)[kCount] * Cohort(s, j)[kTemp];
-  return t / config_.units;
+  if (NumCohorts(s) == 0) return config_.unit.ambient;
+  return CountWeightedSum(s, kTemp) / config_.units;
 }
 
 double SmaBundle::MeanXi(const double* s) const {
-  const int k = NumCohorts(s);
-  if (k == 0) return 1;
-  double x = 0;
-  for (int j = 0; j < k; ++j) x += Cohort(s, j)[kCount] * Cohort(s, j)[kXi];
-  return x / config_.units;
+  if (NumCohorts(s) == 0) return 1;
+  return CountWeightedSum(s, kXi) / config_.units;
 }
 
 double SmaBundle::Heat(const double* s) const {
@@ -255,15 +273,17 @@ double SmaBundle::Heat(const double* s) const {
 
 double SmaBundle::MaxTemperature(const double* s) const {
   const int k = NumCohorts(s);
-  double t = config_.unit.ambient;
-  for (int j = 0; j < k; ++j) t = j == 0 ? Cohort(s, j)[kTemp] : std::max(t, Cohort(s, j)[kTemp]);
+  const double* temp = Field(s, kTemp);
+  double t = k > 0 ? temp[0] : config_.unit.ambient;
+  for (int j = 1; j < k; ++j) t = std::max(t, temp[j]);
   return t;
 }
 
 double SmaBundle::MaxWireStress(const double* s, double stretch) const {
   const int k = NumCohorts(s);
+  const double* xi = Field(s, kXi);
   double f = 0;
-  for (int j = 0; j < k; ++j) f = std::max(f, unit_.Tension(Cohort(s, j)[kXi], stretch));
+  for (int j = 0; j < k; ++j) f = std::max(f, unit_.Tension(xi[j], stretch));
   return unit_.WireStress(f);
 }
 
@@ -271,12 +291,12 @@ int SmaBundle::UnitCohort(const double* s, int i) const {
   return static_cast<int>(UnitIndex(s)[i]);
 }
 bool SmaBundle::UnitOn(const double* s, int i) const {
-  return Cohort(s, UnitCohort(s, i))[kOn] != 0;
+  return Field(s, kOn)[UnitCohort(s, i)] != 0;
 }
 double SmaBundle::UnitTemperature(const double* s, int i) const {
-  return Cohort(s, UnitCohort(s, i))[kTemp];
+  return Field(s, kTemp)[UnitCohort(s, i)];
 }
-double SmaBundle::UnitXi(const double* s, int i) const { return Cohort(s, UnitCohort(s, i))[kXi]; }
+double SmaBundle::UnitXi(const double* s, int i) const { return Field(s, kXi)[UnitCohort(s, i)]; }
 
 double SmaBundle::SettledOnTension(double stretch) const {
   // The fixed point of the exact thermal step and the implicit phase solve does not depend on

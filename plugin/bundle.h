@@ -22,7 +22,7 @@ class SmaBundle {
   static Result<SmaBundle> Create(const BundleConfig& config, double dt);
 
   // Doubles of state needed for `units` units.
-  static int StateSize(int units) { return kHeader + (kCohortStride + 1) * units; }
+  static int StateSize(int units) { return kHeader + (kFields + 1) * units; }
   int state_size() const { return StateSize(config_.units); }
 
   const BundleConfig& config() const { return config_; }
@@ -52,6 +52,13 @@ class SmaBundle {
   double ActDot(const double* s) const { return 0; }
 
   int OnCount(const double* s) const;
+  // OnCount, Tension, MeanTemperature and MeanXi (the plugin's sensor) in one pass, with the
+  // same values.
+  struct Summary {
+    int on_count;
+    double tension, mean_temperature, mean_xi;
+  };
+  Summary Summarize(const double* s, double stretch) const;
   int NumCohorts(const double* s) const { return static_cast<int>(s[kCohortCountSlot]); }
   double MeanTemperature(const double* s) const;
   double MeanXi(const double* s) const;
@@ -81,25 +88,28 @@ class SmaBundle {
   static constexpr int kHeader = 8;
   static constexpr int kMagicSlot = 0, kRngSlot = 1, kCohortCountSlot = 5, kCounterSlot = 6,
                        kPendingSlot = 7;
-  // Cohort: count, on, then the UnitState fields.
-  static constexpr int kCohortStride = 7;
+  // Cohorts as a structure of arrays: field f of cohort j at kHeader + f * N + j (N = units,
+  // the most cohorts there can be), so the batched update loads four cohorts' values at once.
+  static constexpr int kFields = 7;
   static constexpr int kCount = 0, kOn = 1, kTemp = 2, kXi = 3, kTeff = 4, kHeatScale = 5,
                        kCoolScale = 6;
   static constexpr int kMergeEvery = 8;  // steps between merge passes
 
   SmaBundle(BundleConfig c, UnitModel u, double dt);
-  double* Cohort(double* s, int k) const { return s + kHeader + kCohortStride * k; }
-  const double* Cohort(const double* s, int k) const { return s + kHeader + kCohortStride * k; }
-  double* UnitIndex(double* s) const { return s + kHeader + kCohortStride * config_.units; }
-  const double* UnitIndex(const double* s) const {
-    return s + kHeader + kCohortStride * config_.units;
-  }
+  double* Field(double* s, int f) const { return s + kHeader + f * config_.units; }
+  const double* Field(const double* s, int f) const { return s + kHeader + f * config_.units; }
+  // Copies every field of cohort `from` to cohort `to`.
+  void CopyCohort(double* s, int from, int to) const;
+  double* UnitIndex(double* s) const { return Field(s, kFields); }
+  const double* UnitIndex(const double* s) const { return Field(s, kFields); }
+  // Sum over cohorts of count * field f, in four partial sums.
+  double CountWeightedSum(const double* s, int f) const;
   void Merge(double* s) const;
   void Flush(double* s, double stretch) const;
   void Integrate(double* s, double stretch, double dt) const;
   // Drops cohorts with count 0 and relabels units; forward[j] >= 0 sends the units of an
-  // emptied cohort j to cohort forward[j].
-  void Compact(double* s, const std::vector<int>& forward) const;
+  // emptied cohort j to cohort forward[j] (k entries); remap: k ints of scratch.
+  void Compact(double* s, const int* forward, int* remap) const;
 
   BundleConfig config_;
   UnitModel unit_;

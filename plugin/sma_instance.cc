@@ -364,7 +364,7 @@ void SmaInstance::Advance(const mjModel* m, mjData* d) const {
     if (t + 0.5 * h >= next) {
       if (u != 0 && std::isfinite(u)) {
         const double p = std::min(1.0, std::abs(u));
-        act.model.Broadcast(s, u > 0 ? p : 0.0, u < 0 ? p : 0.0, stretch);
+        (void)act.model.Broadcast(s, u > 0 ? p : 0.0, u < 0 ? p : 0.0, stretch);  // p in [0, 1]
       }
       next = broadcast_period_ > 0
                  ? (std::floor((t + 0.5 * h) / broadcast_period_) + 1) * broadcast_period_
@@ -382,10 +382,11 @@ void SmaInstance::Sensor(const mjModel* m, mjData* d) const {
       const SmaActuator& act = actuators_[k];
       const double* s = State(d->plugin_state, m, k);
       const double stretch = Stretch(k, Length(m, d, act.actuator));
-      out[kSensorValues * k + 0] = act.model.OnCount(s);
-      out[kSensorValues * k + 1] = act.model.Tension(s, stretch);
-      out[kSensorValues * k + 2] = act.model.MeanTemperature(s);
-      out[kSensorValues * k + 3] = act.model.MeanXi(s);
+      const SmaBundle::Summary sum = act.model.Summarize(s, stretch);
+      out[kSensorValues * k + 0] = sum.on_count;
+      out[kSensorValues * k + 1] = sum.tension;
+      out[kSensorValues * k + 2] = sum.mean_temperature;
+      out[kSensorValues * k + 3] = sum.mean_xi;
     }
   }
 }

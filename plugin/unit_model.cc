@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <string>
 
+#include "plugin/unit_batch.h"
+
 namespace recruit::sma {
 namespace {
 
@@ -155,6 +157,22 @@ Result<UnitModel> UnitModel::Create(const UnitParams& p) {
   m.on_power_dM_ = joule * (p.resistivity_M - p.resistivity_A);
   m.on_rise_A_ = m.on_power_A_ / m.conductance_;
   m.on_rise_dM_ = m.on_power_dM_ / m.conductance_;
+  m.batch_ = {m.k_A_,
+              m.k_M_,
+              m.k_s_,
+              m.stretch_L_,
+              m.latent_rise_,
+              m.heat_shift_per_newton_,
+              m.cool_shift_per_newton_,
+              p.As,
+              p.Af,
+              p.Ms,
+              p.Mf,
+              m.heat_rate_,
+              m.cool_rate_,
+              p.ambient,
+              m.on_rise_A_,
+              m.on_rise_dM_};
   return m;
 }
 
@@ -346,6 +364,91 @@ void ImposeTemperature(const UnitModel& m, UnitState& s, double t, double stretc
 void AdvanceUnitWithDecay(const UnitModel& m, UnitState& s, bool on, double stretch, double decay) {
   const double t_ss = m.SteadyTemperature(on, s.xi);
   SolvePhase(m, s, t_ss + (s.temperature - t_ss) * decay, stretch);
+}
+
+namespace {
+
+bool UseAvx2(UnitModel::Isa isa) {
+#ifdef RECRUIT_SMA_AVX2_CLONE
+  if (isa == UnitModel::Isa::kBase) return false;
+  return UnitModel::HasAvx2();
+#else
+  return false;
+#endif
+}
+
+}  // namespace
+
+bool UnitModel::HasAvx2() {
+#ifdef RECRUIT_SMA_AVX2_CLONE
+  static const bool has = __builtin_cpu_supports("avx2");
+  return has;
+#else
+  return false;
+#endif
+}
+
+int UnitModel::Lanes(Isa isa) {
+  if (UseAvx2(isa)) return 4;
+#ifdef __AVX__
+  return 4;
+#else
+  return 2;
+#endif
+}
+
+void UnitModel::AdvanceCohorts(const Cohorts& c, int n, double stretch, double decay,
+                               Isa isa) const {
+  if (n == 1 && isa == Isa::kAuto) {  // one cohort (units switched together): the scalar update
+    UnitState s{c.temperature[0], c.xi[0], c.t_eff[0], c.heat_scale[0], c.cool_scale[0]};
+    AdvanceUnitWithDecay(*this, s, c.on[0] != 0, stretch, decay);
+    c.temperature[0] = s.temperature, c.xi[0] = s.xi, c.t_eff[0] = s.t_eff;
+    c.heat_scale[0] = s.heat_scale, c.cool_scale[0] = s.cool_scale;
+    return;
+  }
+  const BatchParams& bp = batch_;
+  const BatchCohorts bc{c.on, c.temperature, c.xi, c.t_eff, c.heat_scale, c.cool_scale};
+#ifdef RECRUIT_SMA_AVX2_CLONE
+  if (UseAvx2(isa)) return batch_avx2::AdvanceCohorts(bp, bc, n, stretch, decay);
+#endif
+  batch_base::AdvanceCohorts(bp, bc, n, stretch, decay);
+}
+
+double UnitModel::SumTension(const double* count, const double* xi, int n, double stretch,
+                             Isa isa) const {
+  if (n < 4 && isa == Isa::kAuto) {  // the kernels' four partial sums, without the kernel
+    double a[4] = {0, 0, 0, 0};
+    for (int j = 0; j < n; ++j) a[j] += count[j] * Tension(xi[j], stretch);
+    return (a[0] + a[1]) + (a[2] + a[3]);
+  }
+  const BatchParams& bp = batch_;
+#ifdef RECRUIT_SMA_AVX2_CLONE
+  if (UseAvx2(isa)) return batch_avx2::SumTension(bp, count, xi, n, stretch);
+#endif
+  return batch_base::SumTension(bp, count, xi, n, stretch);
+}
+
+void UnitModel::WeightedSums(const double* count, const double* const* v, int nf, int n,
+                             double* out) {
+  if (n < 4) {  // the kernels' four partial sums, without the kernel
+    for (int f = 0; f < nf; ++f) {
+      double a[4] = {0, 0, 0, 0};
+      for (int j = 0; j < n; ++j) a[j] += count[j] * v[f][j];
+      out[f] = (a[0] + a[1]) + (a[2] + a[3]);
+    }
+    return;
+  }
+#ifdef RECRUIT_SMA_AVX2_CLONE
+  if (UseAvx2(Isa::kAuto)) return batch_avx2::WeightedSums(count, v, nf, n, out);
+#endif
+  batch_base::WeightedSums(count, v, nf, n, out);
+}
+
+void UnitModel::Relabel(double* idx, int n, const int* remap) {
+#ifdef RECRUIT_SMA_AVX2_CLONE
+  if (UseAvx2(Isa::kAuto)) return batch_avx2::Relabel(idx, n, remap);
+#endif
+  batch_base::Relabel(idx, n, remap);
 }
 
 }  // namespace recruit::sma

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "common/result.h"
+#include "plugin/unit_batch.h"
 
 namespace recruit::sma {
 
@@ -121,6 +122,36 @@ class UnitModel {
   double heat_shift_per_newton() const { return heat_shift_per_newton_; }
   double cool_shift_per_newton() const { return cool_shift_per_newton_; }
 
+  // Advances n cohorts (structure of arrays, one entry per cohort) by one step with thermal decay
+  // factor `decay` at extension `stretch`: lane by lane the same operations as
+  // AdvanceUnitWithDecay, so the results are bit-identical to it (test
+  // BatchedCohortUpdateIsBitIdenticalToScalarUpdate), but four cohorts at a time in SIMD lanes,
+  // the phase solves of the transforming cohorts gathered into full batches (unit_batch.cc).
+  struct Cohorts {
+    const double* on;  // 0 or 1
+    double* temperature;
+    double* xi;
+    double* t_eff;
+    double* heat_scale;
+    double* cool_scale;
+  };
+  // Kernel: kAuto = AVX2 when this build has the AVX2 clone and the CPU runs it, else the
+  // build's own instruction set (kBase). Tests run both.
+  enum class Isa { kAuto, kBase, kAvx2 };
+  void AdvanceCohorts(const Cohorts& c, int n, double stretch, double decay,
+                      Isa isa = Isa::kAuto) const;
+  // Sum over n cohorts of count[j] * Tension(xi[j], stretch), in SIMD lanes.
+  double SumTension(const double* count, const double* xi, int n, double stretch,
+                    Isa isa = Isa::kAuto) const;
+  // Sets out[f] = sum over j < n of count[j] * v[f][j] for f < nf <= 3, in four partial sums
+  // (s0 + s1) + (s2 + s3) of cohorts j mod 4: exact for one cohort.
+  static void WeightedSums(const double* count, const double* const* v, int nf, int n, double* out);
+  // idx[i] = remap[idx[i]] for i < n (cohort indices of units, held as doubles).
+  static void Relabel(double* idx, int n, const int* remap);
+  // Whether kAvx2 is available (built and supported by the CPU); the lanes kAuto uses.
+  static bool HasAvx2();
+  static int Lanes(Isa isa = Isa::kAuto);
+
   // Natural convection (Morgan's horizontal-cylinder correlation, air at the film temperature)
   // plus linearised radiation, for a wire of diameter d at temperature excess dT over ambient.
   static double NaturalConvectionH(double d, double ambient, double dT, double emissivity);
@@ -137,6 +168,7 @@ class UnitModel {
   double latent_rise_ = 0, heat_shift_per_newton_ = 0, cool_shift_per_newton_ = 0;
   double on_power_A_ = 0, on_power_dM_ = 0;  // Joule power (W) in austenite; M minus A
   double on_rise_A_ = 0, on_rise_dM_ = 0;    // the same over the conductance (K)
+  BatchParams batch_{};  // the constants above as the batched kernels take them (Create)
 };
 
 // sin and cos of an angle a in [0, pi] (the cosine curves' range), as a polynomial: with
@@ -144,10 +176,12 @@ class UnitModel {
 // b^20 and b^19. The truncation error is below (pi/2)^21 / 21! < 3e-16 and the rounding error a
 // few ulp, so both are within 1e-15 of the exact values (test
 // PolynomialSinCosMatchesLibmOverTheHalfTurn); the phase solve's tolerances are 1e-13 and above.
-// Inlined, 64 instructions against about 94 for glibc's sincos call (callgrind).
-inline void SinCosHalfTurn(double a, double* sin_a, double* cos_a) {
-  const double b = a - 0.5 * 3.14159265358979323846;
-  const double z = b * b, z2 = z * z, z4 = z2 * z2, z8 = z4 * z4;
+// Inlined, 64 instructions against about 94 for glibc's sincos call (callgrind). T is double or
+// a GCC vector of doubles (the batched cohort update): the same operations lane by lane.
+template <class T>
+inline void SinCosHalfTurn(T a, T* sin_a, T* cos_a) {
+  const T b = a - 0.5 * 3.14159265358979323846;
+  const T z = b * b, z2 = z * z, z4 = z2 * z2, z8 = z4 * z4;
   // Taylor coefficients (-1)^k / (2k)! (cosine) and (-1)^k / (2k+1)! (sine) of z^k, k = 0..10
   // and 0..9, summed by Estrin's scheme (shorter dependency chains than Horner's).
   constexpr double c0 = 1, c1 = -1.0 / 2, c2 = 1.0 / 24, c3 = -1.0 / 720, c4 = 1.0 / 40320,
@@ -157,10 +191,10 @@ inline void SinCosHalfTurn(double a, double* sin_a, double* cos_a) {
   constexpr double s0 = 1, s1 = -1.0 / 6, s2 = 1.0 / 120, s3 = -1.0 / 5040, s4 = 1.0 / 362880,
                    s5 = -1.0 / 39916800, s6 = 1.0 / 6227020800, s7 = -1.0 / 1307674368000,
                    s8 = 1.0 / 355687428096000, s9 = -1.0 / 121645100408832000;
-  const double cos_b = ((c0 + c1 * z) + (c2 + c3 * z) * z2) +
-                       ((c4 + c5 * z) + (c6 + c7 * z) * z2) * z4 + ((c8 + c9 * z) + c10 * z2) * z8;
-  const double sin_b = b * (((s0 + s1 * z) + (s2 + s3 * z) * z2) +
-                            ((s4 + s5 * z) + (s6 + s7 * z) * z2) * z4 + (s8 + s9 * z) * z8);
+  const T cos_b = ((c0 + c1 * z) + (c2 + c3 * z) * z2) + ((c4 + c5 * z) + (c6 + c7 * z) * z2) * z4 +
+                  ((c8 + c9 * z) + c10 * z2) * z8;
+  const T sin_b = b * (((s0 + s1 * z) + (s2 + s3 * z) * z2) +
+                       ((s4 + s5 * z) + (s6 + s7 * z) * z2) * z4 + (s8 + s9 * z) * z8);
   *sin_a = cos_b;
   *cos_a = -sin_b;
 }

@@ -1,0 +1,433 @@
+// The batched cohort update (UnitModel::AdvanceCohorts, SumTension): cohorts as a structure of
+// arrays, one SIMD register of cohorts per batch (2 lanes with the portable SSE2 baseline, 4 with
+// AVX). Every lane performs exactly the operations of SolvePhase and AdvanceUnitWithDecay
+// (unit_model.cc) on one cohort, in the same order and without contraction (-ffp-contract=off,
+// plugin/CMakeLists.txt), so each cohort's result is bit-identical to the scalar update.
+// Branches become lane masks; a lane whose Newton iteration has stopped keeps its values while
+// the others continue.
+#include "plugin/unit_batch.h"
+
+#include <cstring>
+
+#include "plugin/unit_model.h"
+
+// batch_base in the normal compile, batch_avx2 in the AVX2 clone (plugin/CMakeLists.txt).
+#ifndef RECRUIT_SMA_BATCH_NS
+#define RECRUIT_SMA_BATCH_NS batch_base
+#endif
+
+#if defined(__SSE2__)
+#include <immintrin.h>
+#endif
+
+namespace recruit::sma::RECRUIT_SMA_BATCH_NS {
+namespace {
+
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wpsabi"  // vectors are passed only between inlined functions
+
+// Lane masks are vectors of doubles with all bits set or clear (the comparison instructions'
+// result), combined with bit operations.
+#if defined(__AVX__)
+constexpr int kLanes = 4;
+using Vd = __m256d;
+inline Vd Splat(double x) { return _mm256_set1_pd(x); }
+inline Vd Load(const double* p) { return _mm256_loadu_pd(p); }
+inline void Store(double* p, Vd v) { _mm256_storeu_pd(p, v); }
+inline Vd Lt(Vd a, Vd b) { return _mm256_cmp_pd(a, b, _CMP_LT_OQ); }
+inline Vd Le(Vd a, Vd b) { return _mm256_cmp_pd(a, b, _CMP_LE_OQ); }
+inline Vd Ne(Vd a, Vd b) { return _mm256_cmp_pd(a, b, _CMP_NEQ_UQ); }
+inline Vd And(Vd a, Vd b) { return _mm256_and_pd(a, b); }
+inline Vd Or(Vd a, Vd b) { return _mm256_or_pd(a, b); }
+inline Vd AndNot(Vd a, Vd b) { return _mm256_andnot_pd(b, a); }  // a & ~b
+inline Vd Sel(Vd m, Vd a, Vd b) { return _mm256_blendv_pd(b, a, m); }
+inline int Bits(Vd m) { return _mm256_movemask_pd(m); }
+// The first n < 4 lanes only (the others load as 0, are not stored; no access beyond them).
+inline __m256i FirstLanes(int n) {
+  return _mm256_castpd_si256(_mm256_cmp_pd(_mm256_setr_pd(0, 1, 2, 3), Splat(n), _CMP_LT_OQ));
+}
+inline Vd LoadN(const double* p, int n) { return _mm256_maskload_pd(p, FirstLanes(n)); }
+inline void StoreN(double* p, Vd v, int n) { _mm256_maskstore_pd(p, FirstLanes(n), v); }
+#elif defined(__SSE2__)
+constexpr int kLanes = 2;
+using Vd = __m128d;
+inline Vd Splat(double x) { return _mm_set1_pd(x); }
+inline Vd Load(const double* p) { return _mm_loadu_pd(p); }
+inline void Store(double* p, Vd v) { _mm_storeu_pd(p, v); }
+inline Vd Lt(Vd a, Vd b) { return _mm_cmplt_pd(a, b); }
+inline Vd Le(Vd a, Vd b) { return _mm_cmple_pd(a, b); }
+inline Vd Ne(Vd a, Vd b) { return _mm_cmpneq_pd(a, b); }
+inline Vd And(Vd a, Vd b) { return _mm_and_pd(a, b); }
+inline Vd Or(Vd a, Vd b) { return _mm_or_pd(a, b); }
+inline Vd AndNot(Vd a, Vd b) { return _mm_andnot_pd(b, a); }  // a & ~b
+inline Vd Sel(Vd m, Vd a, Vd b) { return _mm_or_pd(_mm_and_pd(m, a), _mm_andnot_pd(m, b)); }
+inline int Bits(Vd m) { return _mm_movemask_pd(m); }
+// The first lane only (n = 1; the other loads as 0, is not stored).
+inline Vd LoadN(const double* p, int) { return _mm_load_sd(p); }
+inline void StoreN(double* p, Vd v, int) { _mm_storel_pd(p, v); }
+#else  // generic vectors (GCC / Clang extension)
+constexpr int kLanes = 2;
+using Vd = double __attribute__((vector_size(16)));
+using Vi = long long __attribute__((vector_size(16)));
+inline Vd Splat(double x) { return Vd{x, x}; }
+inline Vd Load(const double* p) {
+  Vd v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+inline void Store(double* p, Vd v) { std::memcpy(p, &v, sizeof v); }
+inline Vd Lt(Vd a, Vd b) { return reinterpret_cast<Vd>(a < b); }
+inline Vd Le(Vd a, Vd b) { return reinterpret_cast<Vd>(a <= b); }
+inline Vd Ne(Vd a, Vd b) { return reinterpret_cast<Vd>(a != b); }
+inline Vd Bit(Vi x) { return reinterpret_cast<Vd>(x); }
+inline Vi Int(Vd x) { return reinterpret_cast<Vi>(x); }
+inline Vd And(Vd a, Vd b) { return Bit(Int(a) & Int(b)); }
+inline Vd Or(Vd a, Vd b) { return Bit(Int(a) | Int(b)); }
+inline Vd AndNot(Vd a, Vd b) { return Bit(Int(a) & ~Int(b)); }
+inline Vd Sel(Vd m, Vd a, Vd b) { return Or(And(m, a), AndNot(b, m)); }
+inline int Bits(Vd m) { return (Int(m)[0] != 0 ? 1 : 0) | (Int(m)[1] != 0 ? 2 : 0); }
+inline Vd LoadN(const double* p, int) { return Vd{p[0], 0}; }
+inline void StoreN(double* p, Vd v, int) { p[0] = v[0]; }
+#endif
+
+constexpr int kAll = (1 << kLanes) - 1;
+inline Vd Gt(Vd a, Vd b) { return Lt(b, a); }
+inline Vd Ge(Vd a, Vd b) { return Le(b, a); }
+inline Vd Lt(Vd a, double b) { return Lt(a, Splat(b)); }
+inline Vd Gt(Vd a, double b) { return Lt(Splat(b), a); }
+inline Vd Le(Vd a, double b) { return Le(a, Splat(b)); }
+inline Vd Ge(Vd a, double b) { return Le(Splat(b), a); }
+// |x| by clearing the sign bit (std::abs).
+inline Vd Abs(Vd x) { return AndNot(x, Splat(-0.0)); }
+// std::clamp(v, 0, 1) lane by lane (NaN passes through, as there).
+inline Vd Clamp01(Vd v) { return Sel(Lt(v, 0.0), Splat(0), Sel(Gt(v, 1.0), Splat(1), v)); }
+
+// A major curve per lane: MajorHeating (t0 = As, t1 = Af) or MajorCooling (Mf, Ms), 1 at or
+// below t0, 0 at or above t1, the cosine in between; slope as in the scalar overloads.
+inline Vd MajorCurve(Vd te, Vd t0, Vd t1, Vd rate, Vd* slope) {
+  const Vd below = Le(te, t0), above = Ge(te, t1), out = Or(below, above);
+  Vd sn = Splat(0), cs = Splat(0);
+  if (Bits(out) != kAll) SinCosHalfTurn(rate * (te - t0), &sn, &cs);
+  *slope = AndNot((-0.5 * rate) * sn, out);
+  return Sel(below, Splat(1), AndNot(0.5 * (cs + 1.0), above));
+}
+
+// The phase-solve constants of one model and extension, broadcast to every lane once.
+struct Consts {
+  bool rigid;         // no series spring
+  Vd k_A, dk_w, k_s;  // k_A, k_M - k_A, series spring
+  Vd k_s2_dk_w;       // k_s * k_s * (k_M - k_A), grouped as the scalar code evaluates it
+  Vd stretch_L, stretch, latent, pn_h, pn_c;
+  Vd As, Af, Ms, Mf, heat_rate, cool_rate;
+};
+
+inline Consts MakeConsts(const BatchParams& p, double stretch) {
+  Consts k;
+  k.rigid = p.k_s <= 0;
+  k.k_A = Splat(p.k_A);
+  k.dk_w = Splat(p.k_M - p.k_A);
+  k.k_s = Splat(p.k_s);
+  k.k_s2_dk_w = Splat(p.k_s * p.k_s * (p.k_M - p.k_A));
+  k.stretch_L = Splat(p.stretch_L);
+  k.stretch = Splat(stretch);
+  k.latent = Splat(p.latent);
+  k.pn_h = Splat(p.pn_h);
+  k.pn_c = Splat(p.pn_c);
+  k.As = Splat(p.As);
+  k.Af = Splat(p.Af);
+  k.Ms = Splat(p.Ms);
+  k.Mf = Splat(p.Mf);
+  k.heat_rate = Splat(p.heat_rate);
+  k.cool_rate = Splat(p.cool_rate);
+  return k;
+}
+
+// UnitModel::Tension(x, stretch, &slope) lane by lane.
+inline Vd LaneTension(const Consts& c, Vd xi, Vd* slope) {
+  const Vd kw = c.k_A + xi * c.dk_w;
+  Vd k, dk;
+  if (c.rigid) {
+    dk = c.dk_w;
+    k = kw;
+  } else {
+    const Vd inv = 1.0 / (kw + c.k_s);
+    dk = c.k_s2_dk_w * inv * inv;
+    k = kw * c.k_s * inv;
+  }
+  const Vd e = c.stretch - xi * c.stretch_L;
+  const Vd ke = k * e;
+  const Vd slack = Le(ke, 0.0);
+  *slope = AndNot(dk * e - k * c.stretch_L, slack);
+  return AndNot(ke, slack);
+}
+
+// UnitModel::Tension(x, stretch) lane by lane: std::max(0.0, k e).
+inline Vd TensionOnly(const Consts& c, Vd xi) {
+  const Vd kw = c.k_A + xi * c.dk_w;
+  const Vd k = c.rigid ? kw : kw * c.k_s * (1.0 / (kw + c.k_s));
+  const Vd ke = k * (c.stretch - xi * c.stretch_L);
+  return And(ke, Gt(ke, 0.0));
+}
+
+// Per-lane inputs of a phase solve; heat selects gd_h (M -> A on M+) or gd_c (A -> M on M-).
+struct Lanes {
+  Vd heat, xi0, tth, hs, cs, pn, scale, t0, t1, rate;
+};
+
+// gd_h / gd_c of SolvePhase: residual g and its slope dg at x.
+inline void Residual(const Consts& c, const Lanes& L, Vd x, Vd* g, Vd* dg) {
+  Vd dfdx, slope;
+  const Vd te = (L.tth + c.latent * (x - L.xi0)) - L.pn * LaneTension(c, x, &dfdx);
+  const Vd mv = MajorCurve(te, L.t0, L.t1, L.rate, &slope);
+  *g = Sel(L.heat, x - L.hs * mv, x - 1.0 + L.cs * (1.0 - mv));
+  *dg = 1.0 - L.scale * slope * (c.latent - L.pn * dfdx);
+}
+
+// SolveNewton lane by lane from x = xi_n, where the residual is g, dg: heating on [0, xi_n],
+// cooling on [xi_n, 1].
+inline Vd Newton(const Consts& c, const Lanes& L, Vd g, Vd dg) {
+  Vd lo = AndNot(L.xi0, L.heat), hi = Sel(L.heat, L.xi0, Splat(1)), x = L.xi0;
+  Vd active = Or(Le(x, x), Ne(x, x));  // every lane
+  for (int it = 0; it < 60; ++it) {
+    const Vd pos = Gt(g, 0.0);
+    hi = Sel(And(active, pos), x, hi);
+    lo = Sel(AndNot(active, pos), x, lo);
+    const Vd mid = 0.5 * (lo + hi);
+    Vd next = Sel(Gt(dg, 0.0), x - g / dg, mid);
+    next = Sel(And(Gt(next, lo), Lt(next, hi)), next, mid);
+    const Vd step = next - x;
+    x = Sel(active, next, x);
+    active = AndNot(active, Or(Lt(Abs(step), 1e-10), Lt(hi - lo, 1e-15)));
+    if (Bits(active) == 0) break;
+    Vd gn, dgn;
+    Residual(c, L, x, &gn, &dgn);
+    g = Sel(active, gn, g);
+    dg = Sel(active, dgn, dg);
+    active = AndNot(active, Lt(Abs(g), 1e-13));
+    if (Bits(active) == 0) break;
+  }
+  return x;
+}
+
+// Canonical ends of the loop (SolvePhase), so that settled cohorts compare equal.
+inline void Canonical(Vd* xi, Vd* hs, Vd* cs) {
+  const Vd top = Ge(*xi, 1 - 1e-12), bottom = Le(*xi, 1e-12);
+  if (Bits(Or(top, bottom)) == 0) return;
+  const Vd low = AndNot(bottom, top);
+  *xi = Sel(top, Splat(1), AndNot(*xi, low));
+  *hs = Sel(top, Splat(1), AndNot(*hs, low));
+  *cs = Sel(top, Splat(0), Sel(low, Splat(1), *cs));
+}
+
+// kLanes consecutive cohorts' fields in the caller's arrays (the tail: fewer, masked).
+struct Block {
+  const double* on;
+  double *temperature, *xi, *t_eff, *heat_scale, *cool_scale;
+};
+
+#pragma GCC diagnostic pop
+
+}  // namespace
+
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wpsabi"
+
+// Cohorts in chunks of 64: (A) the thermal step, the branch test and the residual at xi_n for
+// all, kLanes at a time; cohorts that do not transform are finished there. (B) The phase solves
+// of those that do, gathered kLanes at a time.
+void AdvanceCohorts(const BatchParams& p, const BatchCohorts& c, int n, double stretch,
+                    double decay) {
+  constexpr int kChunk = 64;
+  const Consts k = MakeConsts(p, stretch);
+  const Vd amb = Splat(p.ambient), rise_A = Splat(p.rise_A), rise_dM = Splat(p.rise_dM);
+  const Vd vdecay = Splat(decay);
+  alignas(32) double tth[kChunk], g0[kChunk], dg0[kChunk], heat[kChunk];
+  int solve[kChunk + kLanes];
+  for (int base = 0; base < n; base += kChunk) {
+    const int m = n - base < kChunk ? n - base : kChunk;
+    int n_solve = 0;
+    // (A) on cohorts base + j .. base + j + kLanes - 1; `valid` has the bits of real lanes.
+    // The block's `count` lanes are real cohorts (kLanes but at the tail); others are zeros.
+    auto phase_a = [&](const Block& b, int j, int count) __attribute__((always_inline)) {
+      auto load = [count](const double* p) { return count == kLanes ? Load(p) : LoadN(p, count); };
+      auto store = [count](double* p, Vd v) {
+        if (count == kLanes) {
+          Store(p, v);
+        } else {
+          StoreN(p, v, count);
+        }
+      };
+      const Vd xi0 = load(b.xi), hs0 = load(b.heat_scale), cs0 = load(b.cool_scale);
+      const Vd T0 = load(b.temperature);
+      const Vd t_ss = Sel(Ne(load(b.on), Splat(0)), amb + (rise_A + xi0 * rise_dM), amb);
+      const Vd t_th = t_ss + (T0 - t_ss) * vdecay;
+      Vd dfdx0;
+      const Vd f0 = LaneTension(k, xi0, &dfdx0);
+      const Vd te_h0 = t_th - k.pn_h * f0;
+      const Vd is_heat = Ge(te_h0, load(b.t_eff));
+      const Vd te0 = Sel(is_heat, te_h0, t_th - k.pn_c * f0);
+      const Vd pn = Sel(is_heat, k.pn_h, k.pn_c);
+      Vd slope;
+      const Vd mv = MajorCurve(te0, Sel(is_heat, k.As, k.Mf), Sel(is_heat, k.Af, k.Ms),
+                               Sel(is_heat, k.heat_rate, k.cool_rate), &slope);
+      const Vd g = Sel(is_heat, xi0 - hs0 * mv, xi0 - 1.0 + cs0 * (1.0 - mv));
+      const Vd dg = 1.0 - Sel(is_heat, hs0, cs0) * slope * (k.latent - pn * dfdx0);
+      const Vd tr = Sel(is_heat, Gt(g, 1e-12), Lt(g, -1e-12));
+      // Cohorts that do not transform keep xi_n and are finished here; the others keep their
+      // old values until (B).
+      Vd x = xi0, h = hs0, cl = cs0;
+      Canonical(&x, &h, &cl);
+      store(b.temperature, Sel(tr, T0, t_th + k.latent * (x - xi0)));
+      store(b.xi, Sel(tr, xi0, x));
+      store(b.t_eff, te0);
+      store(b.heat_scale, Sel(tr, hs0, h));
+      store(b.cool_scale, Sel(tr, cs0, cl));
+      Store(tth + j, t_th);
+      Store(g0 + j, g);
+      Store(dg0 + j, dg);
+      Store(heat + j, is_heat);
+      for (int bits = Bits(tr) & ((1 << count) - 1); bits != 0; bits &= bits - 1) {
+        solve[n_solve++] = j + __builtin_ctz(bits);
+      }
+    };
+    const double* const on = c.on + base;
+    double* const T = c.temperature + base;
+    double* const xi = c.xi + base;
+    double* const te = c.t_eff + base;
+    double* const hs = c.heat_scale + base;
+    double* const cs = c.cool_scale + base;
+    int j = 0;
+    for (; j + kLanes <= m; j += kLanes) {
+      phase_a(Block{on + j, T + j, xi + j, te + j, hs + j, cs + j}, j, kLanes);
+    }
+    if (j < m) phase_a(Block{on + j, T + j, xi + j, te + j, hs + j, cs + j}, j, m - j);
+    // (B) A short batch repeats its last cohort (same inputs, same result).
+    for (int l = n_solve; l % kLanes != 0; ++l) solve[l] = solve[n_solve - 1];
+    for (int b = 0; b < n_solve; b += kLanes) {
+      const int* const idx = solve + b;
+      // Lane-by-lane loads (faster here than the AVX2 gather instruction).
+#if defined(__AVX__)
+      auto gather = [&](const double* a) {
+        return _mm256_setr_pd(a[idx[0]], a[idx[1]], a[idx[2]], a[idx[3]]);
+      };
+#elif defined(__SSE2__)
+      auto gather = [&](const double* a) { return _mm_setr_pd(a[idx[0]], a[idx[1]]); };
+#else
+      auto gather = [&](const double* a) { return Vd{a[idx[0]], a[idx[1]]}; };
+#endif
+      Lanes L;
+      L.heat = gather(heat);
+      L.xi0 = gather(xi);
+      L.tth = gather(tth);
+      L.hs = gather(hs);
+      L.cs = gather(cs);
+      L.pn = Sel(L.heat, k.pn_h, k.pn_c);
+      L.scale = Sel(L.heat, L.hs, L.cs);
+      L.t0 = Sel(L.heat, k.As, k.Mf);
+      L.t1 = Sel(L.heat, k.Af, k.Ms);
+      L.rate = Sel(L.heat, k.heat_rate, k.cool_rate);
+      Vd x = Newton(k, L, gather(g0), gather(dg0));
+      // T_eff at the solution; the opposite branch's scale restarts there (proportional rule).
+      const Vd t_eff = (L.tth + k.latent * (x - L.xi0)) - L.pn * TensionOnly(k, x);
+      Vd unused;
+      const Vd other = MajorCurve(t_eff, Sel(L.heat, k.Mf, k.As), Sel(L.heat, k.Ms, k.Af),
+                                  Sel(L.heat, k.cool_rate, k.heat_rate), &unused);
+      // Heating: cool_scale = (1 - x) / (1 - M-); cooling: heat_scale = x / M+ (one division).
+      const Vd ratio = Clamp01(Sel(L.heat, 1.0 - x, x) / Sel(L.heat, 1.0 - other, other));
+      Vd cl = Sel(L.heat, Sel(Lt(other, 1.0), ratio, Splat(1)), L.cs);
+      Vd h = Sel(L.heat, L.hs, Sel(Gt(other, 0.0), ratio, Splat(1)));
+      Canonical(&x, &h, &cl);
+      alignas(32) double out[5][kLanes];
+      Store(out[0], L.tth + k.latent * (x - L.xi0));
+      Store(out[1], x);
+      Store(out[2], t_eff);
+      Store(out[3], h);
+      Store(out[4], cl);
+      for (int l = 0; l < kLanes; ++l) {
+        const int i = idx[l];
+        T[i] = out[0][l];
+        xi[i] = out[1][l];
+        te[i] = out[2][l];
+        hs[i] = out[3][l];
+        cs[i] = out[4][l];
+      }
+    }
+  }
+}
+
+double SumTension(const BatchParams& p, const double* count, const double* xi, int n,
+                  double stretch) {
+  // Four partial sums (cohort j mod 4; one register with AVX, two with SSE2), added as
+  // (s0 + s1) + (s2 + s3): the same value in both clones.
+  constexpr int kRegs = 4 / kLanes;
+  const Consts k = MakeConsts(p, stretch);
+  Vd acc[kRegs];
+  for (int r = 0; r < kRegs; ++r) acc[r] = Splat(0);
+  int j = 0;
+  for (; j + 4 <= n; j += 4) {
+    for (int r = 0; r < kRegs; ++r) {
+      const int i = j + r * kLanes;
+      acc[r] += Load(count + i) * TensionOnly(k, Load(xi + i));
+    }
+  }
+  alignas(32) double a[4];
+  for (int r = 0; r < kRegs; ++r) Store(a + r * kLanes, acc[r]);
+  // The last n - j < 4 cohorts: masked loads (missing lanes are 0: count 0, xi 0, term +0).
+  for (int r = 0; r < kRegs && j + r * kLanes < n; ++r) {
+    const int i = j + r * kLanes, rest = n - i;
+    const Vd cnt = rest >= kLanes ? Load(count + i) : LoadN(count + i, rest);
+    const Vd x = rest >= kLanes ? Load(xi + i) : LoadN(xi + i, rest);
+    alignas(32) double f[kLanes];
+    Store(f, cnt * TensionOnly(k, x));
+    for (int l = 0; l < kLanes; ++l) a[r * kLanes + l] += f[l];
+  }
+  return (a[0] + a[1]) + (a[2] + a[3]);
+}
+
+namespace {
+
+// WeightedSums for NF fields (unrolled).
+template <int NF>
+void Sums(const double* count, const double* const* v, int n, double* out) {
+  // Four partial sums per field: one register with AVX, two with SSE2.
+  constexpr int kRegs = 4 / kLanes;
+  Vd acc[NF][kRegs];
+  for (int f = 0; f < NF; ++f) {
+    for (int r = 0; r < kRegs; ++r) acc[f][r] = Splat(0);
+  }
+  int j = 0;
+  for (; j + 4 <= n; j += 4) {
+    for (int r = 0; r < kRegs; ++r) {
+      const Vd c = Load(count + j + r * kLanes);
+      for (int f = 0; f < NF; ++f) acc[f][r] += c * Load(v[f] + j + r * kLanes);
+    }
+  }
+  for (int f = 0; f < NF; ++f) {
+    alignas(32) double a[4];
+    for (int r = 0; r < kRegs; ++r) Store(a + r * kLanes, acc[f][r]);
+    for (int l = 0; j + l < n; ++l) a[l] += count[j + l] * v[f][j + l];
+    out[f] = (a[0] + a[1]) + (a[2] + a[3]);
+  }
+}
+
+}  // namespace
+
+void WeightedSums(const double* count, const double* const* v, int nf, int n, double* out) {
+  if (nf == 3) return Sums<3>(count, v, n, out);
+  for (int f = 0; f < nf; ++f) Sums<1>(count, v + f, n, out + f);
+}
+
+void Relabel(double* idx, int n, const int* remap) {
+  int i = 0;
+#if defined(__AVX2__)
+  for (; i + 4 <= n; i += 4) {
+    const __m128i from = _mm256_cvttpd_epi32(_mm256_loadu_pd(idx + i));
+    _mm256_storeu_pd(idx + i, _mm256_cvtepi32_pd(_mm_i32gather_epi32(remap, from, 4)));
+  }
+#endif
+  for (; i < n; ++i) idx[i] = remap[static_cast<int>(idx[i])];
+}
+
+#pragma GCC diagnostic pop
+
+}  // namespace recruit::sma::RECRUIT_SMA_BATCH_NS
