@@ -5,6 +5,8 @@
 #include <cmath>
 #include <iterator>
 
+#include "sim/format_g.h"
+
 namespace recruit::sim {
 
 CsvStepWriter::CsvStepWriter(std::string path, int every)
@@ -24,17 +26,42 @@ Status CsvStepWriter::OnStep(const mjModel*, const mjData*, const TelemetrySampl
     header_written_ = true;
   }
   if (count_++ % every_ != 0 && !s.control_instant) return Status::Ok();
-  auto out = std::back_inserter(buffer_);
-  fmt::format_to(out, "{:.6g},{:.9g},{:.9g},{:.9g}", s.time, s.reference, s.measured, s.angle);
+  // The row is formatted into a buffer sized for the longest row (FormatG: "%.9g" etc. byte
+  // for byte, without fmt's format-string parsing).
+  row_.resize(8 + (4 + 8 * s.bundles.size()) * kFormatGMax);
+  char* p = row_.data();
+  auto num = [&p](double v, int precision) { p = FormatG(v, precision, p); };
+  auto comma = [&p] { *p++ = ','; };
+  num(s.time, 6);
+  comma();
+  num(s.reference, 9);
+  comma();
+  num(s.measured, 9);
+  comma();
+  num(s.angle, 9);
   for (const auto& b : s.bundles) {
-    fmt::format_to(out, ",{:.9g},{:.9g},{},", b.force, b.force_reference, b.true_on);
+    comma();
+    num(b.force, 9);
+    comma();
+    num(b.force_reference, 9);
+    comma();
+    p = FormatInt(b.true_on, p);
+    comma();
     // Non-finite estimates (no estimator, no variance) are left empty: readers take them as NaN.
-    if (std::isfinite(b.estimated_on)) fmt::format_to(out, "{:.6g}", b.estimated_on);
-    buffer_ += ',';
-    if (std::isfinite(b.estimated_on_std)) fmt::format_to(out, "{:.6g}", b.estimated_on_std);
-    fmt::format_to(out, ",{:.6g},{:.6g},{:.6g}", b.p_on, b.p_off, b.mean_temperature);
+    if (std::isfinite(b.estimated_on)) num(b.estimated_on, 6);
+    comma();
+    if (std::isfinite(b.estimated_on_std)) num(b.estimated_on_std, 6);
+    comma();
+    num(b.p_on, 6);
+    comma();
+    num(b.p_off, 6);
+    comma();
+    num(b.mean_temperature, 6);
   }
-  fmt::format_to(out, ",{}\n", s.control_instant ? 1 : 0);
+  *p++ = ',';
+  *p++ = s.control_instant ? '1' : '0';
+  *p++ = '\n';
+  buffer_.append(row_.data(), p);
   if (buffer_.size() > (1 << 20)) {
     file_.stream() << buffer_;
     buffer_.clear();

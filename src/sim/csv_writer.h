@@ -4,6 +4,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "common/atomic_file.h"
 #include "common/step_observer.h"
@@ -24,6 +25,7 @@ class CsvStepWriter : public StepObserver {
   long count_ = 0;
   bool header_written_ = false;
   std::string buffer_;
+  std::vector<char> row_;  // one row being formatted
 };
 
 }  // namespace recruit::sim

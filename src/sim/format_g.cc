@@ -1,0 +1,146 @@
+#include "sim/format_g.h"
+
+#include <fmt/format.h>
+
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+
+namespace recruit::sim {
+namespace {
+
+constexpr std::uint64_t kPow10[] = {1ull,
+                                    10ull,
+                                    100ull,
+                                    1000ull,
+                                    10000ull,
+                                    100000ull,
+                                    1000000ull,
+                                    10000000ull,
+                                    100000000ull,
+                                    1000000000ull,
+                                    10000000000ull,
+                                    100000000000ull,
+                                    1000000000000ull,
+                                    10000000000000ull,
+                                    100000000000000ull,
+                                    1000000000000000ull,
+                                    10000000000000000ull,
+                                    100000000000000000ull,
+                                    1000000000000000000ull,
+                                    10000000000000000000ull};
+
+// Decimal digits of v > 0: from its bit length (1233 / 4096 ~ log10 2), one comparison.
+int NumDigits(std::uint64_t v) {
+  const int t = ((64 - __builtin_clzll(v)) * 1233) >> 12;
+  return t - (v < kPow10[t] ? 1 : 0) + 1;
+}
+
+// s / 10^k and its remainder, k in 1..19, by constants (a multiply, not a divide).
+std::uint64_t DivPow10(std::uint64_t s, int k, std::uint64_t* r) {
+  std::uint64_t q = 0;
+  switch (k) {
+#define RECRUIT_CASE(K) \
+  case K:               \
+    q = s / kPow10[K];  \
+    break;
+    RECRUIT_CASE(1)
+    RECRUIT_CASE(2) RECRUIT_CASE(3) RECRUIT_CASE(4) RECRUIT_CASE(5) RECRUIT_CASE(6) RECRUIT_CASE(7)
+        RECRUIT_CASE(8) RECRUIT_CASE(9) RECRUIT_CASE(10) RECRUIT_CASE(11) RECRUIT_CASE(12)
+            RECRUIT_CASE(13) RECRUIT_CASE(14) RECRUIT_CASE(15) RECRUIT_CASE(16) RECRUIT_CASE(17)
+                RECRUIT_CASE(18) RECRUIT_CASE(19)
+#undef RECRUIT_CASE
+                    default : break;
+  }
+  *r = s - q * kPow10[k];
+  return q;
+}
+
+// The general case (and the rare ones the fast path leaves): fmt, which follows printf.
+char* Slow(double x, int precision, char* out) {
+  return fmt::format_to(out, "{:.{}g}", x, precision);
+}
+
+}  // namespace
+
+// The shortest decimal S that reads back as x (Dragonbox) has n digits. If n <= precision, S is
+// also x rounded to `precision` digits: x is within half an ulp of S, far less than half a unit
+// in the precision-th digit. If n >= precision + 2, rounding S gives the rounding of x: a
+// rounding midpoint (precision + 1 digits) between x and S would be a shorter decimal that reads
+// back as x. With n == precision + 1, S itself can be a midpoint: fmt decides.
+char* FormatG(double x, int precision, char* out) {
+  if (!std::isfinite(x) || precision < 1 || precision > 15) return Slow(x, precision, out);
+  // (Subnormals too: their ulp is not small against the digits kept.)
+  if (x != 0 && std::abs(x) < 2.2250738585072014e-308) return Slow(x, precision, out);
+  if (std::signbit(x)) {
+    *out++ = '-';
+    x = -x;
+  }
+  if (x == 0) {
+    *out++ = '0';
+    return out;
+  }
+  const auto dec = fmt::detail::dragonbox::to_decimal(x);
+  std::uint64_t s = dec.significand;
+  int e = dec.exponent;
+  int n = NumDigits(s);
+  if (n == precision + 1) return Slow(x, precision, out);
+  if (n > precision) {
+    const std::uint64_t div = kPow10[n - precision];
+    std::uint64_t r;
+    std::uint64_t q = DivPow10(s, n - precision, &r);
+    if (2 * r == div) return Slow(x, precision, out);  // a tie: not reached (see above)
+    if (2 * r > div) ++q;
+    e += n - precision;
+    n = precision;
+    if (q == kPow10[precision]) {
+      q = kPow10[precision - 1];
+      ++e;
+    }
+    s = q;
+  }
+  while (s % 10 == 0) {  // %g drops trailing zeros
+    s /= 10;
+    ++e;
+  }
+  n = NumDigits(s);
+  char digits[20];
+  std::to_chars(digits, digits + sizeof digits, s);
+  const int X = n - 1 + e;  // the exponent of the leading digit
+  if (X < -4 || X >= precision) {
+    *out++ = digits[0];
+    if (n > 1) {
+      *out++ = '.';
+      std::memcpy(out, digits + 1, n - 1);
+      out += n - 1;
+    }
+    *out++ = 'e';
+    *out++ = X < 0 ? '-' : '+';
+    const int ax = X < 0 ? -X : X;
+    if (ax < 10) *out++ = '0';
+    return std::to_chars(out, out + 4, ax).ptr;
+  }
+  if (X < 0) {  // 0.000ddd
+    *out++ = '0';
+    *out++ = '.';
+    for (int i = 0; i < -X - 1; ++i) *out++ = '0';
+    std::memcpy(out, digits, n);
+    return out + n;
+  }
+  if (n <= X + 1) {  // an integer: the digits, then zeros
+    std::memcpy(out, digits, n);
+    out += n;
+    for (int i = 0; i < X + 1 - n; ++i) *out++ = '0';
+    return out;
+  }
+  std::memcpy(out, digits, X + 1);
+  out += X + 1;
+  *out++ = '.';
+  std::memcpy(out, digits + X + 1, n - X - 1);
+  return out + (n - X - 1);
+}
+
+char* FormatInt(long x, char* out) { return std::to_chars(out, out + 24, x).ptr; }
+
+}  // namespace recruit::sim
