@@ -3,6 +3,8 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <iterator>
 
 #include "sim/format_g.h"
@@ -27,10 +29,23 @@ Status CsvStepWriter::OnStep(const mjModel*, const mjData*, const TelemetrySampl
   }
   if (count_++ % every_ != 0 && !s.control_instant) return Status::Ok();
   // The row is formatted into a buffer sized for the longest row (FormatG: "%.9g" etc. byte
-  // for byte, without fmt's format-string parsing).
+  // for byte, without fmt's format-string parsing). Most columns hold between control instants
+  // (references, estimates, broadcasts): a column equal to its last value reuses its text.
   row_.resize(8 + (4 + 8 * s.bundles.size()) * kFormatGMax);
+  cache_.resize(4 + 7 * s.bundles.size());
   char* p = row_.data();
-  auto num = [&p](double v, int precision) { p = FormatG(v, precision, p); };
+  Column* col = cache_.data();
+  auto num = [&p, &col](double v, int precision) {
+    Column& c = *col++;
+    std::uint64_t bits;
+    std::memcpy(&bits, &v, sizeof bits);
+    if (c.len == 0 || bits != c.bits) {
+      c.bits = bits;
+      c.len = static_cast<std::uint8_t>(FormatG(v, precision, c.text) - c.text);
+    }
+    std::memcpy(p, c.text, sizeof c.text);  // fixed size: one move, the end is overwritten
+    p += c.len;
+  };
   auto comma = [&p] { *p++ = ','; };
   num(s.time, 6);
   comma();
@@ -48,9 +63,17 @@ Status CsvStepWriter::OnStep(const mjModel*, const mjData*, const TelemetrySampl
     p = FormatInt(b.true_on, p);
     comma();
     // Non-finite estimates (no estimator, no variance) are left empty: readers take them as NaN.
-    if (std::isfinite(b.estimated_on)) num(b.estimated_on, 6);
+    if (std::isfinite(b.estimated_on)) {
+      num(b.estimated_on, 6);
+    } else {
+      ++col;
+    }
     comma();
-    if (std::isfinite(b.estimated_on_std)) num(b.estimated_on_std, 6);
+    if (std::isfinite(b.estimated_on_std)) {
+      num(b.estimated_on_std, 6);
+    } else {
+      ++col;
+    }
     comma();
     num(b.p_on, 6);
     comma();

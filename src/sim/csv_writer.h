@@ -3,11 +3,13 @@
 // and after the run's other outputs are written (a failed summary leaves no CSV behind).
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
 #include "common/atomic_file.h"
 #include "common/step_observer.h"
+#include "sim/format_g.h"
 
 namespace recruit::sim {
 
@@ -26,6 +28,13 @@ class CsvStepWriter : public StepObserver {
   bool header_written_ = false;
   std::string buffer_;
   std::vector<char> row_;  // one row being formatted
+  // Each numeric column's last value and its text.
+  struct Column {
+    std::uint64_t bits = 0;  // of the double
+    std::uint8_t len = 0;    // 0: none yet
+    char text[kFormatGMax];
+  };
+  std::vector<Column> cache_;
 };
 
 }  // namespace recruit::sim
