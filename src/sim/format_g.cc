@@ -46,15 +46,37 @@ std::uint64_t DivPow10(std::uint64_t s, int k, std::uint64_t* r) {
     q = s / kPow10[K];  \
     break;
     RECRUIT_CASE(1)
-    RECRUIT_CASE(2) RECRUIT_CASE(3) RECRUIT_CASE(4) RECRUIT_CASE(5) RECRUIT_CASE(6) RECRUIT_CASE(7)
-        RECRUIT_CASE(8) RECRUIT_CASE(9) RECRUIT_CASE(10) RECRUIT_CASE(11) RECRUIT_CASE(12)
-            RECRUIT_CASE(13) RECRUIT_CASE(14) RECRUIT_CASE(15) RECRUIT_CASE(16) RECRUIT_CASE(17)
-                RECRUIT_CASE(18) RECRUIT_CASE(19)
+    RECRUIT_CASE(2)
+    RECRUIT_CASE(3) RECRUIT_CASE(4) RECRUIT_CASE(5) RECRUIT_CASE(6) RECRUIT_CASE(7) RECRUIT_CASE(8)
+        RECRUIT_CASE(9) RECRUIT_CASE(10) RECRUIT_CASE(11) RECRUIT_CASE(12) RECRUIT_CASE(13)
+            RECRUIT_CASE(14) RECRUIT_CASE(15) RECRUIT_CASE(16) RECRUIT_CASE(17) RECRUIT_CASE(18)
+                RECRUIT_CASE(19)
 #undef RECRUIT_CASE
                     default : break;
   }
   *r = s - q * kPow10[k];
   return q;
+}
+
+constexpr char kDigitPairs[] =
+    "00010203040506070809101112131415161718192021222324252627282930313233343536373839"
+    "40414243444546474849505152535455565758596061626364656667686970717273747576777879"
+    "8081828384858687888990919293949596979899";
+
+// The n decimal digits of v (v < 10^n) at p[0..n).
+void WriteDigits(std::uint64_t v, int n, char* p) {
+  char* end = p + n;
+  while (v >= 100) {
+    end -= 2;
+    std::memcpy(end, kDigitPairs + 2 * (v % 100), 2);
+    v /= 100;
+  }
+  if (v >= 10) {
+    end -= 2;
+    std::memcpy(end, kDigitPairs + 2 * v, 2);
+  } else {
+    *--end = static_cast<char>('0' + v);
+  }
 }
 
 // The general case (and the rare ones the fast path leaves): fmt, which follows printf.
@@ -103,42 +125,44 @@ char* FormatG(double x, int precision, char* out) {
   while (s % 10 == 0) {  // %g drops trailing zeros
     s /= 10;
     ++e;
+    --n;
   }
-  n = NumDigits(s);
-  char digits[20];
-  std::to_chars(digits, digits + sizeof digits, s);
-  const int X = n - 1 + e;  // the exponent of the leading digit
-  if (X < -4 || X >= precision) {
-    *out++ = digits[0];
+  const int X = n - 1 + e;         // the exponent of the leading digit
+  if (X < -4 || X >= precision) {  // d.ddde+XX: the digits one place right, then the point
+    WriteDigits(s, n, out + 1);
+    out[0] = out[1];
     if (n > 1) {
-      *out++ = '.';
-      std::memcpy(out, digits + 1, n - 1);
-      out += n - 1;
+      out[1] = '.';
+      out += n + 1;
+    } else {
+      out += 1;
     }
     *out++ = 'e';
     *out++ = X < 0 ? '-' : '+';
     const int ax = X < 0 ? -X : X;
-    if (ax < 10) *out++ = '0';
+    if (ax < 100) {
+      std::memcpy(out, kDigitPairs + 2 * ax, 2);
+      return out + 2;
+    }
     return std::to_chars(out, out + 4, ax).ptr;
   }
   if (X < 0) {  // 0.000ddd
     *out++ = '0';
     *out++ = '.';
     for (int i = 0; i < -X - 1; ++i) *out++ = '0';
-    std::memcpy(out, digits, n);
+    WriteDigits(s, n, out);
     return out + n;
   }
   if (n <= X + 1) {  // an integer: the digits, then zeros
-    std::memcpy(out, digits, n);
+    WriteDigits(s, n, out);
     out += n;
     for (int i = 0; i < X + 1 - n; ++i) *out++ = '0';
     return out;
   }
-  std::memcpy(out, digits, X + 1);
-  out += X + 1;
-  *out++ = '.';
-  std::memcpy(out, digits + X + 1, n - X - 1);
-  return out + (n - X - 1);
+  WriteDigits(s, n, out + 1);  // ddd.ddd: the integer part moves one place left
+  for (int i = 0; i <= X; ++i) out[i] = out[i + 1];
+  out[X + 1] = '.';
+  return out + n + 1;
 }
 
 char* FormatInt(long x, char* out) { return std::to_chars(out, out + 24, x).ptr; }
