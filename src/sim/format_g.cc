@@ -2,10 +2,12 @@
 
 #include <fmt/format.h>
 
+#include <array>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <utility>
 
 namespace recruit::sim {
 namespace {
@@ -37,23 +39,21 @@ int NumDigits(std::uint64_t v) {
   return t - (v < kPow10[t] ? 1 : 0) + 1;
 }
 
-// s / 10^k and its remainder, k in 1..19, by constants (a multiply, not a divide).
+// s / 10^K for each K: division by a constant compiles to a multiply, not a divide.
+template <std::size_t K>
+std::uint64_t DivByPow10(std::uint64_t s) {
+  return s / kPow10[K];
+}
+template <std::size_t... K>
+constexpr std::array<std::uint64_t (*)(std::uint64_t), sizeof...(K)> DivTable(
+    std::index_sequence<K...>) {
+  return {&DivByPow10<K>...};
+}
+constexpr auto kDivByPow10 = DivTable(std::make_index_sequence<20>());
+
+// s / 10^k and its remainder, k in 0..19.
 std::uint64_t DivPow10(std::uint64_t s, int k, std::uint64_t* r) {
-  std::uint64_t q = 0;
-  switch (k) {
-#define RECRUIT_CASE(K) \
-  case K:               \
-    q = s / kPow10[K];  \
-    break;
-    RECRUIT_CASE(1)
-    RECRUIT_CASE(2)
-    RECRUIT_CASE(3) RECRUIT_CASE(4) RECRUIT_CASE(5) RECRUIT_CASE(6) RECRUIT_CASE(7) RECRUIT_CASE(8)
-        RECRUIT_CASE(9) RECRUIT_CASE(10) RECRUIT_CASE(11) RECRUIT_CASE(12) RECRUIT_CASE(13)
-            RECRUIT_CASE(14) RECRUIT_CASE(15) RECRUIT_CASE(16) RECRUIT_CASE(17) RECRUIT_CASE(18)
-                RECRUIT_CASE(19)
-#undef RECRUIT_CASE
-                    default : break;
-  }
+  const std::uint64_t q = kDivByPow10[k](s);
   *r = s - q * kPow10[k];
   return q;
 }
