@@ -79,6 +79,47 @@ void WriteDigits(std::uint64_t v, int n, char* p) {
   }
 }
 
+constexpr double kExactPow10[] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,
+                                  1e8,  1e9,  1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
+                                  1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
+
+// x > 0 (normal) rounded to `precision` <= 9 significant digits as s 10^e, s of `precision`
+// digits, without Dragonbox: y = x 10^k in one correctly rounded operation (10^k exact for |k| <=
+// 22) is within 2^-24 of the exact product (y < 2^30), so rounding y to an integer rounds the exact
+// product the same way unless y is within 1e-6 of a midpoint (then false: the caller decides).
+bool RoundByScaling(double x, int precision, std::uint64_t* s, int* e) {
+  if (precision > 9) return false;
+  std::uint64_t bits;
+  std::memcpy(&bits, &x, sizeof bits);
+  const int e2 = static_cast<int>((bits >> 52) & 0x7ff) - 1023;
+  int X = (e2 * 1233) >> 12;  // ~ floor(e2 log10 2): the leading digit's exponent or one below
+  for (int attempt = 0; attempt < 3; ++attempt) {
+    const int k = precision - 1 - X;
+    if (k < -22 || k > 22) return false;
+    const double y = k >= 0 ? x * kExactPow10[k] : x / kExactPow10[-k];
+    const double whole = std::floor(y);
+    if (whole < static_cast<double>(kPow10[precision - 1])) {  // X too high
+      --X;
+      continue;
+    }
+    if (whole >= static_cast<double>(kPow10[precision])) {  // X too low
+      ++X;
+      continue;
+    }
+    const double frac = y - whole;  // exact
+    if (std::abs(frac - 0.5) < 1e-6) return false;
+    std::uint64_t q = static_cast<std::uint64_t>(whole) + (frac > 0.5 ? 1 : 0);
+    if (q == kPow10[precision]) {  // rounded up into the next decade
+      q = kPow10[precision - 1];
+      ++X;
+    }
+    *s = q;
+    *e = X - (precision - 1);
+    return true;
+  }
+  return false;
+}
+
 // The general case (and the rare ones the fast path leaves): fmt, which follows printf.
 char* Slow(double x, int precision, char* out) {
   return fmt::format_to(out, "{:.{}g}", x, precision);
@@ -86,7 +127,8 @@ char* Slow(double x, int precision, char* out) {
 
 }  // namespace
 
-// The shortest decimal S that reads back as x (Dragonbox) has n digits. If n <= precision, S is
+// Most doubles at precision <= 9: RoundByScaling. Else the shortest decimal S that reads back as
+// x (Dragonbox), of n digits. If n <= precision, S is
 // also x rounded to `precision` digits: x is within half an ulp of S, far less than half a unit
 // in the precision-th digit. If n >= precision + 2, rounding S gives the rounding of x: a
 // rounding midpoint (precision + 1 digits) between x and S would be a shorter decimal that reads
@@ -103,25 +145,29 @@ char* FormatG(double x, int precision, char* out) {
     *out++ = '0';
     return out;
   }
-  const auto dec = fmt::detail::dragonbox::to_decimal(x);
-  std::uint64_t s = dec.significand;
-  int e = dec.exponent;
-  int n = NumDigits(s);
-  if (n == precision + 1) return Slow(x, precision, out);
-  if (n > precision) {
-    const std::uint64_t div = kPow10[n - precision];
-    std::uint64_t r;
-    std::uint64_t q = DivPow10(s, n - precision, &r);
-    if (2 * r == div) return Slow(x, precision, out);  // a tie: not reached (see above)
-    if (2 * r > div) ++q;
-    e += n - precision;
-    n = precision;
-    if (q == kPow10[precision]) {
-      q = kPow10[precision - 1];
-      ++e;
+  std::uint64_t s;
+  int e;
+  if (!RoundByScaling(x, precision, &s, &e)) {
+    const auto dec = fmt::detail::dragonbox::to_decimal(x);
+    s = dec.significand;
+    e = dec.exponent;
+    const int n = NumDigits(s);
+    if (n == precision + 1) return Slow(x, precision, out);
+    if (n > precision) {
+      const std::uint64_t div = kPow10[n - precision];
+      std::uint64_t r;
+      std::uint64_t q = DivPow10(s, n - precision, &r);
+      if (2 * r == div) return Slow(x, precision, out);  // a tie: not reached (see above)
+      if (2 * r > div) ++q;
+      e += n - precision;
+      if (q == kPow10[precision]) {
+        q = kPow10[precision - 1];
+        ++e;
+      }
+      s = q;
     }
-    s = q;
   }
+  int n = NumDigits(s);
   while (s % 10 == 0) {  // %g drops trailing zeros
     s /= 10;
     ++e;

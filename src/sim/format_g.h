@@ -1,5 +1,5 @@
 // FormatG: a double as printf("%.<precision>g") writes it (and fmt's "{:.<precision>g}"), byte
-// for byte, at about a fifth of fmt's cost: the per-step CSV of `recruit simulate` formats ~10
+// for byte, at about a third of fmt's cost: the per-step CSV of `recruit simulate` formats ~10
 // numbers per physics step, which was most of a run's time outside the physics.
 #pragma once
 

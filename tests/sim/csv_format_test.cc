@@ -46,6 +46,25 @@ TEST(FormatG, EqualsPrintfGForRandomDoublesOfEveryMagnitude) {
   EXPECT_GT(checked, 2000000);
 }
 
+TEST(FormatG, EqualsPrintfGNearRoundingMidpointsAndDecades) {
+  // x = (q + 1/2) 10^k with q of p digits, its neighbours, and values at and just below a power
+  // of ten: where rounding by scaling must give up or carry into the next decade.
+  std::mt19937_64 rng(11);
+  for (int i = 0; i < 200000; ++i) {
+    const int p = 1 + static_cast<int>(rng() % 9);
+    const double q = static_cast<double>(rng() % static_cast<std::uint64_t>(std::pow(10, p)));
+    const double scale = std::pow(10.0, static_cast<int>(rng() % 50) - 25);
+    const double mid = (q + 0.5) * scale, top = (q + 1) * scale;
+    for (double v : {mid, std::nextafter(mid, 0.0), std::nextafter(mid, 1e300), top,
+                     std::nextafter(top, 0.0), scale * 9.99999999999, scale}) {
+      for (int precision : {p, 6, 9}) {
+        ASSERT_EQ(Fast(v, precision), fmt::format("{:.{}g}", v, precision))
+            << fmt::format("{:.17g} p={}", v, precision);
+      }
+    }
+  }
+}
+
 TEST(FormatG, EqualsPrintfGAtTheEdges) {
   const double inf = std::numeric_limits<double>::infinity();
   for (double x : {0.0,
