@@ -17,23 +17,26 @@ CsvStepWriter::CsvStepWriter(std::string path, int every)
 Status CsvStepWriter::OnStep(const mjModel*, const mjData*, const TelemetrySample& s) {
   if (!file_.ok()) return Error{file_.error()};
   if (!header_written_) {
-    buffer_ += "time,reference,measured,angle";
+    std::string header = "time,reference,measured,angle";
     for (const auto& b : s.bundles) {
       for (const char* col : {"force", "force_reference", "true_on", "estimated_on",
                               "estimated_on_std", "p_on", "p_off", "mean_temperature"}) {
-        buffer_ += fmt::format(",{}.{}", b.actuator, col);
+        header += fmt::format(",{}.{}", b.actuator, col);
       }
     }
-    buffer_ += ",control_instant\n";
+    header += ",control_instant\n";
+    Reserve(header.size());
+    std::memcpy(buffer_.data() + used_, header.data(), header.size());
+    used_ += header.size();
     header_written_ = true;
   }
   if (count_++ % every_ != 0 && !s.control_instant) return Status::Ok();
-  // The row is formatted into a buffer sized for the longest row (FormatG: "%.9g" etc. byte
+  // The row is formatted in place, with room for the longest row (FormatG: "%.9g" etc. byte
   // for byte, without fmt's format-string parsing). Most columns hold between control instants
   // (references, estimates, broadcasts): a column equal to its last value reuses its text.
-  row_.resize(8 + (4 + 8 * s.bundles.size()) * kFormatGMax);
+  Reserve(8 + (4 + 8 * s.bundles.size()) * kFormatGMax);
   cache_.resize(4 + 7 * s.bundles.size());
-  char* p = row_.data();
+  char* p = buffer_.data() + used_;
   Column* col = cache_.data();
   auto num = [&p, &col](double v, int precision) {
     Column& c = *col++;
@@ -84,18 +87,23 @@ Status CsvStepWriter::OnStep(const mjModel*, const mjData*, const TelemetrySampl
   *p++ = ',';
   *p++ = s.control_instant ? '1' : '0';
   *p++ = '\n';
-  buffer_.append(row_.data(), p);
-  if (buffer_.size() > (1 << 20)) {
-    file_.stream() << buffer_;
-    buffer_.clear();
-  }
+  used_ = static_cast<std::size_t>(p - buffer_.data());
+  if (used_ > (1 << 20)) Flush();
   return Status::Ok();
+}
+
+void CsvStepWriter::Reserve(std::size_t n) {
+  if (buffer_.size() < used_ + n) buffer_.resize(used_ + n);
+}
+
+void CsvStepWriter::Flush() {
+  file_.stream().write(buffer_.data(), static_cast<std::streamsize>(used_));
+  used_ = 0;
 }
 
 Status CsvStepWriter::Finish() {
   if (!file_.ok()) return Error{file_.error()};
-  file_.stream() << buffer_;
-  buffer_.clear();
+  Flush();
   return Status::Ok();
 }
 

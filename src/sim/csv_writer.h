@@ -22,12 +22,15 @@ class CsvStepWriter : public StepObserver {
   Status Commit();           // the CSV appears under its name
 
  private:
+  void Reserve(std::size_t n);  // room for n more bytes after the used ones
+  void Flush();                 // the used bytes to the file
   AtomicFile file_;
   int every_;
   long count_ = 0;
   bool header_written_ = false;
-  std::string buffer_;
-  std::vector<char> row_;  // one row being formatted
+  // Rows not yet written (the first used_ bytes), flushed past 1 MB.
+  std::vector<char> buffer_;
+  std::size_t used_ = 0;
   // Each numeric column's last value and its text.
   struct Column {
     std::uint64_t bits = 0;  // of the double
