@@ -36,4 +36,20 @@ void* ModuleSymbol(void* module, const char* name, std::string* error) {
   return sym;
 }
 
+const PlotModule* OpenPlotModule(std::string* error) {
+  static PlotModule module;
+  static std::string open_error;
+  static const bool opened = [] {
+    void* m = OpenCommandModule("librecruit-plot.so", &open_error);
+    if (!m) return false;
+    module.run =
+        reinterpret_cast<RecruitPlotRunFn>(ModuleSymbol(m, "recruit_plot_run", &open_error));
+    module.figure =
+        reinterpret_cast<RecruitPlotFigureFn>(ModuleSymbol(m, "recruit_plot_figure", &open_error));
+    return module.run && module.figure;
+  }();
+  if (!opened) *error = open_error;
+  return opened ? &module : nullptr;
+}
+
 }  // namespace recruit::cli

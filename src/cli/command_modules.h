@@ -2,7 +2,7 @@
 // (dlopen), so every other command starts without libav, OSMesa, LLVM and cairo
 // (docs/rendering.md has the measured difference):
 //   librecruit-render.so  `recruit render`: camera check, recorder (OSMesa/EGL, libav);
-//   librecruit-plot.so    `recruit plot` (cairo).
+//   librecruit-plot.so    `recruit plot` and the figures of `recruit sweep` (cairo).
 // They sit next to the `recruit` binary. Only the C entry points below cross the boundary; the
 // structs passed are the ones both sides are compiled with (one build).
 #pragma once
@@ -12,7 +12,9 @@
 #include <vector>
 
 #include "common/step_observer.h"
+#include "plot/figure.h"
 #include "plot/plot_run.h"
+#include "plot/render.h"
 #include "render/video_recorder.h"
 
 namespace recruit::cli {
@@ -42,9 +44,18 @@ void* OpenCommandModule(const std::string& file, std::string* error);
 // The symbol `name` of a module opened above, or null with `error` set.
 void* ModuleSymbol(void* module, const char* name, std::string* error);
 
+struct PlotModule;
+// librecruit-plot.so's entry points, the module opened on the first call; null with `error` set
+// when it cannot be opened.
+const PlotModule* OpenPlotModule(std::string* error);
+
 }  // namespace recruit::cli
 
 extern "C" {
+// librecruit-plot.so: recruit::plot::RenderFigure (`bytes` on success, else `error`).
+using RecruitPlotFigureFn = void (*)(const recruit::plot::Figure* figure, int width, int height,
+                                     recruit::plot::Format format, std::string* bytes,
+                                     std::string* error);
 // librecruit-render.so: checks the options and the camera and opens the outputs.
 using RecruitRenderOpenFn = void (*)(const recruit::cli::RenderOpenRequest* request,
                                      recruit::cli::RenderOpenResult* result);
@@ -52,3 +63,12 @@ using RecruitRenderOpenFn = void (*)(const recruit::cli::RenderOpenRequest* requ
 using RecruitPlotRunFn = void (*)(const recruit::plot::PlotOptions* options,
                                   std::vector<std::string>* written, std::string* error);
 }
+
+namespace recruit::cli {
+
+struct PlotModule {
+  RecruitPlotRunFn run = nullptr;
+  RecruitPlotFigureFn figure = nullptr;
+};
+
+}  // namespace recruit::cli

@@ -58,18 +58,14 @@ void AddPlotCommand(CLI::App& app, int& exit_code) {
     }
     // The drawing code (cairo) is loaded only now (cli/command_modules.h).
     std::string error;
-    void* module = OpenCommandModule("librecruit-plot.so", &error);
-    auto run =
-        module
-            ? reinterpret_cast<RecruitPlotRunFn>(ModuleSymbol(module, "recruit_plot_run", &error))
-            : nullptr;
-    if (!run) {
+    const PlotModule* module = OpenPlotModule(&error);
+    if (!module) {
       std::cerr << "recruit plot: " << error << "\n";
       exit_code = exit_code::kIo;
       return;
     }
     std::vector<std::string> written;
-    run(o.get(), &written, &error);
+    module->run(o.get(), &written, &error);
     if (!error.empty()) {
       std::cerr << "recruit plot: " << error << "\n";
       exit_code = 1;

@@ -3,8 +3,10 @@
 #include <string>
 #include <vector>
 
-// No MuJoCo here: the signature is RecruitPlotRunFn of cli/command_modules.h.
+// No MuJoCo here: the signatures are RecruitPlotRunFn and RecruitPlotFigureFn of
+// cli/command_modules.h.
 #include "plot/plot_run.h"
+#include "plot/render.h"
 
 extern "C" __attribute__((visibility("default"))) void recruit_plot_run(
     const recruit::plot::PlotOptions* options, std::vector<std::string>* written,
@@ -12,6 +14,17 @@ extern "C" __attribute__((visibility("default"))) void recruit_plot_run(
   auto r = recruit::plot::RunPlot(*options);
   if (r.ok()) {
     *written = std::move(*r);
+  } else {
+    *error = r.error();
+  }
+}
+
+extern "C" __attribute__((visibility("default"))) void recruit_plot_figure(
+    const recruit::plot::Figure* figure, int width, int height, recruit::plot::Format format,
+    std::string* bytes, std::string* error) {
+  auto r = recruit::plot::RenderFigure(*figure, width, height, format);
+  if (r.ok()) {
+    *bytes = std::move(*r);
   } else {
     *error = r.error();
   }

@@ -16,6 +16,7 @@
 #include <mutex>
 #include <set>
 
+#include "cli/command_modules.h"
 #include "cli/commands.h"
 #include "cli/errors.h"
 #include "common/atomic_file.h"
@@ -258,6 +259,24 @@ int WriteReports(const std::string& cmd, const Prepared& p,
   if (Status s = sim::WriteSweepReport(cells, p.criterion, out, p.task.name); !s.ok()) {
     return Fail(cmd, s.error(), exit_code::kIo);
   }
+  // The figures are drawn by the plot module (cairo), opened only now.
+  std::string error;
+  const PlotModule* plot = OpenPlotModule(&error);
+  if (!plot) return Fail(cmd, error, exit_code::kIo);
+  if (p.file.axes.empty()) {  // the dT x lambda map, as `recruit plot --stability-map` draws it
+    const plot::PlotOptions map =
+        sweep::StabilityMapOptions(out, p.task.name, static_cast<int>(p.spec.estimators.size()));
+    std::vector<std::string> written;
+    plot->run(&map, &written, &error);
+    if (!error.empty()) return Fail(cmd, "stability map: " + error, exit_code::kIo);
+  }
+  auto render = [plot](const plot::Figure& fig, int w, int h,
+                       plot::Format f) -> Result<std::string> {
+    std::string bytes, why;
+    plot->figure(&fig, w, h, f, &bytes, &why);
+    if (!why.empty()) return Error{why};
+    return bytes;
+  };
   sweep::ReportInput in{p.task.name, p.description, p.criterion, cells, {}};
   // The output-only loop's latency bound needs each plant point's force latency (one open-loop
   // step of its model, ~0.1 s each); a point whose model cannot do it gets none (NaN).
@@ -269,7 +288,8 @@ int WriteReports(const std::string& cmd, const Prepared& p,
       if (tau.ok()) in.latency[i] = *tau;
     });
   }
-  if (Status s = sweep::WriteReport(in, out); !s.ok()) return Fail(cmd, s.error(), exit_code::kIo);
+  if (Status s = sweep::WriteReport(in, out, render); !s.ok())
+    return Fail(cmd, s.error(), exit_code::kIo);
   return exit_code::kOk;
 }
 
@@ -278,8 +298,8 @@ Result<FileLock> OpenOut(const std::string& out, const Prepared& p, const SweepA
   *code = exit_code::kUsage;
   // The outputs must not replace the inputs (a task file kept in the output folder).
   for (const char* name :
-       {"sweep.json", "table.csv", "table.md", "stability.dat", "stability.gp", "stability.png",
-        "sweep.lock", "report.md", "report.html", "shard.json", "progress.log"}) {
+       {"sweep.json", "table.csv", "table.md", "stability.dat", "stability.png", "sweep.lock",
+        "report.md", "report.html", "shard.json", "progress.log"}) {
     Status s = CheckNotAnInput((fs::path(out) / name).string(), "output",
                                {{"--task", p.task_path},
                                 {"--sweep", a.sweep_file},

@@ -3,7 +3,11 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <iterator>
+
+#include "sim/format_g.h"
 
 namespace recruit::sim {
 
@@ -13,39 +17,93 @@ CsvStepWriter::CsvStepWriter(std::string path, int every)
 Status CsvStepWriter::OnStep(const mjModel*, const mjData*, const TelemetrySample& s) {
   if (!file_.ok()) return Error{file_.error()};
   if (!header_written_) {
-    buffer_ += "time,reference,measured,angle";
+    std::string header = "time,reference,measured,angle";
     for (const auto& b : s.bundles) {
       for (const char* col : {"force", "force_reference", "true_on", "estimated_on",
                               "estimated_on_std", "p_on", "p_off", "mean_temperature"}) {
-        buffer_ += fmt::format(",{}.{}", b.actuator, col);
+        header += fmt::format(",{}.{}", b.actuator, col);
       }
     }
-    buffer_ += ",control_instant\n";
+    header += ",control_instant\n";
+    Reserve(header.size());
+    std::memcpy(buffer_.data() + used_, header.data(), header.size());
+    used_ += header.size();
     header_written_ = true;
   }
   if (count_++ % every_ != 0 && !s.control_instant) return Status::Ok();
-  auto out = std::back_inserter(buffer_);
-  fmt::format_to(out, "{:.6g},{:.9g},{:.9g},{:.9g}", s.time, s.reference, s.measured, s.angle);
+  // The row is formatted in place, with room for the longest row (FormatG: "%.9g" etc. byte
+  // for byte, without fmt's format-string parsing). Most columns hold between control instants
+  // (references, estimates, broadcasts): a column equal to its last value reuses its text.
+  Reserve(8 + (4 + 8 * s.bundles.size()) * kFormatGMax);
+  cache_.resize(4 + 7 * s.bundles.size());
+  char* p = buffer_.data() + used_;
+  Column* col = cache_.data();
+  auto num = [&p, &col](double v, int precision) {
+    Column& c = *col++;
+    std::uint64_t bits;
+    std::memcpy(&bits, &v, sizeof bits);
+    if (c.len == 0 || bits != c.bits) {
+      c.bits = bits;
+      c.len = static_cast<std::uint8_t>(FormatG(v, precision, c.text) - c.text);
+    }
+    std::memcpy(p, c.text, sizeof c.text);  // fixed size: one move, the end is overwritten
+    p += c.len;
+  };
+  auto comma = [&p] { *p++ = ','; };
+  num(s.time, 6);
+  comma();
+  num(s.reference, 9);
+  comma();
+  num(s.measured, 9);
+  comma();
+  num(s.angle, 9);
   for (const auto& b : s.bundles) {
-    fmt::format_to(out, ",{:.9g},{:.9g},{},", b.force, b.force_reference, b.true_on);
+    comma();
+    num(b.force, 9);
+    comma();
+    num(b.force_reference, 9);
+    comma();
+    p = FormatInt(b.true_on, p);
+    comma();
     // Non-finite estimates (no estimator, no variance) are left empty: readers take them as NaN.
-    if (std::isfinite(b.estimated_on)) fmt::format_to(out, "{:.6g}", b.estimated_on);
-    buffer_ += ',';
-    if (std::isfinite(b.estimated_on_std)) fmt::format_to(out, "{:.6g}", b.estimated_on_std);
-    fmt::format_to(out, ",{:.6g},{:.6g},{:.6g}", b.p_on, b.p_off, b.mean_temperature);
+    if (std::isfinite(b.estimated_on)) {
+      num(b.estimated_on, 6);
+    } else {
+      ++col;
+    }
+    comma();
+    if (std::isfinite(b.estimated_on_std)) {
+      num(b.estimated_on_std, 6);
+    } else {
+      ++col;
+    }
+    comma();
+    num(b.p_on, 6);
+    comma();
+    num(b.p_off, 6);
+    comma();
+    num(b.mean_temperature, 6);
   }
-  fmt::format_to(out, ",{}\n", s.control_instant ? 1 : 0);
-  if (buffer_.size() > (1 << 20)) {
-    file_.stream() << buffer_;
-    buffer_.clear();
-  }
+  *p++ = ',';
+  *p++ = s.control_instant ? '1' : '0';
+  *p++ = '\n';
+  used_ = static_cast<std::size_t>(p - buffer_.data());
+  if (used_ > (1 << 20)) Flush();
   return Status::Ok();
+}
+
+void CsvStepWriter::Reserve(std::size_t n) {
+  if (buffer_.size() < used_ + n) buffer_.resize(used_ + n);
+}
+
+void CsvStepWriter::Flush() {
+  file_.stream().write(buffer_.data(), static_cast<std::streamsize>(used_));
+  used_ = 0;
 }
 
 Status CsvStepWriter::Finish() {
   if (!file_.ok()) return Error{file_.error()};
-  file_.stream() << buffer_;
-  buffer_.clear();
+  Flush();
   return Status::Ok();
 }
 

@@ -3,10 +3,13 @@
 // and after the run's other outputs are written (a failed summary leaves no CSV behind).
 #pragma once
 
+#include <cstdint>
 #include <string>
+#include <vector>
 
 #include "common/atomic_file.h"
 #include "common/step_observer.h"
+#include "sim/format_g.h"
 
 namespace recruit::sim {
 
@@ -19,11 +22,22 @@ class CsvStepWriter : public StepObserver {
   Status Commit();           // the CSV appears under its name
 
  private:
+  void Reserve(std::size_t n);  // room for n more bytes after the used ones
+  void Flush();                 // the used bytes to the file
   AtomicFile file_;
   int every_;
   long count_ = 0;
   bool header_written_ = false;
-  std::string buffer_;
+  // Rows not yet written (the first used_ bytes), flushed past 1 MB.
+  std::vector<char> buffer_;
+  std::size_t used_ = 0;
+  // Each numeric column's last value and its text.
+  struct Column {
+    std::uint64_t bits = 0;  // of the double
+    std::uint8_t len = 0;    // 0: none yet
+    char text[kFormatGMax];
+  };
+  std::vector<Column> cache_;
 };
 
 }  // namespace recruit::sim

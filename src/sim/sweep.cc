@@ -1,9 +1,6 @@
 #include "sim/sweep.h"
 
-#include <fcntl.h>
 #include <fmt/format.h>
-#include <spawn.h>
-#include <sys/wait.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
@@ -275,55 +272,6 @@ double Sd(const std::vector<double>& v) {
   return std::sqrt(s / (v.size() - 1));
 }
 
-// Text inside a gnuplot single-quoted string: '' is a quote, control characters become spaces
-// (a task name must not end the string and inject commands).
-std::string GnuplotQuoted(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    if (c == '\'') {
-      out += "''";
-    } else if (static_cast<unsigned char>(c) < 0x20) {
-      out += ' ';
-    } else {
-      out += c;
-    }
-  }
-  return out;
-}
-
-// True iff `path` is a whole PNG: gnuplot does not check its writes, so on a full disk it exits
-// 0 with an empty or cut file; a complete PNG ends with the IEND chunk.
-bool IsCompletePng(const std::string& path) {
-  std::FILE* f = std::fopen(path.c_str(), "rb");
-  if (!f) return false;
-  unsigned char head[8] = {}, tail[8] = {};
-  bool ok = std::fread(head, 1, 8, f) == 8 && std::fseek(f, -8, SEEK_END) == 0 &&
-            std::fread(tail, 1, 8, f) == 8;
-  std::fclose(f);
-  static const unsigned char kHead[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
-  static const unsigned char kTail[8] = {'I', 'E', 'N', 'D', 0xae, 0x42, 0x60, 0x82};
-  return ok && std::memcmp(head, kHead, 8) == 0 && std::memcmp(tail, kTail, 8) == 0;
-}
-
-// Runs gnuplot on `script` without a shell (paths may hold any character). Returns its exit
-// status, 127 when gnuplot cannot be started.
-int RunGnuplot(const std::string& script) {
-  pid_t pid = 0;
-  std::string prog = "gnuplot";
-  std::vector<char*> argv = {prog.data(), const_cast<char*>(script.c_str()), nullptr};
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, 2, "/dev/null", O_WRONLY, 0);
-  const int err = posix_spawnp(&pid, "gnuplot", &actions, nullptr, argv.data(), environ);
-  posix_spawn_file_actions_destroy(&actions);
-  if (err != 0) return 127;
-  int status = 0;
-  while (waitpid(pid, &status, 0) < 0) {
-    if (errno != EINTR) return 127;
-  }
-  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-}
-
 }  // namespace
 
 std::vector<CellStats> Aggregate(const std::vector<RunSummary>& runs,
@@ -512,48 +460,9 @@ Status WriteSweepReport(const std::vector<CellStats>& cells, const TrackingCrite
   }
   s = WriteFileAtomically((dir / "stability.dat").string(), dat);
   if (!s.ok()) return s;
-  const std::string png = (dir / "stability.png").string();
-  const std::string tmp_png = png + ".tmp.png";
-  std::string gp = fmt::format(
-      "# Stability map of a recruit sweep (made by `recruit sweep`).\n"
-      "set terminal png size {},420 font ',10' noenhanced\nset output '{}'\n"
-      "set multiplot layout 1,{} title '{}: mean step overshoot (%), ring = meets criterion'\n"
-      "set logscale x 2\nset xlabel 'dT (s)'\nset ylabel 'lambda'\n"
-      "set cbrange [0:50]\nset palette defined (0 'forest-green', 10 'yellow', 50 'red')\n"
-      "set offsets graph 0.1, graph 0.1, graph 0.1, graph 0.1\nunset key\n",
-      std::max(480, 460 * static_cast<int>(ests.size())), GnuplotQuoted(tmp_png), ests.size(),
-      GnuplotQuoted(title));
-  for (size_t i = 0; i < ests.size(); ++i) {
-    gp += fmt::format(
-        "set title '{0}'\nplot '{1}' index {2} using 1:2:3 with points pt 5 ps 5 palette, "
-        "'' index {2} using 1:($4 > 0 ? $2 : 1/0) with points pt 6 ps 6 lc 'black', "
-        "'' index {2} using 1:2:(sprintf('%.0f', $3)) with labels offset 0,2.2\n",
-        GnuplotQuoted(ests[i]), GnuplotQuoted((dir / "stability.dat").string()), i);
-  }
-  gp += "unset multiplot\n";
-  s = WriteFileAtomically((dir / "stability.gp").string(), gp);
-  if (!s.ok()) return s;
-  const int slot = RegisterTempFile(tmp_png);  // removed on SIGINT/SIGTERM too
-  const int rc = RunGnuplot((dir / "stability.gp").string());
-  const bool made = IsCompletePng(tmp_png);
-  Status result;
-  if (rc == 0 && made) {
-    std::error_code ec;
-    fs::rename(tmp_png, png, ec);
-    if (ec) result = Error{"cannot write '" + png + "': " + ec.message()};
-  } else if (rc == 127) {
-    std::fprintf(stderr,
-                 "sweep: gnuplot is missing; stability.png not made (the data is in "
-                 "stability.dat, the script in stability.gp)\n");
-  } else {
-    result = Error{fmt::format(
-        "cannot write '{}': gnuplot exited with status {}{} (disk full?); the data is in "
-        "stability.dat, the script in stability.gp",
-        png, rc, made ? "" : " and wrote an incomplete image")};
-  }
-  if (!result.ok() || rc != 0) std::remove(tmp_png.c_str());
-  UnregisterTempFile(slot);
-  return result;
+  // stability.png is drawn from it by `recruit plot --stability-map`'s code
+  // (sweep::StabilityMapOptions), in the plot module `recruit sweep` opens.
+  return Status::Ok();
 }
 
 }  // namespace recruit::sim

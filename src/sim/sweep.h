@@ -119,10 +119,9 @@ std::vector<CellStats> Aggregate(const std::vector<SweepRun>& grid,
                                  const TrackingCriterion& criterion);
 
 // Writes table.csv, table.md (with a column per plant axis when there are plant points),
-// stability.dat/.gp/.png (when gnuplot is found, and no plant axes) into `out_dir`. The files
-// depend only on the runs' results. Any failed write (full disk) is an error; so is gnuplot failing
-// or writing an empty image (gnuplot missing is only a warning: the data and script are still
-// written).
+// and, without plant axes, stability.dat (the map's data: `recruit sweep` draws stability.png from
+// it with the plot module, sweep::StabilityMapOptions) into `out_dir`. The files depend only on
+// the runs' results. Any failed write (full disk) is an error.
 Status WriteSweepReport(const std::vector<CellStats>& cells, const TrackingCriterion& criterion,
                         const std::string& out_dir, const std::string& title);
 

@@ -8,8 +8,6 @@
 #include <map>
 
 #include "common/atomic_file.h"
-#include "plot/figure.h"
-#include "plot/render.h"
 #include "sweep/latency.h"
 
 namespace recruit::sweep {
@@ -331,7 +329,8 @@ std::string ReportMarkdown(const ReportInput& in, const std::vector<Recommendati
   return md;
 }
 
-Status WriteReport(const ReportInput& in, const std::string& out_dir) {
+Status WriteReport(const ReportInput& in, const std::string& out_dir,
+                   const FigureRenderer& render) {
   const fs::path dir(out_dir);
   const auto recs = Recommend(in.cells);
   const auto sens = Sensitivities(recs);
@@ -344,7 +343,7 @@ Status WriteReport(const ReportInput& in, const std::string& out_dir) {
   for (const auto& [name, fig] : figs) {
     const int h = 120 + 260 * static_cast<int>(std::max<size_t>(1, fig.panels.size()));
     for (const auto fmt_ : {plot::Format::kPng, plot::Format::kSvg}) {
-      auto bytes = plot::RenderFigure(fig, 900, h, fmt_);
+      auto bytes = render(fig, 900, h, fmt_);
       if (!bytes.ok()) return Error{"report figure " + name + ": " + bytes.error()};
       const std::string file = name + (fmt_ == plot::Format::kPng ? ".png" : ".svg");
       if (Status s = WriteFileAtomically((dir / file).string(), *bytes); !s.ok()) return s;
@@ -355,6 +354,19 @@ Status WriteReport(const ReportInput& in, const std::string& out_dir) {
   if (Status s = WriteFileAtomically((dir / "report.md").string(), md); !s.ok()) return s;
   return WriteFileAtomically((dir / "report.html").string(),
                              MarkdownToHtml(md, pngs, "Sampling-period report: " + in.title));
+}
+
+plot::PlotOptions StabilityMapOptions(const std::string& out_dir, const std::string& title,
+                                      int num_estimators) {
+  plot::PlotOptions o;
+  o.stability_map = (fs::path(out_dir) / "stability.dat").string();
+  o.out_dir = out_dir;
+  o.name = "stability";
+  o.formats = "png";
+  o.width = std::max(480, 460 * num_estimators);
+  o.height = 420;
+  o.title = title + ": mean step overshoot (%), ring = meets criterion";
+  return o;
 }
 
 }  // namespace recruit::sweep

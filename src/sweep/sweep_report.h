@@ -6,10 +6,14 @@
 // depends only on the runs' results, so a merged sharded sweep writes the same bytes.
 #pragma once
 
+#include <functional>
 #include <string>
 #include <vector>
 
 #include "common/result.h"
+#include "plot/figure.h"
+#include "plot/plot_run.h"
+#include "plot/render.h"
 #include "sim/sweep.h"
 #include "sweep/recommend.h"
 
@@ -29,7 +33,17 @@ struct ReportInput {
 std::string ReportMarkdown(const ReportInput& in, const std::vector<Recommendation>& recs,
                            const std::vector<Sensitivity>& sens, bool with_figures);
 
+// Draws a figure as PNG or SVG bytes: plot::RenderFigure, which `recruit` reaches through its
+// plot module (cli/command_modules.h) so that only the commands that draw load cairo.
+using FigureRenderer =
+    std::function<Result<std::string>(const plot::Figure&, int width, int height, plot::Format)>;
+
 // Writes report.md, report.html and the figures into `out_dir`.
-Status WriteReport(const ReportInput& in, const std::string& out_dir);
+Status WriteReport(const ReportInput& in, const std::string& out_dir, const FigureRenderer& render);
+
+// What `recruit sweep` asks `recruit plot --stability-map` for: <out_dir>/stability.png from the
+// stability.dat that sim::WriteSweepReport wrote there (a panel of 460 x 420 px per estimator).
+plot::PlotOptions StabilityMapOptions(const std::string& out_dir, const std::string& title,
+                                      int num_estimators);
 
 }  // namespace recruit::sweep

@@ -117,6 +117,23 @@ sigterm_cleans_up)  # a killed simulate leaves no temporary files and dies of SI
   [ $rc -eq 143 ] || fail "exit status $rc, expected 143 (killed by SIGTERM)"
   [ -z "$(ls o | grep '\.tmp\.')" ] || fail "left $(ls o)"
   ;;
+no_render_libs)  # only the commands that draw load the drawing libraries (cairo, libav, GL)
+  # LD_DEBUG=files lists every shared object the loader maps, linked or opened later.
+  libs() { grep -o 'file=[^ ]*' err | sed 's/file=//' | sort -u; }
+  drawing='cairo|libav|OSMesa|libGL|libEGL|pixman|png16|freetype'
+  LD_DEBUG=files expect 0 "$RECRUIT" --help
+  libs | grep -E "$drawing" && fail "--help maps drawing libraries"
+  LD_DEBUG=files expect 0 "$RECRUIT" simulate --task "$TASK" --duration 2 --dT 0.5 --estimator output --out s
+  libs | grep -E "$drawing" && fail "simulate maps drawing libraries"
+  cut -d, -f1-4 s/isometric_steps_steps.csv | head -200 > log.csv
+  LD_DEBUG=files "$RECRUIT" filter --model /no/such.json --log log.csv --out f.csv > out 2> err
+  libs | grep -E "$drawing" && fail "filter maps drawing libraries"
+  # The control: a sweep draws its figures (the plot module maps cairo), and its stability map
+  # is made without gnuplot (PATH without it).
+  PATH=/nonexistent LD_DEBUG=files expect 0 "$RECRUIT" sweep --task "$TASK" --duration 2 --dT 0.5,1 --estimator output --seeds 1 --threads 1 --out w
+  libs | grep -q cairo || fail "the sweep's figures did not load cairo (is the check blind?)"
+  [ -s w/stability.png ] && [ -s w/margin.png ] || fail "sweep figures missing: $(ls w)"
+  ;;
 sweep_lock)  # a second sweep into a locked folder fails at once with a clear message
   mkdir s
   expect 4 flock s/sweep.lock "$RECRUIT" sweep --task "$TASK" --duration 4 --dT 1 \

@@ -19,6 +19,8 @@
 
 #include "common/atomic_file.h"
 #include "common/rng.h"
+#include "plot/plot_run.h"
+#include "plot/render.h"
 #include "sim/task.h"
 #include "sweep/latency.h"
 #include "sweep/recommend.h"
@@ -231,20 +233,22 @@ TEST(Sweep, ARecordMadeFromOtherInputsIsNotReused) {
 }
 
 TEST(Sweep, AReportOnAFullDiskFails) {
-  // RLIMIT_FSIZE (inherited by gnuplot) makes writes past a size fail, as a full disk does: the
-  // report must return an error (in a child, so the limit does not leak into the test).
+  // RLIMIT_FSIZE makes writes past a size fail, as a full disk does: the stability map that
+  // `recruit sweep` draws with the plot module (sweep::StabilityMapOptions) must return an error
+  // and leave no image or temporary file (in a child, so the limit does not leak into the test).
   const auto dir = TempDir("full");
   auto grid = ExpandGrid(Spec());
   auto out = RunSweep(*grid, dir.string(), FakeRun, 2);
   ASSERT_TRUE(out.ok());
   const TrackingCriterion crit;
   const auto cells = Aggregate(out->runs, crit);
+  const plot::PlotOptions map = sweep::StabilityMapOptions(dir.string(), "full", 2);
   // First with room, to size the files: the limit lets every text file through and stops the
-  // image, so this checks gnuplot's failure is seen (not only our own writes').
+  // image, so this checks the image's failed write is seen (not only the tables').
   ASSERT_TRUE(WriteSweepReport(cells, crit, dir.string(), "full").ok());
-  if (!fs::exists(dir / "stability.png")) GTEST_SKIP() << "gnuplot missing";
+  ASSERT_TRUE(plot::RunPlot(map).ok());
   std::uintmax_t text = 0;
-  for (const char* f : {"table.csv", "table.md", "stability.dat", "stability.gp"}) {
+  for (const char* f : {"table.csv", "table.md", "stability.dat"}) {
     text = std::max(text, fs::file_size(dir / f));
   }
   const std::uintmax_t png = fs::file_size(dir / "stability.png");
@@ -255,7 +259,9 @@ TEST(Sweep, AReportOnAFullDiskFails) {
     std::signal(SIGXFSZ, SIG_IGN);
     rlimit lim{text + 100, text + 100};
     ::setrlimit(RLIMIT_FSIZE, &lim);
-    ::_exit(WriteSweepReport(cells, crit, dir.string(), "full").ok() ? 1 : 0);
+    const bool ok =
+        WriteSweepReport(cells, crit, dir.string(), "full").ok() && plot::RunPlot(map).ok();
+    ::_exit(ok ? 1 : 0);
   }
   int status = 0;
   ::waitpid(pid, &status, 0);
@@ -263,27 +269,39 @@ TEST(Sweep, AReportOnAFullDiskFails) {
   EXPECT_EQ(WEXITSTATUS(status), 0) << "the report on a full disk claimed success";
   EXPECT_FALSE(fs::exists(dir / "stability.png"));
   for (auto& e : fs::directory_iterator(dir)) {
-    EXPECT_EQ(e.path().string().find(".tmp."), std::string::npos) << e.path();
+    EXPECT_EQ(e.path().string().find(".tmp"), std::string::npos) << e.path();
   }
   fs::remove_all(dir);
 }
 
-TEST(Sweep, TheStabilityMapIsMadeOrItsFailureReported) {
-  // With room on disk the map is a non-empty PNG (gnuplot installed) or the report says why.
+TEST(Sweep, TheStabilityMapIsDrawnWithoutGnuplot) {
+  // The map is drawn by the program (plot/stability_map.h), the same PNG whether or not gnuplot
+  // is installed: one panel per estimator, 460 px wide each.
   const auto dir = TempDir("png");
   auto grid = ExpandGrid(Spec());
   auto out = RunSweep(*grid, dir.string(), FakeRun, 2);
   ASSERT_TRUE(out.ok());
   const TrackingCriterion crit;
-  // A title with a quote must not break (or inject into) the gnuplot script.
-  ASSERT_TRUE(
-      WriteSweepReport(Aggregate(out->runs, crit), crit, dir.string(), "it's'; system('x").ok());
-  if (::system("command -v gnuplot > /dev/null 2>&1") == 0) {
-    ASSERT_TRUE(fs::exists(dir / "stability.png"));
-    EXPECT_GT(fs::file_size(dir / "stability.png"), 1000u);
-  }
+  const std::string title = "it's'; system('x";
+  ASSERT_TRUE(WriteSweepReport(Aggregate(out->runs, crit), crit, dir.string(), title).ok());
+  EXPECT_FALSE(fs::exists(dir / "stability.gp"));
+  auto written = plot::RunPlot(sweep::StabilityMapOptions(dir.string(), title, 2));
+  ASSERT_TRUE(written.ok()) << written.error();
+  ASSERT_EQ(written->size(), 1u);
+  EXPECT_EQ((*written)[0], (dir / "stability.png").string());
+  const std::string png = *ReadFile((dir / "stability.png").string());
+  ASSERT_GT(png.size(), 1000u);
+  EXPECT_EQ(png.substr(1, 3), "PNG");
+  // Width and height from the PNG header (big-endian at bytes 16 and 20).
+  auto be32 = [&png](size_t at) {
+    unsigned v = 0;
+    for (size_t i = 0; i < 4; ++i) v = (v << 8) | static_cast<unsigned char>(png[at + i]);
+    return v;
+  };
+  EXPECT_EQ(be32(16), 920u);
+  EXPECT_EQ(be32(20), 420u);
   for (auto& e : fs::directory_iterator(dir)) {
-    EXPECT_EQ(e.path().string().find(".tmp."), std::string::npos) << e.path();
+    EXPECT_EQ(e.path().string().find(".tmp"), std::string::npos) << e.path();
   }
   fs::remove_all(dir);
 }
@@ -637,7 +655,7 @@ TEST(SweepSensitivity, SyntheticPlantGivesItsClosedFormElasticities) {
 
   // The report: the table names every plant point, the HTML embeds its figures.
   sweep::ReportInput in{"synthetic", "a test", crit, cells, {}};
-  ASSERT_TRUE(sweep::WriteReport(in, dir.string()).ok());
+  ASSERT_TRUE(sweep::WriteReport(in, dir.string(), plot::RenderFigure).ok());
   const std::string md = *ReadFile((dir / "report.md").string());
   EXPECT_NE(md.find("| output | 0.2 | a | +0.500 (d ln dT*/d ln x)"), std::string::npos) << md;
   EXPECT_NE(ReadFile((dir / "report.html").string())->find("data:image/png;base64,iVBORw0KGgo"),

@@ -1,0 +1,216 @@
+#include "sim/format_g.h"
+
+#include <fmt/format.h>
+
+#include <array>
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <utility>
+
+namespace recruit::sim {
+namespace {
+
+constexpr std::uint64_t kPow10[] = {1ull,
+                                    10ull,
+                                    100ull,
+                                    1000ull,
+                                    10000ull,
+                                    100000ull,
+                                    1000000ull,
+                                    10000000ull,
+                                    100000000ull,
+                                    1000000000ull,
+                                    10000000000ull,
+                                    100000000000ull,
+                                    1000000000000ull,
+                                    10000000000000ull,
+                                    100000000000000ull,
+                                    1000000000000000ull,
+                                    10000000000000000ull,
+                                    100000000000000000ull,
+                                    1000000000000000000ull,
+                                    10000000000000000000ull};
+
+// Decimal digits of v > 0: from its bit length (1233 / 4096 ~ log10 2), one comparison.
+int NumDigits(std::uint64_t v) {
+  const int t = ((64 - __builtin_clzll(v)) * 1233) >> 12;
+  return t - (v < kPow10[t] ? 1 : 0) + 1;
+}
+
+// s / 10^K for each K: division by a constant compiles to a multiply, not a divide.
+template <std::size_t K>
+std::uint64_t DivByPow10(std::uint64_t s) {
+  return s / kPow10[K];
+}
+template <std::size_t... K>
+constexpr std::array<std::uint64_t (*)(std::uint64_t), sizeof...(K)> DivTable(
+    std::index_sequence<K...>) {
+  return {&DivByPow10<K>...};
+}
+constexpr auto kDivByPow10 = DivTable(std::make_index_sequence<20>());
+
+// s / 10^k and its remainder, k in 0..19.
+std::uint64_t DivPow10(std::uint64_t s, int k, std::uint64_t* r) {
+  const std::uint64_t q = kDivByPow10[k](s);
+  *r = s - q * kPow10[k];
+  return q;
+}
+
+constexpr char kDigitPairs[] =
+    "00010203040506070809101112131415161718192021222324252627282930313233343536373839"
+    "40414243444546474849505152535455565758596061626364656667686970717273747576777879"
+    "8081828384858687888990919293949596979899";
+
+// The n decimal digits of v (v < 10^n) at p[0..n).
+void WriteDigits(std::uint64_t v, int n, char* p) {
+  char* end = p + n;
+  while (v >= 100) {
+    end -= 2;
+    std::memcpy(end, kDigitPairs + 2 * (v % 100), 2);
+    v /= 100;
+  }
+  if (v >= 10) {
+    end -= 2;
+    std::memcpy(end, kDigitPairs + 2 * v, 2);
+  } else {
+    *--end = static_cast<char>('0' + v);
+  }
+}
+
+constexpr double kExactPow10[] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,
+                                  1e8,  1e9,  1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
+                                  1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
+
+// x > 0 (normal) rounded to `precision` <= 9 significant digits as s 10^e, s of `precision`
+// digits, without Dragonbox: y = x 10^k in one correctly rounded operation (10^k exact for |k| <=
+// 22) is within 2^-24 of the exact product (y < 2^30), so rounding y to an integer rounds the exact
+// product the same way unless y is within 1e-6 of a midpoint (then false: the caller decides).
+bool RoundByScaling(double x, int precision, std::uint64_t* s, int* e) {
+  if (precision > 9) return false;
+  std::uint64_t bits;
+  std::memcpy(&bits, &x, sizeof bits);
+  const int e2 = static_cast<int>((bits >> 52) & 0x7ff) - 1023;
+  int X = (e2 * 1233) >> 12;  // ~ floor(e2 log10 2): the leading digit's exponent or one below
+  for (int attempt = 0; attempt < 3; ++attempt) {
+    const int k = precision - 1 - X;
+    if (k < -22 || k > 22) return false;
+    const double y = k >= 0 ? x * kExactPow10[k] : x / kExactPow10[-k];
+    const double whole = std::floor(y);
+    if (whole < static_cast<double>(kPow10[precision - 1])) {  // X too high
+      --X;
+      continue;
+    }
+    if (whole >= static_cast<double>(kPow10[precision])) {  // X too low
+      ++X;
+      continue;
+    }
+    const double frac = y - whole;  // exact
+    if (std::abs(frac - 0.5) < 1e-6) return false;
+    std::uint64_t q = static_cast<std::uint64_t>(whole) + (frac > 0.5 ? 1 : 0);
+    if (q == kPow10[precision]) {  // rounded up into the next decade
+      q = kPow10[precision - 1];
+      ++X;
+    }
+    *s = q;
+    *e = X - (precision - 1);
+    return true;
+  }
+  return false;
+}
+
+// The general case (and the rare ones the fast path leaves): fmt, which follows printf.
+char* Slow(double x, int precision, char* out) {
+  return fmt::format_to(out, "{:.{}g}", x, precision);
+}
+
+}  // namespace
+
+// Most doubles at precision <= 9: RoundByScaling. Else the shortest decimal S that reads back as
+// x (Dragonbox), of n digits. If n <= precision, S is
+// also x rounded to `precision` digits: x is within half an ulp of S, far less than half a unit
+// in the precision-th digit. If n >= precision + 2, rounding S gives the rounding of x: a
+// rounding midpoint (precision + 1 digits) between x and S would be a shorter decimal that reads
+// back as x. With n == precision + 1, S itself can be a midpoint: fmt decides.
+char* FormatG(double x, int precision, char* out) {
+  if (!std::isfinite(x) || precision < 1 || precision > 15) return Slow(x, precision, out);
+  // (Subnormals too: their ulp is not small against the digits kept.)
+  if (x != 0 && std::abs(x) < 2.2250738585072014e-308) return Slow(x, precision, out);
+  if (std::signbit(x)) {
+    *out++ = '-';
+    x = -x;
+  }
+  if (x == 0) {
+    *out++ = '0';
+    return out;
+  }
+  std::uint64_t s;
+  int e;
+  if (!RoundByScaling(x, precision, &s, &e)) {
+    const auto dec = fmt::detail::dragonbox::to_decimal(x);
+    s = dec.significand;
+    e = dec.exponent;
+    const int n = NumDigits(s);
+    if (n == precision + 1) return Slow(x, precision, out);
+    if (n > precision) {
+      const std::uint64_t div = kPow10[n - precision];
+      std::uint64_t r;
+      std::uint64_t q = DivPow10(s, n - precision, &r);
+      if (2 * r == div) return Slow(x, precision, out);  // a tie: not reached (see above)
+      if (2 * r > div) ++q;
+      e += n - precision;
+      if (q == kPow10[precision]) {
+        q = kPow10[precision - 1];
+        ++e;
+      }
+      s = q;
+    }
+  }
+  int n = NumDigits(s);
+  while (s % 10 == 0) {  // %g drops trailing zeros
+    s /= 10;
+    ++e;
+    --n;
+  }
+  const int X = n - 1 + e;         // the exponent of the leading digit
+  if (X < -4 || X >= precision) {  // d.ddde+XX: the digits one place right, then the point
+    WriteDigits(s, n, out + 1);
+    out[0] = out[1];
+    if (n > 1) {
+      out[1] = '.';
+      out += n + 1;
+    } else {
+      out += 1;
+    }
+    *out++ = 'e';
+    *out++ = X < 0 ? '-' : '+';
+    const int ax = X < 0 ? -X : X;
+    if (ax < 100) {
+      std::memcpy(out, kDigitPairs + 2 * ax, 2);
+      return out + 2;
+    }
+    return std::to_chars(out, out + 4, ax).ptr;
+  }
+  if (X < 0) {  // 0.000ddd
+    *out++ = '0';
+    *out++ = '.';
+    for (int i = 0; i < -X - 1; ++i) *out++ = '0';
+    WriteDigits(s, n, out);
+    return out + n;
+  }
+  if (n <= X + 1) {  // an integer: the digits, then zeros
+    WriteDigits(s, n, out);
+    out += n;
+    for (int i = 0; i < X + 1 - n; ++i) *out++ = '0';
+    return out;
+  }
+  WriteDigits(s, n, out + 1);  // ddd.ddd: the integer part moves one place left
+  for (int i = 0; i <= X; ++i) out[i] = out[i + 1];
+  out[X + 1] = '.';
+  return out + n + 1;
+}
+
+char* FormatInt(long x, char* out) { return std::to_chars(out, out + 24, x).ptr; }
+
+}  // namespace recruit::sim

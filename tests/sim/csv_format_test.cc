@@ -1,0 +1,164 @@
+// The per-step CSV's number formatting against its reference: FormatG must write what
+// fmt's "{:.Ng}" (printf's "%.Ng") writes, and CsvStepWriter the rows the previous writer (fmt
+// format strings, kept below) wrote, byte for byte.
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <iterator>
+#include <limits>
+#include <random>
+
+#include "common/atomic_file.h"
+#include "sim/csv_writer.h"
+#include "sim/format_g.h"
+
+namespace recruit::sim {
+namespace {
+
+std::string Fast(double x, int precision) {
+  char buf[kFormatGMax];
+  return std::string(buf, FormatG(x, precision, buf));
+}
+
+TEST(FormatG, EqualsPrintfGForRandomDoublesOfEveryMagnitude) {
+  std::mt19937_64 rng(42);
+  std::uniform_real_distribution<double> exponent(-320, 308);
+  long checked = 0;
+  for (int i = 0; i < 200000; ++i) {
+    const double x = std::pow(10.0, exponent(rng)) * (rng() & 1 ? -1 : 1);
+    std::uint64_t bits = rng();
+    double any;
+    std::memcpy(&any, &bits, sizeof any);  // any bit pattern, NaN and subnormals included
+    // Short decimals and exact midpoints (x.5 at the digit after the precision).
+    const double shortd = static_cast<double>(rng() % 100000000000ull) / std::pow(10.0, rng() % 14);
+    const double mid =
+        static_cast<double>((rng() % 2000000) * 2 + 1) * 5 / std::pow(10.0, rng() % 12);
+    for (double v : {x, any, shortd, mid}) {
+      for (int p : {6, 9, 1 + static_cast<int>(rng() % 17)}) {
+        ASSERT_EQ(Fast(v, p), fmt::format("{:.{}g}", v, p)) << fmt::format("{:.17g} p={}", v, p);
+        ++checked;
+      }
+    }
+  }
+  EXPECT_GT(checked, 2000000);
+}
+
+TEST(FormatG, EqualsPrintfGNearRoundingMidpointsAndDecades) {
+  // x = (q + 1/2) 10^k with q of p digits, its neighbours, and values at and just below a power
+  // of ten: where rounding by scaling must give up or carry into the next decade.
+  std::mt19937_64 rng(11);
+  for (int i = 0; i < 200000; ++i) {
+    const int p = 1 + static_cast<int>(rng() % 9);
+    const double q = static_cast<double>(rng() % static_cast<std::uint64_t>(std::pow(10, p)));
+    const double scale = std::pow(10.0, static_cast<int>(rng() % 50) - 25);
+    const double mid = (q + 0.5) * scale, top = (q + 1) * scale;
+    for (double v : {mid, std::nextafter(mid, 0.0), std::nextafter(mid, 1e300), top,
+                     std::nextafter(top, 0.0), scale * 9.99999999999, scale}) {
+      for (int precision : {p, 6, 9}) {
+        ASSERT_EQ(Fast(v, precision), fmt::format("{:.{}g}", v, precision))
+            << fmt::format("{:.17g} p={}", v, precision);
+      }
+    }
+  }
+}
+
+TEST(FormatG, EqualsPrintfGAtTheEdges) {
+  const double inf = std::numeric_limits<double>::infinity();
+  for (double x : {0.0,
+                   1.0,
+                   0.1,
+                   1e-5,
+                   1e-4,
+                   99999.95,
+                   999999.5,
+                   9999999.5,
+                   999999999.5,
+                   1e9,
+                   1e15,
+                   123456789.0,
+                   0.5,
+                   2.5,
+                   1e300,
+                   5e-324,
+                   2.2250738585072014e-308,
+                   1.7976931348623157e308,
+                   1234567.5,
+                   12345675.0,
+                   0.000123456785,
+                   inf,
+                   std::numeric_limits<double>::quiet_NaN()}) {
+    for (int p = 1; p <= 17; ++p) {
+      EXPECT_EQ(Fast(x, p), fmt::format("{:.{}g}", x, p)) << x << " p=" << p;
+      EXPECT_EQ(Fast(-x, p), fmt::format("{:.{}g}", -x, p)) << -x << " p=" << p;
+    }
+  }
+}
+
+// The row the previous writer formatted (fmt format strings), the reference.
+std::string ReferenceRow(const TelemetrySample& s) {
+  std::string row;
+  auto out = std::back_inserter(row);
+  fmt::format_to(out, "{:.6g},{:.9g},{:.9g},{:.9g}", s.time, s.reference, s.measured, s.angle);
+  for (const auto& b : s.bundles) {
+    fmt::format_to(out, ",{:.9g},{:.9g},{},", b.force, b.force_reference, b.true_on);
+    if (std::isfinite(b.estimated_on)) fmt::format_to(out, "{:.6g}", b.estimated_on);
+    row += ',';
+    if (std::isfinite(b.estimated_on_std)) fmt::format_to(out, "{:.6g}", b.estimated_on_std);
+    fmt::format_to(out, ",{:.6g},{:.6g},{:.6g}", b.p_on, b.p_off, b.mean_temperature);
+  }
+  fmt::format_to(out, ",{}\n", s.control_instant ? 1 : 0);
+  return row;
+}
+
+TEST(CsvStepWriter, WritesThePreviousWritersRowsByteForByte) {
+  // Two bundles; values that hold for a few steps (the writer reuses a column's text), change,
+  // and turn NaN (empty cells) and back.
+  const auto path = std::filesystem::temp_directory_path() / "recruit_csv_format_test.csv";
+  CsvStepWriter writer(path.string());
+  TelemetrySample s;
+  s.bundles.resize(2);
+  s.bundles[0].actuator = "flexor";
+  s.bundles[1].actuator = "extensor";
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> n(0, 30);
+  std::string expected =
+      "time,reference,measured,angle,flexor.force,flexor.force_reference,flexor.true_on,"
+      "flexor.estimated_on,flexor.estimated_on_std,flexor.p_on,flexor.p_off,"
+      "flexor.mean_temperature,extensor.force,extensor.force_reference,extensor.true_on,"
+      "extensor.estimated_on,extensor.estimated_on_std,extensor.p_on,extensor.p_off,"
+      "extensor.mean_temperature,control_instant\n";
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (int step = 0; step < 3000; ++step) {
+    s.time = 0.002 * (step + 1);
+    s.control_instant = step % 7 == 0;
+    s.measured = n(rng);
+    s.angle = n(rng) * 1e-3;
+    if (s.control_instant) s.reference = std::round(n(rng));
+    for (auto& b : s.bundles) {
+      b.force = n(rng);
+      b.mean_temperature = 20 + std::abs(n(rng));
+      if (s.control_instant) {
+        b.force_reference = n(rng);
+        b.true_on = static_cast<int>(rng() % 61);
+        b.estimated_on = step % 5 == 0 ? nan : std::abs(n(rng));
+        b.estimated_on_std = step % 3 == 0 ? nan : std::abs(n(rng)) * 1e-3;
+        b.p_on = std::abs(n(rng)) / 100;
+        b.p_off = step % 2 ? 0.0 : -0.0;
+      }
+    }
+    ASSERT_TRUE(writer.OnStep(nullptr, nullptr, s).ok());
+    expected += ReferenceRow(s);
+  }
+  ASSERT_TRUE(writer.Finish().ok());
+  ASSERT_TRUE(writer.Commit().ok());
+  auto text = ReadFile(path.string());
+  ASSERT_TRUE(text.ok());
+  EXPECT_TRUE(*text == expected);
+  std::filesystem::remove(path);
+}
+
+}  // namespace
+}  // namespace recruit::sim
