@@ -221,6 +221,19 @@ void ProjectOntoSimplexInto(const V& x, double N, V& out, V& work) {
 using Packet = Eigen::internal::packet_traits<double>::type;
 constexpr int kPacket = Eigen::internal::packet_traits<double>::size;
 
+// One packet of CombineColumns.
+template <int T, bool Acc>
+EIGEN_ALWAYS_INLINE void CombineStep(double* __restrict out, const double* __restrict s0,
+                                     const double* __restrict s1, const double* __restrict s2,
+                                     const Packet& p0, const Packet& p1, const Packet& p2) {
+  using namespace Eigen::internal;
+  Packet v =
+      Acc ? pmadd(p0, ploadu<Packet>(s0), ploadu<Packet>(out)) : pmul(p0, ploadu<Packet>(s0));
+  if (T > 1) v = pmadd(p1, ploadu<Packet>(s1), v);
+  if (T > 2) v = pmadd(p2, ploadu<Packet>(s2), v);
+  pstoreu(out, v);
+}
+
 // out[0..len) = (Acc ? out : 0) + a0 s0 + a1 s1 + a2 s2 (the first T of the three terms).
 template <int Len, int T, bool Acc>
 EIGEN_ALWAYS_INLINE void CombineColumns(double* __restrict out, const double* __restrict s0,
@@ -230,12 +243,17 @@ EIGEN_ALWAYS_INLINE void CombineColumns(double* __restrict out, const double* __
   const Eigen::Index len = Len == Eigen::Dynamic ? len_dynamic : Len;
   const Packet p0 = pset1<Packet>(a0), p1 = pset1<Packet>(a1), p2 = pset1<Packet>(a2);
   Eigen::Index r = 0;
-  for (; r + kPacket <= len; r += kPacket) {
-    Packet v = Acc ? pmadd(p0, ploadu<Packet>(s0 + r), ploadu<Packet>(out + r))
-                   : pmul(p0, ploadu<Packet>(s0 + r));
-    if (T > 1) v = pmadd(p1, ploadu<Packet>(s1 + r), v);
-    if (T > 2) v = pmadd(p2, ploadu<Packet>(s2 + r), v);
-    pstoreu(out + r, v);
+  if constexpr (Len == Eigen::Dynamic || Len / kPacket <= 16) {
+    // Fixed lengths are unrolled completely by the compiler.
+    for (; r + kPacket <= len; r += kPacket) {
+      CombineStep<T, Acc>(out + r, s0 + r, s1 + r, s2 + r, p0, p1, p2);
+    }
+  } else {
+    // Long fixed lengths (m = 50 with SSE2): partly (measured: 7k fewer instructions a step).
+#pragma GCC unroll 8
+    for (; r + kPacket <= len; r += kPacket) {
+      CombineStep<T, Acc>(out + r, s0 + r, s1 + r, s2 + r, p0, p1, p2);
+    }
   }
   if constexpr (Len != Eigen::Dynamic && Len % kPacket == 0) return;  // no tail
   for (; r < len; ++r) {
