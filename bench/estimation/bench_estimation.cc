@@ -90,19 +90,21 @@ Sequence Simulate(const FilterModel& f, int steps, uint64_t seed, bool distinct_
 double StepFlops(int m) { return (m < 16 ? 4.0 : 3.0) * m * m * m + 11.0 * m * m + 10.0 * m; }
 
 // The same with a sparse A (PopulationKalmanFilterT::PredictRows, PredictBroadcast): first
-// pass 2 m nnz (B = (P - diag xq) A^T) + 4 nnz (A x, A xq), second pass 2 len(i) per nonzero
-// A(i, l) with len(i) = rows 0..i rounded up to an even count (upper triangle of A B), update
-// 4 m^2 + O(m), the projection onto 1^T P = 0 (3 m^2) every 16th step.
+// pass 2 m nnz (B = (P - diag xq) A^T) + 2 nnz (A x; A xq = A x for a feasible x), second pass
+// 2 len(i) per nonzero A(i, l) with len(i) = rows 0..i rounded up to whole SIMD packets (upper
+// triangle of A B), update 4 m^2 + O(m), the projection onto 1^T P = 0 (3 m^2) every 16th step.
 double SparseStepFlops(const Eigen::SparseMatrix<double>& A) {
   const double m = static_cast<double>(A.rows());
+  const int round = std::max(2, kf_detail::kPacket);
   double second = 0.0;
   for (int l = 0; l < A.outerSize(); ++l) {
     for (Eigen::SparseMatrix<double>::InnerIterator it(A, l); it; ++it) {
-      second += 2.0 * std::min<double>(m, static_cast<double>((it.row() + 2) & ~1));
+      const int len = (static_cast<int>(it.row()) + round) / round * round;
+      second += 2.0 * std::min<double>(m, len);
     }
   }
   const double nnz = static_cast<double>(A.nonZeros());
-  return 2.0 * m * nnz + 4.0 * nnz + second + 4.0 * m * m + 3.0 * m * m / 16.0 + 10.0 * m;
+  return 2.0 * m * nnz + 2.0 * nnz + second + 4.0 * m * m + 3.0 * m * m / 16.0 + 10.0 * m;
 }
 
 template <int M>

@@ -46,6 +46,16 @@ KalmanOnCountEstimator::KalmanOnCountEstimator(FilterModel model, PopulationKalm
   r_ = model_.R;
 }
 
+double KalmanOnCountEstimator::EstimatedOnVariance() const {
+  // on^T P on, column by column: no temporary vector (the controller reads it every step).
+  const auto& P = filter_.covariance();
+  double v = 0;
+  for (Eigen::Index j = 0; j < P.cols(); ++j) {
+    if (on_mask_[j] != 0.0) v += on_mask_.dot(P.col(j));
+  }
+  return v;
+}
+
 void KalmanOnCountEstimator::Reset() { filter_.Reset(model_.x0, model_.P0); }
 
 void KalmanOnCountEstimator::Observe(double measured_force, double tendon_length) {

@@ -30,9 +30,7 @@ class KalmanOnCountEstimator final : public OnCountEstimator {
   void Observe(double measured_force, double tendon_length) override;
   void Broadcasted(const Broadcast& b) override;
   double EstimatedOn() const override { return on_mask_.dot(filter_.estimate()); }
-  double EstimatedOnVariance() const override {
-    return on_mask_.dot(filter_.covariance() * on_mask_);
-  }
+  double EstimatedOnVariance() const override;
   Eigen::VectorXd StateEstimate() const override { return filter_.estimate(); }
   std::vector<std::string> StateNames() const override { return model_.state_names; }
   std::vector<bool> OnStates() const override { return model_.broadcast.is_on; }

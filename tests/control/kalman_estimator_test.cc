@@ -5,14 +5,51 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cmath>
+#include <cstdlib>
 #include <nlohmann/json.hpp>
 
 #include "common/rng.h"
 #include "control/on_count_estimator.h"
+#include "control/recruitment_controller.h"
 #include "estimation/filter_model.h"
 #include "identification/model_export.h"
 #include "identification/transient_chain.h"
+
+namespace {
+std::atomic<long> g_mallocs{0};
+}  // namespace
+
+#if defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(memory_sanitizer)
+#define RECRUIT_SANITIZED_MALLOC 1
+#endif
+#endif
+#if defined(__GLIBC__) && !defined(__SANITIZE_ADDRESS__) && !defined(RECRUIT_SANITIZED_MALLOC)
+// glibc lets a program replace malloc: these count every heap allocation of this test program
+// (operator new and Eigen's dynamic matrices alike) and forward to glibc's own allocator.
+#define RECRUIT_COUNTS_MALLOC 1
+extern "C" {
+void* __libc_malloc(size_t n);
+void* __libc_calloc(size_t n, size_t size);
+void* __libc_realloc(void* p, size_t n);
+void __libc_free(void* p);
+void* malloc(size_t n) {
+  ++g_mallocs;
+  return __libc_malloc(n);
+}
+void* calloc(size_t n, size_t size) {
+  ++g_mallocs;
+  return __libc_calloc(n, size);
+}
+void* realloc(void* p, size_t n) {
+  ++g_mallocs;
+  return __libc_realloc(p, n);
+}
+void free(void* p) { __libc_free(p); }
+}
+#endif
 
 namespace recruit::control {
 namespace {
@@ -97,6 +134,45 @@ TEST(KalmanAugmented, SparseBroadcastPredictionEqualsTheDenseFilter) {
     ASSERT_LE((est.filter().covariance() - dense->covariance()).cwiseAbs().maxCoeff(), 1e-12 * 3600)
         << k;
   }
+}
+
+// A control instant with the Kalman estimators (Observe: SetOutput with the length-dependent H,
+// the scalar update; the law; Broadcasted: the sparse PredictBroadcast) makes no heap
+// allocation once running, with and without the tendon geometry.
+TEST(KalmanAugmented, ControlStepsDoNotAllocate) {
+#ifndef RECRUIT_COUNTS_MALLOC
+  GTEST_SKIP() << "malloc is not replaceable here (sanitizer or not glibc)";
+#else
+  const long check = g_mallocs.load();
+  Eigen::VectorXd heap = Eigen::VectorXd::Ones(64);  // the counter sees Eigen's heap
+  EXPECT_GT(g_mallocs.load(), check);
+  EXPECT_EQ(heap.sum(), 64.0);
+  for (const char* kind : {"kalman2", "kalman-augmented"}) {
+    for (bool geometry : {false, true}) {
+      ControllerParams p;
+      p.num_units = 60;
+      p.unit_force = 0.45;
+      p.dT = 0.5;
+      p.lambda = 0.5;
+      if (geometry) {
+        UnitGeometry g;
+        g.ref_length = 0.2;
+        p.geometry = g;
+      }
+      auto spec = EstimatorSpec::Parse(kind, "extended");
+      ASSERT_TRUE(spec.ok()) << spec.error();
+      auto c = RecruitmentController::Create(p, *spec);
+      ASSERT_TRUE(c.ok()) << c.error();
+      long before = 0;
+      for (int k = 0; k <= 100; ++k) {
+        if (k == 1) before = g_mallocs.load();
+        const double y = 12.0 + 0.5 * (k % 9);
+        c->Step(15.0, y, 0.2 + 1e-4 * (k % 5));
+      }
+      EXPECT_EQ(g_mallocs.load() - before, 0) << kind << (geometry ? " with geometry" : "");
+    }
+  }
+#endif
 }
 
 TEST(KalmanAugmented, ModelIsRescaledToTheBundlesUnits) {

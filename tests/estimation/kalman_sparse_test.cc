@@ -218,6 +218,11 @@ void BroadcastMatchesDense(int m, CovarianceMode mode, uint64_t seed) {
     ASSERT_LT((sparse->covariance() - dense->covariance()).cwiseAbs().maxCoeff(), 1e-12 * scale)
         << "step " << t;
     ASSERT_LT((sparse->estimate() - dense->estimate()).cwiseAbs().maxCoeff(), 1e-12 * 60.0);
+    // The A of the last PredictBroadcast (filled on demand) is the model's A(p_on, p_off).
+    ASSERT_LE((Eigen::MatrixXd(sparse->broadcast_matrix()) - f.broadcast.Matrix(p_on, p_off))
+                  .cwiseAbs()
+                  .maxCoeff(),
+              1e-15);
     const Eigen::Matrix<double, 1, 1> y(f.H.row(0).dot(dense->estimate()) +
                                         0.6 * (rng.Uniform() - 0.5));
     sparse->Update(y);

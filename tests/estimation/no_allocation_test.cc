@@ -1,5 +1,6 @@
-// The fixed-size filter's Predict and Update do not touch the heap: global operator new is
-// replaced in this test program by a counting one.
+// The filter's steps do not touch the heap: global operator new is replaced in this test
+// program by a counting one, and (glibc, no sanitizer) so is malloc, which also sees Eigen's
+// dynamic-size matrices (they allocate with malloc, not operator new).
 #include <gtest/gtest.h>
 
 #include <atomic>
@@ -8,12 +9,43 @@
 #include <new>
 #include <vector>
 
+#include "estimation/count_filter.h"
 #include "estimation/population_kalman_filter.h"
 #include "test_util.h"
 
 namespace {
 std::atomic<long> g_allocations{0};
+std::atomic<long> g_mallocs{0};
 }  // namespace
+
+#if defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(memory_sanitizer)
+#define RECRUIT_SANITIZED_MALLOC 1
+#endif
+#endif
+#if defined(__GLIBC__) && !defined(__SANITIZE_ADDRESS__) && !defined(RECRUIT_SANITIZED_MALLOC)
+// glibc lets a program replace malloc; these count and forward to glibc's own allocator.
+#define RECRUIT_COUNTS_MALLOC 1
+extern "C" {
+void* __libc_malloc(size_t n);
+void* __libc_calloc(size_t n, size_t size);
+void* __libc_realloc(void* p, size_t n);
+void __libc_free(void* p);
+void* malloc(size_t n) {
+  ++g_mallocs;
+  return __libc_malloc(n);
+}
+void* calloc(size_t n, size_t size) {
+  ++g_mallocs;
+  return __libc_calloc(n, size);
+}
+void* realloc(void* p, size_t n) {
+  ++g_mallocs;
+  return __libc_realloc(p, n);
+}
+void free(void* p) { __libc_free(p); }
+}
+#endif
 
 void* operator new(std::size_t n) {
   ++g_allocations;
@@ -101,6 +133,79 @@ long AllocationsPerBroadcastSteps() {
 // (the broadcast pattern of PredictBroadcast is built once at Create and written in place).
 static_assert(PopulationKalmanFilterT<20, 1>::Mat::RowsAtCompileTime == 20);
 static_assert(sizeof(PopulationKalmanFilterT<20, 1>) >= 4 * 20 * 20 * sizeof(double));
+
+// The m-state heating / cooling chain with a force sensor (at most 3 nonzeros per column of A).
+FilterModel ChainModel(int m) {
+  FilterModel f = testing_util::ThreeStateModel(60, std::sqrt(0.3));
+  f.broadcast = BroadcastTransitionModel::HeatingChain(m, 0.5);
+  f.state_names = f.broadcast.state_names;
+  f.H = Eigen::MatrixXd::Constant(1, m, 0.2);
+  f.H(0, 0) = 0.0;
+  f.G = Eigen::MatrixXd::Zero(m, 0);
+  f.x0 = Eigen::VectorXd::Zero(m);
+  f.x0(0) = 60;
+  f.P0 = Eigen::MatrixXd::Zero(m, m);
+  return f;
+}
+
+// malloc calls in 100 steps of the controller's sequence on the dynamic-size filter
+// (src/control/kalman_estimator.cc: SetOutput with an H that changes every step, Update,
+// PredictBroadcast), after one warm-up step. Large p_off drives counts below zero at times, so
+// the simplex projection runs too.
+long MallocsPerDynamicSteps(int m, CovarianceMode mode) {
+  const FilterModel f = ChainModel(m);
+  auto kf = PopulationKalmanFilter::Create(f, mode);
+  EXPECT_TRUE(kf.ok()) << kf.error();
+  if (!kf.ok()) return -1;
+  Eigen::MatrixXd h = f.H, r = f.R;
+  Eigen::VectorXd y(1);
+  long before = 0;
+  for (int t = 0; t <= 100; ++t) {
+    if (t == 1) before = g_mallocs.load();
+    h(0, m - 1) = 0.1 + 0.001 * t;
+    kf->SetOutput(h, r);
+    y(0) = 5.0 + 0.1 * (t % 7);
+    kf->Update(y);
+    kf->PredictBroadcast(0.003 * t, 0.009 * t);
+  }
+  return g_mallocs.load() - before;
+}
+
+// The same through MakeCountFilter's Kalman adapter (what `recruit filter` runs: fixed size for
+// m = 20, dynamic for m = 50), with MeanAndVariance as the streamed output reads it.
+long MallocsPerCountFilterSteps(int m) {
+  const FilterModel f = ChainModel(m);
+  auto cf = MakeCountFilter(f, CountFilterOptions{});
+  EXPECT_TRUE(cf.ok()) << cf.error();
+  if (!cf.ok()) return -1;
+  Eigen::VectorXd y(1), mean(m), var(m);
+  long before = 0;
+  for (int t = 0; t <= 100; ++t) {
+    if (t == 1) before = g_mallocs.load();
+    y(0) = 5.0 + 0.1 * (t % 7);
+    (*cf)->Update(y);
+    (*cf)->MeanAndVariance(mean, var);
+    (*cf)->PredictBroadcast(f.broadcast, 0.003 * t, 0.009 * t);
+  }
+  return g_mallocs.load() - before;
+}
+
+TEST(EstimationKalmanNoAllocation, DynamicSizeAndCountFilterSteps) {
+#ifndef RECRUIT_COUNTS_MALLOC
+  GTEST_SKIP() << "malloc is not replaceable here (sanitizer or not glibc)";
+#else
+  // The counter works: an Eigen heap matrix goes through malloc.
+  const long before = g_mallocs.load();
+  Eigen::MatrixXd heap = Eigen::MatrixXd::Ones(30, 30);
+  EXPECT_GT(g_mallocs.load(), before);
+  EXPECT_EQ(heap.sum(), 900.0);
+  EXPECT_EQ(MallocsPerDynamicSteps(20, CovarianceMode::kExtended), 0);
+  EXPECT_EQ(MallocsPerDynamicSteps(50, CovarianceMode::kExtended), 0);
+  EXPECT_EQ(MallocsPerDynamicSteps(20, CovarianceMode::kConservative), 0);
+  EXPECT_EQ(MallocsPerCountFilterSteps(20), 0);
+  EXPECT_EQ(MallocsPerCountFilterSteps(50), 0);
+#endif
+}
 
 TEST(EstimationKalmanNoAllocation, FixedSizePredictAndUpdate) {
   EXPECT_EQ(AllocationsPerSteps<2>(CovarianceMode::kExtended), 0);
