@@ -715,4 +715,11 @@ Status PopulationKalmanFilterT<M, R>::UpdateChecked(const Eigen::VectorXd& y) {
   return Status::Ok();
 }
 
+// Compiled once, in population_kalman_filter.cc; other files use these without instantiating them
+// again (each instantiation is tens of seconds of compile time).
+extern template class PopulationKalmanFilterT<Eigen::Dynamic, Eigen::Dynamic>;
+extern template class PopulationKalmanFilterT<2, 1>;
+extern template class PopulationKalmanFilterT<3, 1>;
+extern template class PopulationKalmanFilterT<20, 1>;
+
 }  // namespace recruit
