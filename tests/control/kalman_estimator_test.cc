@@ -5,7 +5,6 @@
 
 #include <gtest/gtest.h>
 
-#include <atomic>
 #include <cmath>
 #include <cstdlib>
 #include <nlohmann/json.hpp>
@@ -16,40 +15,7 @@
 #include "estimation/filter_model.h"
 #include "identification/model_export.h"
 #include "identification/transient_chain.h"
-
-namespace {
-std::atomic<long> g_mallocs{0};
-}  // namespace
-
-#if defined(__has_feature)
-#if __has_feature(address_sanitizer) || __has_feature(memory_sanitizer)
-#define RECRUIT_SANITIZED_MALLOC 1
-#endif
-#endif
-#if defined(__GLIBC__) && !defined(__SANITIZE_ADDRESS__) && !defined(RECRUIT_SANITIZED_MALLOC)
-// glibc lets a program replace malloc: these count every heap allocation of this test program
-// (operator new and Eigen's dynamic matrices alike) and forward to glibc's own allocator.
-#define RECRUIT_COUNTS_MALLOC 1
-extern "C" {
-void* __libc_malloc(size_t n);
-void* __libc_calloc(size_t n, size_t size);
-void* __libc_realloc(void* p, size_t n);
-void __libc_free(void* p);
-void* malloc(size_t n) {
-  ++g_mallocs;
-  return __libc_malloc(n);
-}
-void* calloc(size_t n, size_t size) {
-  ++g_mallocs;
-  return __libc_calloc(n, size);
-}
-void* realloc(void* p, size_t n) {
-  ++g_mallocs;
-  return __libc_realloc(p, n);
-}
-void free(void* p) { __libc_free(p); }
-}
-#endif
+#include "tests/common/malloc_counter.h"
 
 namespace recruit::control {
 namespace {
@@ -143,9 +109,9 @@ TEST(KalmanAugmented, ControlStepsDoNotAllocate) {
 #ifndef RECRUIT_COUNTS_MALLOC
   GTEST_SKIP() << "malloc is not replaceable here (sanitizer or not glibc)";
 #else
-  const long check = g_mallocs.load();
+  const long check = testing::MallocCount();
   Eigen::VectorXd heap = Eigen::VectorXd::Ones(64);  // the counter sees Eigen's heap
-  EXPECT_GT(g_mallocs.load(), check);
+  EXPECT_GT(testing::MallocCount(), check);
   EXPECT_EQ(heap.sum(), 64.0);
   for (const char* kind : {"kalman2", "kalman-augmented"}) {
     for (bool geometry : {false, true}) {
@@ -165,11 +131,11 @@ TEST(KalmanAugmented, ControlStepsDoNotAllocate) {
       ASSERT_TRUE(c.ok()) << c.error();
       long before = 0;
       for (int k = 0; k <= 100; ++k) {
-        if (k == 1) before = g_mallocs.load();
+        if (k == 1) before = testing::MallocCount();
         const double y = 12.0 + 0.5 * (k % 9);
         c->Step(15.0, y, 0.2 + 1e-4 * (k % 5));
       }
-      EXPECT_EQ(g_mallocs.load() - before, 0) << kind << (geometry ? " with geometry" : "");
+      EXPECT_EQ(testing::MallocCount() - before, 0) << kind << (geometry ? " with geometry" : "");
     }
   }
 #endif

@@ -12,40 +12,11 @@
 #include "estimation/count_filter.h"
 #include "estimation/population_kalman_filter.h"
 #include "test_util.h"
+#include "tests/common/malloc_counter.h"
 
 namespace {
 std::atomic<long> g_allocations{0};
-std::atomic<long> g_mallocs{0};
 }  // namespace
-
-#if defined(__has_feature)
-#if __has_feature(address_sanitizer) || __has_feature(memory_sanitizer)
-#define RECRUIT_SANITIZED_MALLOC 1
-#endif
-#endif
-#if defined(__GLIBC__) && !defined(__SANITIZE_ADDRESS__) && !defined(RECRUIT_SANITIZED_MALLOC)
-// glibc lets a program replace malloc; these count and forward to glibc's own allocator.
-#define RECRUIT_COUNTS_MALLOC 1
-extern "C" {
-void* __libc_malloc(size_t n);
-void* __libc_calloc(size_t n, size_t size);
-void* __libc_realloc(void* p, size_t n);
-void __libc_free(void* p);
-void* malloc(size_t n) {
-  ++g_mallocs;
-  return __libc_malloc(n);
-}
-void* calloc(size_t n, size_t size) {
-  ++g_mallocs;
-  return __libc_calloc(n, size);
-}
-void* realloc(void* p, size_t n) {
-  ++g_mallocs;
-  return __libc_realloc(p, n);
-}
-void free(void* p) { __libc_free(p); }
-}
-#endif
 
 void* operator new(std::size_t n) {
   ++g_allocations;
@@ -161,14 +132,14 @@ long MallocsPerDynamicSteps(int m, CovarianceMode mode) {
   Eigen::VectorXd y(1);
   long before = 0;
   for (int t = 0; t <= 100; ++t) {
-    if (t == 1) before = g_mallocs.load();
+    if (t == 1) before = testing::MallocCount();
     h(0, m - 1) = 0.1 + 0.001 * t;
     kf->SetOutput(h, r);
     y(0) = 5.0 + 0.1 * (t % 7);
     kf->Update(y);
     kf->PredictBroadcast(0.003 * t, 0.009 * t);
   }
-  return g_mallocs.load() - before;
+  return testing::MallocCount() - before;
 }
 
 // The same through MakeCountFilter's Kalman adapter (what `recruit filter` runs: fixed size for
@@ -181,13 +152,13 @@ long MallocsPerCountFilterSteps(int m) {
   Eigen::VectorXd y(1), mean(m), var(m);
   long before = 0;
   for (int t = 0; t <= 100; ++t) {
-    if (t == 1) before = g_mallocs.load();
+    if (t == 1) before = testing::MallocCount();
     y(0) = 5.0 + 0.1 * (t % 7);
     (*cf)->Update(y);
     (*cf)->MeanAndVariance(mean, var);
     (*cf)->PredictBroadcast(f.broadcast, 0.003 * t, 0.009 * t);
   }
-  return g_mallocs.load() - before;
+  return testing::MallocCount() - before;
 }
 
 TEST(EstimationKalmanNoAllocation, DynamicSizeAndCountFilterSteps) {
@@ -195,9 +166,9 @@ TEST(EstimationKalmanNoAllocation, DynamicSizeAndCountFilterSteps) {
   GTEST_SKIP() << "malloc is not replaceable here (sanitizer or not glibc)";
 #else
   // The counter works: an Eigen heap matrix goes through malloc.
-  const long before = g_mallocs.load();
+  const long before = testing::MallocCount();
   Eigen::MatrixXd heap = Eigen::MatrixXd::Ones(30, 30);
-  EXPECT_GT(g_mallocs.load(), before);
+  EXPECT_GT(testing::MallocCount(), before);
   EXPECT_EQ(heap.sum(), 900.0);
   EXPECT_EQ(MallocsPerDynamicSteps(20, CovarianceMode::kExtended), 0);
   EXPECT_EQ(MallocsPerDynamicSteps(50, CovarianceMode::kExtended), 0);
