@@ -7,6 +7,8 @@
 #include <cstdint>
 #include <cstring>
 
+#include "common/decimal_digits.h"
+
 namespace recruit {
 namespace {
 
@@ -14,35 +16,6 @@ constexpr char kDigitPairs[] =
     "00010203040506070809101112131415161718192021222324252627282930313233343536373839"
     "40414243444546474849505152535455565758596061626364656667686970717273747576777879"
     "8081828384858687888990919293949596979899";
-
-constexpr uint64_t kPow10[20] = {1ull,
-                                 10ull,
-                                 100ull,
-                                 1000ull,
-                                 10000ull,
-                                 100000ull,
-                                 1000000ull,
-                                 10000000ull,
-                                 100000000ull,
-                                 1000000000ull,
-                                 10000000000ull,
-                                 100000000000ull,
-                                 1000000000000ull,
-                                 10000000000000ull,
-                                 100000000000000ull,
-                                 1000000000000000ull,
-                                 10000000000000000ull,
-                                 100000000000000000ull,
-                                 1000000000000000000ull,
-                                 10000000000000000000ull};
-
-// Decimal digits of v >= 1: t = floor(bits log10(2)) (1233 / 4096 ~ log10(2)) is the count or
-// one less.
-int DigitCount(uint64_t v) {
-  const int bits = 64 - __builtin_clzll(v);
-  const int t = (bits * 1233) >> 12;
-  return t + (v >= kPow10[t]);
-}
 
 // The eight decimal digits of c < 10^8 (leading zeros included) as eight characters in
 // memory order (little-endian), in SIMD-within-a-register arithmetic: two 4-digit halves, then
@@ -104,7 +77,7 @@ char* WriteShortest(char* p, double v) {
     sig /= 10;
     ++e;
   }
-  const int n = DigitCount(sig);
+  const int n = DecimalDigits(sig);
   // std::to_chars's choice: scientific d[.ddd]e(+|-)XX[X] or fixed, the shorter, fixed on a tie.
   const int sci_exp = e + n - 1;
   const int abs_sci = sci_exp < 0 ? -sci_exp : sci_exp;

@@ -9,35 +9,10 @@
 #include <cstring>
 #include <utility>
 
+#include "common/decimal_digits.h"
+
 namespace recruit::sim {
 namespace {
-
-constexpr std::uint64_t kPow10[] = {1ull,
-                                    10ull,
-                                    100ull,
-                                    1000ull,
-                                    10000ull,
-                                    100000ull,
-                                    1000000ull,
-                                    10000000ull,
-                                    100000000ull,
-                                    1000000000ull,
-                                    10000000000ull,
-                                    100000000000ull,
-                                    1000000000000ull,
-                                    10000000000000ull,
-                                    100000000000000ull,
-                                    1000000000000000ull,
-                                    10000000000000000ull,
-                                    100000000000000000ull,
-                                    1000000000000000000ull,
-                                    10000000000000000000ull};
-
-// Decimal digits of v > 0: from its bit length (1233 / 4096 ~ log10 2), one comparison.
-int NumDigits(std::uint64_t v) {
-  const int t = ((64 - __builtin_clzll(v)) * 1233) >> 12;
-  return t - (v < kPow10[t] ? 1 : 0) + 1;
-}
 
 // s / 10^K for each K: division by a constant compiles to a multiply, not a divide.
 template <std::size_t K>
@@ -151,7 +126,7 @@ char* FormatG(double x, int precision, char* out) {
     const auto dec = fmt::detail::dragonbox::to_decimal(x);
     s = dec.significand;
     e = dec.exponent;
-    const int n = NumDigits(s);
+    const int n = DecimalDigits(s);
     if (n == precision + 1) return Slow(x, precision, out);
     if (n > precision) {
       const std::uint64_t div = kPow10[n - precision];
@@ -167,7 +142,7 @@ char* FormatG(double x, int precision, char* out) {
       s = q;
     }
   }
-  int n = NumDigits(s);
+  int n = DecimalDigits(s);
   while (s % 10 == 0) {  // %g drops trailing zeros
     s /= 10;
     ++e;
