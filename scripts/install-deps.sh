@@ -23,7 +23,7 @@ PY_PACKAGES=("mujoco==${MUJOCO_VERSION}" "numpy" "pytest" "filterpy" "pybind11" 
 DEMO_PACKAGES=(
   build-essential cmake ninja-build pkg-config ccache
   python3 python3-venv
-  libosmesa6-dev libcairo2-dev
+  libosmesa6-dev libegl-dev libcairo2-dev
   libeigen3-dev libcli11-dev nlohmann-json3-dev libfmt-dev libtbb-dev
   libavcodec-dev libavformat-dev libavutil-dev libswscale-dev
   liblodepng-dev libstb-dev
