@@ -77,17 +77,23 @@ long AllocationsPerSparseSteps() {
 
 // PredictBroadcast (the filter's own sparse A, filled in place) and the scalar update, with the
 // m = 20 heating / cooling chain.
+// The m-state heating / cooling chain with a force sensor (at most 3 nonzeros per column of A).
+FilterModel ChainModel(int m) {
+  FilterModel f = testing_util::ThreeStateModel(60, std::sqrt(0.3));
+  f.broadcast = BroadcastTransitionModel::HeatingChain(m, 0.5);
+  f.state_names = f.broadcast.state_names;
+  f.H = Eigen::MatrixXd::Constant(1, m, 0.2);
+  f.H(0, 0) = 0.0;
+  f.G = Eigen::MatrixXd::Zero(m, 0);
+  f.x0 = Eigen::VectorXd::Zero(m);
+  f.x0(0) = 60;
+  f.P0 = Eigen::MatrixXd::Zero(m, m);
+  return f;
+}
+
 long AllocationsPerBroadcastSteps() {
   constexpr int M = 20;
-  FilterModel f = testing_util::ThreeStateModel(60, std::sqrt(0.3));
-  f.broadcast = BroadcastTransitionModel::HeatingChain(M, 0.5);
-  f.state_names = f.broadcast.state_names;
-  f.H = Eigen::MatrixXd::Constant(1, M, 0.2);
-  f.H(0, 0) = 0.0;
-  f.G = Eigen::MatrixXd::Zero(M, 0);
-  f.x0 = Eigen::VectorXd::Zero(M);
-  f.x0(0) = 60;
-  f.P0 = Eigen::MatrixXd::Zero(M, M);
+  const FilterModel f = ChainModel(M);
   auto kf = PopulationKalmanFilterT<M, 1>::Create(f, CovarianceMode::kExtended);
   EXPECT_TRUE(kf.ok()) << kf.error();
   if (!kf.ok()) return -1;
@@ -104,20 +110,6 @@ long AllocationsPerBroadcastSteps() {
 // (the broadcast pattern of PredictBroadcast is built once at Create and written in place).
 static_assert(PopulationKalmanFilterT<20, 1>::Mat::RowsAtCompileTime == 20);
 static_assert(sizeof(PopulationKalmanFilterT<20, 1>) >= 4 * 20 * 20 * sizeof(double));
-
-// The m-state heating / cooling chain with a force sensor (at most 3 nonzeros per column of A).
-FilterModel ChainModel(int m) {
-  FilterModel f = testing_util::ThreeStateModel(60, std::sqrt(0.3));
-  f.broadcast = BroadcastTransitionModel::HeatingChain(m, 0.5);
-  f.state_names = f.broadcast.state_names;
-  f.H = Eigen::MatrixXd::Constant(1, m, 0.2);
-  f.H(0, 0) = 0.0;
-  f.G = Eigen::MatrixXd::Zero(m, 0);
-  f.x0 = Eigen::VectorXd::Zero(m);
-  f.x0(0) = 60;
-  f.P0 = Eigen::MatrixXd::Zero(m, m);
-  return f;
-}
 
 // malloc calls in 100 steps of the controller's sequence on the dynamic-size filter
 // (src/control/kalman_estimator.cc: SetOutput with an H that changes every step, Update,
