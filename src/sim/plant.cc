@@ -16,6 +16,10 @@ Result<std::unique_ptr<Plant>> Plant::Create(const Task& task) {
   }
   mjModel* m = p->model_.get();
   if (task.timestep > 0) m->opt.timestep = task.timestep;
+  // The run reads each bundle through SmaHost and the joint from qpos, never sensordata: MuJoCo's
+  // sensor stage (the plugin's ground-truth sums over every cohort, and the model's own sensors)
+  // would be evaluated every step for nothing. Sensors never act on the dynamics.
+  m->opt.disableflags |= mjDSBL_SENSOR;
   auto host = sma::SmaHost::Create(m);
   if (!host.ok()) return Error{where + ".model: " + host.error()};
   p->host_ = std::move(host).value();
