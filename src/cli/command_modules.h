@@ -24,6 +24,7 @@ class RenderSession : public StepObserver {
  public:
   // "N frames at F frames/s, WxH (GL driver)\n  wrote a.mp4, a.gif, ..." after Finish.
   virtual std::string Report() const = 0;
+  bool Draws() const override { return true; }
 };
 
 struct RenderOpenRequest {

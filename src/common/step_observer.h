@@ -15,6 +15,8 @@ class StepObserver {
   virtual Status OnStep(const mjModel* m, const mjData* d, const TelemetrySample& sample) = 0;
   // Called once when the run ends normally (flush, finish the file).
   virtual Status Finish() { return Status::Ok(); }
+  // True if it draws the model: only then are the model's textures generated at full size.
+  virtual bool Draws() const { return false; }
 };
 
 }  // namespace recruit

@@ -343,7 +343,9 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
     return Error{where + ": controller.lambda must be in (0, 1]"};
   }
 
-  auto plant_or = Plant::Create(task);
+  const bool draws = std::any_of(observers.begin(), observers.end(),
+                                 [](const StepObserver* o) { return o->Draws(); });
+  auto plant_or = Plant::Create(task, /*textures=*/draws);
   if (!plant_or.ok()) return Error{plant_or.error()};
   Plant& plant = **plant_or;
   plant.Reset(options.seed);

@@ -11,6 +11,7 @@
 
 #include "common/atomic_file.h"
 #include "sim/csv_writer.h"
+#include "sim/plant.h"
 #include "sim/run_task.h"
 #include "sim/sweep.h"
 
@@ -243,6 +244,56 @@ TEST(ClosedLoop, TaskFieldsThatDoNotMatchTheModelAreNamed) {
   r = RunTask(LoadTask("isometric_steps.json"), bad);
   ASSERT_FALSE(r.ok());
   EXPECT_NE(r.error().find("controller.estimator"), std::string::npos) << r.error();
+}
+
+// A run that draws nothing loads the model with 1-pixel builtin textures: the same physics step
+// for step (against the model as mj_loadXML gives it), and far fewer texture bytes.
+TEST(ClosedLoop, PlantWithoutTexturesStepsLikeTheFullModel) {
+  const Task task = LoadTask("arm_push.json");
+  auto full = Plant::Create(task, /*textures=*/true);
+  auto bare = Plant::Create(task, /*textures=*/false);
+  ASSERT_TRUE(full.ok() && bare.ok());
+  Plant& a = **full;
+  Plant& b = **bare;
+  EXPECT_GT(a.model()->ntexdata, 100000);
+  EXPECT_LT(b.model()->ntexdata, 100);
+  EXPECT_EQ(a.model()->ntex, b.model()->ntex);
+  a.Reset(5);
+  b.Reset(5);
+  for (int step = 0; step < 3000; ++step) {
+    if (step % 500 == 0) {
+      ASSERT_TRUE(a.Broadcast(0, 0.3, 0.05).ok());
+      ASSERT_TRUE(b.Broadcast(0, 0.3, 0.05).ok());
+    }
+    a.Step();
+    b.Step();
+  }
+  EXPECT_GT(a.OnCount(0), 0);
+  EXPECT_EQ(a.OnCount(0), b.OnCount(0));
+  EXPECT_EQ(a.angle(), b.angle());
+  EXPECT_EQ(a.Force(0), b.Force(0));
+}
+
+// An observer that draws is handed the model with its textures at full size.
+TEST(ClosedLoop, AnObserverThatDrawsGetsTheFullTextures) {
+  struct Drawer : StepObserver {
+    int ntexdata = -1;
+    Status OnStep(const mjModel* m, const mjData*, const TelemetrySample&) override {
+      ntexdata = m->ntexdata;
+      return Status::Ok();
+    }
+    bool Draws() const override { return true; }
+  } drawer;
+  const Task task = LoadTask("arm_push.json");
+  RunOptions o;
+  o.duration = 0.01;
+  o.quiet = true;
+  ASSERT_TRUE(RunTask(task, o, {&drawer}).ok());
+  char error[500] = "";
+  mjModel* m = mj_loadXML(task.model_path.c_str(), nullptr, error, sizeof error);
+  ASSERT_NE(m, nullptr) << error;
+  EXPECT_EQ(drawer.ntexdata, m->ntexdata);
+  mj_deleteModel(m);
 }
 
 }  // namespace
