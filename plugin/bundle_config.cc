@@ -8,6 +8,8 @@
 #include <set>
 #include <sstream>
 
+#include "common/short_text.h"
+
 namespace recruit::sma {
 namespace {
 
@@ -21,12 +23,6 @@ struct Key {
 
 // A value as quoted in a message: at most 40 characters.
 std::string Short(const std::string& v) { return v.size() <= 40 ? v : v.substr(0, 37) + "..."; }
-
-std::string Num(double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
-}
 
 #define UNIT_FIELD(f) [](BundleConfig& c, double v) { c.unit.f = v; }
 
@@ -136,7 +132,7 @@ Result<BundleConfig> BundleConfig::FromPairs(
     const bool low_bad = spec->lo_open ? !(v > spec->lo) : !(v >= spec->lo);
     if (low_bad || v > spec->hi) {
       return Error{where + key + "=" + Short(value) + " is out of range: must be in " +
-                   (spec->lo_open ? "(" : "[") + Num(spec->lo) + ", " + Num(spec->hi) + "]" +
+                   (spec->lo_open ? "(" : "[") + GText(spec->lo) + ", " + GText(spec->hi) + "]" +
                    (spec->unit[0] ? std::string(" ") + spec->unit : std::string())};
     }
     if ((key == "units" || key == "series" || key == "parallel") && v != std::floor(v)) {

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <string>
 
+#include "common/short_text.h"
 #include "plugin/unit_batch.h"
 
 namespace recruit::sma {
@@ -36,12 +37,6 @@ double SolveNewton(const GD& gd, double lo, double hi, double x, double g, doubl
     if (std::abs(g) < 1e-13) break;
   }
   return x;
-}
-
-std::string Num(double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
 }
 
 // Dynalloy Flexinol wire table: diameter (mm), current for a 1 s contraction (mA), still-air
@@ -100,18 +95,18 @@ double UnitModel::NaturalConvectionH(double d, double ambient, double dT, double
 }
 
 Result<UnitModel> UnitModel::Create(const UnitParams& p) {
-  if (!(p.Mf < p.Ms)) return Error{"Mf=" + Num(p.Mf) + " must be below Ms=" + Num(p.Ms)};
-  if (!(p.As < p.Af)) return Error{"As=" + Num(p.As) + " must be below Af=" + Num(p.Af)};
+  if (!(p.Mf < p.Ms)) return Error{"Mf=" + GText(p.Mf) + " must be below Ms=" + GText(p.Ms)};
+  if (!(p.As < p.Af)) return Error{"As=" + GText(p.As) + " must be below Af=" + GText(p.Af)};
   if (p.law == ForceLaw::kSpring && !(p.coil_diameter > p.wire_diameter)) {
-    return Error{"coil_diameter=" + Num(p.coil_diameter) +
-                 " must exceed wire_diameter=" + Num(p.wire_diameter)};
+    return Error{"coil_diameter=" + GText(p.coil_diameter) +
+                 " must exceed wire_diameter=" + GText(p.wire_diameter)};
   }
   if (p.series < 1 || p.parallel < 1) {
-    return Error{"series=" + Num(p.series) + " and parallel=" + Num(p.parallel) +
+    return Error{"series=" + GText(p.series) + " and parallel=" + GText(p.parallel) +
                  " must be whole numbers >= 1"};
   }
   if (!(p.series_spring >= 0)) {
-    return Error{"series_spring=" + Num(p.series_spring) + " must be >= 0 (0 = rigid)"};
+    return Error{"series_spring=" + GText(p.series_spring) + " must be >= 0 (0 = rigid)"};
   }
   UnitModel m;
   m.p_ = p;

@@ -2,6 +2,7 @@
 // whole in a message.
 #pragma once
 
+#include <cstdio>
 #include <string>
 #include <string_view>
 
@@ -36,6 +37,13 @@ inline std::string ShortenLongTokens(std::string_view message, size_t max = 40) 
     i = j;
   }
   return out;
+}
+
+// `v` as printf's "%g" writes it (six significant digits): a number quoted in a message.
+inline std::string GText(double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
 }
 
 }  // namespace recruit

@@ -6,12 +6,12 @@
 #include <cmath>
 #include <memory>
 
+#include "plot/cairo_text.h"
 #include "plot/decimate.h"
 
 namespace recruit::plot {
 namespace {
 
-constexpr const char* kFont = "DejaVu Sans";
 const Color kInk{0.15, 0.15, 0.15}, kGrid{0.88, 0.88, 0.88}, kFrame{0.35, 0.35, 0.35};
 
 using CairoPtr = std::unique_ptr<cairo_t, decltype(&cairo_destroy)>;
@@ -19,28 +19,16 @@ using SurfacePtr = std::unique_ptr<cairo_surface_t, decltype(&cairo_surface_dest
 
 void SetColor(cairo_t* cr, const Color& c) { cairo_set_source_rgba(cr, c.r, c.g, c.b, c.a); }
 
-void SetFont(cairo_t* cr, double px) {
-  cairo_select_font_face(cr, kFont, CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_NORMAL);
-  cairo_set_font_size(cr, px);
-}
-
 double CairoTextWidth(cairo_t* cr, const std::string& text, double px) {
-  SetFont(cr, px);
+  SetFigureFont(cr, px);
   cairo_text_extents_t e;
   cairo_text_extents(cr, text.c_str(), &e);
   return e.x_advance;
 }
 
-// Draws `text` with its anchor at (x, y): ax = 0 left, 0.5 centre, 1 right; y is the text's
-// vertical centre (ascent of digits).
 void Text(cairo_t* cr, const std::string& text, double x, double y, double px, double ax,
           const Color& c = kInk) {
-  SetFont(cr, px);
-  cairo_text_extents_t e;
-  cairo_text_extents(cr, text.c_str(), &e);
-  SetColor(cr, c);
-  cairo_move_to(cr, x - ax * e.x_advance, y + 0.36 * px);
-  cairo_show_text(cr, text.c_str());
+  DrawText(cr, text, x, y, px, ax, c.r, c.g, c.b, c.a);
 }
 
 void SetDash(cairo_t* cr, LineStyle style, double line_px) {

@@ -10,27 +10,15 @@
 #include <set>
 #include <sstream>
 
+#include "plot/cairo_text.h"
 #include "plot/run_data.h"
 
 namespace recruit::plot {
 namespace {
 
-constexpr const char* kFont = "DejaVu Sans";
-
 cairo_status_t Append(void* closure, const unsigned char* data, unsigned int length) {
   static_cast<std::string*>(closure)->append(reinterpret_cast<const char*>(data), length);
   return CAIRO_STATUS_SUCCESS;
-}
-
-void Text(cairo_t* cr, const std::string& t, double x, double y, double px, double ax,
-          double r = 0.15, double g = 0.15, double b = 0.15) {
-  cairo_select_font_face(cr, kFont, CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_NORMAL);
-  cairo_set_font_size(cr, px);
-  cairo_text_extents_t e;
-  cairo_text_extents(cr, t.c_str(), &e);
-  cairo_set_source_rgb(cr, r, g, b);
-  cairo_move_to(cr, x - ax * e.x_advance, y + 0.36 * px);
-  cairo_show_text(cr, t.c_str());
 }
 
 void Draw(cairo_t* cr, const std::vector<StabilityPanel>& panels, const std::string& title,
@@ -38,7 +26,7 @@ void Draw(cairo_t* cr, const std::vector<StabilityPanel>& panels, const std::str
   cairo_set_source_rgb(cr, 1, 1, 1);
   cairo_paint(cr);
   const double px = std::clamp(height / 28.0, 9.0, 40.0);  // font size
-  Text(cr, title, width / 2.0, 1.2 * px, 1.1 * px, 0.5);
+  DrawText(cr, title, width / 2.0, 1.2 * px, 1.1 * px, 0.5);
   const int n = static_cast<int>(panels.size());
   const double key_w = 6 * px;  // colour key on the right
   const double panel_w = (width - key_w) / std::max(1, n);
@@ -49,7 +37,7 @@ void Draw(cairo_t* cr, const std::vector<StabilityPanel>& panels, const std::str
     for (const auto& c : panel.cells) dts.insert(c.dT), lambdas.insert(c.lambda);
     const std::vector<double> xs(dts.begin(), dts.end()), ys(lambdas.begin(), lambdas.end());
     const double left = p * panel_w + 4.5 * px, right = (p + 1) * panel_w - px;
-    Text(cr, panel.estimator, (left + right) / 2, top - 0.9 * px, px, 0.5);
+    DrawText(cr, panel.estimator, (left + right) / 2, top - 0.9 * px, px, 0.5);
     const double cw = (right - left) / std::max<size_t>(1, xs.size());
     const double ch = (bottom - top) / std::max<size_t>(1, ys.size());
     for (const auto& c : panel.cells) {
@@ -66,19 +54,19 @@ void Draw(cairo_t* cr, const std::vector<StabilityPanel>& panels, const std::str
         cairo_arc(cr, x + cw / 2, y + ch / 2, 0.42 * std::min(cw, ch), 0, 2 * M_PI);
         cairo_stroke(cr);
       }
-      Text(cr, fmt::format("{:.0f}", c.overshoot_percent), x + cw / 2, y + ch / 2, px, 0.5);
+      DrawText(cr, fmt::format("{:.0f}", c.overshoot_percent), x + cw / 2, y + ch / 2, px, 0.5);
     }
     for (size_t i = 0; i < xs.size(); ++i) {
-      Text(cr, fmt::format("{:g}", xs[i]), left + (i + 0.5) * cw, bottom + 0.9 * px, px, 0.5);
+      DrawText(cr, fmt::format("{:g}", xs[i]), left + (i + 0.5) * cw, bottom + 0.9 * px, px, 0.5);
     }
-    Text(cr, "dT (s)", (left + right) / 2, bottom + 2.3 * px, px, 0.5);
+    DrawText(cr, "dT (s)", (left + right) / 2, bottom + 2.3 * px, px, 0.5);
     for (size_t j = 0; j < ys.size(); ++j) {
-      Text(cr, fmt::format("{:g}", ys[j]), left - 0.4 * px, bottom - (j + 0.5) * ch, px, 1);
+      DrawText(cr, fmt::format("{:g}", ys[j]), left - 0.4 * px, bottom - (j + 0.5) * ch, px, 1);
     }
     cairo_save(cr);
     cairo_translate(cr, p * panel_w + 1.0 * px, (top + bottom) / 2);
     cairo_rotate(cr, -M_PI / 2);
-    Text(cr, "lambda", 0, 0, px, 0.5);
+    DrawText(cr, "lambda", 0, 0, px, 0.5);
     cairo_restore(cr);
   }
   // Key: the colour ramp 0..50 % with ticks.
@@ -91,10 +79,10 @@ void Draw(cairo_t* cr, const std::vector<StabilityPanel>& panels, const std::str
     cairo_fill(cr);
   }
   for (int v : {0, 10, 20, 30, 40, 50}) {
-    Text(cr, v == 50 ? ">=50" : std::to_string(v), kx + kw + 0.3 * px,
-         bottom - (bottom - top) * v / 50.0, 0.85 * px, 0);
+    DrawText(cr, v == 50 ? ">=50" : std::to_string(v), kx + kw + 0.3 * px,
+             bottom - (bottom - top) * v / 50.0, 0.85 * px, 0);
   }
-  Text(cr, "overshoot (%)", kx + kw / 2, top - 0.9 * px, 0.85 * px, 0.5);
+  DrawText(cr, "overshoot (%)", kx + kw / 2, top - 0.9 * px, 0.85 * px, 0.5);
 }
 
 }  // namespace

@@ -10,7 +10,7 @@ namespace {
 // The model at `path`; without `textures`, every builtin texture (a sky, a floor grid) compiled
 // at 1 x 1 pixel. Their pixels only colour renders, yet generating them (and the plugin hashing
 // them with the rest of the model) was ~5 % of a 60 s arm run's instructions.
-mjModel* LoadModel(const std::string& path, bool textures, char* error, int error_size) {
+mjModel* LoadPlantModel(const std::string& path, bool textures, char* error, int error_size) {
   if (textures) return mj_loadXML(path.c_str(), nullptr, error, error_size);
   mjSpec* spec = mj_parseXML(path.c_str(), nullptr, error, error_size);
   if (spec == nullptr) return nullptr;
@@ -32,7 +32,7 @@ Result<std::unique_ptr<Plant>> Plant::Create(const Task& task, bool textures) {
   std::unique_ptr<Plant> p(new Plant());
   p->task_ = &task;
   char load_error[1000] = "";
-  p->model_.reset(LoadModel(task.model_path, textures, load_error, sizeof load_error));
+  p->model_.reset(LoadPlantModel(task.model_path, textures, load_error, sizeof load_error));
   if (!p->model_) {
     return Error{where + ".model: cannot load '" + task.model_path + "': " + load_error};
   }
