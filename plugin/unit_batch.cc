@@ -28,7 +28,33 @@ namespace {
 
 // Lane masks are vectors of doubles with all bits set or clear (the comparison instructions'
 // result), combined with bit operations.
-#if defined(__AVX__)
+#if defined(RECRUIT_SMA_LANES8)
+// The AVX-512 clone (AdvanceCohorts only): 8 lanes. Comparisons give mask registers, widened to
+// all-bits vectors so that the code below is the same for every width; a select is one
+// three-input bit operation.
+constexpr int kLanes = 8;
+using Vd = __m512d;
+inline Vd Splat(double x) { return _mm512_set1_pd(x); }
+inline Vd Load(const double* p) { return _mm512_loadu_pd(p); }
+inline void Store(double* p, Vd v) { _mm512_storeu_pd(p, v); }
+inline Vd Widen(__mmask8 k) { return _mm512_castsi512_pd(_mm512_movm_epi64(k)); }
+inline Vd Lt(Vd a, Vd b) { return Widen(_mm512_cmp_pd_mask(a, b, _CMP_LT_OQ)); }
+inline Vd Le(Vd a, Vd b) { return Widen(_mm512_cmp_pd_mask(a, b, _CMP_LE_OQ)); }
+inline Vd Ne(Vd a, Vd b) { return Widen(_mm512_cmp_pd_mask(a, b, _CMP_NEQ_UQ)); }
+inline Vd And(Vd a, Vd b) { return _mm512_and_pd(a, b); }
+inline Vd Or(Vd a, Vd b) { return _mm512_or_pd(a, b); }
+inline Vd AndNot(Vd a, Vd b) { return _mm512_andnot_pd(b, a); }  // a & ~b
+inline Vd Sel(Vd m, Vd a, Vd b) {                                // m ? a : b, bit by bit
+  const __m512i r = _mm512_ternarylogic_epi64(_mm512_castpd_si512(m), _mm512_castpd_si512(a),
+                                              _mm512_castpd_si512(b), 0xCA);
+  return _mm512_castsi512_pd(r);
+}
+inline int Bits(Vd m) { return _mm512_movepi64_mask(_mm512_castpd_si512(m)); }
+// The first n < 8 lanes only (the others load as 0, are not stored; no access beyond them).
+inline __mmask8 FirstLanes(int n) { return static_cast<__mmask8>((1u << n) - 1); }
+inline Vd LoadN(const double* p, int n) { return _mm512_maskz_loadu_pd(FirstLanes(n), p); }
+inline void StoreN(double* p, Vd v, int n) { _mm512_mask_storeu_pd(p, FirstLanes(n), v); }
+#elif defined(__AVX__)
 constexpr int kLanes = 4;
 using Vd = __m256d;
 inline Vd Splat(double x) { return _mm256_set1_pd(x); }
@@ -306,7 +332,12 @@ void AdvanceCohorts(const BatchParams& p, const BatchCohorts& c, int n, double s
     for (int b = 0; b < n_solve; b += kLanes) {
       const int* const idx = solve + b;
       // Lane-by-lane loads (faster here than the AVX2 gather instruction).
-#if defined(__AVX__)
+#if defined(RECRUIT_SMA_LANES8)
+      auto gather = [&](const double* a) {
+        return _mm512_setr_pd(a[idx[0]], a[idx[1]], a[idx[2]], a[idx[3]], a[idx[4]], a[idx[5]],
+                              a[idx[6]], a[idx[7]]);
+      };
+#elif defined(__AVX__)
       auto gather = [&](const double* a) {
         return _mm256_setr_pd(a[idx[0]], a[idx[1]], a[idx[2]], a[idx[3]]);
       };
@@ -355,6 +386,8 @@ void AdvanceCohorts(const BatchParams& p, const BatchCohorts& c, int n, double s
   }
 }
 
+// The sums keep four partial sums (lane j mod 4), so the 8-lane clone has none of them.
+#ifndef RECRUIT_SMA_LANES8
 double SumTension(const BatchParams& p, const double* count, const double* xi, int n,
                   double stretch) {
   // Four partial sums (cohort j mod 4; one register with AVX, two with SSE2), added as
@@ -427,6 +460,7 @@ void Relabel(double* idx, int n, const int* remap) {
 #endif
   for (; i < n; ++i) idx[i] = remap[static_cast<int>(idx[i])];
 }
+#endif  // RECRUIT_SMA_LANES8
 
 #pragma GCC diagnostic pop
 

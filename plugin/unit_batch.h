@@ -46,4 +46,12 @@ void Relabel(double* idx, int n, const int* remap);
 }  // namespace batch_avx2
 #endif
 
+#ifdef RECRUIT_SMA_AVX512_CLONE
+// AVX-512 (F and DQ), 8 lanes: only the update; the sums keep their four partial sums (AVX2).
+namespace batch_avx512 {
+void AdvanceCohorts(const BatchParams& p, const BatchCohorts& c, int n, double stretch,
+                    double decay);
+}  // namespace batch_avx512
+#endif
+
 }  // namespace recruit::sma

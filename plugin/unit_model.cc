@@ -377,6 +377,11 @@ bool UseAvx2(UnitModel::Isa isa) {
 #endif
 }
 
+// The 8-lane update: asked for, or kAuto on a CPU that has it.
+bool UseAvx512(UnitModel::Isa isa) {
+  return (isa == UnitModel::Isa::kAuto || isa == UnitModel::Isa::kAvx512) && UnitModel::HasAvx512();
+}
+
 }  // namespace
 
 bool UnitModel::HasAvx2() {
@@ -388,7 +393,18 @@ bool UnitModel::HasAvx2() {
 #endif
 }
 
+bool UnitModel::HasAvx512() {
+#ifdef RECRUIT_SMA_AVX512_CLONE
+  static const bool has =
+      __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") && HasAvx2();
+  return has;
+#else
+  return false;
+#endif
+}
+
 int UnitModel::Lanes(Isa isa) {
+  if (UseAvx512(isa)) return 8;
   if (UseAvx2(isa)) return 4;
 #ifdef __AVX__
   return 4;
@@ -408,6 +424,9 @@ void UnitModel::AdvanceCohorts(const Cohorts& c, int n, double stretch, double d
   }
   const BatchParams& bp = batch_;
   const BatchCohorts bc{c.on, c.temperature, c.xi, c.t_eff, c.heat_scale, c.cool_scale};
+#ifdef RECRUIT_SMA_AVX512_CLONE
+  if (UseAvx512(isa)) return batch_avx512::AdvanceCohorts(bp, bc, n, stretch, decay);
+#endif
 #ifdef RECRUIT_SMA_AVX2_CLONE
   if (UseAvx2(isa)) return batch_avx2::AdvanceCohorts(bp, bc, n, stretch, decay);
 #endif

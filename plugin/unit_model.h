@@ -135,9 +135,10 @@ class UnitModel {
     double* heat_scale;
     double* cool_scale;
   };
-  // Kernel: kAuto = AVX2 when this build has the AVX2 clone and the CPU runs it, else the
-  // build's own instruction set (kBase). Tests run both.
-  enum class Isa { kAuto, kBase, kAvx2 };
+  // Kernel: kAuto = AVX-512 (8 lanes) for the update and AVX2 for the sums when this build has
+  // those clones and the CPU runs them, else AVX2, else the build's own instruction set (kBase).
+  // kAvx512 uses AVX2 for the sums. Tests run each.
+  enum class Isa { kAuto, kBase, kAvx2, kAvx512 };
   void AdvanceCohorts(const Cohorts& c, int n, double stretch, double decay,
                       Isa isa = Isa::kAuto) const;
   // Sum over n cohorts of count[j] * Tension(xi[j], stretch), in SIMD lanes.
@@ -150,6 +151,7 @@ class UnitModel {
   static void Relabel(double* idx, int n, const int* remap);
   // Whether kAvx2 is available (built and supported by the CPU); the lanes kAuto uses.
   static bool HasAvx2();
+  static bool HasAvx512();  // the AVX-512 update (F and DQ): built and supported
   static int Lanes(Isa isa = Isa::kAuto);
 
   // Natural convection (Morgan's horizontal-cylinder correlation, air at the film temperature)

@@ -2,7 +2,7 @@
 // the scalar per-cohort update it replaces in the bundle (AdvanceUnitWithDecay, kept as the
 // reference): bit-identical results, cohort by cohort, for random states and along trajectories
 // with random switching, across unit models and cohort counts that leave partial SIMD batches and
-// span several 64-cohort chunks; for the build's own kernel and the AVX2 clone.
+// span several 64-cohort chunks; for the build's own kernel and the AVX2 and AVX-512 clones.
 #include <gtest/gtest.h>
 
 #include <cstring>
@@ -78,6 +78,9 @@ class BatchedCohorts : public ::testing::TestWithParam<std::tuple<std::string, U
     if (isa() == UnitModel::Isa::kAvx2 && !UnitModel::HasAvx2()) {
       GTEST_SKIP() << "no AVX2 kernel in this build or CPU";
     }
+    if (isa() == UnitModel::Isa::kAvx512 && !UnitModel::HasAvx512()) {
+      GTEST_SKIP() << "no AVX-512 kernel in this build or CPU";
+    }
   }
   const std::string& config() const { return std::get<0>(GetParam()); }
   UnitModel::Isa isa() const { return std::get<1>(GetParam()); }
@@ -148,7 +151,8 @@ INSTANTIATE_TEST_SUITE_P(
                                          "series_spring=0",           // rigid: no series spring
                                          "law=spring current=0.235",  // coiled spring
                                          "parallel=2 series=3", "latent_heat=0"),
-                       ::testing::Values(UnitModel::Isa::kBase, UnitModel::Isa::kAvx2)));
+                       ::testing::Values(UnitModel::Isa::kBase, UnitModel::Isa::kAvx2,
+                                         UnitModel::Isa::kAvx512)));
 
 // The tension sum over cohorts against the scalar sum of count * Tension: the same to rounding
 // of the summation order (four partial sums), exactly for one cohort.
