@@ -77,6 +77,7 @@ Status SmaBundle::Broadcast(double* s, double p_on, double p_off, double stretch
   if (!(p_on >= 0 && p_on <= 1) || !(p_off >= 0 && p_off <= 1)) {
     return Error{"actuator '" + config_.actuator + "': broadcast probabilities must be in [0, 1]"};
   }
+  DropKept(s);
   Flush(s, stretch);  // time not yet integrated ran with the old on/off states
   Rng rng = LoadRng(s + kRngSlot);
   const int k0 = NumCohorts(s);
@@ -120,6 +121,7 @@ Status SmaBundle::Broadcast(double* s, double p_on, double p_off, double stretch
 }
 
 void SmaBundle::Advance(double* s, double stretch, double dt) const {
+  DropKept(s);
   if (config_.update_period <= 0) {
     Integrate(s, stretch, dt);
     return;
@@ -240,16 +242,47 @@ double SmaBundle::CountWeightedSum(const double* s, int f) const {
 }
 
 SmaBundle::Summary SmaBundle::Summarize(const double* s, double stretch) const {
+  // One pass: the sums of OnCount, MeanTemperature, MeanXi and Tension together.
   const int k = NumCohorts(s);
   const double* v[3] = {Field(s, kOn), Field(s, kTemp), Field(s, kXi)};
-  double sum[3];
-  UnitModel::WeightedSums(Field(s, kCount), v, 3, k, sum);
+  double sum[4];
+  unit_.Observe(Field(s, kCount), v, k, stretch, false, sum);
   Summary r;
   r.on_count = static_cast<int>(sum[0]);
-  r.tension = Tension(s, stretch);
+  r.tension = sum[3];
   r.mean_temperature = k == 0 ? config_.unit.ambient : sum[1] / config_.units;
   r.mean_xi = k == 0 ? 1 : sum[2] / config_.units;
   return r;
+}
+
+SmaBundle::Telemetry SmaBundle::Observe(const double* s, double stretch) const {
+  const int k = NumCohorts(s);
+  const double* v[3] = {Field(s, kOn), Field(s, kTemp), Field(s, kXi)};
+  double sum[5];
+  unit_.Observe(Field(s, kCount), v, k, stretch, true, sum);
+  Telemetry r;
+  r.on_count = static_cast<int>(sum[0]);
+  r.tension = sum[3];
+  r.mean_temperature = k == 0 ? config_.unit.ambient : sum[1] / config_.units;
+  r.mean_xi = k == 0 ? 1 : sum[2] / config_.units;
+  r.max_temperature = MaxTemperature(s);
+  r.max_wire_stress = unit_.WireStress(sum[4]);
+  return r;
+}
+
+SmaBundle::Summary SmaBundle::SummarizeAndKeep(double* s, double stretch) const {
+  const Summary r = Summarize(s, stretch);
+  s[kKeptSlot] = 1;
+  s[kKeptStretchSlot] = stretch;
+  s[kKeptTensionSlot] = r.tension;
+  return r;
+}
+
+double SmaBundle::TakeTension(double* s, double stretch) const {
+  const bool kept = s[kKeptSlot] == 1 && s[kKeptStretchSlot] == stretch;
+  const double t = kept ? s[kKeptTensionSlot] : Tension(s, stretch);
+  DropKept(s);
+  return t;
 }
 
 int SmaBundle::OnCount(const double* s) const { return static_cast<int>(CountWeightedSum(s, kOn)); }

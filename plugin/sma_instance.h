@@ -92,9 +92,11 @@ class SmaInstance {
 
   // The engine's callbacks. `block` is the instance's plugin_state.
   void Reset(const mjModel* m, double* block) const;  // every unit off at actuator_length0
-  void Compute(const mjModel* m, mjData* d) const;    // actuator_force = -tension (pure)
-  void Advance(const mjModel* m, mjData* d) const;    // ctrl broadcasts, then one timestep
-  void Sensor(const mjModel* m, mjData* d) const;     // kSensorValues per actuator
+  // Compute and Sensor change no unit: the sensor keeps its tension in the block for Compute,
+  // which takes it (SmaBundle::SummarizeAndKeep, TakeTension).
+  void Compute(const mjModel* m, mjData* d) const;  // actuator_force = -tension
+  void Advance(const mjModel* m, mjData* d) const;  // ctrl broadcasts, then one timestep
+  void Sensor(const mjModel* m, mjData* d) const;   // kSensorValues per actuator
 
   // Unit extension (m) of actuator k at tendon length `length`.
   double Stretch(int k, double length) const {

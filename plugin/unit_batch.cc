@@ -419,6 +419,63 @@ double SumTension(const BatchParams& p, const double* count, const double* xi, i
 
 namespace {
 
+// max(a, b) lane by lane for values that are never NaN (tensions: >= +0), where the order of
+// the comparisons cannot change the result.
+inline Vd MaxOf(Vd a, Vd b) { return Sel(Gt(a, b), a, b); }
+
+// Observe with or without the largest tension (the sensor needs only the sums).
+template <bool kPeak>
+void ObservePass(const BatchParams& p, const double* count, const double* const* v, int n,
+                 double stretch, double* out) {
+  constexpr int kRegs = 4 / kLanes;
+  const Consts k = MakeConsts(p, stretch);
+  Vd acc[4][kRegs], peak[kRegs];
+  for (int r = 0; r < kRegs; ++r) {
+    for (int f = 0; f < 4; ++f) acc[f][r] = Splat(0);
+    peak[r] = Splat(0);
+  }
+  int j = 0;
+  for (; j + 4 <= n; j += 4) {
+    for (int r = 0; r < kRegs; ++r) {
+      const int i = j + r * kLanes;
+      const Vd c = Load(count + i), x = Load(v[2] + i), t = TensionOnly(k, x);
+      acc[0][r] += c * Load(v[0] + i);
+      acc[1][r] += c * Load(v[1] + i);
+      acc[2][r] += c * x;
+      acc[3][r] += c * t;
+      if (kPeak) peak[r] = MaxOf(t, peak[r]);
+    }
+  }
+  alignas(32) double a[4][4], top[4];
+  for (int r = 0; r < kRegs; ++r) {
+    for (int f = 0; f < 4; ++f) Store(a[f] + r * kLanes, acc[f][r]);
+    Store(top + r * kLanes, peak[r]);
+  }
+  // The last n - j < 4 cohorts: the sums one by one (as Sums), the tension from masked loads
+  // (as SumTension: missing lanes add count 0 times a tension, +0).
+  for (int f = 0; f < 3; ++f) {
+    for (int l = 0; j + l < n; ++l) a[f][l] += count[j + l] * v[f][j + l];
+  }
+  double top_tail = 0;
+  for (int r = 0; r < kRegs && j + r * kLanes < n; ++r) {
+    const int i = j + r * kLanes, rest = n - i;
+    const Vd cnt = rest >= kLanes ? Load(count + i) : LoadN(count + i, rest);
+    const Vd x = rest >= kLanes ? Load(v[2] + i) : LoadN(v[2] + i, rest);
+    const Vd t = TensionOnly(k, x);
+    alignas(32) double f[kLanes], tl[kLanes];
+    Store(f, cnt * t);
+    Store(tl, t);
+    for (int l = 0; l < kLanes; ++l) a[3][r * kLanes + l] += f[l];
+    for (int l = 0; l < kLanes && l < rest; ++l) top_tail = tl[l] > top_tail ? tl[l] : top_tail;
+  }
+  for (int f = 0; f < 4; ++f) out[f] = (a[f][0] + a[f][1]) + (a[f][2] + a[f][3]);
+  if (kPeak) {
+    double m = top_tail;
+    for (int l = 0; l < 4 && l < n; ++l) m = top[l] > m ? top[l] : m;
+    out[4] = m;
+  }
+}
+
 // WeightedSums for NF fields (unrolled).
 template <int NF>
 void Sums(const double* count, const double* const* v, int n, double* out) {
@@ -448,6 +505,12 @@ void Sums(const double* count, const double* const* v, int n, double* out) {
 void WeightedSums(const double* count, const double* const* v, int nf, int n, double* out) {
   if (nf == 3) return Sums<3>(count, v, n, out);
   for (int f = 0; f < nf; ++f) Sums<1>(count, v + f, n, out + f);
+}
+
+void Observe(const BatchParams& p, const double* count, const double* const* v, int n,
+             double stretch, bool peak, double* out) {
+  if (peak) return ObservePass<true>(p, count, v, n, stretch, out);
+  ObservePass<false>(p, count, v, n, stretch, out);
 }
 
 void Relabel(double* idx, int n, const int* remap) {

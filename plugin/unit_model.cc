@@ -463,6 +463,27 @@ void UnitModel::WeightedSums(const double* count, const double* const* v, int nf
   batch_base::WeightedSums(count, v, nf, n, out);
 }
 
+void UnitModel::Observe(const double* count, const double* const* v, int n, double stretch,
+                        bool peak, double* out, Isa isa) const {
+  if (n < 4 && isa == Isa::kAuto) {  // WeightedSums' and SumTension's paths for few cohorts
+    double a[4][4] = {}, top = 0;
+    for (int j = 0; j < n; ++j) {
+      const double t = Tension(v[2][j], stretch);
+      for (int f = 0; f < 3; ++f) a[f][j] += count[j] * v[f][j];
+      a[3][j] += count[j] * t;
+      top = std::max(top, t);
+    }
+    for (int f = 0; f < 4; ++f) out[f] = (a[f][0] + a[f][1]) + (a[f][2] + a[f][3]);
+    if (peak) out[4] = top;
+    return;
+  }
+  const BatchParams& bp = batch_;
+#ifdef RECRUIT_SMA_AVX2_CLONE
+  if (UseAvx2(isa)) return batch_avx2::Observe(bp, count, v, n, stretch, peak, out);
+#endif
+  batch_base::Observe(bp, count, v, n, stretch, peak, out);
+}
+
 void UnitModel::Relabel(double* idx, int n, const int* remap) {
 #ifdef RECRUIT_SMA_AVX2_CLONE
   if (UseAvx2(Isa::kAuto)) return batch_avx2::Relabel(idx, n, remap);

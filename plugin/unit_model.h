@@ -147,6 +147,11 @@ class UnitModel {
   // Sets out[f] = sum over j < n of count[j] * v[f][j] for f < nf <= 3, in four partial sums
   // (s0 + s1) + (s2 + s3) of cohorts j mod 4: exact for one cohort.
   static void WeightedSums(const double* count, const double* const* v, int nf, int n, double* out);
+  // WeightedSums of v[0..2] (on, temperature, xi) and SumTension of xi = v[2] in one pass, each
+  // bit for bit the value those give, in out[0..3]; with `peak` also out[4] = the largest
+  // Tension(xi[j], stretch) over the cohorts (0 for none).
+  void Observe(const double* count, const double* const* v, int n, double stretch, bool peak,
+               double* out, Isa isa = Isa::kAuto) const;
   // idx[i] = remap[idx[i]] for i < n (cohort indices of units, held as doubles).
   static void Relabel(double* idx, int n, const int* remap);
   // Whether kAvx2 is available (built and supported by the CPU); the lanes kAuto uses.

@@ -5,6 +5,7 @@
 // span several 64-cohort chunks; for the build's own kernel and the AVX2 and AVX-512 clones.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstring>
 #include <string>
 #include <tuple>
@@ -176,6 +177,47 @@ TEST(BatchedCohortSums, SumTensionMatchesScalarSum) {
           EXPECT_TRUE(SameBits(got, ref)) << got << " vs " << ref;
         } else {
           EXPECT_NEAR(got, ref, 1e-14 * (1 + ref)) << "n " << n << " stretch " << stretch;
+        }
+      }
+    }
+  }
+}
+
+// Observe (the sensor's and the run loop's one pass) against the separate kernels it fuses:
+// WeightedSums of (on, T, xi) and SumTension bit for bit, and the largest tension against a
+// plain scalar maximum of UnitModel::Tension; every cohort count around the SIMD widths, slack
+// and taut extensions, each kernel.
+TEST(BatchedCohortSums, ObserveEqualsTheSeparateSumsAndTheScalarMaximum) {
+  const UnitModel m = MakeModel("");
+  std::vector<UnitModel::Isa> isas = {UnitModel::Isa::kAuto, UnitModel::Isa::kBase};
+  if (UnitModel::HasAvx2()) isas.push_back(UnitModel::Isa::kAvx2);
+  Rng rng(11);
+  for (int n : {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 33, 300}) {
+    std::vector<double> count(n), on(n), temperature(n), xi(n);
+    for (int j = 0; j < n; ++j) {
+      count[j] = 1 + static_cast<int>(10 * rng.Uniform());
+      on[j] = rng.Uniform() < 0.5 ? 1 : 0;
+      temperature[j] = 20 + 100 * rng.Uniform();
+      xi[j] = rng.Uniform() < 0.3 ? 1 : rng.Uniform();
+    }
+    const double* v[3] = {on.data(), temperature.data(), xi.data()};
+    double sums[3];
+    UnitModel::WeightedSums(count.data(), v, 3, n, sums);
+    for (double stretch : {0.0, 1e-3, 4e-3, 6e-3}) {
+      double top = 0;
+      for (int j = 0; j < n; ++j) top = std::max(top, m.Tension(xi[j], stretch));
+      for (UnitModel::Isa isa : isas) {
+        const double tension = m.SumTension(count.data(), xi.data(), n, stretch, isa);
+        for (bool peak : {false, true}) {
+          double out[5] = {-1, -1, -1, -1, -1};
+          m.Observe(count.data(), v, n, stretch, peak, out, isa);
+          const std::string where = "n " + std::to_string(n) + " stretch " +
+                                    std::to_string(stretch) + " isa " +
+                                    std::to_string(static_cast<int>(isa));
+          for (int f = 0; f < 3; ++f) EXPECT_TRUE(SameBits(out[f], sums[f])) << where << " f " << f;
+          EXPECT_TRUE(SameBits(out[3], tension)) << where << ": " << out[3] << " vs " << tension;
+          if (peak) EXPECT_TRUE(SameBits(out[4], top)) << where << ": " << out[4] << " vs " << top;
+          if (!peak) EXPECT_EQ(out[4], -1) << where;  // not written
         }
       }
     }
