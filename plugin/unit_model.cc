@@ -368,40 +368,34 @@ void AdvanceUnitWithDecay(const UnitModel& m, UnitState& s, bool on, double stre
 
 namespace {
 
-bool UseAvx2(UnitModel::Isa isa) {
+// The CPU's features, read once when the library loads: a function-local static would test its
+// guard at every dispatch of a kernel (twice per step). Before initialisation (another library's
+// static constructors) both read false, which selects the build's own kernels: same results.
+struct CpuFeatures {
+  bool avx2 = false, avx512 = false;
+  CpuFeatures() {
 #ifdef RECRUIT_SMA_AVX2_CLONE
-  if (isa == UnitModel::Isa::kBase) return false;
-  return UnitModel::HasAvx2();
-#else
-  return false;
+    __builtin_cpu_init();
+    avx2 = __builtin_cpu_supports("avx2");
+#ifdef RECRUIT_SMA_AVX512_CLONE
+    avx512 = avx2 && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq");
 #endif
-}
+#endif
+  }
+};
+const CpuFeatures cpu;
+
+bool UseAvx2(UnitModel::Isa isa) { return isa != UnitModel::Isa::kBase && cpu.avx2; }
 
 // The 8-lane update: asked for, or kAuto on a CPU that has it.
 bool UseAvx512(UnitModel::Isa isa) {
-  return (isa == UnitModel::Isa::kAuto || isa == UnitModel::Isa::kAvx512) && UnitModel::HasAvx512();
+  return (isa == UnitModel::Isa::kAuto || isa == UnitModel::Isa::kAvx512) && cpu.avx512;
 }
 
 }  // namespace
 
-bool UnitModel::HasAvx2() {
-#ifdef RECRUIT_SMA_AVX2_CLONE
-  static const bool has = __builtin_cpu_supports("avx2");
-  return has;
-#else
-  return false;
-#endif
-}
-
-bool UnitModel::HasAvx512() {
-#ifdef RECRUIT_SMA_AVX512_CLONE
-  static const bool has =
-      __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") && HasAvx2();
-  return has;
-#else
-  return false;
-#endif
-}
+bool UnitModel::HasAvx2() { return cpu.avx2; }
+bool UnitModel::HasAvx512() { return cpu.avx512; }
 
 int UnitModel::Lanes(Isa isa) {
   if (UseAvx512(isa)) return 8;
