@@ -7,6 +7,7 @@
 // the others continue.
 #include "plugin/unit_batch.h"
 
+#include <cmath>
 #include <cstring>
 
 #include "plugin/unit_model.h"
@@ -511,6 +512,47 @@ void Observe(const BatchParams& p, const double* count, const double* const* v, 
              double stretch, bool peak, double* out) {
   if (peak) return ObservePass<true>(p, count, v, n, stretch, out);
   ObservePass<false>(p, count, v, n, stretch, out);
+}
+
+bool MergeOrder(const double* on, const double* temp, int n, int* order, double* t, int* idx) {
+  // Off cohorts' temperatures in t[0..n0), on cohorts' in t[s1..s1 + n1) (s1 = n + kLanes),
+  // each followed by kLanes of +inf (read, never used), with their indices in idx, written
+  // without branches on the data; on values other than 0 and 1, and NaN temperatures, give up.
+  // Scratch: 2 (n + kLanes) each.
+  const int s1 = n + kLanes;
+  int n0 = 0, n1 = 0;
+  bool bad = false;
+  for (int j = 0; j < n; ++j) {
+    const bool is_off = on[j] == 0, is_on = on[j] == 1;
+    bad |= !(is_off || is_on) || !(temp[j] == temp[j]);
+    t[n0] = temp[j], idx[n0] = j, n0 += is_off;
+    t[s1 + n1] = temp[j], idx[s1 + n1] = j, n1 += is_on;
+  }
+  if (bad) return false;
+  for (int l = 0; l < kLanes; ++l) t[n0 + l] = t[s1 + n1 + l] = HUGE_VAL;
+  for (int j = 0; j < n; ++j) order[j] = -1;
+  // Position = the group's start + how many of its temperatures are lower, counted for kLanes
+  // cohorts at once (the lanes past the group are not used); two cohorts with the same
+  // position tie.
+  const Vd one = Splat(1.0);
+  for (int g = 0; g < 2; ++g) {
+    const double* tg = t + g * s1;
+    const int* ig = idx + g * s1;
+    const int ng = g == 0 ? n0 : n1, start = g == 0 ? 0 : n0;
+    for (int b = 0; b < ng; b += kLanes) {
+      const Vd x = Load(tg + b);
+      Vd c = Splat(0);
+      for (int j = 0; j < ng; ++j) c += And(Lt(Splat(tg[j]), x), one);
+      alignas(64) double rank[kLanes];
+      Store(rank, c);
+      for (int l = 0; l < kLanes && b + l < ng; ++l) {
+        const int pos = start + static_cast<int>(rank[l]);
+        bad |= order[pos] >= 0;
+        order[pos] = ig[b + l];
+      }
+    }
+  }
+  return !bad;
 }
 
 void Relabel(double* idx, int n, const int* remap) {

@@ -37,6 +37,8 @@ void Observe(const BatchParams& p, const double* count, const double* const* v, 
              double stretch, bool peak, double* out);
 // idx[i] = remap[idx[i]] for i < n (indices held as doubles).
 void Relabel(double* idx, int n, const int* remap);
+// UnitModel::MergeOrder; t and idx: 2 (n + 4) of scratch each.
+bool MergeOrder(const double* on, const double* temp, int n, int* order, double* t, int* idx);
 }  // namespace batch_base
 
 #ifdef RECRUIT_SMA_AVX2_CLONE
@@ -49,6 +51,7 @@ void WeightedSums(const double* count, const double* const* v, int nf, int n, do
 void Observe(const BatchParams& p, const double* count, const double* const* v, int n,
              double stretch, bool peak, double* out);
 void Relabel(double* idx, int n, const int* remap);
+bool MergeOrder(const double* on, const double* temp, int n, int* order, double* t, int* idx);
 }  // namespace batch_avx2
 #endif
 

@@ -478,6 +478,14 @@ void UnitModel::Observe(const double* count, const double* const* v, int n, doub
   batch_base::Observe(bp, count, v, n, stretch, peak, out);
 }
 
+bool UnitModel::MergeOrder(const double* on, const double* temp, int n, int* order, double* t,
+                           int* idx, Isa isa) {
+#ifdef RECRUIT_SMA_AVX2_CLONE
+  if (UseAvx2(isa)) return batch_avx2::MergeOrder(on, temp, n, order, t, idx);
+#endif
+  return batch_base::MergeOrder(on, temp, n, order, t, idx);
+}
+
 void UnitModel::Relabel(double* idx, int n, const int* remap) {
 #ifdef RECRUIT_SMA_AVX2_CLONE
   if (UseAvx2(Isa::kAuto)) return batch_avx2::Relabel(idx, n, remap);

@@ -407,7 +407,9 @@ TEST(SmaBundle, ObserveAndSummarizeEqualTheSeparateReads) {
   b.Reset(s.data(), 3, e);
   int checks = 0;
   for (int i = 0; i < 6000; ++i) {
-    if (i % 300 == 0) ASSERT_TRUE(b.Broadcast(s.data(), 0.2, 0.1, e).ok());
+    if (i % 300 == 0) {
+      ASSERT_TRUE(b.Broadcast(s.data(), 0.2, 0.1, e).ok());
+    }
     b.Advance(s.data(), e, 1e-3);
     if (i % 37 != 0) continue;
     for (double stretch : {e, 0.8 * e, -e}) {

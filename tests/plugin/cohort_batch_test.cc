@@ -216,12 +216,68 @@ TEST(BatchedCohortSums, ObserveEqualsTheSeparateSumsAndTheScalarMaximum) {
                                     std::to_string(static_cast<int>(isa));
           for (int f = 0; f < 3; ++f) EXPECT_TRUE(SameBits(out[f], sums[f])) << where << " f " << f;
           EXPECT_TRUE(SameBits(out[3], tension)) << where << ": " << out[3] << " vs " << tension;
-          if (peak) EXPECT_TRUE(SameBits(out[4], top)) << where << ": " << out[4] << " vs " << top;
-          if (!peak) EXPECT_EQ(out[4], -1) << where;  // not written
+          if (peak) {
+            EXPECT_TRUE(SameBits(out[4], top)) << where << ": " << out[4] << " vs " << top;
+          } else {
+            EXPECT_EQ(out[4], -1) << where;  // not written
+          }
         }
       }
     }
   }
+}
+
+// The merge pass's order without a sort (MergeOrder) against std::sort with the merge's
+// comparator: the same permutation whenever it answers; it answers for distinct keys and gives
+// up on ties (equal temperatures, +0 and -0), NaN and on values other than 0 and 1, where the
+// merge sorts as before. Each kernel, cohort counts around the SIMD widths.
+TEST(MergeOrder, IsStdSortsOrderForDistinctKeysAndGivesUpOnTies) {
+  std::vector<UnitModel::Isa> isas = {UnitModel::Isa::kAuto, UnitModel::Isa::kBase};
+  if (UnitModel::HasAvx2()) isas.push_back(UnitModel::Isa::kAvx2);
+  Rng rng(5);
+  auto sorted = [](const std::vector<double>& on, const std::vector<double>& t) {
+    std::vector<int> idx(on.size());
+    for (size_t j = 0; j < idx.size(); ++j) idx[j] = static_cast<int>(j);
+    std::sort(idx.begin(), idx.end(), [&](int a, int b) {
+      if (on[a] != on[b]) return on[a] < on[b];
+      return t[a] < t[b];
+    });
+    return idx;
+  };
+  int answered = 0, gave_up = 0;
+  for (int n = 1; n <= 64; ++n) {
+    for (int trial = 0; trial < 20; ++trial) {
+      std::vector<double> on(n), t(n);
+      for (int j = 0; j < n; ++j) {
+        on[j] = rng.Uniform() < 0.5 ? 1 : 0;
+        t[j] = 20 + 100 * rng.Uniform();
+      }
+      const int kind = trial % 5;  // 0, 1: distinct; 2: a tie; 3: NaN; 4: on = 0.5
+      const int a = static_cast<int>(n * rng.Uniform()), b = (a + 1) % n;
+      if (kind == 2 && n > 1) on[b] = on[a], t[b] = t[a];
+      if (kind == 2 && n > 1 && trial % 10 == 7) t[a] = 0.0, t[b] = -0.0;  // +0 and -0 tie
+      if (kind == 3) t[a] = std::nan("");
+      if (kind == 4) on[a] = 0.5;
+      const bool tie = kind == 2 && n > 1;
+      const bool distinct = kind < 2 || (kind == 2 && n == 1);
+      const std::vector<int> want = sorted(on, t);
+      for (UnitModel::Isa isa : isas) {
+        std::vector<int> order(n, -7), idx(2 * n + 8);
+        std::vector<double> scratch(2 * n + 8);
+        const bool ok = UnitModel::MergeOrder(on.data(), t.data(), n, order.data(), scratch.data(),
+                                              idx.data(), isa);
+        if (distinct) {
+          EXPECT_TRUE(ok) << "n " << n << " trial " << trial;
+          EXPECT_EQ(order, want) << "n " << n << " trial " << trial;
+        } else if (tie || kind == 3 || kind == 4) {
+          EXPECT_FALSE(ok) << "n " << n << " trial " << trial << " kind " << kind;
+        }
+        (ok ? answered : gave_up) += 1;
+      }
+    }
+  }
+  EXPECT_GT(answered, 1000);
+  EXPECT_GT(gave_up, 1000);
 }
 
 }  // namespace
