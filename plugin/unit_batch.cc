@@ -27,30 +27,32 @@ namespace {
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wpsabi"  // vectors are passed only between inlined functions
 
-// Lane masks are vectors of doubles with all bits set or clear (the comparison instructions'
-// result), combined with bit operations.
+// Lane masks (type Mask) are vectors of doubles with all bits set or clear (the comparison
+// instructions' result), combined with bit operations; in the AVX-512 clone they are mask
+// registers. ToVd / ToMask convert them to and from all-bits vectors (to store them).
 #if defined(RECRUIT_SMA_LANES8)
-// The AVX-512 clone (AdvanceCohorts only): 8 lanes. Comparisons give mask registers, widened to
-// all-bits vectors so that the code below is the same for every width; a select is one
-// three-input bit operation.
+// The AVX-512 clone (AdvanceCohorts only): 8 lanes, comparisons into mask registers, which
+// select (blend), zero lanes and combine without vector instructions of their own.
 constexpr int kLanes = 8;
 using Vd = __m512d;
+using Mask = __mmask8;
 inline Vd Splat(double x) { return _mm512_set1_pd(x); }
 inline Vd Load(const double* p) { return _mm512_loadu_pd(p); }
 inline void Store(double* p, Vd v) { _mm512_storeu_pd(p, v); }
-inline Vd Widen(__mmask8 k) { return _mm512_castsi512_pd(_mm512_movm_epi64(k)); }
-inline Vd Lt(Vd a, Vd b) { return Widen(_mm512_cmp_pd_mask(a, b, _CMP_LT_OQ)); }
-inline Vd Le(Vd a, Vd b) { return Widen(_mm512_cmp_pd_mask(a, b, _CMP_LE_OQ)); }
-inline Vd Ne(Vd a, Vd b) { return Widen(_mm512_cmp_pd_mask(a, b, _CMP_NEQ_UQ)); }
-inline Vd And(Vd a, Vd b) { return _mm512_and_pd(a, b); }
-inline Vd Or(Vd a, Vd b) { return _mm512_or_pd(a, b); }
-inline Vd AndNot(Vd a, Vd b) { return _mm512_andnot_pd(b, a); }  // a & ~b
-inline Vd Sel(Vd m, Vd a, Vd b) {                                // m ? a : b, bit by bit
-  const __m512i r = _mm512_ternarylogic_epi64(_mm512_castpd_si512(m), _mm512_castpd_si512(a),
-                                              _mm512_castpd_si512(b), 0xCA);
-  return _mm512_castsi512_pd(r);
-}
-inline int Bits(Vd m) { return _mm512_movepi64_mask(_mm512_castpd_si512(m)); }
+inline Vd ToVd(Mask k) { return _mm512_castsi512_pd(_mm512_movm_epi64(k)); }
+inline Mask ToMask(Vd v) { return _mm512_movepi64_mask(_mm512_castpd_si512(v)); }
+inline Mask Lt(Vd a, Vd b) { return _mm512_cmp_pd_mask(a, b, _CMP_LT_OQ); }
+inline Mask Le(Vd a, Vd b) { return _mm512_cmp_pd_mask(a, b, _CMP_LE_OQ); }
+inline Mask Ne(Vd a, Vd b) { return _mm512_cmp_pd_mask(a, b, _CMP_NEQ_UQ); }
+inline Mask And(Mask a, Mask b) { return static_cast<Mask>(a & b); }
+inline Mask Or(Mask a, Mask b) { return static_cast<Mask>(a | b); }
+inline Mask AndNot(Mask a, Mask b) { return static_cast<Mask>(a & ~b); }  // a & ~b
+inline Vd And(Vd v, Mask m) { return _mm512_maskz_mov_pd(m, v); }         // v where m, else +0
+inline Vd AndNot(Vd v, Mask m) { return _mm512_maskz_mov_pd(static_cast<Mask>(~m), v); }
+inline Vd AndNot(Vd a, Vd b) { return _mm512_andnot_pd(b, a); }              // a & ~b, bit by bit
+inline Vd Sel(Mask m, Vd a, Vd b) { return _mm512_mask_blend_pd(m, b, a); }  // m ? a : b
+inline Mask Sel(Mask m, Mask a, Mask b) { return static_cast<Mask>((m & a) | (~m & b)); }
+inline int Bits(Mask m) { return m; }
 // The first n < 8 lanes only (the others load as 0, are not stored; no access beyond them).
 inline __mmask8 FirstLanes(int n) { return static_cast<__mmask8>((1u << n) - 1); }
 inline Vd LoadN(const double* p, int n) { return _mm512_maskz_loadu_pd(FirstLanes(n), p); }
@@ -58,6 +60,7 @@ inline void StoreN(double* p, Vd v, int n) { _mm512_mask_storeu_pd(p, FirstLanes
 #elif defined(__AVX__)
 constexpr int kLanes = 4;
 using Vd = __m256d;
+using Mask = Vd;
 inline Vd Splat(double x) { return _mm256_set1_pd(x); }
 inline Vd Load(const double* p) { return _mm256_loadu_pd(p); }
 inline void Store(double* p, Vd v) { _mm256_storeu_pd(p, v); }
@@ -78,6 +81,7 @@ inline void StoreN(double* p, Vd v, int n) { _mm256_maskstore_pd(p, FirstLanes(n
 #elif defined(__SSE2__)
 constexpr int kLanes = 2;
 using Vd = __m128d;
+using Mask = Vd;
 inline Vd Splat(double x) { return _mm_set1_pd(x); }
 inline Vd Load(const double* p) { return _mm_loadu_pd(p); }
 inline void Store(double* p, Vd v) { _mm_storeu_pd(p, v); }
@@ -95,6 +99,7 @@ inline void StoreN(double* p, Vd v, int) { _mm_storel_pd(p, v); }
 #else  // generic vectors (GCC / Clang extension)
 constexpr int kLanes = 2;
 using Vd = double __attribute__((vector_size(16)));
+using Mask = Vd;
 using Vi = long long __attribute__((vector_size(16)));
 inline Vd Splat(double x) { return Vd{x, x}; }
 inline Vd Load(const double* p) {
@@ -117,13 +122,18 @@ inline Vd LoadN(const double* p, int) { return Vd{p[0], 0}; }
 inline void StoreN(double* p, Vd v, int) { p[0] = v[0]; }
 #endif
 
+#if !defined(RECRUIT_SMA_LANES8)
+inline Vd ToVd(Mask m) { return m; }
+inline Mask ToMask(Vd v) { return v; }
+#endif
+
 constexpr int kAll = (1 << kLanes) - 1;
-inline Vd Gt(Vd a, Vd b) { return Lt(b, a); }
-inline Vd Ge(Vd a, Vd b) { return Le(b, a); }
-inline Vd Lt(Vd a, double b) { return Lt(a, Splat(b)); }
-inline Vd Gt(Vd a, double b) { return Lt(Splat(b), a); }
-inline Vd Le(Vd a, double b) { return Le(a, Splat(b)); }
-inline Vd Ge(Vd a, double b) { return Le(Splat(b), a); }
+inline Mask Gt(Vd a, Vd b) { return Lt(b, a); }
+inline Mask Ge(Vd a, Vd b) { return Le(b, a); }
+inline Mask Lt(Vd a, double b) { return Lt(a, Splat(b)); }
+inline Mask Gt(Vd a, double b) { return Lt(Splat(b), a); }
+inline Mask Le(Vd a, double b) { return Le(a, Splat(b)); }
+inline Mask Ge(Vd a, double b) { return Le(Splat(b), a); }
 // |x| by clearing the sign bit (std::abs).
 inline Vd Abs(Vd x) { return AndNot(x, Splat(-0.0)); }
 // std::clamp(v, 0, 1) lane by lane (NaN passes through, as there).
@@ -132,7 +142,7 @@ inline Vd Clamp01(Vd v) { return Sel(Lt(v, 0.0), Splat(0), Sel(Gt(v, 1.0), Splat
 // A major curve per lane: MajorHeating (t0 = As, t1 = Af) or MajorCooling (Mf, Ms), 1 at or
 // below t0, 0 at or above t1, the cosine in between; slope as in the scalar overloads.
 inline Vd MajorCurve(Vd te, Vd t0, Vd t1, Vd rate, Vd* slope) {
-  const Vd below = Le(te, t0), above = Ge(te, t1), out = Or(below, above);
+  const Mask below = Le(te, t0), above = Ge(te, t1), out = Or(below, above);
   Vd sn = Splat(0), cs = Splat(0);
   if (Bits(out) != kAll) SinCosHalfTurn(rate * (te - t0), &sn, &cs);
   *slope = AndNot((-0.5 * rate) * sn, out);
@@ -183,7 +193,7 @@ inline Vd LaneTension(const Consts& c, Vd xi, Vd* slope) {
   }
   const Vd e = c.stretch - xi * c.stretch_L;
   const Vd ke = k * e;
-  const Vd slack = Le(ke, 0.0);
+  const Mask slack = Le(ke, 0.0);
   *slope = AndNot(dk * e - k * c.stretch_L, slack);
   return AndNot(ke, slack);
 }
@@ -198,7 +208,8 @@ inline Vd TensionOnly(const Consts& c, Vd xi) {
 
 // Per-lane inputs of a phase solve; heat selects gd_h (M -> A on M+) or gd_c (A -> M on M-).
 struct Lanes {
-  Vd heat, xi0, tth, hs, cs, pn, scale, t0, t1, rate;
+  Mask heat;
+  Vd xi0, tth, hs, cs, pn, scale, t0, t1, rate;
 };
 
 // gd_h / gd_c of SolvePhase: residual g and its slope dg at x.
@@ -214,9 +225,9 @@ inline void Residual(const Consts& c, const Lanes& L, Vd x, Vd* g, Vd* dg) {
 // cooling on [xi_n, 1].
 inline Vd Newton(const Consts& c, const Lanes& L, Vd g, Vd dg) {
   Vd lo = AndNot(L.xi0, L.heat), hi = Sel(L.heat, L.xi0, Splat(1)), x = L.xi0;
-  Vd active = Or(Le(x, x), Ne(x, x));  // every lane
+  Mask active = Or(Le(x, x), Ne(x, x));  // every lane
   for (int it = 0; it < 60; ++it) {
-    const Vd pos = Gt(g, 0.0);
+    const Mask pos = Gt(g, 0.0);
     hi = Sel(And(active, pos), x, hi);
     lo = Sel(AndNot(active, pos), x, lo);
     const Vd mid = 0.5 * (lo + hi);
@@ -238,9 +249,9 @@ inline Vd Newton(const Consts& c, const Lanes& L, Vd g, Vd dg) {
 
 // Canonical ends of the loop (SolvePhase), so that settled cohorts compare equal.
 inline void Canonical(Vd* xi, Vd* hs, Vd* cs) {
-  const Vd top = Ge(*xi, 1 - 1e-12), bottom = Le(*xi, 1e-12);
+  const Mask top = Ge(*xi, 1 - 1e-12), bottom = Le(*xi, 1e-12);
   if (Bits(Or(top, bottom)) == 0) return;
-  const Vd low = AndNot(bottom, top);
+  const Mask low = AndNot(bottom, top);
   *xi = Sel(top, Splat(1), AndNot(*xi, low));
   *hs = Sel(top, Splat(1), AndNot(*hs, low));
   *cs = Sel(top, Splat(0), Sel(low, Splat(1), *cs));
@@ -291,7 +302,7 @@ void AdvanceCohorts(const BatchParams& p, const BatchCohorts& c, int n, double s
       Vd dfdx0;
       const Vd f0 = LaneTension(k, xi0, &dfdx0);
       const Vd te_h0 = t_th - k.pn_h * f0;
-      const Vd is_heat = Ge(te_h0, load(b.t_eff));
+      const Mask is_heat = Ge(te_h0, load(b.t_eff));
       const Vd te0 = Sel(is_heat, te_h0, t_th - k.pn_c * f0);
       const Vd pn = Sel(is_heat, k.pn_h, k.pn_c);
       Vd slope;
@@ -299,7 +310,7 @@ void AdvanceCohorts(const BatchParams& p, const BatchCohorts& c, int n, double s
                                Sel(is_heat, k.heat_rate, k.cool_rate), &slope);
       const Vd g = Sel(is_heat, xi0 - hs0 * mv, xi0 - 1.0 + cs0 * (1.0 - mv));
       const Vd dg = 1.0 - Sel(is_heat, hs0, cs0) * slope * (k.latent - pn * dfdx0);
-      const Vd tr = Sel(is_heat, Gt(g, 1e-12), Lt(g, -1e-12));
+      const Mask tr = Sel(is_heat, Gt(g, 1e-12), Lt(g, -1e-12));
       // Cohorts that do not transform keep xi_n and are finished here; the others keep their
       // old values until (B).
       Vd x = xi0, h = hs0, cl = cs0;
@@ -312,7 +323,7 @@ void AdvanceCohorts(const BatchParams& p, const BatchCohorts& c, int n, double s
       Store(tth + j, t_th);
       Store(g0 + j, g);
       Store(dg0 + j, dg);
-      Store(heat + j, is_heat);
+      Store(heat + j, ToVd(is_heat));
       for (int bits = Bits(tr) & ((1 << count) - 1); bits != 0; bits &= bits - 1) {
         solve[n_solve++] = j + __builtin_ctz(bits);
       }
@@ -348,7 +359,7 @@ void AdvanceCohorts(const BatchParams& p, const BatchCohorts& c, int n, double s
       auto gather = [&](const double* a) { return Vd{a[idx[0]], a[idx[1]]}; };
 #endif
       Lanes L;
-      L.heat = gather(heat);
+      L.heat = ToMask(gather(heat));
       L.xi0 = gather(xi);
       L.tth = gather(tth);
       L.hs = gather(hs);
