@@ -320,11 +320,12 @@ double SmaBundle::MaxTemperature(const double* s) const {
 }
 
 double SmaBundle::MaxWireStress(const double* s, double stretch) const {
-  const int k = NumCohorts(s);
-  const double* xi = Field(s, kXi);
-  double f = 0;
-  for (int j = 0; j < k; ++j) f = std::max(f, unit_.Tension(xi[j], stretch));
-  return unit_.WireStress(f);
+  // The largest tension from Observe's SIMD pass (exactly the scalar maximum of
+  // UnitModel::Tension: tensions are never NaN); its sums are a few loads more.
+  const double* v[3] = {Field(s, kOn), Field(s, kTemp), Field(s, kXi)};
+  double out[5];
+  unit_.Observe(Field(s, kCount), v, NumCohorts(s), stretch, true, out);
+  return unit_.WireStress(out[4]);
 }
 
 int SmaBundle::UnitCohort(const double* s, int i) const {

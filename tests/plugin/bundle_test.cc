@@ -421,6 +421,14 @@ TEST(SmaBundle, ObserveAndSummarizeEqualTheSeparateReads) {
       EXPECT_TRUE(SameBits(t.mean_xi, b.MeanXi(st))) << "step " << i;
       EXPECT_TRUE(SameBits(t.max_temperature, b.MaxTemperature(st))) << "step " << i;
       EXPECT_TRUE(SameBits(t.max_wire_stress, b.MaxWireStress(st, stretch))) << "step " << i;
+      // and against the per-unit debug interface: the scalar maxima over units
+      double top_f = 0, top_t = b.UnitTemperature(st, 0);
+      for (int u = 0; u < b.num_units(); ++u) {
+        top_f = std::max(top_f, b.unit().Tension(b.UnitXi(st, u), stretch));
+        top_t = std::max(top_t, b.UnitTemperature(st, u));
+      }
+      EXPECT_TRUE(SameBits(t.max_wire_stress, b.unit().WireStress(top_f))) << "step " << i;
+      EXPECT_TRUE(SameBits(t.max_temperature, top_t)) << "step " << i;
       const SmaBundle::Summary sum = b.Summarize(st, stretch);
       EXPECT_EQ(sum.on_count, t.on_count);
       EXPECT_TRUE(SameBits(sum.tension, t.tension));
