@@ -160,8 +160,8 @@ void SmaBundle::Merge(double* s) const {
   // parallel on their own mjData).
   constexpr int kSmall = 64;
   MergeKey small_order[kSmall];
-  int small_forward[kSmall], small_remap[kSmall], rank[3 * kSmall + 8];
-  double t_scratch[2 * kSmall + 8];
+  int small_forward[kSmall], small_remap[kSmall], rank[3 * kSmall + 16];
+  double t_scratch[2 * kSmall + 16];
   static thread_local std::vector<MergeKey> big_order;
   static thread_local std::vector<int> big_forward, big_remap;
   if (k > kSmall) {

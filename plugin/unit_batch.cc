@@ -525,6 +525,9 @@ void Observe(const BatchParams& p, const double* count, const double* const* v, 
   ObservePass<false>(p, count, v, n, stretch, out);
 }
 
+#endif  // RECRUIT_SMA_LANES8
+
+// The merge order has no sums: every clone has it (the 8-lane one counts eight ranks at once).
 bool MergeOrder(const double* on, const double* temp, int n, int* order, double* t, int* idx) {
   // Off cohorts' temperatures in t[0..n0), on cohorts' in t[s1..s1 + n1) (s1 = n + kLanes),
   // each followed by kLanes of +inf (read, never used), with their indices in idx, written
@@ -553,7 +556,7 @@ bool MergeOrder(const double* on, const double* temp, int n, int* order, double*
     for (int b = 0; b < ng; b += kLanes) {
       const Vd x = Load(tg + b);
       Vd c = Splat(0);
-      for (int j = 0; j < ng; ++j) c += And(Lt(Splat(tg[j]), x), one);
+      for (int j = 0; j < ng; ++j) c += And(one, Lt(Splat(tg[j]), x));
       alignas(64) double rank[kLanes];
       Store(rank, c);
       for (int l = 0; l < kLanes && b + l < ng; ++l) {
@@ -566,6 +569,7 @@ bool MergeOrder(const double* on, const double* temp, int n, int* order, double*
   return !bad;
 }
 
+#ifndef RECRUIT_SMA_LANES8
 void Relabel(double* idx, int n, const int* remap) {
   int i = 0;
 #if defined(__AVX2__)

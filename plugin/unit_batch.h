@@ -37,7 +37,7 @@ void Observe(const BatchParams& p, const double* count, const double* const* v, 
              double stretch, bool peak, double* out);
 // idx[i] = remap[idx[i]] for i < n (indices held as doubles).
 void Relabel(double* idx, int n, const int* remap);
-// UnitModel::MergeOrder; t and idx: 2 (n + 4) of scratch each.
+// UnitModel::MergeOrder; t and idx: 2 (n + 8) of scratch each.
 bool MergeOrder(const double* on, const double* temp, int n, int* order, double* t, int* idx);
 }  // namespace batch_base
 
@@ -56,10 +56,12 @@ bool MergeOrder(const double* on, const double* temp, int n, int* order, double*
 #endif
 
 #ifdef RECRUIT_SMA_AVX512_CLONE
-// AVX-512 (F and DQ), 8 lanes: only the update; the sums keep their four partial sums (AVX2).
+// AVX-512 (F and DQ), 8 lanes: the update and the merge order; the sums keep their four partial
+// sums (AVX2).
 namespace batch_avx512 {
 void AdvanceCohorts(const BatchParams& p, const BatchCohorts& c, int n, double stretch,
                     double decay);
+bool MergeOrder(const double* on, const double* temp, int n, int* order, double* t, int* idx);
 }  // namespace batch_avx512
 #endif
 

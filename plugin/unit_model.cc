@@ -480,6 +480,9 @@ void UnitModel::Observe(const double* count, const double* const* v, int n, doub
 
 bool UnitModel::MergeOrder(const double* on, const double* temp, int n, int* order, double* t,
                            int* idx, Isa isa) {
+#ifdef RECRUIT_SMA_AVX512_CLONE
+  if (UseAvx512(isa)) return batch_avx512::MergeOrder(on, temp, n, order, t, idx);
+#endif
 #ifdef RECRUIT_SMA_AVX2_CLONE
   if (UseAvx2(isa)) return batch_avx2::MergeOrder(on, temp, n, order, t, idx);
 #endif

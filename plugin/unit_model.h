@@ -155,7 +155,7 @@ class UnitModel {
   // The cohorts' order by (on, temperature) for the merge pass, without branches on the data:
   // when no two keys tie (and on is 0 or 1, no temperature NaN) that order is unique, so it is
   // std::sort's; order[p] = the cohort at position p. False (order unspecified) otherwise: the
-  // caller sorts. Scratch: t and idx 2 (n + 4) entries each.
+  // caller sorts. Scratch: t and idx 2 (n + 8) entries each.
   static bool MergeOrder(const double* on, const double* temp, int n, int* order, double* t,
                          int* idx, Isa isa = Isa::kAuto);
   // idx[i] = remap[idx[i]] for i < n (cohort indices of units, held as doubles).

@@ -234,6 +234,7 @@ TEST(BatchedCohortSums, ObserveEqualsTheSeparateSumsAndTheScalarMaximum) {
 TEST(MergeOrder, IsStdSortsOrderForDistinctKeysAndGivesUpOnTies) {
   std::vector<UnitModel::Isa> isas = {UnitModel::Isa::kAuto, UnitModel::Isa::kBase};
   if (UnitModel::HasAvx2()) isas.push_back(UnitModel::Isa::kAvx2);
+  if (UnitModel::HasAvx512()) isas.push_back(UnitModel::Isa::kAvx512);
   Rng rng(5);
   auto sorted = [](const std::vector<double>& on, const std::vector<double>& t) {
     std::vector<int> idx(on.size());
@@ -262,8 +263,8 @@ TEST(MergeOrder, IsStdSortsOrderForDistinctKeysAndGivesUpOnTies) {
       const bool distinct = kind < 2 || (kind == 2 && n == 1);
       const std::vector<int> want = sorted(on, t);
       for (UnitModel::Isa isa : isas) {
-        std::vector<int> order(n, -7), idx(2 * n + 8);
-        std::vector<double> scratch(2 * n + 8);
+        std::vector<int> order(n, -7), idx(2 * n + 16);
+        std::vector<double> scratch(2 * n + 16);
         const bool ok = UnitModel::MergeOrder(on.data(), t.data(), n, order.data(), scratch.data(),
                                               idx.data(), isa);
         if (distinct) {
