@@ -320,6 +320,11 @@ Result<std::unique_ptr<SmaInstance>> SmaInstance::Build(const mjModel* m, int in
                  " drives no actuator: use it in an <actuator><plugin ... tendon=\"...\"/>"};
   }
   p->state_size_ = offset;
+  // The sensor callback writes these every step: found once instead of scanning every sensor
+  // (not for StateSize: the compiler asks it before the sensors are filled in).
+  for (int j = 0; check_actuators && j < m->nsensor; ++j) {
+    if (m->sensor_plugin[j] == instance) p->sensor_adr_.push_back(m->sensor_adr[j]);
+  }
   return p;
 }
 
@@ -376,9 +381,8 @@ void SmaInstance::Advance(const mjModel* m, mjData* d) const {
 }
 
 void SmaInstance::Sensor(const mjModel* m, mjData* d) const {
-  for (int j = 0; j < m->nsensor; ++j) {
-    if (m->sensor_plugin[j] != instance_) continue;
-    double* out = d->sensordata + m->sensor_adr[j];
+  for (const int adr : sensor_adr_) {
+    double* out = d->sensordata + adr;
     for (int k = 0; k < static_cast<int>(actuators_.size()); ++k) {
       const SmaActuator& act = actuators_[k];
       double* s = State(d->plugin_state, m, k);

@@ -128,6 +128,7 @@ class SmaInstance {
   std::uint64_t seed_ = 0;
   double broadcast_period_ = 0;
   int state_size_ = 0;
+  std::vector<int> sensor_adr_;  // sensordata address of each sensor on this instance
   std::vector<SmaActuator> actuators_;
 };
 
