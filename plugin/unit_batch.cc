@@ -223,28 +223,72 @@ inline void Residual(const Consts& c, const Lanes& L, Vd x, Vd* g, Vd* dg) {
 
 // SolveNewton lane by lane from x = xi_n, where the residual is g, dg: heating on [0, xi_n],
 // cooling on [xi_n, 1].
+// One batch's Newton state; a lane whose `active` bit is clear keeps its values.
+struct NewtonLanes {
+  Vd lo, hi, x, g, dg;
+  Mask active;
+};
+
+inline NewtonLanes NewtonStart(const Lanes& L, Vd g, Vd dg) {
+  NewtonLanes s;
+  s.lo = AndNot(L.xi0, L.heat);
+  s.hi = Sel(L.heat, L.xi0, Splat(1));
+  s.x = L.xi0;
+  s.g = g;
+  s.dg = dg;
+  s.active = Or(Le(s.x, s.x), Ne(s.x, s.x));  // every lane
+  return s;
+}
+
+// The bracket update and the Newton (or bisection) step of the active lanes.
+inline void NewtonStep(NewtonLanes& s) {
+  const Mask pos = Gt(s.g, 0.0);
+  s.hi = Sel(And(s.active, pos), s.x, s.hi);
+  s.lo = Sel(AndNot(s.active, pos), s.x, s.lo);
+  const Vd mid = 0.5 * (s.lo + s.hi);
+  Vd next = Sel(Gt(s.dg, 0.0), s.x - s.g / s.dg, mid);
+  next = Sel(And(Gt(next, s.lo), Lt(next, s.hi)), next, mid);
+  const Vd step = next - s.x;
+  s.x = Sel(s.active, next, s.x);
+  s.active = AndNot(s.active, Or(Lt(Abs(step), 1e-10), Lt(s.hi - s.lo, 1e-15)));
+}
+
+// The residual at the new x of the lanes still active.
+inline void NewtonResidual(const Consts& c, const Lanes& L, NewtonLanes& s) {
+  Vd gn, dgn;
+  Residual(c, L, s.x, &gn, &dgn);
+  s.g = Sel(s.active, gn, s.g);
+  s.dg = Sel(s.active, dgn, s.dg);
+  s.active = AndNot(s.active, Lt(Abs(s.g), 1e-13));
+}
+
 inline Vd Newton(const Consts& c, const Lanes& L, Vd g, Vd dg) {
-  Vd lo = AndNot(L.xi0, L.heat), hi = Sel(L.heat, L.xi0, Splat(1)), x = L.xi0;
-  Mask active = Or(Le(x, x), Ne(x, x));  // every lane
+  NewtonLanes s = NewtonStart(L, g, dg);
   for (int it = 0; it < 60; ++it) {
-    const Mask pos = Gt(g, 0.0);
-    hi = Sel(And(active, pos), x, hi);
-    lo = Sel(AndNot(active, pos), x, lo);
-    const Vd mid = 0.5 * (lo + hi);
-    Vd next = Sel(Gt(dg, 0.0), x - g / dg, mid);
-    next = Sel(And(Gt(next, lo), Lt(next, hi)), next, mid);
-    const Vd step = next - x;
-    x = Sel(active, next, x);
-    active = AndNot(active, Or(Lt(Abs(step), 1e-10), Lt(hi - lo, 1e-15)));
-    if (Bits(active) == 0) break;
-    Vd gn, dgn;
-    Residual(c, L, x, &gn, &dgn);
-    g = Sel(active, gn, g);
-    dg = Sel(active, dgn, dg);
-    active = AndNot(active, Lt(Abs(g), 1e-13));
-    if (Bits(active) == 0) break;
+    NewtonStep(s);
+    if (Bits(s.active) == 0) break;
+    NewtonResidual(c, L, s);
+    if (Bits(s.active) == 0) break;
   }
-  return x;
+  return s.x;
+}
+
+// Two batches in one loop, so that their dependency chains (division, polynomial, division)
+// overlap: lane by lane the same iterations as Newton, since a lane that has stopped keeps its
+// values while the other batch's lanes go on.
+inline void Newton2(const Consts& c, const Lanes& La, const Lanes& Lb, Vd ga, Vd dga, Vd gb, Vd dgb,
+                    Vd* xa, Vd* xb) {
+  NewtonLanes a = NewtonStart(La, ga, dga), b = NewtonStart(Lb, gb, dgb);
+  for (int it = 0; it < 60; ++it) {
+    NewtonStep(a);
+    NewtonStep(b);
+    if ((Bits(a.active) | Bits(b.active)) == 0) break;
+    NewtonResidual(c, La, a);
+    NewtonResidual(c, Lb, b);
+    if ((Bits(a.active) | Bits(b.active)) == 0) break;
+  }
+  *xa = a.x;
+  *xb = b.x;
 }
 
 // Canonical ends of the loop (SolvePhase), so that settled cohorts compare equal.
@@ -339,11 +383,11 @@ void AdvanceCohorts(const BatchParams& p, const BatchCohorts& c, int n, double s
       phase_a(Block{on + j, T + j, xi + j, te + j, hs + j, cs + j}, j, kLanes);
     }
     if (j < m) phase_a(Block{on + j, T + j, xi + j, te + j, hs + j, cs + j}, j, m - j);
-    // (B) A short batch repeats its last cohort (same inputs, same result).
+    // (B) A short batch repeats its last cohort (same inputs, same result). Batches go through
+    // Newton in pairs (their cohorts differ: both are read before either is written).
     for (int l = n_solve; l % kLanes != 0; ++l) solve[l] = solve[n_solve - 1];
-    for (int b = 0; b < n_solve; b += kLanes) {
-      const int* const idx = solve + b;
-      // Lane-by-lane loads (faster here than the AVX2 gather instruction).
+    auto prepare = [&](const int* idx, Lanes* L, Vd* g, Vd* dg) __attribute__((always_inline)) {
+      // Lane-by-lane loads (faster here than the gather instructions).
 #if defined(RECRUIT_SMA_LANES8)
       auto gather = [&](const double* a) {
         return _mm512_setr_pd(a[idx[0]], a[idx[1]], a[idx[2]], a[idx[3]], a[idx[4]], a[idx[5]],
@@ -358,18 +402,20 @@ void AdvanceCohorts(const BatchParams& p, const BatchCohorts& c, int n, double s
 #else
       auto gather = [&](const double* a) { return Vd{a[idx[0]], a[idx[1]]}; };
 #endif
-      Lanes L;
-      L.heat = ToMask(gather(heat));
-      L.xi0 = gather(xi);
-      L.tth = gather(tth);
-      L.hs = gather(hs);
-      L.cs = gather(cs);
-      L.pn = Sel(L.heat, k.pn_h, k.pn_c);
-      L.scale = Sel(L.heat, L.hs, L.cs);
-      L.t0 = Sel(L.heat, k.As, k.Mf);
-      L.t1 = Sel(L.heat, k.Af, k.Ms);
-      L.rate = Sel(L.heat, k.heat_rate, k.cool_rate);
-      Vd x = Newton(k, L, gather(g0), gather(dg0));
+      L->heat = ToMask(gather(heat));
+      L->xi0 = gather(xi);
+      L->tth = gather(tth);
+      L->hs = gather(hs);
+      L->cs = gather(cs);
+      L->pn = Sel(L->heat, k.pn_h, k.pn_c);
+      L->scale = Sel(L->heat, L->hs, L->cs);
+      L->t0 = Sel(L->heat, k.As, k.Mf);
+      L->t1 = Sel(L->heat, k.Af, k.Ms);
+      L->rate = Sel(L->heat, k.heat_rate, k.cool_rate);
+      *g = gather(g0);
+      *dg = gather(dg0);
+    };
+    auto finish = [&](const int* idx, const Lanes& L, Vd x) __attribute__((always_inline)) {
       // T_eff at the solution; the opposite branch's scale restarts there (proportional rule).
       const Vd t_eff = (L.tth + k.latent * (x - L.xi0)) - L.pn * TensionOnly(k, x);
       Vd unused;
@@ -380,7 +426,7 @@ void AdvanceCohorts(const BatchParams& p, const BatchCohorts& c, int n, double s
       Vd cl = Sel(L.heat, Sel(Lt(other, 1.0), ratio, Splat(1)), L.cs);
       Vd h = Sel(L.heat, L.hs, Sel(Gt(other, 0.0), ratio, Splat(1)));
       Canonical(&x, &h, &cl);
-      alignas(32) double out[5][kLanes];
+      alignas(64) double out[5][kLanes];
       Store(out[0], L.tth + k.latent * (x - L.xi0));
       Store(out[1], x);
       Store(out[2], t_eff);
@@ -394,6 +440,22 @@ void AdvanceCohorts(const BatchParams& p, const BatchCohorts& c, int n, double s
         hs[i] = out[3][l];
         cs[i] = out[4][l];
       }
+    };
+    int b = 0;
+    for (; b + kLanes < n_solve; b += 2 * kLanes) {
+      Lanes La, Lb;
+      Vd ga, dga, gb, dgb, xa, xb;
+      prepare(solve + b, &La, &ga, &dga);
+      prepare(solve + b + kLanes, &Lb, &gb, &dgb);
+      Newton2(k, La, Lb, ga, dga, gb, dgb, &xa, &xb);
+      finish(solve + b, La, xa);
+      finish(solve + b + kLanes, Lb, xb);
+    }
+    if (b < n_solve) {
+      Lanes L;
+      Vd g, dg;
+      prepare(solve + b, &L, &g, &dg);
+      finish(solve + b, L, Newton(k, L, g, dg));
     }
   }
 }
