@@ -77,6 +77,7 @@ Status SmaBundle::Broadcast(double* s, double p_on, double p_off, double stretch
   if (!(p_on >= 0 && p_on <= 1) || !(p_off >= 0 && p_off <= 1)) {
     return Error{"actuator '" + config_.actuator + "': broadcast probabilities must be in [0, 1]"};
   }
+  DropKept(s);
   Flush(s, stretch);  // time not yet integrated ran with the old on/off states
   Rng rng = LoadRng(s + kRngSlot);
   const int k0 = NumCohorts(s);
@@ -120,6 +121,7 @@ Status SmaBundle::Broadcast(double* s, double p_on, double p_off, double stretch
 }
 
 void SmaBundle::Advance(double* s, double stretch, double dt) const {
+  DropKept(s);
   if (config_.update_period <= 0) {
     Integrate(s, stretch, dt);
     return;
@@ -158,7 +160,8 @@ void SmaBundle::Merge(double* s) const {
   // parallel on their own mjData).
   constexpr int kSmall = 64;
   MergeKey small_order[kSmall];
-  int small_forward[kSmall], small_remap[kSmall];
+  int small_forward[kSmall], small_remap[kSmall], rank[3 * kSmall + 16];
+  double t_scratch[2 * kSmall + 16];
   static thread_local std::vector<MergeKey> big_order;
   static thread_local std::vector<int> big_forward, big_remap;
   if (k > kSmall) {
@@ -169,14 +172,20 @@ void SmaBundle::Merge(double* s) const {
   MergeKey* const order = k > kSmall ? big_order.data() : small_order;
   int* const forward = k > kSmall ? big_forward.data() : small_forward;
   int* const remap = k > kSmall ? big_remap.data() : small_remap;
-  // Sorted by (on, T) as keys held by value: std::sort's moves depend only on the comparisons,
-  // so the order (ties included) is that of sorting the indices with the same comparator.
+  // Sorted by (on, T). Without ties the order is unique, and MergeOrder finds it without the
+  // sort's unpredictable branches (k^2 / 2 comparisons in SIMD lanes: up to 64 cohorts, faster
+  // than the sort); with ties or more cohorts, std::sort as before: keys held by value, whose
+  // moves depend only on the comparisons, so the order of ties is that of sorting the indices.
   const double *on = Field(s, kOn), *temp = Field(s, kTemp);
-  for (int j = 0; j < k; ++j) order[j] = {on[j], temp[j], j};
-  std::sort(order, order + k, [](const MergeKey& a, const MergeKey& b) {
-    if (a.on != b.on) return a.on < b.on;
-    return a.temp < b.temp;
-  });
+  if (k <= kSmall && UnitModel::MergeOrder(on, temp, k, rank, t_scratch, rank + k)) {
+    for (int j = 0; j < k; ++j) order[j] = {on[rank[j]], temp[rank[j]], rank[j]};
+  } else {
+    for (int j = 0; j < k; ++j) order[j] = {on[j], temp[j], j};
+    std::sort(order, order + k, [](const MergeKey& a, const MergeKey& b) {
+      if (a.on != b.on) return a.on < b.on;
+      return a.temp < b.temp;
+    });
+  }
   bool merged = false;
   std::fill(forward, forward + k, -1);  // representative that absorbed each merged cohort
   double* count = Field(s, kCount);
@@ -240,16 +249,47 @@ double SmaBundle::CountWeightedSum(const double* s, int f) const {
 }
 
 SmaBundle::Summary SmaBundle::Summarize(const double* s, double stretch) const {
+  // One pass: the sums of OnCount, MeanTemperature, MeanXi and Tension together.
   const int k = NumCohorts(s);
   const double* v[3] = {Field(s, kOn), Field(s, kTemp), Field(s, kXi)};
-  double sum[3];
-  UnitModel::WeightedSums(Field(s, kCount), v, 3, k, sum);
+  double sum[4];
+  unit_.Observe(Field(s, kCount), v, k, stretch, false, sum);
   Summary r;
   r.on_count = static_cast<int>(sum[0]);
-  r.tension = Tension(s, stretch);
+  r.tension = sum[3];
   r.mean_temperature = k == 0 ? config_.unit.ambient : sum[1] / config_.units;
   r.mean_xi = k == 0 ? 1 : sum[2] / config_.units;
   return r;
+}
+
+SmaBundle::Telemetry SmaBundle::Observe(const double* s, double stretch) const {
+  const int k = NumCohorts(s);
+  const double* v[3] = {Field(s, kOn), Field(s, kTemp), Field(s, kXi)};
+  double sum[5];
+  unit_.Observe(Field(s, kCount), v, k, stretch, true, sum);
+  Telemetry r;
+  r.on_count = static_cast<int>(sum[0]);
+  r.tension = sum[3];
+  r.mean_temperature = k == 0 ? config_.unit.ambient : sum[1] / config_.units;
+  r.mean_xi = k == 0 ? 1 : sum[2] / config_.units;
+  r.max_temperature = MaxTemperature(s);
+  r.max_wire_stress = unit_.WireStress(sum[4]);
+  return r;
+}
+
+SmaBundle::Summary SmaBundle::SummarizeAndKeep(double* s, double stretch) const {
+  const Summary r = Summarize(s, stretch);
+  s[kKeptSlot] = 1;
+  s[kKeptStretchSlot] = stretch;
+  s[kKeptTensionSlot] = r.tension;
+  return r;
+}
+
+double SmaBundle::TakeTension(double* s, double stretch) const {
+  const bool kept = s[kKeptSlot] == 1 && s[kKeptStretchSlot] == stretch;
+  const double t = kept ? s[kKeptTensionSlot] : Tension(s, stretch);
+  DropKept(s);
+  return t;
 }
 
 int SmaBundle::OnCount(const double* s) const { return static_cast<int>(CountWeightedSum(s, kOn)); }
@@ -280,11 +320,12 @@ double SmaBundle::MaxTemperature(const double* s) const {
 }
 
 double SmaBundle::MaxWireStress(const double* s, double stretch) const {
-  const int k = NumCohorts(s);
-  const double* xi = Field(s, kXi);
-  double f = 0;
-  for (int j = 0; j < k; ++j) f = std::max(f, unit_.Tension(xi[j], stretch));
-  return unit_.WireStress(f);
+  // The largest tension from Observe's SIMD pass (exactly the scalar maximum of
+  // UnitModel::Tension: tensions are never NaN); its sums are a few loads more.
+  const double* v[3] = {Field(s, kOn), Field(s, kTemp), Field(s, kXi)};
+  double out[5];
+  unit_.Observe(Field(s, kCount), v, NumCohorts(s), stretch, true, out);
+  return unit_.WireStress(out[4]);
 }
 
 int SmaBundle::UnitCohort(const double* s, int i) const {

@@ -59,6 +59,22 @@ class SmaBundle {
     double tension, mean_temperature, mean_xi;
   };
   Summary Summarize(const double* s, double stretch) const;
+  // What a run loop reads after each step, in one pass over the cohorts: each value the same,
+  // bit for bit, as OnCount, Tension, MeanTemperature, MeanXi, MaxTemperature and MaxWireStress
+  // give (one tension evaluation per cohort serves the sum and the maximum).
+  struct Telemetry {
+    int on_count;
+    double tension, mean_temperature, mean_xi, max_temperature, max_wire_stress;
+  };
+  Telemetry Observe(const double* s, double stretch) const;
+
+  // The plugin's sensor and actuator force in one mj_forward (the sensor runs first, at the
+  // position stage): SummarizeAndKeep is Summarize and also keeps the tension with its extension
+  // in the block; TakeTension returns the kept tension when `stretch` is that extension, else
+  // Tension(s, stretch), and clears what was kept either way, so a full mj_forward leaves the
+  // block as it was. Reset, Broadcast and Advance clear it too (the units change).
+  Summary SummarizeAndKeep(double* s, double stretch) const;
+  double TakeTension(double* s, double stretch) const;
   int NumCohorts(const double* s) const { return static_cast<int>(s[kCohortCountSlot]); }
   double MeanTemperature(const double* s) const;
   double MeanXi(const double* s) const;
@@ -84,10 +100,12 @@ class SmaBundle {
   double SettledOnTension(double stretch) const;
 
  private:
-  // Header: magic, 4 random-stream words, cohort count, update counter, pending time (s).
-  static constexpr int kHeader = 8;
+  // Header: magic, 4 random-stream words, cohort count, update counter, pending time (s), the
+  // kept tension (flag 1 when kept, extension (m), tension (N); all 0 when none), 1 reserved
+  // (so that the cohort fields start 32 bytes after the block, as before).
+  static constexpr int kHeader = 12;
   static constexpr int kMagicSlot = 0, kRngSlot = 1, kCohortCountSlot = 5, kCounterSlot = 6,
-                       kPendingSlot = 7;
+                       kPendingSlot = 7, kKeptSlot = 8, kKeptStretchSlot = 9, kKeptTensionSlot = 10;
   // Cohorts as a structure of arrays: field f of cohort j at kHeader + f * N + j (N = units,
   // the most cohorts there can be), so the batched update loads four cohorts' values at once.
   static constexpr int kFields = 7;
@@ -105,6 +123,10 @@ class SmaBundle {
   // Sum over cohorts of count * field f, in four partial sums.
   double CountWeightedSum(const double* s, int f) const;
   void Merge(double* s) const;
+  // Forgets a kept tension (SummarizeAndKeep): the units are about to change.
+  static void DropKept(double* s) {
+    s[kKeptSlot] = 0, s[kKeptStretchSlot] = 0, s[kKeptTensionSlot] = 0;
+  }
   void Flush(double* s, double stretch) const;
   void Integrate(double* s, double stretch, double dt) const;
   // Drops cohorts with count 0 and relabels units; forward[j] >= 0 sends the units of an

@@ -51,6 +51,12 @@ class SmaHost {
   // Ground truth and telemetry.
   int OnCount(const mjData* d, int b) const { return bundle(b).OnCount(State(d, b)); }
   double Force(const mjData* d, int b) const;  // tension (N) at the current tendon length
+  // OnCount, Force, MeanTemperature, MeanXi, and the peak-relevant MaxTemperature and
+  // MaxWireStress (SmaBundle) of bundle b in one pass, each bit for bit the same value: for run
+  // loops that read several of them after every step.
+  SmaBundle::Telemetry Observe(const mjData* d, int b) const {
+    return bundle(b).Observe(State(d, b), Stretch(d, b));
+  }
   double MeanTemperature(const mjData* d, int b) const {
     return bundle(b).MeanTemperature(State(d, b));
   }

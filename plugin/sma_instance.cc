@@ -320,6 +320,11 @@ Result<std::unique_ptr<SmaInstance>> SmaInstance::Build(const mjModel* m, int in
                  " drives no actuator: use it in an <actuator><plugin ... tendon=\"...\"/>"};
   }
   p->state_size_ = offset;
+  // The sensor callback writes these every step: found once instead of scanning every sensor
+  // (not for StateSize: the compiler asks it before the sensors are filled in).
+  for (int j = 0; check_actuators && j < m->nsensor; ++j) {
+    if (m->sensor_plugin[j] == instance) p->sensor_adr_.push_back(m->sensor_adr[j]);
+  }
   return p;
 }
 
@@ -343,8 +348,9 @@ void SmaInstance::Compute(const mjModel* m, mjData* d) const {
   for (int k = 0; k < static_cast<int>(actuators_.size()); ++k) {
     const int a = actuators_[k].actuator;
     const double stretch = Stretch(k, Length(m, d, a));
+    // The sensor (position stage) usually summed this tension already in this mj_forward.
     d->actuator_force[m->actuator_outadr[a]] =
-        -actuators_[k].model.Tension(State(d->plugin_state, m, k), stretch);
+        -actuators_[k].model.TakeTension(State(d->plugin_state, m, k), stretch);
   }
 }
 
@@ -375,14 +381,14 @@ void SmaInstance::Advance(const mjModel* m, mjData* d) const {
 }
 
 void SmaInstance::Sensor(const mjModel* m, mjData* d) const {
-  for (int j = 0; j < m->nsensor; ++j) {
-    if (m->sensor_plugin[j] != instance_) continue;
-    double* out = d->sensordata + m->sensor_adr[j];
+  for (const int adr : sensor_adr_) {
+    double* out = d->sensordata + adr;
     for (int k = 0; k < static_cast<int>(actuators_.size()); ++k) {
       const SmaActuator& act = actuators_[k];
-      const double* s = State(d->plugin_state, m, k);
+      double* s = State(d->plugin_state, m, k);
       const double stretch = Stretch(k, Length(m, d, act.actuator));
-      const SmaBundle::Summary sum = act.model.Summarize(s, stretch);
+      // Keeps the tension for the actuator's force, computed later in the same mj_forward.
+      const SmaBundle::Summary sum = act.model.SummarizeAndKeep(s, stretch);
       out[kSensorValues * k + 0] = sum.on_count;
       out[kSensorValues * k + 1] = sum.tension;
       out[kSensorValues * k + 2] = sum.mean_temperature;

@@ -92,9 +92,11 @@ class SmaInstance {
 
   // The engine's callbacks. `block` is the instance's plugin_state.
   void Reset(const mjModel* m, double* block) const;  // every unit off at actuator_length0
-  void Compute(const mjModel* m, mjData* d) const;    // actuator_force = -tension (pure)
-  void Advance(const mjModel* m, mjData* d) const;    // ctrl broadcasts, then one timestep
-  void Sensor(const mjModel* m, mjData* d) const;     // kSensorValues per actuator
+  // Compute and Sensor change no unit: the sensor keeps its tension in the block for Compute,
+  // which takes it (SmaBundle::SummarizeAndKeep, TakeTension).
+  void Compute(const mjModel* m, mjData* d) const;  // actuator_force = -tension
+  void Advance(const mjModel* m, mjData* d) const;  // ctrl broadcasts, then one timestep
+  void Sensor(const mjModel* m, mjData* d) const;   // kSensorValues per actuator
 
   // Unit extension (m) of actuator k at tendon length `length`.
   double Stretch(int k, double length) const {
@@ -126,6 +128,7 @@ class SmaInstance {
   std::uint64_t seed_ = 0;
   double broadcast_period_ = 0;
   int state_size_ = 0;
+  std::vector<int> sensor_adr_;  // sensordata address of each sensor on this instance
   std::vector<SmaActuator> actuators_;
 };
 

@@ -7,6 +7,7 @@
 // the others continue.
 #include "plugin/unit_batch.h"
 
+#include <cmath>
 #include <cstring>
 
 #include "plugin/unit_model.h"
@@ -26,11 +27,40 @@ namespace {
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wpsabi"  // vectors are passed only between inlined functions
 
-// Lane masks are vectors of doubles with all bits set or clear (the comparison instructions'
-// result), combined with bit operations.
-#if defined(__AVX__)
+// Lane masks (type Mask) are vectors of doubles with all bits set or clear (the comparison
+// instructions' result), combined with bit operations; in the AVX-512 clone they are mask
+// registers. ToVd / ToMask convert them to and from all-bits vectors (to store them).
+#if defined(RECRUIT_SMA_LANES8)
+// The AVX-512 clone (AdvanceCohorts only): 8 lanes, comparisons into mask registers, which
+// select (blend), zero lanes and combine without vector instructions of their own.
+constexpr int kLanes = 8;
+using Vd = __m512d;
+using Mask = __mmask8;
+inline Vd Splat(double x) { return _mm512_set1_pd(x); }
+inline Vd Load(const double* p) { return _mm512_loadu_pd(p); }
+inline void Store(double* p, Vd v) { _mm512_storeu_pd(p, v); }
+inline Vd ToVd(Mask k) { return _mm512_castsi512_pd(_mm512_movm_epi64(k)); }
+inline Mask ToMask(Vd v) { return _mm512_movepi64_mask(_mm512_castpd_si512(v)); }
+inline Mask Lt(Vd a, Vd b) { return _mm512_cmp_pd_mask(a, b, _CMP_LT_OQ); }
+inline Mask Le(Vd a, Vd b) { return _mm512_cmp_pd_mask(a, b, _CMP_LE_OQ); }
+inline Mask Ne(Vd a, Vd b) { return _mm512_cmp_pd_mask(a, b, _CMP_NEQ_UQ); }
+inline Mask And(Mask a, Mask b) { return static_cast<Mask>(a & b); }
+inline Mask Or(Mask a, Mask b) { return static_cast<Mask>(a | b); }
+inline Mask AndNot(Mask a, Mask b) { return static_cast<Mask>(a & ~b); }  // a & ~b
+inline Vd And(Vd v, Mask m) { return _mm512_maskz_mov_pd(m, v); }         // v where m, else +0
+inline Vd AndNot(Vd v, Mask m) { return _mm512_maskz_mov_pd(static_cast<Mask>(~m), v); }
+inline Vd AndNot(Vd a, Vd b) { return _mm512_andnot_pd(b, a); }              // a & ~b, bit by bit
+inline Vd Sel(Mask m, Vd a, Vd b) { return _mm512_mask_blend_pd(m, b, a); }  // m ? a : b
+inline Mask Sel(Mask m, Mask a, Mask b) { return static_cast<Mask>((m & a) | (~m & b)); }
+inline int Bits(Mask m) { return m; }
+// The first n < 8 lanes only (the others load as 0, are not stored; no access beyond them).
+inline __mmask8 FirstLanes(int n) { return static_cast<__mmask8>((1u << n) - 1); }
+inline Vd LoadN(const double* p, int n) { return _mm512_maskz_loadu_pd(FirstLanes(n), p); }
+inline void StoreN(double* p, Vd v, int n) { _mm512_mask_storeu_pd(p, FirstLanes(n), v); }
+#elif defined(__AVX__)
 constexpr int kLanes = 4;
 using Vd = __m256d;
+using Mask = Vd;
 inline Vd Splat(double x) { return _mm256_set1_pd(x); }
 inline Vd Load(const double* p) { return _mm256_loadu_pd(p); }
 inline void Store(double* p, Vd v) { _mm256_storeu_pd(p, v); }
@@ -51,6 +81,7 @@ inline void StoreN(double* p, Vd v, int n) { _mm256_maskstore_pd(p, FirstLanes(n
 #elif defined(__SSE2__)
 constexpr int kLanes = 2;
 using Vd = __m128d;
+using Mask = Vd;
 inline Vd Splat(double x) { return _mm_set1_pd(x); }
 inline Vd Load(const double* p) { return _mm_loadu_pd(p); }
 inline void Store(double* p, Vd v) { _mm_storeu_pd(p, v); }
@@ -68,6 +99,7 @@ inline void StoreN(double* p, Vd v, int) { _mm_storel_pd(p, v); }
 #else  // generic vectors (GCC / Clang extension)
 constexpr int kLanes = 2;
 using Vd = double __attribute__((vector_size(16)));
+using Mask = Vd;
 using Vi = long long __attribute__((vector_size(16)));
 inline Vd Splat(double x) { return Vd{x, x}; }
 inline Vd Load(const double* p) {
@@ -90,13 +122,18 @@ inline Vd LoadN(const double* p, int) { return Vd{p[0], 0}; }
 inline void StoreN(double* p, Vd v, int) { p[0] = v[0]; }
 #endif
 
+#if !defined(RECRUIT_SMA_LANES8)
+inline Vd ToVd(Mask m) { return m; }
+inline Mask ToMask(Vd v) { return v; }
+#endif
+
 constexpr int kAll = (1 << kLanes) - 1;
-inline Vd Gt(Vd a, Vd b) { return Lt(b, a); }
-inline Vd Ge(Vd a, Vd b) { return Le(b, a); }
-inline Vd Lt(Vd a, double b) { return Lt(a, Splat(b)); }
-inline Vd Gt(Vd a, double b) { return Lt(Splat(b), a); }
-inline Vd Le(Vd a, double b) { return Le(a, Splat(b)); }
-inline Vd Ge(Vd a, double b) { return Le(Splat(b), a); }
+inline Mask Gt(Vd a, Vd b) { return Lt(b, a); }
+inline Mask Ge(Vd a, Vd b) { return Le(b, a); }
+inline Mask Lt(Vd a, double b) { return Lt(a, Splat(b)); }
+inline Mask Gt(Vd a, double b) { return Lt(Splat(b), a); }
+inline Mask Le(Vd a, double b) { return Le(a, Splat(b)); }
+inline Mask Ge(Vd a, double b) { return Le(Splat(b), a); }
 // |x| by clearing the sign bit (std::abs).
 inline Vd Abs(Vd x) { return AndNot(x, Splat(-0.0)); }
 // std::clamp(v, 0, 1) lane by lane (NaN passes through, as there).
@@ -105,7 +142,7 @@ inline Vd Clamp01(Vd v) { return Sel(Lt(v, 0.0), Splat(0), Sel(Gt(v, 1.0), Splat
 // A major curve per lane: MajorHeating (t0 = As, t1 = Af) or MajorCooling (Mf, Ms), 1 at or
 // below t0, 0 at or above t1, the cosine in between; slope as in the scalar overloads.
 inline Vd MajorCurve(Vd te, Vd t0, Vd t1, Vd rate, Vd* slope) {
-  const Vd below = Le(te, t0), above = Ge(te, t1), out = Or(below, above);
+  const Mask below = Le(te, t0), above = Ge(te, t1), out = Or(below, above);
   Vd sn = Splat(0), cs = Splat(0);
   if (Bits(out) != kAll) SinCosHalfTurn(rate * (te - t0), &sn, &cs);
   *slope = AndNot((-0.5 * rate) * sn, out);
@@ -156,7 +193,7 @@ inline Vd LaneTension(const Consts& c, Vd xi, Vd* slope) {
   }
   const Vd e = c.stretch - xi * c.stretch_L;
   const Vd ke = k * e;
-  const Vd slack = Le(ke, 0.0);
+  const Mask slack = Le(ke, 0.0);
   *slope = AndNot(dk * e - k * c.stretch_L, slack);
   return AndNot(ke, slack);
 }
@@ -171,7 +208,8 @@ inline Vd TensionOnly(const Consts& c, Vd xi) {
 
 // Per-lane inputs of a phase solve; heat selects gd_h (M -> A on M+) or gd_c (A -> M on M-).
 struct Lanes {
-  Vd heat, xi0, tth, hs, cs, pn, scale, t0, t1, rate;
+  Mask heat;
+  Vd xi0, tth, hs, cs, pn, scale, t0, t1, rate;
 };
 
 // gd_h / gd_c of SolvePhase: residual g and its slope dg at x.
@@ -185,35 +223,79 @@ inline void Residual(const Consts& c, const Lanes& L, Vd x, Vd* g, Vd* dg) {
 
 // SolveNewton lane by lane from x = xi_n, where the residual is g, dg: heating on [0, xi_n],
 // cooling on [xi_n, 1].
+// One batch's Newton state; a lane whose `active` bit is clear keeps its values.
+struct NewtonLanes {
+  Vd lo, hi, x, g, dg;
+  Mask active;
+};
+
+inline NewtonLanes NewtonStart(const Lanes& L, Vd g, Vd dg) {
+  NewtonLanes s;
+  s.lo = AndNot(L.xi0, L.heat);
+  s.hi = Sel(L.heat, L.xi0, Splat(1));
+  s.x = L.xi0;
+  s.g = g;
+  s.dg = dg;
+  s.active = Or(Le(s.x, s.x), Ne(s.x, s.x));  // every lane
+  return s;
+}
+
+// The bracket update and the Newton (or bisection) step of the active lanes.
+inline void NewtonStep(NewtonLanes& s) {
+  const Mask pos = Gt(s.g, 0.0);
+  s.hi = Sel(And(s.active, pos), s.x, s.hi);
+  s.lo = Sel(AndNot(s.active, pos), s.x, s.lo);
+  const Vd mid = 0.5 * (s.lo + s.hi);
+  Vd next = Sel(Gt(s.dg, 0.0), s.x - s.g / s.dg, mid);
+  next = Sel(And(Gt(next, s.lo), Lt(next, s.hi)), next, mid);
+  const Vd step = next - s.x;
+  s.x = Sel(s.active, next, s.x);
+  s.active = AndNot(s.active, Or(Lt(Abs(step), 1e-10), Lt(s.hi - s.lo, 1e-15)));
+}
+
+// The residual at the new x of the lanes still active.
+inline void NewtonResidual(const Consts& c, const Lanes& L, NewtonLanes& s) {
+  Vd gn, dgn;
+  Residual(c, L, s.x, &gn, &dgn);
+  s.g = Sel(s.active, gn, s.g);
+  s.dg = Sel(s.active, dgn, s.dg);
+  s.active = AndNot(s.active, Lt(Abs(s.g), 1e-13));
+}
+
 inline Vd Newton(const Consts& c, const Lanes& L, Vd g, Vd dg) {
-  Vd lo = AndNot(L.xi0, L.heat), hi = Sel(L.heat, L.xi0, Splat(1)), x = L.xi0;
-  Vd active = Or(Le(x, x), Ne(x, x));  // every lane
+  NewtonLanes s = NewtonStart(L, g, dg);
   for (int it = 0; it < 60; ++it) {
-    const Vd pos = Gt(g, 0.0);
-    hi = Sel(And(active, pos), x, hi);
-    lo = Sel(AndNot(active, pos), x, lo);
-    const Vd mid = 0.5 * (lo + hi);
-    Vd next = Sel(Gt(dg, 0.0), x - g / dg, mid);
-    next = Sel(And(Gt(next, lo), Lt(next, hi)), next, mid);
-    const Vd step = next - x;
-    x = Sel(active, next, x);
-    active = AndNot(active, Or(Lt(Abs(step), 1e-10), Lt(hi - lo, 1e-15)));
-    if (Bits(active) == 0) break;
-    Vd gn, dgn;
-    Residual(c, L, x, &gn, &dgn);
-    g = Sel(active, gn, g);
-    dg = Sel(active, dgn, dg);
-    active = AndNot(active, Lt(Abs(g), 1e-13));
-    if (Bits(active) == 0) break;
+    NewtonStep(s);
+    if (Bits(s.active) == 0) break;
+    NewtonResidual(c, L, s);
+    if (Bits(s.active) == 0) break;
   }
-  return x;
+  return s.x;
+}
+
+// Two batches in one loop, so that their dependency chains (division, polynomial, division)
+// overlap: lane by lane the same iterations as Newton, since a lane that has stopped keeps its
+// values while the other batch's lanes go on.
+inline void Newton2(const Consts& c, const Lanes& La, const Lanes& Lb, Vd ga, Vd dga, Vd gb, Vd dgb,
+                    Vd* xa, Vd* xb) {
+  NewtonLanes a = NewtonStart(La, ga, dga), b = NewtonStart(Lb, gb, dgb);
+  for (int it = 0; it < 60; ++it) {
+    NewtonStep(a);
+    NewtonStep(b);
+    if ((Bits(a.active) | Bits(b.active)) == 0) break;
+    NewtonResidual(c, La, a);
+    NewtonResidual(c, Lb, b);
+    if ((Bits(a.active) | Bits(b.active)) == 0) break;
+  }
+  *xa = a.x;
+  *xb = b.x;
 }
 
 // Canonical ends of the loop (SolvePhase), so that settled cohorts compare equal.
 inline void Canonical(Vd* xi, Vd* hs, Vd* cs) {
-  const Vd top = Ge(*xi, 1 - 1e-12), bottom = Le(*xi, 1e-12);
+  const Mask top = Ge(*xi, 1 - 1e-12), bottom = Le(*xi, 1e-12);
   if (Bits(Or(top, bottom)) == 0) return;
-  const Vd low = AndNot(bottom, top);
+  const Mask low = AndNot(bottom, top);
   *xi = Sel(top, Splat(1), AndNot(*xi, low));
   *hs = Sel(top, Splat(1), AndNot(*hs, low));
   *cs = Sel(top, Splat(0), Sel(low, Splat(1), *cs));
@@ -264,7 +346,7 @@ void AdvanceCohorts(const BatchParams& p, const BatchCohorts& c, int n, double s
       Vd dfdx0;
       const Vd f0 = LaneTension(k, xi0, &dfdx0);
       const Vd te_h0 = t_th - k.pn_h * f0;
-      const Vd is_heat = Ge(te_h0, load(b.t_eff));
+      const Mask is_heat = Ge(te_h0, load(b.t_eff));
       const Vd te0 = Sel(is_heat, te_h0, t_th - k.pn_c * f0);
       const Vd pn = Sel(is_heat, k.pn_h, k.pn_c);
       Vd slope;
@@ -272,7 +354,7 @@ void AdvanceCohorts(const BatchParams& p, const BatchCohorts& c, int n, double s
                                Sel(is_heat, k.heat_rate, k.cool_rate), &slope);
       const Vd g = Sel(is_heat, xi0 - hs0 * mv, xi0 - 1.0 + cs0 * (1.0 - mv));
       const Vd dg = 1.0 - Sel(is_heat, hs0, cs0) * slope * (k.latent - pn * dfdx0);
-      const Vd tr = Sel(is_heat, Gt(g, 1e-12), Lt(g, -1e-12));
+      const Mask tr = Sel(is_heat, Gt(g, 1e-12), Lt(g, -1e-12));
       // Cohorts that do not transform keep xi_n and are finished here; the others keep their
       // old values until (B).
       Vd x = xi0, h = hs0, cl = cs0;
@@ -285,7 +367,7 @@ void AdvanceCohorts(const BatchParams& p, const BatchCohorts& c, int n, double s
       Store(tth + j, t_th);
       Store(g0 + j, g);
       Store(dg0 + j, dg);
-      Store(heat + j, is_heat);
+      Store(heat + j, ToVd(is_heat));
       for (int bits = Bits(tr) & ((1 << count) - 1); bits != 0; bits &= bits - 1) {
         solve[n_solve++] = j + __builtin_ctz(bits);
       }
@@ -301,12 +383,17 @@ void AdvanceCohorts(const BatchParams& p, const BatchCohorts& c, int n, double s
       phase_a(Block{on + j, T + j, xi + j, te + j, hs + j, cs + j}, j, kLanes);
     }
     if (j < m) phase_a(Block{on + j, T + j, xi + j, te + j, hs + j, cs + j}, j, m - j);
-    // (B) A short batch repeats its last cohort (same inputs, same result).
+    // (B) A short batch repeats its last cohort (same inputs, same result). Batches go through
+    // Newton in pairs (their cohorts differ: both are read before either is written).
     for (int l = n_solve; l % kLanes != 0; ++l) solve[l] = solve[n_solve - 1];
-    for (int b = 0; b < n_solve; b += kLanes) {
-      const int* const idx = solve + b;
-      // Lane-by-lane loads (faster here than the AVX2 gather instruction).
-#if defined(__AVX__)
+    auto prepare = [&](const int* idx, Lanes* L, Vd* g, Vd* dg) __attribute__((always_inline)) {
+      // Lane-by-lane loads (faster here than the gather instructions).
+#if defined(RECRUIT_SMA_LANES8)
+      auto gather = [&](const double* a) {
+        return _mm512_setr_pd(a[idx[0]], a[idx[1]], a[idx[2]], a[idx[3]], a[idx[4]], a[idx[5]],
+                              a[idx[6]], a[idx[7]]);
+      };
+#elif defined(__AVX__)
       auto gather = [&](const double* a) {
         return _mm256_setr_pd(a[idx[0]], a[idx[1]], a[idx[2]], a[idx[3]]);
       };
@@ -315,18 +402,20 @@ void AdvanceCohorts(const BatchParams& p, const BatchCohorts& c, int n, double s
 #else
       auto gather = [&](const double* a) { return Vd{a[idx[0]], a[idx[1]]}; };
 #endif
-      Lanes L;
-      L.heat = gather(heat);
-      L.xi0 = gather(xi);
-      L.tth = gather(tth);
-      L.hs = gather(hs);
-      L.cs = gather(cs);
-      L.pn = Sel(L.heat, k.pn_h, k.pn_c);
-      L.scale = Sel(L.heat, L.hs, L.cs);
-      L.t0 = Sel(L.heat, k.As, k.Mf);
-      L.t1 = Sel(L.heat, k.Af, k.Ms);
-      L.rate = Sel(L.heat, k.heat_rate, k.cool_rate);
-      Vd x = Newton(k, L, gather(g0), gather(dg0));
+      L->heat = ToMask(gather(heat));
+      L->xi0 = gather(xi);
+      L->tth = gather(tth);
+      L->hs = gather(hs);
+      L->cs = gather(cs);
+      L->pn = Sel(L->heat, k.pn_h, k.pn_c);
+      L->scale = Sel(L->heat, L->hs, L->cs);
+      L->t0 = Sel(L->heat, k.As, k.Mf);
+      L->t1 = Sel(L->heat, k.Af, k.Ms);
+      L->rate = Sel(L->heat, k.heat_rate, k.cool_rate);
+      *g = gather(g0);
+      *dg = gather(dg0);
+    };
+    auto finish = [&](const int* idx, const Lanes& L, Vd x) __attribute__((always_inline)) {
       // T_eff at the solution; the opposite branch's scale restarts there (proportional rule).
       const Vd t_eff = (L.tth + k.latent * (x - L.xi0)) - L.pn * TensionOnly(k, x);
       Vd unused;
@@ -337,7 +426,7 @@ void AdvanceCohorts(const BatchParams& p, const BatchCohorts& c, int n, double s
       Vd cl = Sel(L.heat, Sel(Lt(other, 1.0), ratio, Splat(1)), L.cs);
       Vd h = Sel(L.heat, L.hs, Sel(Gt(other, 0.0), ratio, Splat(1)));
       Canonical(&x, &h, &cl);
-      alignas(32) double out[5][kLanes];
+      alignas(64) double out[5][kLanes];
       Store(out[0], L.tth + k.latent * (x - L.xi0));
       Store(out[1], x);
       Store(out[2], t_eff);
@@ -351,10 +440,28 @@ void AdvanceCohorts(const BatchParams& p, const BatchCohorts& c, int n, double s
         hs[i] = out[3][l];
         cs[i] = out[4][l];
       }
+    };
+    int b = 0;
+    for (; b + kLanes < n_solve; b += 2 * kLanes) {
+      Lanes La, Lb;
+      Vd ga, dga, gb, dgb, xa, xb;
+      prepare(solve + b, &La, &ga, &dga);
+      prepare(solve + b + kLanes, &Lb, &gb, &dgb);
+      Newton2(k, La, Lb, ga, dga, gb, dgb, &xa, &xb);
+      finish(solve + b, La, xa);
+      finish(solve + b + kLanes, Lb, xb);
+    }
+    if (b < n_solve) {
+      Lanes L;
+      Vd g, dg;
+      prepare(solve + b, &L, &g, &dg);
+      finish(solve + b, L, Newton(k, L, g, dg));
     }
   }
 }
 
+// The sums keep four partial sums (lane j mod 4), so the 8-lane clone has none of them.
+#ifndef RECRUIT_SMA_LANES8
 double SumTension(const BatchParams& p, const double* count, const double* xi, int n,
                   double stretch) {
   // Four partial sums (cohort j mod 4; one register with AVX, two with SSE2), added as
@@ -385,6 +492,63 @@ double SumTension(const BatchParams& p, const double* count, const double* xi, i
 }
 
 namespace {
+
+// max(a, b) lane by lane for values that are never NaN (tensions: >= +0), where the order of
+// the comparisons cannot change the result.
+inline Vd MaxOf(Vd a, Vd b) { return Sel(Gt(a, b), a, b); }
+
+// Observe with or without the largest tension (the sensor needs only the sums).
+template <bool kPeak>
+void ObservePass(const BatchParams& p, const double* count, const double* const* v, int n,
+                 double stretch, double* out) {
+  constexpr int kRegs = 4 / kLanes;
+  const Consts k = MakeConsts(p, stretch);
+  Vd acc[4][kRegs], peak[kRegs];
+  for (int r = 0; r < kRegs; ++r) {
+    for (int f = 0; f < 4; ++f) acc[f][r] = Splat(0);
+    peak[r] = Splat(0);
+  }
+  int j = 0;
+  for (; j + 4 <= n; j += 4) {
+    for (int r = 0; r < kRegs; ++r) {
+      const int i = j + r * kLanes;
+      const Vd c = Load(count + i), x = Load(v[2] + i), t = TensionOnly(k, x);
+      acc[0][r] += c * Load(v[0] + i);
+      acc[1][r] += c * Load(v[1] + i);
+      acc[2][r] += c * x;
+      acc[3][r] += c * t;
+      if (kPeak) peak[r] = MaxOf(t, peak[r]);
+    }
+  }
+  alignas(32) double a[4][4], top[4];
+  for (int r = 0; r < kRegs; ++r) {
+    for (int f = 0; f < 4; ++f) Store(a[f] + r * kLanes, acc[f][r]);
+    Store(top + r * kLanes, peak[r]);
+  }
+  // The last n - j < 4 cohorts: the sums one by one (as Sums), the tension from masked loads
+  // (as SumTension: missing lanes add count 0 times a tension, +0).
+  for (int f = 0; f < 3; ++f) {
+    for (int l = 0; j + l < n; ++l) a[f][l] += count[j + l] * v[f][j + l];
+  }
+  double top_tail = 0;
+  for (int r = 0; r < kRegs && j + r * kLanes < n; ++r) {
+    const int i = j + r * kLanes, rest = n - i;
+    const Vd cnt = rest >= kLanes ? Load(count + i) : LoadN(count + i, rest);
+    const Vd x = rest >= kLanes ? Load(v[2] + i) : LoadN(v[2] + i, rest);
+    const Vd t = TensionOnly(k, x);
+    alignas(32) double f[kLanes], tl[kLanes];
+    Store(f, cnt * t);
+    Store(tl, t);
+    for (int l = 0; l < kLanes; ++l) a[3][r * kLanes + l] += f[l];
+    for (int l = 0; l < kLanes && l < rest; ++l) top_tail = tl[l] > top_tail ? tl[l] : top_tail;
+  }
+  for (int f = 0; f < 4; ++f) out[f] = (a[f][0] + a[f][1]) + (a[f][2] + a[f][3]);
+  if (kPeak) {
+    double m = top_tail;
+    for (int l = 0; l < 4 && l < n; ++l) m = top[l] > m ? top[l] : m;
+    out[4] = m;
+  }
+}
 
 // WeightedSums for NF fields (unrolled).
 template <int NF>
@@ -417,6 +581,57 @@ void WeightedSums(const double* count, const double* const* v, int nf, int n, do
   for (int f = 0; f < nf; ++f) Sums<1>(count, v + f, n, out + f);
 }
 
+void Observe(const BatchParams& p, const double* count, const double* const* v, int n,
+             double stretch, bool peak, double* out) {
+  if (peak) return ObservePass<true>(p, count, v, n, stretch, out);
+  ObservePass<false>(p, count, v, n, stretch, out);
+}
+
+#endif  // RECRUIT_SMA_LANES8
+
+// The merge order has no sums: every clone has it (the 8-lane one counts eight ranks at once).
+bool MergeOrder(const double* on, const double* temp, int n, int* order, double* t, int* idx) {
+  // Off cohorts' temperatures in t[0..n0), on cohorts' in t[s1..s1 + n1) (s1 = n + kLanes),
+  // each followed by kLanes of +inf (read, never used), with their indices in idx, written
+  // without branches on the data; on values other than 0 and 1, and NaN temperatures, give up.
+  // Scratch: 2 (n + kLanes) each.
+  const int s1 = n + kLanes;
+  int n0 = 0, n1 = 0;
+  bool bad = false;
+  for (int j = 0; j < n; ++j) {
+    const bool is_off = on[j] == 0, is_on = on[j] == 1;
+    bad |= !(is_off || is_on) || !(temp[j] == temp[j]);
+    t[n0] = temp[j], idx[n0] = j, n0 += is_off;
+    t[s1 + n1] = temp[j], idx[s1 + n1] = j, n1 += is_on;
+  }
+  if (bad) return false;
+  for (int l = 0; l < kLanes; ++l) t[n0 + l] = t[s1 + n1 + l] = HUGE_VAL;
+  for (int j = 0; j < n; ++j) order[j] = -1;
+  // Position = the group's start + how many of its temperatures are lower, counted for kLanes
+  // cohorts at once (the lanes past the group are not used); two cohorts with the same
+  // position tie.
+  const Vd one = Splat(1.0);
+  for (int g = 0; g < 2; ++g) {
+    const double* tg = t + g * s1;
+    const int* ig = idx + g * s1;
+    const int ng = g == 0 ? n0 : n1, start = g == 0 ? 0 : n0;
+    for (int b = 0; b < ng; b += kLanes) {
+      const Vd x = Load(tg + b);
+      Vd c = Splat(0);
+      for (int j = 0; j < ng; ++j) c += And(one, Lt(Splat(tg[j]), x));
+      alignas(64) double rank[kLanes];
+      Store(rank, c);
+      for (int l = 0; l < kLanes && b + l < ng; ++l) {
+        const int pos = start + static_cast<int>(rank[l]);
+        bad |= order[pos] >= 0;
+        order[pos] = ig[b + l];
+      }
+    }
+  }
+  return !bad;
+}
+
+#ifndef RECRUIT_SMA_LANES8
 void Relabel(double* idx, int n, const int* remap) {
   int i = 0;
 #if defined(__AVX2__)
@@ -427,6 +642,7 @@ void Relabel(double* idx, int n, const int* remap) {
 #endif
   for (; i < n; ++i) idx[i] = remap[static_cast<int>(idx[i])];
 }
+#endif  // RECRUIT_SMA_LANES8
 
 #pragma GCC diagnostic pop
 

@@ -363,27 +363,37 @@ void AdvanceUnitWithDecay(const UnitModel& m, UnitState& s, bool on, double stre
 
 namespace {
 
-bool UseAvx2(UnitModel::Isa isa) {
+// The CPU's features, read once when the library loads: a function-local static would test its
+// guard at every dispatch of a kernel (twice per step). Before initialisation (another library's
+// static constructors) both read false, which selects the build's own kernels: same results.
+struct CpuFeatures {
+  bool avx2 = false, avx512 = false;
+  CpuFeatures() {
 #ifdef RECRUIT_SMA_AVX2_CLONE
-  if (isa == UnitModel::Isa::kBase) return false;
-  return UnitModel::HasAvx2();
-#else
-  return false;
+    __builtin_cpu_init();
+    avx2 = __builtin_cpu_supports("avx2");
+#ifdef RECRUIT_SMA_AVX512_CLONE
+    avx512 = avx2 && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq");
 #endif
+#endif
+  }
+};
+const CpuFeatures cpu;
+
+bool UseAvx2(UnitModel::Isa isa) { return isa != UnitModel::Isa::kBase && cpu.avx2; }
+
+// The 8-lane update: asked for, or kAuto on a CPU that has it.
+bool UseAvx512(UnitModel::Isa isa) {
+  return (isa == UnitModel::Isa::kAuto || isa == UnitModel::Isa::kAvx512) && cpu.avx512;
 }
 
 }  // namespace
 
-bool UnitModel::HasAvx2() {
-#ifdef RECRUIT_SMA_AVX2_CLONE
-  static const bool has = __builtin_cpu_supports("avx2");
-  return has;
-#else
-  return false;
-#endif
-}
+bool UnitModel::HasAvx2() { return cpu.avx2; }
+bool UnitModel::HasAvx512() { return cpu.avx512; }
 
 int UnitModel::Lanes(Isa isa) {
+  if (UseAvx512(isa)) return 8;
   if (UseAvx2(isa)) return 4;
 #ifdef __AVX__
   return 4;
@@ -403,6 +413,9 @@ void UnitModel::AdvanceCohorts(const Cohorts& c, int n, double stretch, double d
   }
   const BatchParams& bp = batch_;
   const BatchCohorts bc{c.on, c.temperature, c.xi, c.t_eff, c.heat_scale, c.cool_scale};
+#ifdef RECRUIT_SMA_AVX512_CLONE
+  if (UseAvx512(isa)) return batch_avx512::AdvanceCohorts(bp, bc, n, stretch, decay);
+#endif
 #ifdef RECRUIT_SMA_AVX2_CLONE
   if (UseAvx2(isa)) return batch_avx2::AdvanceCohorts(bp, bc, n, stretch, decay);
 #endif
@@ -437,6 +450,38 @@ void UnitModel::WeightedSums(const double* count, const double* const* v, int nf
   if (UseAvx2(Isa::kAuto)) return batch_avx2::WeightedSums(count, v, nf, n, out);
 #endif
   batch_base::WeightedSums(count, v, nf, n, out);
+}
+
+void UnitModel::Observe(const double* count, const double* const* v, int n, double stretch,
+                        bool peak, double* out, Isa isa) const {
+  if (n < 4 && isa == Isa::kAuto) {  // WeightedSums' and SumTension's paths for few cohorts
+    double a[4][4] = {}, top = 0;
+    for (int j = 0; j < n; ++j) {
+      const double t = Tension(v[2][j], stretch);
+      for (int f = 0; f < 3; ++f) a[f][j] += count[j] * v[f][j];
+      a[3][j] += count[j] * t;
+      top = std::max(top, t);
+    }
+    for (int f = 0; f < 4; ++f) out[f] = (a[f][0] + a[f][1]) + (a[f][2] + a[f][3]);
+    if (peak) out[4] = top;
+    return;
+  }
+  const BatchParams& bp = batch_;
+#ifdef RECRUIT_SMA_AVX2_CLONE
+  if (UseAvx2(isa)) return batch_avx2::Observe(bp, count, v, n, stretch, peak, out);
+#endif
+  batch_base::Observe(bp, count, v, n, stretch, peak, out);
+}
+
+bool UnitModel::MergeOrder(const double* on, const double* temp, int n, int* order, double* t,
+                           int* idx, Isa isa) {
+#ifdef RECRUIT_SMA_AVX512_CLONE
+  if (UseAvx512(isa)) return batch_avx512::MergeOrder(on, temp, n, order, t, idx);
+#endif
+#ifdef RECRUIT_SMA_AVX2_CLONE
+  if (UseAvx2(isa)) return batch_avx2::MergeOrder(on, temp, n, order, t, idx);
+#endif
+  return batch_base::MergeOrder(on, temp, n, order, t, idx);
 }
 
 void UnitModel::Relabel(double* idx, int n, const int* remap) {

@@ -135,9 +135,10 @@ class UnitModel {
     double* heat_scale;
     double* cool_scale;
   };
-  // Kernel: kAuto = AVX2 when this build has the AVX2 clone and the CPU runs it, else the
-  // build's own instruction set (kBase). Tests run both.
-  enum class Isa { kAuto, kBase, kAvx2 };
+  // Kernel: kAuto = AVX-512 (8 lanes) for the update and AVX2 for the sums when this build has
+  // those clones and the CPU runs them, else AVX2, else the build's own instruction set (kBase).
+  // kAvx512 uses AVX2 for the sums. Tests run each.
+  enum class Isa { kAuto, kBase, kAvx2, kAvx512 };
   void AdvanceCohorts(const Cohorts& c, int n, double stretch, double decay,
                       Isa isa = Isa::kAuto) const;
   // Sum over n cohorts of count[j] * Tension(xi[j], stretch), in SIMD lanes.
@@ -146,10 +147,22 @@ class UnitModel {
   // Sets out[f] = sum over j < n of count[j] * v[f][j] for f < nf <= 3, in four partial sums
   // (s0 + s1) + (s2 + s3) of cohorts j mod 4: exact for one cohort.
   static void WeightedSums(const double* count, const double* const* v, int nf, int n, double* out);
+  // WeightedSums of v[0..2] (on, temperature, xi) and SumTension of xi = v[2] in one pass, each
+  // bit for bit the value those give, in out[0..3]; with `peak` also out[4] = the largest
+  // Tension(xi[j], stretch) over the cohorts (0 for none).
+  void Observe(const double* count, const double* const* v, int n, double stretch, bool peak,
+               double* out, Isa isa = Isa::kAuto) const;
+  // The cohorts' order by (on, temperature) for the merge pass, without branches on the data:
+  // when no two keys tie (and on is 0 or 1, no temperature NaN) that order is unique, so it is
+  // std::sort's; order[p] = the cohort at position p. False (order unspecified) otherwise: the
+  // caller sorts. Scratch: t and idx 2 (n + 8) entries each.
+  static bool MergeOrder(const double* on, const double* temp, int n, int* order, double* t,
+                         int* idx, Isa isa = Isa::kAuto);
   // idx[i] = remap[idx[i]] for i < n (cohort indices of units, held as doubles).
   static void Relabel(double* idx, int n, const int* remap);
   // Whether kAvx2 is available (built and supported by the CPU); the lanes kAuto uses.
   static bool HasAvx2();
+  static bool HasAvx512();  // the AVX-512 update (F and DQ): built and supported
   static int Lanes(Isa isa = Isa::kAuto);
 
   // Natural convection (Morgan's horizontal-cylinder correlation, air at the film temperature)

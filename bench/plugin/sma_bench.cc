@@ -9,6 +9,7 @@
 #include <time.h>
 
 #include <cstdio>
+#include <cstdlib>
 #include <string>
 
 #include "plugin/sma_host.h"
@@ -24,10 +25,18 @@ mjModel* Load(const std::string& path) {
   return m;
 }
 
+// The models' folder: RECRUIT_BENCH_MODELS when set (e.g. another checkout's models/, to
+// measure this plugin on its benches), else this source tree's models/.
+std::string ModelPath(const char* file) {
+  const char* dir = std::getenv("RECRUIT_BENCH_MODELS");
+  return std::string(dir != nullptr && dir[0] != '\0' ? dir : RECRUIT_SOURCE_DIR "/models") + "/" +
+         file;
+}
+
 std::string BenchWithUnits(int units, int update_ms) {
   char buf[256];
   std::snprintf(buf, sizeof buf, "/tmp/recruit_sma_bench_%d_%d.xml", units, update_ms);
-  std::FILE* in = std::fopen(RECRUIT_SOURCE_DIR "/models/isometric_bench.xml", "r");
+  std::FILE* in = std::fopen(ModelPath("isometric_bench.xml").c_str(), "r");
   std::string xml;
   char chunk[4096];
   size_t n;
@@ -59,7 +68,7 @@ void Control(const SmaHost& p, mjData* d, Regime regime, long i) {
 }
 
 void BM_MuscleBaseline(benchmark::State& state) {
-  mjModel* m = Load(RECRUIT_SOURCE_DIR "/models/isometric_bench_muscle.xml");
+  mjModel* m = Load(ModelPath("isometric_bench_muscle.xml"));
   mjData* d = mj_makeData(m);
   d->ctrl[0] = 1;
   for (auto _ : state) mj_step(m, d);
@@ -121,7 +130,7 @@ double ThreadCpuSeconds() {
 void BM_SmaOverMuscle(benchmark::State& state) {
   const auto regime = static_cast<Regime>(state.range(0));
   const int update_ms = static_cast<int>(state.range(1));
-  mjModel* mm = Load(RECRUIT_SOURCE_DIR "/models/isometric_bench_muscle.xml");
+  mjModel* mm = Load(ModelPath("isometric_bench_muscle.xml"));
   mjModel* ms = Load(BenchWithUnits(60, update_ms));
   auto p = SmaHost::Create(ms);
   mjData* dm = mj_makeData(mm);

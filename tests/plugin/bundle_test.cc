@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <string>
 #include <vector>
 
@@ -393,6 +394,98 @@ TEST(SmaBundle, RandomSwitchingTraceUnchangedFromScalarImplementation) {
     ++k;
   }
   EXPECT_EQ(k, 11);
+}
+
+bool SameBits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+// Observe and Summarize (one pass) give what the separate reads give, bit for bit, along a
+// random-switching run with merges, at a taut and a slack extension.
+TEST(SmaBundle, ObserveAndSummarizeEqualTheSeparateReads) {
+  const SmaBundle b = MakeBundle(60, 0.5, 0.01);
+  const double e = b.config().unit.prestretch;
+  std::vector<double> s(b.state_size());
+  b.Reset(s.data(), 3, e);
+  int checks = 0;
+  for (int i = 0; i < 6000; ++i) {
+    if (i % 300 == 0) {
+      ASSERT_TRUE(b.Broadcast(s.data(), 0.2, 0.1, e).ok());
+    }
+    b.Advance(s.data(), e, 1e-3);
+    if (i % 37 != 0) continue;
+    for (double stretch : {e, 0.8 * e, -e}) {
+      const double* st = s.data();
+      const SmaBundle::Telemetry t = b.Observe(st, stretch);
+      EXPECT_EQ(t.on_count, b.OnCount(st));
+      EXPECT_TRUE(SameBits(t.tension, b.Tension(st, stretch))) << "step " << i;
+      EXPECT_TRUE(SameBits(t.mean_temperature, b.MeanTemperature(st))) << "step " << i;
+      EXPECT_TRUE(SameBits(t.mean_xi, b.MeanXi(st))) << "step " << i;
+      EXPECT_TRUE(SameBits(t.max_temperature, b.MaxTemperature(st))) << "step " << i;
+      EXPECT_TRUE(SameBits(t.max_wire_stress, b.MaxWireStress(st, stretch))) << "step " << i;
+      // and against the per-unit debug interface: the scalar maxima over units
+      double top_f = 0, top_t = b.UnitTemperature(st, 0);
+      for (int u = 0; u < b.num_units(); ++u) {
+        top_f = std::max(top_f, b.unit().Tension(b.UnitXi(st, u), stretch));
+        top_t = std::max(top_t, b.UnitTemperature(st, u));
+      }
+      EXPECT_TRUE(SameBits(t.max_wire_stress, b.unit().WireStress(top_f))) << "step " << i;
+      EXPECT_TRUE(SameBits(t.max_temperature, top_t)) << "step " << i;
+      const SmaBundle::Summary sum = b.Summarize(st, stretch);
+      EXPECT_EQ(sum.on_count, t.on_count);
+      EXPECT_TRUE(SameBits(sum.tension, t.tension));
+      EXPECT_TRUE(SameBits(sum.mean_temperature, t.mean_temperature));
+      EXPECT_TRUE(SameBits(sum.mean_xi, t.mean_xi));
+      ++checks;
+    }
+  }
+  EXPECT_GT(checks, 400);
+}
+
+// The tension the sensor keeps (SummarizeAndKeep) is what TakeTension returns at that extension
+// and only there, is taken once (the block is then as before), and never outlives a change of
+// the units (Broadcast, Advance, Reset).
+TEST(SmaBundle, KeptTensionIsTakenOnceAtItsExtensionAndDroppedWhenUnitsChange) {
+  const SmaBundle b = MakeBundle(60, 0.5, 0.01);
+  const double e = b.config().unit.prestretch;
+  std::vector<double> s(b.state_size());
+  b.Reset(s.data(), 9, e);
+  ASSERT_TRUE(b.Broadcast(s.data(), 0.5, 0, e).ok());
+  for (int i = 0; i < 1500; ++i) b.Advance(s.data(), e, 1e-3);
+  ASSERT_GT(b.Tension(s.data(), e), 0);
+  auto same_block = [](const std::vector<double>& a, const std::vector<double>& c) {
+    return std::memcmp(a.data(), c.data(), a.size() * sizeof(double)) == 0;
+  };
+  // Kept, then taken at the same extension: the same value; the block as before keeping.
+  const std::vector<double> before = s;
+  const SmaBundle::Summary sum = b.SummarizeAndKeep(s.data(), e);
+  EXPECT_TRUE(SameBits(sum.tension, b.Tension(s.data(), e)));
+  EXPECT_TRUE(SameBits(b.TakeTension(s.data(), e), b.Tension(s.data(), e)));
+  EXPECT_TRUE(same_block(s, before));
+  // Taken at another extension: that extension's tension, and nothing stays kept.
+  b.SummarizeAndKeep(s.data(), e);
+  EXPECT_TRUE(SameBits(b.TakeTension(s.data(), 0.9 * e), b.Tension(s.data(), 0.9 * e)));
+  EXPECT_TRUE(same_block(s, before));
+  // Nothing kept: computed.
+  EXPECT_TRUE(SameBits(b.TakeTension(s.data(), e), b.Tension(s.data(), e)));
+  // The units change after keeping: the block is that of the same change without keeping (so
+  // nothing stays kept), and TakeTension gives the new tension.
+  auto changed = [&](const char* what, auto change) {
+    std::vector<double> plain = s;
+    b.SummarizeAndKeep(s.data(), e);
+    change(s.data());
+    change(plain.data());
+    EXPECT_TRUE(same_block(s, plain)) << what;
+    EXPECT_TRUE(SameBits(b.TakeTension(s.data(), e), b.Tension(plain.data(), e))) << what;
+  };
+  changed("advance", [&](double* st) { b.Advance(st, e, 1e-3); });
+  changed("broadcast", [&](double* st) { ASSERT_TRUE(b.Broadcast(st, 0, 1, e).ok()); });
+  changed("reset", [&](double* st) { b.Reset(st, 9, e); });
+  // and the advance moved the tension (the kept value would have been wrong)
+  const double kept = b.Tension(s.data(), e);
+  b.SummarizeAndKeep(s.data(), e);
+  ASSERT_TRUE(b.Broadcast(s.data(), 1, 0, e).ok());
+  for (int i = 0; i < 1500; ++i) b.Advance(s.data(), e, 1e-3);
+  EXPECT_GT(b.TakeTension(s.data(), e), kept + 1);
+  EXPECT_TRUE(SameBits(b.TakeTension(s.data(), e), b.Tension(s.data(), e)));
 }
 
 TEST(SmaBundle, RejectsProbabilitiesOutsideUnitInterval) {

@@ -2,9 +2,10 @@
 // the scalar per-cohort update it replaces in the bundle (AdvanceUnitWithDecay, kept as the
 // reference): bit-identical results, cohort by cohort, for random states and along trajectories
 // with random switching, across unit models and cohort counts that leave partial SIMD batches and
-// span several 64-cohort chunks; for the build's own kernel and the AVX2 clone.
+// span several 64-cohort chunks; for the build's own kernel and the AVX2 and AVX-512 clones.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstring>
 #include <string>
 #include <tuple>
@@ -78,6 +79,9 @@ class BatchedCohorts : public ::testing::TestWithParam<std::tuple<std::string, U
     if (isa() == UnitModel::Isa::kAvx2 && !UnitModel::HasAvx2()) {
       GTEST_SKIP() << "no AVX2 kernel in this build or CPU";
     }
+    if (isa() == UnitModel::Isa::kAvx512 && !UnitModel::HasAvx512()) {
+      GTEST_SKIP() << "no AVX-512 kernel in this build or CPU";
+    }
   }
   const std::string& config() const { return std::get<0>(GetParam()); }
   UnitModel::Isa isa() const { return std::get<1>(GetParam()); }
@@ -148,7 +152,8 @@ INSTANTIATE_TEST_SUITE_P(
                                          "series_spring=0",           // rigid: no series spring
                                          "law=spring current=0.235",  // coiled spring
                                          "parallel=2 series=3", "latent_heat=0"),
-                       ::testing::Values(UnitModel::Isa::kBase, UnitModel::Isa::kAvx2)));
+                       ::testing::Values(UnitModel::Isa::kBase, UnitModel::Isa::kAvx2,
+                                         UnitModel::Isa::kAvx512)));
 
 // The tension sum over cohorts against the scalar sum of count * Tension: the same to rounding
 // of the summation order (four partial sums), exactly for one cohort.
@@ -176,6 +181,104 @@ TEST(BatchedCohortSums, SumTensionMatchesScalarSum) {
       }
     }
   }
+}
+
+// Observe (the sensor's and the run loop's one pass) against the separate kernels it fuses:
+// WeightedSums of (on, T, xi) and SumTension bit for bit, and the largest tension against a
+// plain scalar maximum of UnitModel::Tension; every cohort count around the SIMD widths, slack
+// and taut extensions, each kernel.
+TEST(BatchedCohortSums, ObserveEqualsTheSeparateSumsAndTheScalarMaximum) {
+  const UnitModel m = MakeModel("");
+  std::vector<UnitModel::Isa> isas = {UnitModel::Isa::kAuto, UnitModel::Isa::kBase};
+  if (UnitModel::HasAvx2()) isas.push_back(UnitModel::Isa::kAvx2);
+  Rng rng(11);
+  for (int n : {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 33, 300}) {
+    std::vector<double> count(n), on(n), temperature(n), xi(n);
+    for (int j = 0; j < n; ++j) {
+      count[j] = 1 + static_cast<int>(10 * rng.Uniform());
+      on[j] = rng.Uniform() < 0.5 ? 1 : 0;
+      temperature[j] = 20 + 100 * rng.Uniform();
+      xi[j] = rng.Uniform() < 0.3 ? 1 : rng.Uniform();
+    }
+    const double* v[3] = {on.data(), temperature.data(), xi.data()};
+    double sums[3];
+    UnitModel::WeightedSums(count.data(), v, 3, n, sums);
+    for (double stretch : {0.0, 1e-3, 4e-3, 6e-3}) {
+      double top = 0;
+      for (int j = 0; j < n; ++j) top = std::max(top, m.Tension(xi[j], stretch));
+      for (UnitModel::Isa isa : isas) {
+        const double tension = m.SumTension(count.data(), xi.data(), n, stretch, isa);
+        for (bool peak : {false, true}) {
+          double out[5] = {-1, -1, -1, -1, -1};
+          m.Observe(count.data(), v, n, stretch, peak, out, isa);
+          const std::string where = "n " + std::to_string(n) + " stretch " +
+                                    std::to_string(stretch) + " isa " +
+                                    std::to_string(static_cast<int>(isa));
+          for (int f = 0; f < 3; ++f) EXPECT_TRUE(SameBits(out[f], sums[f])) << where << " f " << f;
+          EXPECT_TRUE(SameBits(out[3], tension)) << where << ": " << out[3] << " vs " << tension;
+          if (peak) {
+            EXPECT_TRUE(SameBits(out[4], top)) << where << ": " << out[4] << " vs " << top;
+          } else {
+            EXPECT_EQ(out[4], -1) << where;  // not written
+          }
+        }
+      }
+    }
+  }
+}
+
+// The merge pass's order without a sort (MergeOrder) against std::sort with the merge's
+// comparator: the same permutation whenever it answers; it answers for distinct keys and gives
+// up on ties (equal temperatures, +0 and -0), NaN and on values other than 0 and 1, where the
+// merge sorts as before. Each kernel, cohort counts around the SIMD widths.
+TEST(MergeOrder, IsStdSortsOrderForDistinctKeysAndGivesUpOnTies) {
+  std::vector<UnitModel::Isa> isas = {UnitModel::Isa::kAuto, UnitModel::Isa::kBase};
+  if (UnitModel::HasAvx2()) isas.push_back(UnitModel::Isa::kAvx2);
+  if (UnitModel::HasAvx512()) isas.push_back(UnitModel::Isa::kAvx512);
+  Rng rng(5);
+  auto sorted = [](const std::vector<double>& on, const std::vector<double>& t) {
+    std::vector<int> idx(on.size());
+    for (size_t j = 0; j < idx.size(); ++j) idx[j] = static_cast<int>(j);
+    std::sort(idx.begin(), idx.end(), [&](int a, int b) {
+      if (on[a] != on[b]) return on[a] < on[b];
+      return t[a] < t[b];
+    });
+    return idx;
+  };
+  int answered = 0, gave_up = 0;
+  for (int n = 1; n <= 64; ++n) {
+    for (int trial = 0; trial < 20; ++trial) {
+      std::vector<double> on(n), t(n);
+      for (int j = 0; j < n; ++j) {
+        on[j] = rng.Uniform() < 0.5 ? 1 : 0;
+        t[j] = 20 + 100 * rng.Uniform();
+      }
+      const int kind = trial % 5;  // 0, 1: distinct; 2: a tie; 3: NaN; 4: on = 0.5
+      const int a = static_cast<int>(n * rng.Uniform()), b = (a + 1) % n;
+      if (kind == 2 && n > 1) on[b] = on[a], t[b] = t[a];
+      if (kind == 2 && n > 1 && trial % 10 == 7) t[a] = 0.0, t[b] = -0.0;  // +0 and -0 tie
+      if (kind == 3) t[a] = std::nan("");
+      if (kind == 4) on[a] = 0.5;
+      const bool tie = kind == 2 && n > 1;
+      const bool distinct = kind < 2 || (kind == 2 && n == 1);
+      const std::vector<int> want = sorted(on, t);
+      for (UnitModel::Isa isa : isas) {
+        std::vector<int> order(n, -7), idx(2 * n + 16);
+        std::vector<double> scratch(2 * n + 16);
+        const bool ok = UnitModel::MergeOrder(on.data(), t.data(), n, order.data(), scratch.data(),
+                                              idx.data(), isa);
+        if (distinct) {
+          EXPECT_TRUE(ok) << "n " << n << " trial " << trial;
+          EXPECT_EQ(order, want) << "n " << n << " trial " << trial;
+        } else if (tie || kind == 3 || kind == 4) {
+          EXPECT_FALSE(ok) << "n " << n << " trial " << trial << " kind " << kind;
+        }
+        (ok ? answered : gave_up) += 1;
+      }
+    }
+  }
+  EXPECT_GT(answered, 1000);
+  EXPECT_GT(gave_up, 1000);
 }
 
 }  // namespace

@@ -31,8 +31,9 @@ using testing::ModelPtr;
 using testing::PluginState;
 using testing::SameBits;
 
-constexpr int kSlots = 2;   // per actuator before the bundle's block (plugin/README.md)
-constexpr int kHeader = 8;  // SmaBundle header: magic, 4 RNG words, cohorts, counter, pending
+constexpr int kSlots = 2;  // per actuator before the bundle's block (plugin/README.md)
+// SmaBundle header: magic, 4 RNG words, cohorts, counter, pending, kept tension (3), reserved
+constexpr int kHeader = 12;
 
 ModelPtr MustLoad(const std::string& xml) {
   auto m = Load(xml);

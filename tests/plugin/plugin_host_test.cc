@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <iterator>
 #include <string>
 #include <vector>
@@ -67,6 +68,57 @@ TEST(PluginSensor, ReportsWhatTheHostApiReads) {
   }
   EXPECT_GT(checks, 50);
   EXPECT_GT(max_on, 0);
+}
+
+// The sensor keeps its tension for the actuator's force in the same mj_forward (issue 15): the
+// dynamics are those of a run whose sensors are disabled (the force then always summed afresh),
+// bit for bit, under Euler and RK4 (whose later stages compute the force without the sensor);
+// a full mj_forward leaves plugin_state as it was; the actuator force is minus Force.
+TEST(PluginSensor, KeptTensionChangesNothingWithOrWithoutSensorsUnderEulerAndRk4) {
+  testing::WarningCapture fit_warnings;  // elbow_arm.xml's units do not fit its tendons
+  auto m = LoadModel(RECRUIT_SOURCE_DIR "/models/elbow_arm.xml");
+  ASSERT_TRUE(m.ok()) << m.error();
+  mjModel* mm = m->get();
+  auto host = SmaHost::Create(mm);
+  ASSERT_TRUE(host.ok()) << host.error();
+  const SmaHost& h = **host;
+  DataPtr with(mj_makeData(mm)), without(mj_makeData(mm));
+  h.Reset(with.get(), 8);
+  h.Reset(without.get(), 8);
+  auto same = [](const double* a, const double* b, int n) {
+    return std::memcmp(a, b, n * sizeof(double)) == 0;
+  };
+  Rng rng(4);
+  const int flags = mm->opt.disableflags;
+  int checks = 0;
+  for (int step = 0; step < 4000; ++step) {
+    mm->opt.integrator = step < 2000 ? mjINT_EULER : mjINT_RK4;
+    if (step % 50 == 0) {
+      const double p_on = 0.3 * rng.Uniform(), p_off = 0.2 * rng.Uniform();
+      for (mjData* d : {with.get(), without.get()}) {
+        for (int b = 0; b < h.num_bundles(); ++b) ASSERT_TRUE(h.Broadcast(d, b, p_on, p_off).ok());
+      }
+    }
+    mm->opt.disableflags = flags;
+    mj_step(mm, with.get());
+    mm->opt.disableflags = flags | mjDSBL_SENSOR;
+    mj_step(mm, without.get());
+    mm->opt.disableflags = flags;
+    ASSERT_TRUE(same(with->qpos, without->qpos, mm->nq)) << "step " << step;
+    ASSERT_TRUE(same(with->qvel, without->qvel, mm->nv)) << "step " << step;
+    ASSERT_TRUE(same(with->plugin_state, without->plugin_state, mm->npluginstate))
+        << "step " << step;
+    if (step % 41 != 0) continue;
+    const std::vector<double> before(with->plugin_state, with->plugin_state + mm->npluginstate);
+    mj_forward(mm, with.get());
+    EXPECT_TRUE(same(before.data(), with->plugin_state, mm->npluginstate)) << "step " << step;
+    for (int b = 0; b < h.num_bundles(); ++b) {
+      EXPECT_EQ(with->actuator_force[h.actuator_id(b)], -h.Force(with.get(), b));
+    }
+    ++checks;
+  }
+  EXPECT_GT(checks, 90);
+  EXPECT_GT(h.OnCount(with.get(), 0) + h.OnCount(with.get(), 1), 0);
 }
 
 // Issue 15: the Fig. 4 trace of `sma_fig4_step models/isometric_bench.xml 12 20` (on at 1 s,
