@@ -90,6 +90,8 @@ Result<std::unique_ptr<Plant>> Plant::Create(const Task& task, bool textures) {
   p->body_mass0_.assign(m->body_mass, m->body_mass + m->nbody);
   p->body_inertia0_.assign(m->body_inertia, m->body_inertia + 3 * m->nbody);
   p->data_.reset(mj_makeData(m));
+  p->observed_.resize(p->bundles_.size());
+  p->ForgetObserved();
   return p;
 }
 
@@ -102,6 +104,7 @@ void Plant::Reset(std::uint64_t seed) {
   ApplyPayloads();
   host_->Reset(data_.get(), seed);
   mj_forward(m, data_.get());
+  ForgetObserved();
   peak_temperature_.assign(bundles_.size(), -std::numeric_limits<double>::infinity());
   peak_stress_.assign(bundles_.size(), 0.0);
   TrackPeaks();
@@ -111,7 +114,16 @@ void Plant::Step() {
   ApplyPayloads();
   ApplyPushes();
   mj_step(model_.get(), data_.get());
+  ForgetObserved();
   TrackPeaks();
+}
+
+const sma::SmaBundle::Telemetry& Plant::Observed(int i) const {
+  if (!observed_valid_[i]) {
+    observed_[i] = host_->Observe(data_.get(), bundles_[i]);
+    observed_valid_[i] = true;
+  }
+  return observed_[i];
 }
 
 void Plant::ApplyPayloads() {
@@ -148,11 +160,9 @@ void Plant::ApplyPushes() {
 
 void Plant::TrackPeaks() {
   for (int i = 0; i < num_bundles(); ++i) {
-    const sma::SmaBundle& bundle = host_->bundle(bundles_[i]);
-    const double* state = host_->State(data_.get(), bundles_[i]);
-    peak_temperature_[i] = std::max(peak_temperature_[i], bundle.MaxTemperature(state));
-    peak_stress_[i] = std::max(
-        peak_stress_[i], bundle.MaxWireStress(state, host_->Stretch(data_.get(), bundles_[i])));
+    const sma::SmaBundle::Telemetry& now = Observed(i);
+    peak_temperature_[i] = std::max(peak_temperature_[i], now.max_temperature);
+    peak_stress_[i] = std::max(peak_stress_[i], now.max_wire_stress);
   }
 }
 

@@ -45,10 +45,12 @@ class Plant {
   int bundle_index(int i) const { return bundles_[i]; }  // in the host
   const std::string& bundle_name(int i) const { return host_->bundle_name(bundles_[i]); }
   int num_units(int i) const { return host_->num_units(bundles_[i]); }
-  double Force(int i) const { return host_->Force(data_.get(), bundles_[i]); }  // exact, N
+  double Force(int i) const { return Observed(i).tension; }  // exact, N
   double TendonLength(int i) const { return data_->ten_length[host_->tendon_id(bundles_[i])]; }
-  int OnCount(int i) const { return host_->OnCount(data_.get(), bundles_[i]); }
+  int OnCount(int i) const { return Observed(i).on_count; }
+  double MeanTemperature(int i) const { return Observed(i).mean_temperature; }  // C
   Status Broadcast(int i, double p_on, double p_off) {
+    observed_valid_[i] = false;  // the units' states change
     return host_->Broadcast(data_.get(), bundles_[i], p_on, p_off);
   }
 
@@ -66,6 +68,11 @@ class Plant {
   void ApplyPayloads();
   void ApplyPushes();
   void TrackPeaks();
+  // Bundle i's units as they are now (force, on count, temperatures, stress): one pass over its
+  // cohorts after each step or broadcast, bit for bit what the separate reads give. A run reads
+  // them several times a step (measurement, telemetry, peaks); the pass is ~1/10 of a step.
+  const sma::SmaBundle::Telemetry& Observed(int i) const;
+  void ForgetObserved() { observed_valid_.assign(bundles_.size(), false); }
 
   const Task* task_ = nullptr;
   ModelPtr model_;
@@ -76,6 +83,8 @@ class Plant {
   std::vector<int> push_body_, payload_body_;
   std::vector<bool> payload_done_;
   std::vector<double> peak_temperature_, peak_stress_;
+  mutable std::vector<sma::SmaBundle::Telemetry> observed_;  // a cache: see Observed
+  mutable std::vector<bool> observed_valid_;
   // Each payload body's mass and inertia as loaded (Reset restores them).
   std::vector<double> body_mass0_, body_inertia0_;
 };

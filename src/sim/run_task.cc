@@ -233,7 +233,7 @@ void FillTelemetry(const Plant& plant, double reference, double measured, double
     bt.force = i == 0 && !std::isnan(force0) ? force0 : plant.Force(i);
     bt.true_on = channels[i].switches.last();
     bt.on_fraction = static_cast<double>(bt.true_on) / plant.num_units(i);
-    bt.mean_temperature = plant.host().MeanTemperature(plant.data(), b);
+    bt.mean_temperature = plant.MeanTemperature(i);
     bt.heat = plant.host().Heat(plant.data(), b);
   }
 }
