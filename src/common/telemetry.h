@@ -19,9 +19,11 @@ struct BundleTelemetry {
   double estimated_on_std = std::numeric_limits<double>::quiet_NaN();
   double on_fraction = 0;       // true_on / num_units
   double mean_temperature = 0;  // deg C over all units
-  double heat = 0;              // 0 at ambient .. 1 at the on-state steady temperature
-  double force_reference = 0;   // N, the force the bundle's recruitment controller tracks
-  double p_on = 0, p_off = 0;   // the bundle's last broadcast
+  // 0 at ambient .. 1 at the on-state steady temperature; computed only for a run with an
+  // observer that draws (StepObserver::Draws: the tendons' colour), else NaN.
+  double heat = std::numeric_limits<double>::quiet_NaN();
+  double force_reference = 0;  // N, the force the bundle's recruitment controller tracks
+  double p_on = 0, p_off = 0;  // the bundle's last broadcast
 };
 
 struct TelemetrySample {

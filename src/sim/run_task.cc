@@ -220,8 +220,9 @@ Status ControlBundle(Channel& ch, Plant& plant, int i, double force_ref, BundleT
 }
 
 // The per-step telemetry observers see. `force0`: bundle 0's force when already computed this
-// step (the measured force of a force task; a sum over the units), else NaN.
-void FillTelemetry(const Plant& plant, double reference, double measured, double force0,
+// step (the measured force of a force task; a sum over the units), else NaN. `heat`: only the
+// drawing observers use it (another pass over the units).
+void FillTelemetry(const Plant& plant, double reference, double measured, double force0, bool heat,
                    const std::vector<Channel>& channels, TelemetrySample& sample) {
   sample.time = plant.time();
   sample.reference = reference;
@@ -234,7 +235,7 @@ void FillTelemetry(const Plant& plant, double reference, double measured, double
     bt.true_on = channels[i].switches.last();
     bt.on_fraction = static_cast<double>(bt.true_on) / plant.num_units(i);
     bt.mean_temperature = plant.MeanTemperature(i);
-    bt.heat = plant.host().Heat(plant.data(), b);
+    if (heat) bt.heat = plant.host().Heat(plant.data(), b);
   }
 }
 
@@ -405,7 +406,7 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
     if (!observers.empty()) {
       FillTelemetry(plant, r, y,
                     task.tracked == Tracked::kForce ? y : std::numeric_limits<double>::quiet_NaN(),
-                    channels, sample);
+                    draws, channels, sample);
       for (StepObserver* o : observers) {
         if (Status st = o->OnStep(plant.model(), plant.data(), sample); !st.ok()) {
           return Error{st.error()};
