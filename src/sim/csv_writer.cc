@@ -33,18 +33,28 @@ Status CsvStepWriter::OnStep(const mjModel*, const mjData*, const TelemetrySampl
   if (count_++ % every_ != 0 && !s.control_instant) return Status::Ok();
   // The row is formatted in place, with room for the longest row (FormatG: "%.9g" etc. byte
   // for byte, without fmt's format-string parsing). Most columns hold between control instants
-  // (references, estimates, broadcasts): a column equal to its last value reuses its text.
+  // (references, estimates, broadcasts): a column equal to its last value reuses its text, and
+  // one equal to the number formatted just before in the row (an angle task's measured value and
+  // angle, a force task's measured value and force) copies that one's.
   Reserve(8 + (4 + 8 * s.bundles.size()) * kFormatGMax);
   cache_.resize(4 + 7 * s.bundles.size());
   char* p = buffer_.data() + used_;
   Column* col = cache_.data();
-  auto num = [&p, &col](double v, int precision) {
+  const Column* last = nullptr;  // the number formatted last in this row
+  int last_precision = 0;
+  auto num = [&p, &col, &last, &last_precision](double v, int precision) {
     Column& c = *col++;
     std::uint64_t bits;
     std::memcpy(&bits, &v, sizeof bits);
     if (c.len == 0 || bits != c.bits) {
-      c.bits = bits;
-      c.len = static_cast<std::uint8_t>(FormatG(v, precision, c.text) - c.text);
+      if (last != nullptr && last->bits == bits && last_precision == precision) {
+        c = *last;
+      } else {
+        c.bits = bits;
+        c.len = static_cast<std::uint8_t>(FormatG(v, precision, c.text) - c.text);
+      }
+      last = &c;
+      last_precision = precision;
     }
     std::memcpy(p, c.text, sizeof c.text);  // fixed size: one move, the end is overwritten
     p += c.len;

@@ -149,6 +149,12 @@ TEST(CsvStepWriter, WritesThePreviousWritersRowsByteForByte) {
         b.p_off = step % 2 ? 0.0 : -0.0;
       }
     }
+    // Equal values in other columns of the row: the writer may copy the text it formatted just
+    // before when the precision is the same, and must not when it differs.
+    if (step % 4 == 1) s.angle = s.measured;
+    if (step % 4 == 2) s.bundles[0].force = s.measured;
+    if (step % 4 == 3) s.bundles[0].mean_temperature = s.bundles[0].force;  // %.6g after %.9g
+    if (step % 8 == 5) s.bundles[1].force = s.bundles[0].mean_temperature;  // %.9g after %.6g
     ASSERT_TRUE(writer.OnStep(nullptr, nullptr, s).ok());
     expected += ReferenceRow(s);
   }
