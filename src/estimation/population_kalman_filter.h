@@ -521,8 +521,8 @@ void PopulationKalmanFilterT<M, R>::PredictRowsWith(const int* ptr, const int* c
   // (P stays exactly symmetric). About m nnz(A) flops.
   double* Bt = M_.data();
   Kernels::Transpose(B, Bt, m);
-  Kernels::UpperProduct(P_.data(), Bt, m, ptr, col, val, qz ? ax : nullptr,
-                        has_process_noise_ ? GQG_.data() : nullptr);
+  Kernels::template UpperProduct<M>(P_.data(), Bt, m, ptr, col, val, qz ? ax : nullptr,
+                                    has_process_noise_ ? GQG_.data() : nullptr);
   Kernels::MirrorUpper(P_.data(), m);
   x_ = tmp_;
   if (++sparse_steps_ >= kSparseReprojectPeriod) {
