@@ -460,17 +460,18 @@ void PopulationKalmanFilterT<M, R>::PredictBroadcast(double p_on, double p_off) 
   // the compressed rows (As_ is filled only when broadcast_matrix() is called).
   last_p_on_ = p_on;
   last_p_off_ = p_off;
-  const size_t nnz = bc_val_.size();
-  const double* __restrict on = bc_on_.data();
-  const double* __restrict off = bc_off_.data();
-  const double* __restrict base = bc_base_.data();
-  const double* __restrict target = bc_target_.data();
-  double* __restrict val = bc_val_.data();
-  for (size_t e = 0; e < nnz; ++e) {
-    const double p = on[e] * p_off + off[e] * p_on;  // exact: one term is 0
-    val[e] = (1.0 - p) * base[e] + target[e] * p;    // target: 1, else 0
+#ifdef RECRUIT_KF_AVX_CLONE
+  if (avx_) {
+    kf_detail::avx::Kernels::FillBroadcast(bc_val_.size(), p_on, p_off, bc_on_.data(),
+                                           bc_off_.data(), bc_base_.data(), bc_target_.data(),
+                                           bc_val_.data());
+    return PredictRowsWith<kf_detail::avx::Kernels>(bc_ptr_.data(), bc_col_.data(), bc_val_.data());
   }
-  PredictRows(bc_ptr_.data(), bc_col_.data(), bc_val_.data());
+#endif
+  kf_detail::base::Kernels::FillBroadcast(bc_val_.size(), p_on, p_off, bc_on_.data(),
+                                          bc_off_.data(), bc_base_.data(), bc_target_.data(),
+                                          bc_val_.data());
+  PredictRowsWith<kf_detail::base::Kernels>(bc_ptr_.data(), bc_col_.data(), bc_val_.data());
 }
 
 template <int M, int R>
