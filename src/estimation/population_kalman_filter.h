@@ -112,9 +112,13 @@ class PopulationKalmanFilterT {
   }
   // Which copy of the sparse step's kernels runs (PredictBroadcast, Predict(SparseMatrix), the
   // r = 1 Update): the portable x86-64 build has a second copy compiled for AVX, chosen at
-  // Create when the CPU has AVX. Both give bit-identical results. set_avx_kernels(false) forces
-  // the baseline copy (tests, benchmarks); true takes effect only where the AVX copy can run.
+  // Create when the CPU has AVX and m >= kAvxMinStates. Both give bit-identical results.
+  // set_avx_kernels(false) forces the baseline copy, true the AVX copy where it can run (tests,
+  // benchmarks).
   bool avx_kernels() const { return avx_; }
+  // Below this many states the AVX copy is not the default: it has little to do 4 lanes wide,
+  // and its calls cost more (m = 2: the controller's step measured 3-6 % slower with it).
+  static constexpr int kAvxMinStates = 8;
   void set_avx_kernels(bool on) { avx_ = on && kf_detail::CpuHasAvx(); }
   // Measurement update with y(t) (eqs. 15, 17, 19, 20 in Joseph form).
   void Update(const OutVec& y);
@@ -321,7 +325,7 @@ Result<PopulationKalmanFilterT<M, R>> PopulationKalmanFilterT<M, R>::Create(
   f.has_process_noise_ = model.G.cols() > 0;
   f.x_ = x0;
   f.P_ = P0;
-  f.avx_ = kf_detail::CpuHasAvx();
+  f.avx_ = kf_detail::CpuHasAvx() && m >= kAvxMinStates;
   f.xq_.resize(m);
   f.ax_.resize(m);
   f.tmp_.resize(m);
