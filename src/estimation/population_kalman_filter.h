@@ -42,7 +42,7 @@
 #include <emmintrin.h>
 #endif
 // The portable x86-64 build carries a second copy of the sparse step's kernels compiled for AVX
-// (sparse_step_kernels.inc), chosen at run time; builds that already target AVX do not.
+// (sparse_step_kernels.h), chosen at run time; builds that already target AVX do not.
 #if defined(__x86_64__) && defined(__SSE2__) && !defined(__AVX__) && defined(__GNUC__)
 #define RECRUIT_KF_AVX_CLONE 1
 #include <immintrin.h>
@@ -251,7 +251,7 @@ namespace base {
 #define RECRUIT_KF_AVX 0
 #define RECRUIT_KF_INLINE EIGEN_ALWAYS_INLINE
 #define RECRUIT_KF_PASS EIGEN_ALWAYS_INLINE
-#include "estimation/sparse_step_kernels.inc"
+#include "estimation/sparse_step_kernels.h"
 #undef RECRUIT_KF_AVX
 #undef RECRUIT_KF_INLINE
 #undef RECRUIT_KF_PASS
@@ -263,7 +263,7 @@ namespace avx {
 #define RECRUIT_KF_AVX 1
 #define RECRUIT_KF_INLINE inline __attribute__((always_inline, target("avx")))
 #define RECRUIT_KF_PASS __attribute__((noinline, target("avx")))
-#include "estimation/sparse_step_kernels.inc"
+#include "estimation/sparse_step_kernels.h"
 #undef RECRUIT_KF_AVX
 #undef RECRUIT_KF_INLINE
 #undef RECRUIT_KF_PASS

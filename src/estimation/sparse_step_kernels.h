@@ -1,6 +1,7 @@
 // The sparse filter step's kernels: column combinations (pass 1 of the prediction, u = P h),
 // the upper triangle of A B (pass 2), the rank-1 update P - w w^T, transposition and mirror.
-// Included twice by population_kalman_filter.h (no include guard): into kf_detail::base for the
+// Not a header of its own: included twice by population_kalman_filter.h (hence no include
+// guard; named .h so that it is installed with the headers): into kf_detail::base for the
 // build's instruction set (Eigen's packets; FMA in the x86-64-v3 build) and, in the portable
 // x86-64 build, into kf_detail::avx, where every function is compiled for AVX by a target
 // attribute (not by a compiler flag, so that no inline code shared with other files is
@@ -15,6 +16,9 @@
 // Expects, defined by the includer: RECRUIT_KF_AVX (0 or 1), RECRUIT_KF_INLINE (inlined kernel
 // pieces) and RECRUIT_KF_PASS (the entry points: always inlined in the base copy; not inlined
 // in the AVX copy, whose callers are compiled for the baseline).
+#ifndef RECRUIT_KF_AVX
+#error "sparse_step_kernels.h is included by population_kalman_filter.h only"
+#endif
 
 #if RECRUIT_KF_AVX
 // 4 and 2 lanes; MulAdd is a multiply then an add (two roundings), as Eigen's SSE2 pmadd.
