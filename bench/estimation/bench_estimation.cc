@@ -8,7 +8,10 @@
 //    from (p_on, p_off) inside the timed step: path 0 = legacy dense, 1 = dense, 2 = sparse A;
 //    BM_KalmanStepDynamic: the same with dynamic-size matrices;
 //  - BM_Gemm: a 256 x 256 dense matrix product, the machine's achievable flop rate with the
-//    same compiler flags (the reference for the flop bound);
+//    same compiler flags (the reference for the flop bound; bench_gemm_avx.cc is the same for
+//    AVX without FMA, the reference of the sparse step's AVX kernels);
+//  - BM_ChainStep<M>/<path>: the heating / cooling chain, dense A, sparse A with the kernels
+//    the filter picks (AVX where the CPU has it), sparse A with the baseline kernels;
 //  - BM_Estimator/<kind>/m: time per step of the extended Kalman filter, the exact filter
 //    (every step a new A, and a constant, cached A) and a particle filter with the smallest
 //    particle count whose RMSE is within 5 % of the Kalman filter's (found by a calibration
@@ -212,7 +215,10 @@ BENCHMARK(BM_BroadcastStep)->Arg(0)->Arg(1)->Arg(2);
 // nonzeros per column of A), N = 60, a force sensor, random (p_on, p_off) in [0, 0.3] and the
 // measurements of a simulated run. range(0): 0 = dense A (FillMatrix + Predict(Mat), the
 // reference of this run), 1 = sparse A (PredictBroadcast: FillSparse in place + sparse
-// predict). Counters: flops per step of the algorithm the path runs, GFLOPS achieved.
+// predict) with the kernels the filter chooses (the AVX copy where the CPU has it, counter
+// avx = 1), 2 = the same with the baseline kernels forced. Counters: flops per step of the
+// algorithm the path runs (for paths 1 and 2 the same count, that of the baseline kernels, so
+// that their rates compare as their times), GFLOPS achieved.
 template <int M>
 void BM_ChainStep(benchmark::State& state) {
   FilterModel f = ChainModel(M);
@@ -234,12 +240,13 @@ void BM_ChainStep(benchmark::State& state) {
     y[t] = f.H * x + Eigen::VectorXd::Constant(1, std::sqrt(f.R(0, 0)) * Gaussian(rng));
     x = SimulateStepAggregate(b.Matrix(p_on[t], p_off[t]), x, rng);
   }
-  const bool sparse = state.range(0) == 1;
+  const bool sparse = state.range(0) >= 1;
   auto kf = PopulationKalmanFilterT<M, 1>::Create(f, CovarianceMode::kExtended);
   if (!kf.ok()) {
     state.SkipWithError(kf.error().c_str());
     return;
   }
+  if (state.range(0) == 2) kf->set_avx_kernels(false);
   Eigen::Matrix<double, M, M> A;
   int t = 0;
   for (auto _ : state) {
@@ -255,12 +262,13 @@ void BM_ChainStep(benchmark::State& state) {
   }
   const double flops = sparse ? SparseStepFlops(kf->broadcast_matrix()) : StepFlops(M);
   state.counters["nnz_A"] = static_cast<double>(kf->broadcast_matrix().nonZeros());
+  state.counters["avx"] = sparse && kf->avx_kernels() ? 1.0 : 0.0;  // the dense path has none
   state.counters["flops"] = flops;
   state.counters["GFLOPS"] =
       benchmark::Counter(flops * 1e-9 * state.iterations(), benchmark::Counter::kIsRate);
 }
-BENCHMARK_TEMPLATE(BM_ChainStep, 20)->Arg(0)->Arg(1);
-BENCHMARK_TEMPLATE(BM_ChainStep, 50)->Arg(0)->Arg(1);
+BENCHMARK_TEMPLATE(BM_ChainStep, 20)->Arg(0)->Arg(1)->Arg(2);
+BENCHMARK_TEMPLATE(BM_ChainStep, 50)->Arg(0)->Arg(1)->Arg(2);
 
 void BM_KalmanStepDynamic(benchmark::State& state) {
   const int m = static_cast<int>(state.range(0));

@@ -41,6 +41,12 @@
 #ifdef __SSE2__
 #include <emmintrin.h>
 #endif
+// The portable x86-64 build carries a second copy of the sparse step's kernels compiled for AVX
+// (sparse_step_kernels.h), chosen at run time; builds that already target AVX do not.
+#if defined(__x86_64__) && defined(__SSE2__) && !defined(__AVX__) && defined(__GNUC__)
+#define RECRUIT_KF_AVX_CLONE 1
+#include <immintrin.h>
+#endif
 
 #include "common/result.h"
 #include "estimation/filter_model.h"
@@ -53,6 +59,10 @@ enum class CovarianceMode { kExtended, kConservative, kPlain };
 // "extended", "conservative", "plain".
 const char* ToString(CovarianceMode mode);
 Result<CovarianceMode> ParseCovarianceMode(const std::string& name);
+
+namespace kf_detail {
+inline bool CpuHasAvx();  // below
+}  // namespace kf_detail
 
 template <int M, int R>
 class PopulationKalmanFilterT {
@@ -100,6 +110,16 @@ class PopulationKalmanFilterT {
     if (has_broadcast_) broadcast_.FillSparse(last_p_on_, last_p_off_, As_);
     return As_;
   }
+  // Which copy of the sparse step's kernels runs (PredictBroadcast, Predict(SparseMatrix), the
+  // r = 1 Update): the portable x86-64 build has a second copy compiled for AVX, chosen at
+  // Create when the CPU has AVX and m >= kAvxMinStates. Both give bit-identical results.
+  // set_avx_kernels(false) forces the baseline copy, true the AVX copy where it can run (tests,
+  // benchmarks).
+  bool avx_kernels() const { return avx_; }
+  // Below this many states the AVX copy is not the default: it has little to do 4 lanes wide,
+  // and its calls cost more (m = 2: the controller's step measured 3-6 % slower with it).
+  static constexpr int kAvxMinStates = 8;
+  void set_avx_kernels(bool on) { avx_ = on && kf_detail::CpuHasAvx(); }
   // Measurement update with y(t) (eqs. 15, 17, 19, 20 in Joseph form).
   void Update(const OutVec& y);
 
@@ -140,6 +160,8 @@ class PopulationKalmanFilterT {
   void PrepareCovariancePredict();
   // The r = 1 update: scalar innovation variance, no factorisation.
   void UpdateScalar(double y);
+  template <class Kernels>  // kf_detail::base::Kernels or kf_detail::avx::Kernels
+  void UpdateScalarWith(double y);
   // Adds diag(A xq) and G Qw G^T to P_ (ax_ = A xq computed by the caller), x_ = tmp_ (= A x),
   // re-projects.
   void FinishPredict();
@@ -153,6 +175,8 @@ class PopulationKalmanFilterT {
   // The sparse prediction with A in compressed-row form (row i: entries ptr[i]..ptr[i+1] - 1,
   // columns col[], values val[]): P = A (P - diag xq) A^T + diag(A xq) + G Qw G^T, x = A x.
   void PredictRows(const int* ptr, const int* col, const double* val);
+  template <class Kernels>
+  void PredictRowsWith(const int* ptr, const int* col, const double* val);
 
   CovarianceMode mode_ = CovarianceMode::kExtended;
   double N_ = 0.0;
@@ -188,6 +212,7 @@ class PopulationKalmanFilterT {
   std::vector<int> iota_;  // 0, 1, ..., m - 1 (P h as a combination of all columns of P)
   int sparse_steps_ = 0;   // sparse predictions since P was last projected onto 1^T P = 0
   bool xq_is_x_ = false;   // SetQzPoint: xq = x (the extended mode, x feasible); xq_ not set
+  bool avx_ = false;       // the sparse step runs the AVX copy of its kernels
 };
 
 using PopulationKalmanFilter = PopulationKalmanFilterT<Eigen::Dynamic, Eigen::Dynamic>;
@@ -221,126 +246,40 @@ void ProjectOntoSimplexInto(const V& x, double N, V& out, V& work) {
 using Packet = Eigen::internal::packet_traits<double>::type;
 constexpr int kPacket = Eigen::internal::packet_traits<double>::size;
 
-// One packet of CombineColumns.
-template <int T, bool Acc>
-EIGEN_ALWAYS_INLINE void CombineStep(double* __restrict out, const double* __restrict s0,
-                                     const double* __restrict s1, const double* __restrict s2,
-                                     const Packet& p0, const Packet& p1, const Packet& p2) {
-  using namespace Eigen::internal;
-  Packet v =
-      Acc ? pmadd(p0, ploadu<Packet>(s0), ploadu<Packet>(out)) : pmul(p0, ploadu<Packet>(s0));
-  if (T > 1) v = pmadd(p1, ploadu<Packet>(s1), v);
-  if (T > 2) v = pmadd(p2, ploadu<Packet>(s2), v);
-  pstoreu(out, v);
-}
+// The sparse step's kernels for the build's instruction set.
+namespace base {
+#define RECRUIT_KF_AVX 0
+#define RECRUIT_KF_INLINE EIGEN_ALWAYS_INLINE
+#define RECRUIT_KF_PASS EIGEN_ALWAYS_INLINE
+#include "estimation/sparse_step_kernels.h"
+#undef RECRUIT_KF_AVX
+#undef RECRUIT_KF_INLINE
+#undef RECRUIT_KF_PASS
+}  // namespace base
 
-// out[0..len) = (Acc ? out : 0) + a0 s0 + a1 s1 + a2 s2 (the first T of the three terms).
-template <int Len, int T, bool Acc>
-EIGEN_ALWAYS_INLINE void CombineColumns(double* __restrict out, const double* __restrict s0,
-                                        const double* __restrict s1, const double* __restrict s2,
-                                        double a0, double a1, double a2, Eigen::Index len_dynamic) {
-  using namespace Eigen::internal;
-  const Eigen::Index len = Len == Eigen::Dynamic ? len_dynamic : Len;
-  const Packet p0 = pset1<Packet>(a0), p1 = pset1<Packet>(a1), p2 = pset1<Packet>(a2);
-  Eigen::Index r = 0;
-  if constexpr (Len == Eigen::Dynamic || Len / kPacket <= 16) {
-    // Fixed lengths are unrolled completely by the compiler.
-    for (; r + kPacket <= len; r += kPacket) {
-      CombineStep<T, Acc>(out + r, s0 + r, s1 + r, s2 + r, p0, p1, p2);
-    }
-  } else {
-    // Long fixed lengths (m = 50 with SSE2): partly (measured: 6k fewer instructions a step).
-#pragma GCC unroll 8
-    for (; r + kPacket <= len; r += kPacket) {
-      CombineStep<T, Acc>(out + r, s0 + r, s1 + r, s2 + r, p0, p1, p2);
-    }
-  }
-  if constexpr (Len != Eigen::Dynamic && Len % kPacket == 0) return;  // no tail
-  for (; r < len; ++r) {
-    double v = (Acc ? out[r] : 0.0) + a0 * s0[r];
-    if (T > 1) v += a1 * s1[r];
-    if (T > 2) v += a2 * s2[r];
-    out[r] = v;
-  }
-}
+#ifdef RECRUIT_KF_AVX_CLONE
+// The same kernels compiled for AVX (no FMA; bit-identical results), for CPUs that have it.
+namespace avx {
+#define RECRUIT_KF_AVX 1
+#define RECRUIT_KF_INLINE inline __attribute__((always_inline, target("avx")))
+#define RECRUIT_KF_PASS __attribute__((noinline, target("avx")))
+#include "estimation/sparse_step_kernels.h"
+#undef RECRUIT_KF_AVX
+#undef RECRUIT_KF_INLINE
+#undef RECRUIT_KF_PASS
+}  // namespace avx
 
-// out[0..len) = sum_k a[k] src(0..len, c[k]) for n terms (column-major src, leading dimension
-// ld); zero for n = 0. Up to three columns per loop, so that `out` is written once per three
-// terms. Len: the length when fixed at compile time (unrolled), else Eigen::Dynamic.
-template <int Len>
-EIGEN_ALWAYS_INLINE void RowCombination(double* __restrict out, const double* __restrict src,
-                                        Eigen::Index ld, Eigen::Index len_dynamic, const int* c,
-                                        const double* a, int n) {
-  const Eigen::Index len = Len == Eigen::Dynamic ? len_dynamic : Len;
-  if (n == 0) {
-    for (Eigen::Index r = 0; r < len; ++r) out[r] = 0.0;
-    return;
-  }
-  const double* s0 = src + c[0] * ld;
-  // The first one to three terms initialise out, the rest accumulate three at a time.
-  int k;
-  if (n == 1) {
-    CombineColumns<Len, 1, false>(out, s0, s0, s0, a[0], 0.0, 0.0, len);
-    return;
-  } else if (n == 2) {
-    CombineColumns<Len, 2, false>(out, s0, src + c[1] * ld, s0, a[0], a[1], 0.0, len);
-    return;
-  } else {
-    CombineColumns<Len, 3, false>(out, s0, src + c[1] * ld, src + c[2] * ld, a[0], a[1], a[2], len);
-    k = 3;
-  }
-  for (; k + 3 <= n; k += 3) {
-    CombineColumns<Len, 3, true>(out, src + c[k] * ld, src + c[k + 1] * ld, src + c[k + 2] * ld,
-                                 a[k], a[k + 1], a[k + 2], len);
-  }
-  if (n - k == 2) {
-    CombineColumns<Len, 2, true>(out, src + c[k] * ld, src + c[k + 1] * ld, s0, a[k], a[k + 1], 0.0,
-                                 len);
-  } else if (n - k == 1) {
-    CombineColumns<Len, 1, true>(out, src + c[k] * ld, s0, s0, a[k], 0.0, 0.0, len);
-  }
+// Whether this CPU and its operating system run AVX (checked once per process).
+inline bool CpuHasAvx() {
+  static const bool has = [] {
+    __builtin_cpu_init();  // in case this runs before the run-time library's constructor
+    return __builtin_cpu_supports("avx") != 0;
+  }();
+  return has;
 }
-
-// dst = src^T, m x m column-major; 2 x 2 blocks with SSE2 when m is even.
-inline void Transpose(const double* __restrict src, double* __restrict dst, Eigen::Index m) {
-#ifdef __SSE2__
-  if (m % 2 == 0) {
-    for (Eigen::Index j = 0; j < m; j += 2) {
-      for (Eigen::Index i = 0; i < m; i += 2) {
-        const __m128d c0 = _mm_loadu_pd(src + i + j * m);
-        const __m128d c1 = _mm_loadu_pd(src + i + (j + 1) * m);
-        _mm_storeu_pd(dst + j + i * m, _mm_unpacklo_pd(c0, c1));
-        _mm_storeu_pd(dst + j + (i + 1) * m, _mm_unpackhi_pd(c0, c1));
-      }
-    }
-    return;
-  }
+#else
+inline bool CpuHasAvx() { return false; }
 #endif
-  for (Eigen::Index j = 0; j < m; ++j) {
-    for (Eigen::Index i = 0; i < m; ++i) dst[j + i * m] = src[i + j * m];
-  }
-}
-
-// Copies the strict upper triangle of the m x m column-major P to its lower triangle.
-inline void MirrorUpper(double* P, Eigen::Index m) {
-#ifdef __SSE2__
-  if (m % 2 == 0) {
-    for (Eigen::Index j = 0; j < m; j += 2) {
-      for (Eigen::Index i = 0; i < j; i += 2) {  // the 2 x 2 block (i, j) above the diagonal
-        const __m128d c0 = _mm_loadu_pd(P + i + j * m);
-        const __m128d c1 = _mm_loadu_pd(P + i + (j + 1) * m);
-        _mm_storeu_pd(P + j + i * m, _mm_unpacklo_pd(c0, c1));
-        _mm_storeu_pd(P + j + (i + 1) * m, _mm_unpackhi_pd(c0, c1));
-      }
-      P[j + 1 + j * m] = P[j + (j + 1) * m];
-    }
-    return;
-  }
-#endif
-  for (Eigen::Index i = 0; i < m; ++i) {
-    for (Eigen::Index j = i + 1; j < m; ++j) P[j + i * m] = P[i + j * m];
-  }
-}
 
 }  // namespace kf_detail
 
@@ -386,6 +325,7 @@ Result<PopulationKalmanFilterT<M, R>> PopulationKalmanFilterT<M, R>::Create(
   f.has_process_noise_ = model.G.cols() > 0;
   f.x_ = x0;
   f.P_ = P0;
+  f.avx_ = kf_detail::CpuHasAvx() && m >= kAvxMinStates;
   f.xq_.resize(m);
   f.ax_.resize(m);
   f.tmp_.resize(m);
@@ -524,21 +464,32 @@ void PopulationKalmanFilterT<M, R>::PredictBroadcast(double p_on, double p_off) 
   // the compressed rows (As_ is filled only when broadcast_matrix() is called).
   last_p_on_ = p_on;
   last_p_off_ = p_off;
-  const size_t nnz = bc_val_.size();
-  const double* __restrict on = bc_on_.data();
-  const double* __restrict off = bc_off_.data();
-  const double* __restrict base = bc_base_.data();
-  const double* __restrict target = bc_target_.data();
-  double* __restrict val = bc_val_.data();
-  for (size_t e = 0; e < nnz; ++e) {
-    const double p = on[e] * p_off + off[e] * p_on;  // exact: one term is 0
-    val[e] = (1.0 - p) * base[e] + target[e] * p;    // target: 1, else 0
+#ifdef RECRUIT_KF_AVX_CLONE
+  if (avx_) {
+    kf_detail::avx::Kernels::FillBroadcast(bc_val_.size(), p_on, p_off, bc_on_.data(),
+                                           bc_off_.data(), bc_base_.data(), bc_target_.data(),
+                                           bc_val_.data());
+    return PredictRowsWith<kf_detail::avx::Kernels>(bc_ptr_.data(), bc_col_.data(), bc_val_.data());
   }
-  PredictRows(bc_ptr_.data(), bc_col_.data(), bc_val_.data());
+#endif
+  kf_detail::base::Kernels::FillBroadcast(bc_val_.size(), p_on, p_off, bc_on_.data(),
+                                          bc_off_.data(), bc_base_.data(), bc_target_.data(),
+                                          bc_val_.data());
+  PredictRowsWith<kf_detail::base::Kernels>(bc_ptr_.data(), bc_col_.data(), bc_val_.data());
 }
 
 template <int M, int R>
 void PopulationKalmanFilterT<M, R>::PredictRows(const int* ptr, const int* col, const double* val) {
+#ifdef RECRUIT_KF_AVX_CLONE
+  if (avx_) return PredictRowsWith<kf_detail::avx::Kernels>(ptr, col, val);
+#endif
+  PredictRowsWith<kf_detail::base::Kernels>(ptr, col, val);
+}
+
+template <int M, int R>
+template <class Kernels>
+void PopulationKalmanFilterT<M, R>::PredictRowsWith(const int* ptr, const int* col,
+                                                    const double* val) {
   SetQzPoint();
   const Eigen::Index m = x_.size();
   const bool qz = mode_ != CovarianceMode::kPlain;
@@ -554,10 +505,7 @@ void PopulationKalmanFilterT<M, R>::PredictRows(const int* ptr, const int* col, 
   // Pass 1, B = (P - diag xq) A^T column by column: B(:, i) = sum over row i of A of
   // A(i, l) (P - diag xq)(:, l); each column of B written once (no zeroing), 2 m nnz(A) flops;
   // with A x and A xq.
-  for (Eigen::Index i = 0; i < m; ++i) {
-    kf_detail::RowCombination<M>(B + i * m, P, m, m, col + ptr[i], val + ptr[i],
-                                 ptr[i + 1] - ptr[i]);
-  }
+  Kernels::template CombineRows<M>(B, P, m, ptr, col, val);
   const double* x = x_.data();
   for (Eigen::Index i = 0; i < m; ++i) {
     double ti = 0.0;
@@ -577,19 +525,10 @@ void PopulationKalmanFilterT<M, R>::PredictRows(const int* ptr, const int* col, 
   // diagonal term and G Qw G^T are added in the same pass, then the upper triangle is mirrored
   // (P stays exactly symmetric). About m nnz(A) flops.
   double* Bt = M_.data();
-  kf_detail::Transpose(B, Bt, m);
-  double* Pw = P_.data();
-  constexpr Eigen::Index kRound = kf_detail::kPacket > 1 ? kf_detail::kPacket : 2;
-  for (Eigen::Index j = 0; j < m; ++j) {
-    // Rows 0..j, rounded up to whole packets (the extra entries are below the diagonal,
-    // overwritten by the mirror).
-    const Eigen::Index len = std::min<Eigen::Index>(m, (j + kRound) & ~(kRound - 1));
-    kf_detail::RowCombination<Eigen::Dynamic>(Pw + j * m, Bt, m, len, col + ptr[j], val + ptr[j],
-                                              ptr[j + 1] - ptr[j]);
-    if (qz) Pw[j * m + j] += ax[j];
-    if (has_process_noise_) P_.col(j).head(j + 1) += GQG_.col(j).head(j + 1);
-  }
-  kf_detail::MirrorUpper(Pw, m);
+  Kernels::Transpose(B, Bt, m);
+  Kernels::template UpperProduct<M>(P_.data(), Bt, m, ptr, col, val, qz ? ax : nullptr,
+                                    has_process_noise_ ? GQG_.data() : nullptr);
+  Kernels::MirrorUpper(P_.data(), m);
   x_ = tmp_;
   if (++sparse_steps_ >= kSparseReprojectPeriod) {
     sparse_steps_ = 0;
@@ -601,6 +540,15 @@ void PopulationKalmanFilterT<M, R>::PredictRows(const int* ptr, const int* col, 
 
 template <int M, int R>
 void PopulationKalmanFilterT<M, R>::UpdateScalar(double y) {
+#ifdef RECRUIT_KF_AVX_CLONE
+  if (avx_) return UpdateScalarWith<kf_detail::avx::Kernels>(y);
+#endif
+  UpdateScalarWith<kf_detail::base::Kernels>(y);
+}
+
+template <int M, int R>
+template <class Kernels>
+void PopulationKalmanFilterT<M, R>::UpdateScalarWith(double y) {
   // r = 1: S = h P h^T + R is a scalar, K = P h^T / S; no factorisation, no matrix inverse.
   const Eigen::Index m = x_.size();
   const auto h = H_.row(0);
@@ -608,8 +556,7 @@ void PopulationKalmanFilterT<M, R>::UpdateScalar(double y) {
   auto k = K_.col(0);
   // P h^T as a combination of P's columns, three per pass over u (no call into Eigen's general
   // matrix-vector kernel, whose set-up dominates at these sizes). H is 1 x m: h is contiguous.
-  kf_detail::RowCombination<M>(u.data(), P_.data(), m, m, iota_.data(), H_.data(),
-                               static_cast<int>(m));
+  Kernels::template MatVec<M>(u.data(), P_.data(), m, iota_.data(), H_.data());
   const double s = h.dot(u) + R_(0, 0);
   S_(0, 0) = s;
   k = u / s;
@@ -621,11 +568,7 @@ void PopulationKalmanFilterT<M, R>::UpdateScalar(double y) {
   // symmetric. 1^T P = 0 before gives 1^T u = 0, so the update keeps 1^T P = 0 up to round-off,
   // removed at the next Predict; the estimate is re-centred on sum = N at once (O(m)).
   kw_ = u / std::sqrt(s);
-  const double* w = kw_.data();
-  double* P = P_.data();
-  for (Eigen::Index j = 0; j < m; ++j) {
-    kf_detail::CombineColumns<M, 1, true>(P + j * m, w, w, w, -w[j], 0.0, 0.0, m);
-  }
+  Kernels::template SubtractOuter<M>(P_.data(), kw_.data(), m);
   x_.array() += (N_ - x_.sum()) / static_cast<double>(m);
 }
 
