@@ -7,11 +7,13 @@
 #include <optional>
 #include <string>
 
+#include "common/atomic_file.h"
 #include "control/kalman_estimator.h"
 #include "control/model_plant.h"
 #include "control/on_count_estimator.h"
 #include "control/output_estimator.h"
 #include "estimation/filter_model.h"
+#include "estimation/json_matrix.h"
 #include "estimation/population_kalman_filter.h"
 
 namespace recruit::control {
@@ -131,10 +133,9 @@ std::string DefaultModelFile(double dT, int num_states) {
 
 namespace {
 
-// The identification record of a model file ("identification" object), {} when absent.
-nlohmann::json IdentificationOf(const std::string& file) {
-  std::ifstream in(file);
-  nlohmann::json j = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
+// The identification record of a model file's content ("identification" object), {} when
+// absent.
+nlohmann::json IdentificationOf(const nlohmann::json& j) {
   if (j.is_object() && j.contains("identification") && j["identification"].is_object()) {
     return j["identification"];
   }
@@ -210,7 +211,10 @@ Result<std::unique_ptr<OnCountEstimator>> MakeEstimator(const EstimatorSpec& spe
   } else {
     const std::string file = ResolveModelPath(
         spec.model_file.empty() ? DefaultModelFile(dT, spec.num_states) : spec.model_file);
-    auto loaded = FilterModel::FromJson(file);
+    // The file is read and parsed once, for the model, its plant and its identification record.
+    auto text = ReadFile(file);
+    auto json = text.ok() ? json_io::ParseJson(*text, file) : Error{text.error()};
+    auto loaded = json.ok() ? FilterModel::FromJsonValue(*json, file) : Error{json.error()};
     if (!loaded) {
       return Error{"estimator: " + loaded.error() +
                    (spec.model_file.empty()
@@ -221,7 +225,9 @@ Result<std::unique_ptr<OnCountEstimator>> MakeEstimator(const EstimatorSpec& spe
     }
     model = std::move(loaded).value();
     if (!spec.plant.is_null()) {
-      if (Status s = CheckModelPlant(file, spec.plant); !s) return Error{"estimator: " + s.error()};
+      if (Status s = CheckModelPlant(file, *json, spec.plant); !s) {
+        return Error{"estimator: " + s.error()};
+      }
     }
     if (model.transition != TransitionSource::kBroadcast) {
       return Error{"estimator: " + file + ": transition.type must be \"broadcast\""};
@@ -244,7 +250,7 @@ Result<std::unique_ptr<OnCountEstimator>> MakeEstimator(const EstimatorSpec& spe
     if (spec.force_noise_std > 0) {
       model.R = Eigen::MatrixXd::Constant(1, 1, spec.force_noise_std * spec.force_noise_std);
     }
-    const nlohmann::json ident = IdentificationOf(file);
+    const nlohmann::json ident = IdentificationOf(*json);
     if (geometry) {
       auto map = ModelForceMap(model, ident, *geometry, file);
       if (!map) return Error{"estimator: " + map.error()};

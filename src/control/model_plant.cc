@@ -67,7 +67,15 @@ Status CheckModelPlant(const std::string& model_file, const nlohmann::json& plan
   } catch (const nlohmann::json::exception& e) {
     return Error{model_file + ": not valid JSON: " + e.what()};
   }
-  if (!j.contains("identification") || !j["identification"].contains("plant")) return {};
+  return CheckModelPlant(model_file, j, plant);
+}
+
+Status CheckModelPlant(const std::string& model_file, const nlohmann::json& j,
+                       const nlohmann::json& plant) {
+  if (!j.is_object() || !j.contains("identification") || !j["identification"].is_object() ||
+      !j["identification"].contains("plant")) {
+    return {};
+  }
   const nlohmann::json& had = j["identification"]["plant"];
   if (had.value("hash", "") == plant.value("hash", "")) return {};
   std::string diff;

@@ -21,5 +21,8 @@ std::string PlantHash(const nlohmann::json& unit);
 // a record passes (e.g. fitted from a log: its plant is unknown). A different hash is an error
 // naming the model file's plant and this one and the unit parameters that differ.
 Status CheckModelPlant(const std::string& model_file, const nlohmann::json& plant);
+// The same for the file's content, already parsed (`model`); `model_file` names it in messages.
+Status CheckModelPlant(const std::string& model_file, const nlohmann::json& model,
+                       const nlohmann::json& plant);
 
 }  // namespace recruit::control
