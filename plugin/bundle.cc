@@ -254,6 +254,10 @@ SmaBundle::Summary SmaBundle::Summarize(const double* s, double stretch) const {
   const double* v[3] = {Field(s, kOn), Field(s, kTemp), Field(s, kXi)};
   double sum[4];
   unit_.Observe(Field(s, kCount), v, k, stretch, false, sum);
+  return FromSums(sum, k);
+}
+
+SmaBundle::Summary SmaBundle::FromSums(const double* sum, int k) const {
   Summary r;
   r.on_count = static_cast<int>(sum[0]);
   r.tension = sum[3];
@@ -268,10 +272,7 @@ SmaBundle::Telemetry SmaBundle::Observe(const double* s, double stretch) const {
   double sum[5];
   unit_.Observe(Field(s, kCount), v, k, stretch, true, sum);
   Telemetry r;
-  r.on_count = static_cast<int>(sum[0]);
-  r.tension = sum[3];
-  r.mean_temperature = k == 0 ? config_.unit.ambient : sum[1] / config_.units;
-  r.mean_xi = k == 0 ? 1 : sum[2] / config_.units;
+  static_cast<Summary&>(r) = FromSums(sum, k);
   r.max_temperature = MaxTemperature(s);
   r.max_wire_stress = unit_.WireStress(sum[4]);
   return r;

@@ -62,9 +62,8 @@ class SmaBundle {
   // What a run loop reads after each step, in one pass over the cohorts: each value the same,
   // bit for bit, as OnCount, Tension, MeanTemperature, MeanXi, MaxTemperature and MaxWireStress
   // give (one tension evaluation per cohort serves the sum and the maximum).
-  struct Telemetry {
-    int on_count;
-    double tension, mean_temperature, mean_xi, max_temperature, max_wire_stress;
+  struct Telemetry : Summary {
+    double max_temperature, max_wire_stress;
   };
   Telemetry Observe(const double* s, double stretch) const;
 
@@ -100,6 +99,8 @@ class SmaBundle {
   double SettledOnTension(double stretch) const;
 
  private:
+  // Summary from the sums of UnitModel::Observe (on, temperature, xi, tension) over k cohorts.
+  Summary FromSums(const double* sum, int k) const;
   // Header: magic, 4 random-stream words, cohort count, update counter, pending time (s), the
   // kept tension (flag 1 when kept, extension (m), tension (N); all 0 when none), 1 reserved
   // (so that the cohort fields start 32 bytes after the block, as before).
