@@ -1,0 +1,52 @@
+#!/usr/bin/env python3
+"""Whole-process CPU of two `recruit` binaries, alternated run by run.
+
+For each task, runs `BINARY simulate --task models/tasks/TASK.json --seed 3 --out TMP` N times
+with each binary in turn and prints a Markdown row: the median CPU time of the child (user + sys,
+getrusage), the simulated seconds per CPU second (x real time) and the ratio OLD / NEW.
+Alternating the two binaries makes the ratio robust to the shared machine's drift
+(docs/benchmarks.md, "Issue 15, session 5").
+
+Usage, from the repository root:
+    python3 bench/process/whole_process_cpu.py OLD NEW N TASK [TASK ...]
+"""
+import json
+import resource
+import statistics
+import subprocess
+import sys
+import tempfile
+
+
+def child_cpu(binary, task, out):
+    """CPU seconds (user + sys) of one `simulate` run of `task`."""
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    subprocess.run([binary, "simulate", "--task", f"models/tasks/{task}.json", "--seed", "3",
+                    "--out", out], check=True, stdout=subprocess.DEVNULL,
+                   stderr=subprocess.DEVNULL)
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+
+
+def main(argv):
+    if len(argv) < 5:
+        sys.exit(__doc__)
+    old, new, runs, tasks = argv[1], argv[2], int(argv[3]), argv[4:]
+    print("| task | simulated | before: CPU (x real time) | after: CPU (x real time) | "
+          "before / after |")
+    print("|---|---|---|---|---|")
+    for task in tasks:
+        with open(f"models/tasks/{task}.json") as f:
+            duration = json.load(f)["duration"]
+        old_cpu, new_cpu = [], []
+        with tempfile.TemporaryDirectory() as out:
+            for _ in range(runs):
+                old_cpu.append(child_cpu(old, task, out))
+                new_cpu.append(child_cpu(new, task, out))
+        a, b = statistics.median(old_cpu), statistics.median(new_cpu)
+        print(f"| {task} | {duration:.0f} s | {a * 1000:.1f} ms ({duration / a:.0f}x) | "
+              f"{b * 1000:.1f} ms ({duration / b:.0f}x) | {a / b:.2f} |")
+
+
+if __name__ == "__main__":
+    main(sys.argv)
