@@ -12,7 +12,9 @@
 namespace recruit::sim {
 
 CsvStepWriter::CsvStepWriter(std::string path, int every)
-    : file_(std::move(path)), every_(every < 1 ? 1 : every) {}
+    : file_(std::move(path)), every_(every < 1 ? 1 : every) {
+  buffer_.reserve(2 * kFlushBytes);
+}
 
 Status CsvStepWriter::OnStep(const mjModel*, const mjData*, const TelemetrySample& s) {
   if (!file_.ok()) return Error{file_.error()};
@@ -98,7 +100,7 @@ Status CsvStepWriter::OnStep(const mjModel*, const mjData*, const TelemetrySampl
   *p++ = s.control_instant ? '1' : '0';
   *p++ = '\n';
   used_ = static_cast<std::size_t>(p - buffer_.data());
-  if (used_ > (1 << 20)) Flush();
+  if (used_ > kFlushBytes) Flush();
   return Status::Ok();
 }
 

@@ -28,7 +28,10 @@ class CsvStepWriter : public StepObserver {
   int every_;
   long count_ = 0;
   bool header_written_ = false;
-  // Rows not yet written (the first used_ bytes), flushed past 1 MB.
+  // Rows not yet written (the first used_ bytes), flushed past kFlushBytes. Small and reserved
+  // once: a 1 MB buffer grown by doubling touched ~650 more pages (a 60 s arm run: 1392 -> 732
+  // page faults, 2.5 MB less memory; its CPU time did not change measurably).
+  static constexpr std::size_t kFlushBytes = 64 * 1024;
   std::vector<char> buffer_;
   std::size_t used_ = 0;
   // Each numeric column's last value and its text.
