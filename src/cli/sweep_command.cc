@@ -210,7 +210,7 @@ Result<Prepared> Prepare(const SweepArgs& a, int* code) {
       fs::create_directories(dir, ec);
       const fs::path file = fs::absolute(
           dir / (fs::path(p.task.model_path).stem().string() + "_" + h.Hex() + ".xml"));
-      if (!fs::exists(file)) {
+      if (!fs::exists(file, ec)) {
         if (Status s = WriteFileAtomically(file.string(), in->model_text); !s.ok()) {
           *code = exit_code::kIo;
           return Error{s.error()};
@@ -341,7 +341,8 @@ int RunSweepCommand(const SweepArgs& a) {
                        {"filter_model", a.filter_model}};
   if (!a.sweep_file.empty()) id["sweep"] = fs::absolute(a.sweep_file).lexically_normal().string();
   if (!a.shard.empty()) id["shard"] = a.shard;
-  if (fs::exists(id_path)) {
+  std::error_code ec;  // a path the system refuses fails below, when the sweep writes it
+  if (fs::exists(id_path, ec)) {
     auto old = LoadJsonFile(id_path);
     if (!old.ok()) return Fail(cmd, old.error());
     if (*old != id) {
@@ -433,7 +434,8 @@ int RunMergeCommand(const SweepArgs& a) {
   int n = 0;
   for (const auto& d : a.shards) {
     const std::string mpath = (fs::path(d) / "shard.json").string();
-    if (!fs::exists(mpath)) {
+    std::error_code ec;
+    if (!fs::exists(mpath, ec)) {
       std::cerr << "recruit sweep merge: '" << d << "' has no shard.json (unfinished shard)\n";
       continue;
     }

@@ -175,7 +175,8 @@ Result<SweepOutcome> RunSweep(const std::vector<SweepRun>& grid, const std::stri
   for (size_t i = 0; i < grid.size(); ++i) {
     const fs::path p = runs_dir / (grid[i].Key() + ".json");
     bool reused = false;
-    if (fs::exists(p)) {
+    std::error_code ec;  // an unreadable record is not reused
+    if (fs::exists(p, ec)) {
       auto j = LoadJsonFile(p.string());
       if (j.ok() && j->is_object()) {
         auto s = RunSummaryFromJson(*j);

@@ -6,6 +6,7 @@
 
 #include "common/atomic_file.h"
 #include "common/json_file.h"
+#include "common/short_text.h"
 
 namespace recruit::sim {
 namespace {
@@ -112,8 +113,12 @@ Result<Task> Task::FromJsonText(const std::string& text, const std::string& sour
     RECRUIT_TRY(String(j, "description", file, &task.description, false));
   RECRUIT_TRY(String(j, "model", file, &task.model_path, true));
   task.model_path = Resolve(task.model_path, source);
-  if (!fs::exists(task.model_path)) {
-    return Error{file + ".model: model file '" + task.model_path + "' does not exist"};
+  // The error_code form: a path the system refuses (too long, ...) is an error message, not an
+  // exception (found by the task fuzzer).
+  std::error_code ec;
+  if (!fs::exists(task.model_path, ec)) {
+    return Error{file + ".model: model file '" + ShortText(task.model_path, 120) +
+                 "' does not exist" + (ec ? " (" + ec.message() + ")" : "")};
   }
   std::string tracked;
   RECRUIT_TRY(String(j, "tracked", file, &tracked, true));
