@@ -70,7 +70,8 @@ class Plant {
   void TrackPeaks();
   // Bundle i's units as they are now (force, on count, temperatures, stress): one pass over its
   // cohorts after each step or broadcast, bit for bit what the separate reads give. A run reads
-  // them several times a step (measurement, telemetry, peaks); the pass is ~1/10 of a step.
+  // them several times a step (measurement, telemetry, peaks): one pass, ~280 instructions for
+  // 60 units (callgrind, arm_push), instead of four.
   const sma::SmaBundle::Telemetry& Observed(int i) const;
   void ForgetObserved() { observed_valid_.assign(bundles_.size(), false); }
 

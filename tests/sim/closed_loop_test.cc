@@ -274,6 +274,36 @@ TEST(ClosedLoop, PlantWithoutTexturesStepsLikeTheFullModel) {
   EXPECT_EQ(a.Force(0), b.Force(0));
 }
 
+// The plant's reads of a bundle (kept from one pass after each step) follow every broadcast and
+// step: each equals the host's separate read of the same mjData at that moment.
+TEST(ClosedLoop, PlantReadsFollowBroadcastsAndSteps) {
+  const Task task = LoadTask("arm_push.json");
+  auto created = Plant::Create(task, /*textures=*/false);
+  ASSERT_TRUE(created.ok()) << created.error();
+  Plant& plant = **created;
+  plant.Reset(11);
+  const sma::SmaHost& host = plant.host();
+  auto expect_fresh = [&](int i) {
+    const int b = plant.bundle_index(i);
+    EXPECT_EQ(plant.OnCount(i), host.OnCount(plant.data(), b));
+    EXPECT_EQ(plant.Force(i), host.Force(plant.data(), b));
+    EXPECT_EQ(plant.MeanTemperature(i), host.MeanTemperature(plant.data(), b));
+  };
+  int changed = 0;
+  for (int step = 0; step < 600; ++step) {
+    if (step % 100 == 0) {
+      const int before = plant.OnCount(0);
+      ASSERT_TRUE(plant.Broadcast(0, 0.5, 0.1).ok());
+      changed += plant.OnCount(0) != before;
+      expect_fresh(0);
+    }
+    plant.Step();
+    expect_fresh(0);
+    expect_fresh(1);
+  }
+  EXPECT_GT(changed, 0) << "no broadcast changed the on count: the test checks nothing";
+}
+
 // An observer that draws is handed the model with its textures at full size.
 TEST(ClosedLoop, AnObserverThatDrawsGetsTheFullTextures) {
   struct Drawer : StepObserver {
