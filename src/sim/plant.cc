@@ -3,15 +3,18 @@
 #include <algorithm>
 #include <cstdio>
 #include <limits>
+#include <vector>
 
 namespace recruit::sim {
 namespace {
 
-// The model at `path`; without `textures`, every builtin texture (a sky, a floor grid) compiled
-// at 1 x 1 pixel. Their pixels only colour renders, yet generating them (and the plugin hashing
-// them with the rest of the model) was ~4 % of a 60 s arm run's instructions (34 of 792 M).
-mjModel* LoadPlantModel(const std::string& path, bool textures, char* error, int error_size) {
-  if (textures) return mj_loadXML(path.c_str(), nullptr, error, error_size);
+// The model at `path`; without `drawn` (a run that draws nothing), every builtin texture (a
+// sky, a floor grid) compiled at 1 x 1 pixel, and no camera or light. Texture pixels only colour
+// renders, yet generating them (and the plugin hashing them with the rest of the model) was ~4 %
+// of a 60 s arm run's instructions (34 of 792 M); MuJoCo places every camera and light at each
+// step (~1 %), which only a renderer reads.
+mjModel* LoadPlantModel(const std::string& path, bool drawn, char* error, int error_size) {
+  if (drawn) return mj_loadXML(path.c_str(), nullptr, error, error_size);
   mjSpec* spec = mj_parseXML(path.c_str(), nullptr, error, error_size);
   if (spec == nullptr) return nullptr;
   for (mjsElement* e = mjs_firstElement(spec, mjOBJ_TEXTURE); e != nullptr;
@@ -19,20 +22,38 @@ mjModel* LoadPlantModel(const std::string& path, bool textures, char* error, int
     mjsTexture* t = mjs_asTexture(e);
     if (t->builtin != mjBUILTIN_NONE) t->width = t->height = 1;
   }
+  std::vector<mjsElement*> unseen;
+  for (mjtObj type : {mjOBJ_CAMERA, mjOBJ_LIGHT}) {
+    for (mjsElement* e = mjs_firstElement(spec, type); e != nullptr; e = mjs_nextElement(spec, e)) {
+      unseen.push_back(e);
+    }
+  }
+  for (mjsElement* e : unseen) mjs_delete(spec, e);
   mjModel* m = mj_compile(spec, nullptr);
   if (m == nullptr) std::snprintf(error, error_size, "%s", mjs_getError(spec));
   mj_deleteSpec(spec);
   return m;
 }
 
+// True if any joint or tendon has dry friction (a frictionloss constraint row).
+bool HasFrictionLoss(const mjModel* m) {
+  for (int i = 0; i < m->nv; ++i) {
+    if (m->dof_frictionloss[i] > 0) return true;
+  }
+  for (int i = 0; i < m->ntendon; ++i) {
+    if (m->tendon_frictionloss[i] > 0) return true;
+  }
+  return false;
+}
+
 }  // namespace
 
-Result<std::unique_ptr<Plant>> Plant::Create(const Task& task, bool textures) {
+Result<std::unique_ptr<Plant>> Plant::Create(const Task& task, bool drawn) {
   const std::string where = task.source.empty() ? task.name : task.source;
   std::unique_ptr<Plant> p(new Plant());
   p->task_ = &task;
   char load_error[1000] = "";
-  p->model_.reset(LoadPlantModel(task.model_path, textures, load_error, sizeof load_error));
+  p->model_.reset(LoadPlantModel(task.model_path, drawn, load_error, sizeof load_error));
   if (!p->model_) {
     return Error{where + ".model: cannot load '" + task.model_path + "': " + load_error};
   }
@@ -42,6 +63,10 @@ Result<std::unique_ptr<Plant>> Plant::Create(const Task& task, bool textures) {
   // sensor stage (the plugin's ground-truth sums over every cohort, and the model's own sensors)
   // would be evaluated every step for nothing. Sensors never act on the dynamics.
   m->opt.disableflags |= mjDSBL_SENSOR;
+  // Constraint kinds the model has none of: MuJoCo still visits them every step (~1 % of an arm
+  // step). Disabling them changes nothing else: no such row would ever be made.
+  if (!HasFrictionLoss(m)) m->opt.disableflags |= mjDSBL_FRICTIONLOSS;
+  if (m->neq == 0) m->opt.disableflags |= mjDSBL_EQUALITY;
   auto host = sma::SmaHost::Create(m);
   if (!host.ok()) return Error{where + ".model: " + host.error()};
   p->host_ = std::move(host).value();

@@ -22,9 +22,10 @@ namespace recruit::sim {
 class Plant {
  public:
   // Loads task.model_path (timestep overridden by task.timestep when > 0) and finds the task's
-  // bundles, joint and bodies; errors name the task file's field. Without `textures` the
-  // model's builtin textures are made 1 pixel (nothing draws it; the physics is the same).
-  static Result<std::unique_ptr<Plant>> Create(const Task& task, bool textures = true);
+  // bundles, joint and bodies; errors name the task file's field. Without `drawn` (nothing
+  // will draw the model) its builtin textures are made 1 pixel and its cameras and lights are
+  // left out; the physics is the same.
+  static Result<std::unique_ptr<Plant>> Create(const Task& task, bool drawn = true);
 
   // Every unit off and cold (the units' streams seeded by `seed`), the model at rest, forces
   // computed; the payloads due at t = 0 applied.

@@ -346,7 +346,7 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
 
   const bool draws = std::any_of(observers.begin(), observers.end(),
                                  [](const StepObserver* o) { return o->Draws(); });
-  auto plant_or = Plant::Create(task, /*textures=*/draws);
+  auto plant_or = Plant::Create(task, /*drawn=*/draws);
   if (!plant_or.ok()) return Error{plant_or.error()};
   Plant& plant = **plant_or;
   plant.Reset(options.seed);

@@ -246,18 +246,23 @@ TEST(ClosedLoop, TaskFieldsThatDoNotMatchTheModelAreNamed) {
   EXPECT_NE(r.error().find("controller.estimator"), std::string::npos) << r.error();
 }
 
-// A run that draws nothing loads the model with 1-pixel builtin textures: the same physics step
-// for step (against the model as mj_loadXML gives it), and far fewer texture bytes.
-TEST(ClosedLoop, PlantWithoutTexturesStepsLikeTheFullModel) {
+// A run that draws nothing loads the model with 1-pixel builtin textures and without cameras and
+// lights: the same physics step for step (against the model as mj_loadXML gives it), far fewer
+// texture bytes, nothing for MuJoCo to place at each step.
+TEST(ClosedLoop, PlantThatIsNotDrawnStepsLikeTheFullModel) {
   const Task task = LoadTask("arm_push.json");
-  auto full = Plant::Create(task, /*textures=*/true);
-  auto bare = Plant::Create(task, /*textures=*/false);
+  auto full = Plant::Create(task, /*drawn=*/true);
+  auto bare = Plant::Create(task, /*drawn=*/false);
   ASSERT_TRUE(full.ok() && bare.ok());
   Plant& a = **full;
   Plant& b = **bare;
   EXPECT_GT(a.model()->ntexdata, 100000);
   EXPECT_LT(b.model()->ntexdata, 100);
   EXPECT_EQ(a.model()->ntex, b.model()->ntex);
+  EXPECT_GE(a.model()->ncam, 1);
+  EXPECT_GE(a.model()->nlight, 1);
+  EXPECT_EQ(b.model()->ncam, 0);
+  EXPECT_EQ(b.model()->nlight, 0);
   a.Reset(5);
   b.Reset(5);
   for (int step = 0; step < 3000; ++step) {
@@ -271,14 +276,17 @@ TEST(ClosedLoop, PlantWithoutTexturesStepsLikeTheFullModel) {
   EXPECT_GT(a.OnCount(0), 0);
   EXPECT_EQ(a.OnCount(0), b.OnCount(0));
   EXPECT_EQ(a.angle(), b.angle());
+  EXPECT_EQ(a.angular_velocity(), b.angular_velocity());
   EXPECT_EQ(a.Force(0), b.Force(0));
+  EXPECT_EQ(a.Force(1), b.Force(1));
+  EXPECT_EQ(a.MeanTemperature(0), b.MeanTemperature(0));
 }
 
 // The plant's reads of a bundle (kept from one pass after each step) follow every broadcast and
 // step: each equals the host's separate read of the same mjData at that moment.
 TEST(ClosedLoop, PlantReadsFollowBroadcastsAndSteps) {
   const Task task = LoadTask("arm_push.json");
-  auto created = Plant::Create(task, /*textures=*/false);
+  auto created = Plant::Create(task, /*drawn=*/false);
   ASSERT_TRUE(created.ok()) << created.error();
   Plant& plant = **created;
   plant.Reset(11);
@@ -304,12 +312,15 @@ TEST(ClosedLoop, PlantReadsFollowBroadcastsAndSteps) {
   EXPECT_GT(changed, 0) << "no broadcast changed the on count: the test checks nothing";
 }
 
-// An observer that draws is handed the model with its textures at full size.
-TEST(ClosedLoop, AnObserverThatDrawsGetsTheFullTextures) {
+// An observer that draws is handed the model with its textures at full size, its cameras and
+// lights.
+TEST(ClosedLoop, AnObserverThatDrawsGetsTheFullModel) {
   struct Drawer : StepObserver {
-    int ntexdata = -1;
+    int ntexdata = -1, ncam = -1, nlight = -1;
     Status OnStep(const mjModel* m, const mjData*, const TelemetrySample&) override {
       ntexdata = m->ntexdata;
+      ncam = m->ncam;
+      nlight = m->nlight;
       return Status::Ok();
     }
     bool Draws() const override { return true; }
@@ -323,6 +334,8 @@ TEST(ClosedLoop, AnObserverThatDrawsGetsTheFullTextures) {
   mjModel* m = mj_loadXML(task.model_path.c_str(), nullptr, error, sizeof error);
   ASSERT_NE(m, nullptr) << error;
   EXPECT_EQ(drawer.ntexdata, m->ntexdata);
+  EXPECT_EQ(drawer.ncam, m->ncam);
+  EXPECT_EQ(drawer.nlight, m->nlight);
   mj_deleteModel(m);
 }
 
