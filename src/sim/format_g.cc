@@ -38,20 +38,22 @@ constexpr char kDigitPairs[] =
     "40414243444546474849505152535455565758596061626364656667686970717273747576777879"
     "8081828384858687888990919293949596979899";
 
-// The n decimal digits of v (v < 10^n) at p[0..n).
+// The n decimal digits of v (v < 10^n) at p[0..n), leading zeros included. Most values have at
+// most 9 digits: their pairs come from 32-bit divisions, cheaper than 64-bit ones.
 void WriteDigits(std::uint64_t v, int n, char* p) {
   char* end = p + n;
-  while (v >= 100) {
+  while (v > 0xffffffffull) {
     end -= 2;
     std::memcpy(end, kDigitPairs + 2 * (v % 100), 2);
     v /= 100;
   }
-  if (v >= 10) {
+  auto w = static_cast<std::uint32_t>(v);
+  while (end - p >= 2) {
     end -= 2;
-    std::memcpy(end, kDigitPairs + 2 * v, 2);
-  } else {
-    *--end = static_cast<char>('0' + v);
+    std::memcpy(end, kDigitPairs + 2 * (w % 100), 2);
+    w /= 100;
   }
+  if (end > p) *--end = static_cast<char>('0' + w);
 }
 
 constexpr double kExactPow10[] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,
@@ -72,18 +74,20 @@ bool RoundByScaling(double x, int precision, std::uint64_t* s, int* e) {
     const int k = precision - 1 - X;
     if (k < -22 || k > 22) return false;
     const double y = k >= 0 ? x * kExactPow10[k] : x / kExactPow10[-k];
-    const double whole = std::floor(y);
-    if (whole < static_cast<double>(kPow10[precision - 1])) {  // X too high
+    // y < 10^(precision + 1) (X is the leading digit's exponent or one below): truncation is
+    // floor, one instruction where std::floor is a libm call on the portable instruction set.
+    const auto whole = static_cast<std::uint64_t>(static_cast<std::int64_t>(y));
+    if (whole < kPow10[precision - 1]) {  // X too high
       --X;
       continue;
     }
-    if (whole >= static_cast<double>(kPow10[precision])) {  // X too low
+    if (whole >= kPow10[precision]) {  // X too low
       ++X;
       continue;
     }
-    const double frac = y - whole;  // exact
+    const double frac = y - static_cast<double>(whole);  // exact
     if (std::abs(frac - 0.5) < 1e-6) return false;
-    std::uint64_t q = static_cast<std::uint64_t>(whole) + (frac > 0.5 ? 1 : 0);
+    std::uint64_t q = whole + (frac > 0.5 ? 1 : 0);
     if (q == kPow10[precision]) {  // rounded up into the next decade
       q = kPow10[precision - 1];
       ++X;
@@ -180,9 +184,12 @@ char* FormatG(double x, int precision, char* out) {
     for (int i = 0; i < X + 1 - n; ++i) *out++ = '0';
     return out;
   }
-  WriteDigits(s, n, out + 1);  // ddd.ddd: the integer part moves one place left
-  for (int i = 0; i <= X; ++i) out[i] = out[i + 1];
+  // ddd.ddd: the X + 1 digits of the integer part, the point, the n - X - 1 of the fraction.
+  std::uint64_t fraction;
+  const std::uint64_t integer = DivPow10(s, n - X - 1, &fraction);
+  WriteDigits(integer, X + 1, out);
   out[X + 1] = '.';
+  WriteDigits(fraction, n - X - 1, out + X + 2);
   return out + n + 1;
 }
 

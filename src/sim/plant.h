@@ -86,7 +86,7 @@ class Plant {
   std::vector<bool> payload_done_;
   std::vector<double> peak_temperature_, peak_stress_;
   mutable std::vector<sma::SmaBundle::Telemetry> observed_;  // a cache: see Observed
-  mutable std::vector<bool> observed_valid_;
+  mutable std::vector<unsigned char> observed_valid_;
   // Each payload body's mass and inertia as loaded (Reset restores them).
   std::vector<double> body_mass0_, body_inertia0_;
 };
