@@ -8,15 +8,8 @@
 namespace recruit::sim {
 namespace {
 
-// The model at `path`; without `drawn` (a run that draws nothing), every builtin texture (a
-// sky, a floor grid) compiled at 1 x 1 pixel, and no camera or light. Texture pixels only colour
-// renders, yet generating them (and the plugin hashing them with the rest of the model) was ~4 %
-// of a 60 s arm run's instructions (34 of 792 M); MuJoCo places every camera and light at each
-// step (~1 %), which only a renderer reads.
-mjModel* LoadPlantModel(const std::string& path, bool drawn, char* error, int error_size) {
-  if (drawn) return mj_loadXML(path.c_str(), nullptr, error, error_size);
-  mjSpec* spec = mj_parseXML(path.c_str(), nullptr, error, error_size);
-  if (spec == nullptr) return nullptr;
+// Builtin textures at 1 x 1 pixel, no camera, no light.
+void LeaveOutWhatOnlyRendersRead(mjSpec* spec) {
   for (mjsElement* e = mjs_firstElement(spec, mjOBJ_TEXTURE); e != nullptr;
        e = mjs_nextElement(spec, e)) {
     mjsTexture* t = mjs_asTexture(e);
@@ -29,6 +22,20 @@ mjModel* LoadPlantModel(const std::string& path, bool drawn, char* error, int er
     }
   }
   for (mjsElement* e : unseen) mjs_delete(spec, e);
+}
+
+// The model at `path`; without `drawn` (a run that draws nothing), every builtin texture (a
+// sky, a floor grid) compiled at 1 x 1 pixel, and no camera or light. Texture pixels only colour
+// renders, yet generating them (and the plugin hashing them with the rest of the model) was ~4 %
+// of a 60 s arm run's instructions (34 of 792 M); MuJoCo places every camera and light at each
+// step (~1 %), which only a renderer reads.
+mjModel* LoadPlantModel(const std::string& path, bool drawn, char* error, int error_size) {
+  mjSpec* spec = mj_parseXML(path.c_str(), nullptr, error, error_size);
+  if (spec == nullptr) return nullptr;
+  // The compiler's thread pool only speeds up mesh processing; without meshes, starting and
+  // joining its threads is all it does.
+  if (mjs_firstElement(spec, mjOBJ_MESH) == nullptr) spec->compiler.usethread = false;
+  if (!drawn) LeaveOutWhatOnlyRendersRead(spec);
   mjModel* m = mj_compile(spec, nullptr);
   if (m == nullptr) std::snprintf(error, error_size, "%s", mjs_getError(spec));
   mj_deleteSpec(spec);

@@ -331,5 +331,47 @@ TEST(FitCheck, UnlimitedJointsAreNotChecked) {
   EXPECT_EQ(warnings.joined(), "");
 }
 
+// Over one joint the range comes from 33 points and a golden-section search at each interior
+// extreme: a two-site tendon whose length has its minimum inside the joint's range (off the
+// grid) and another whose length has its maximum there, against the law of cosines. Site A is
+// fixed at distance 0.2 m from a vertical hinge, site B turns with it at 0.1 m: the length is
+// sqrt(0.05 - 0.04 cos(q - q_B)), q in -50..70 deg.
+TEST(FitCheck, FindsAnExtremeInsideTheRangeOfOneJoint) {
+  auto model = [](const char* b_pos) {
+    return std::string(R"(<mujoco>
+  <compiler angle="degree" autolimits="true"/>
+  <extension><plugin plugin="recruit.sma"><instance name="units"/></plugin></extension>
+  <worldbody>
+    <site name="a" pos="0.2 0 0"/>
+    <body name="arm">
+      <joint name="turn" type="hinge" axis="0 0 1" range="-50 70"/>
+      <geom type="sphere" size="0.01" mass="0.1" contype="0" conaffinity="0"/>
+      <site name="b" pos=")") +
+           b_pos + R"("/>
+    </body>
+  </worldbody>
+  <tendon><spatial name="t"><site site="a"/><site site="b"/></spatial></tendon>
+  <actuator><plugin name="m" instance="units" tendon="t" ctrlrange="-1 1"/></actuator>
+</mujoco>)";
+  };
+  auto length = [](double q_deg) { return std::sqrt(0.05 - 0.04 * std::cos(q_deg * mjPI / 180)); };
+  testing::WarningCapture warnings;  // the default units do not fit: not the point here
+  // B toward A at q = 0: the shortest length (0.1 m) at q = 0, 13.3 grid steps from -50 deg.
+  auto near = LoadModelFromString(model("0.1 0 0"));
+  ASSERT_TRUE(near.ok()) << near.error();
+  std::vector<TendonFit> fits = FitsOf(near->get());
+  ASSERT_EQ(fits.size(), 1u);
+  EXPECT_EQ(fits[0].joints, 1);
+  EXPECT_NEAR(fits[0].length_min, 0.1, 1e-10);
+  EXPECT_NEAR(fits[0].length_max, length(70), 1e-12);
+  // B away from A at q = 0: the longest length (0.3 m) there.
+  auto far = LoadModelFromString(model("-0.1 0 0"));
+  ASSERT_TRUE(far.ok()) << far.error();
+  fits = FitsOf(far->get());
+  ASSERT_EQ(fits.size(), 1u);
+  EXPECT_NEAR(fits[0].length_max, 0.3, 1e-10);
+  EXPECT_NEAR(fits[0].length_min, length(180 - 70), 1e-12);
+}
+
 }  // namespace
 }  // namespace recruit::sma
