@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "common/atomic_file.h"
+#include "plugin/sma_host.h"
 #include "sim/csv_writer.h"
 #include "sim/plant.h"
 #include "sim/run_task.h"
@@ -280,6 +281,51 @@ TEST(ClosedLoop, PlantThatIsNotDrawnStepsLikeTheFullModel) {
   EXPECT_EQ(a.Force(0), b.Force(0));
   EXPECT_EQ(a.Force(1), b.Force(1));
   EXPECT_EQ(a.MeanTemperature(0), b.MeanTemperature(0));
+}
+
+// The plant disables MuJoCo stages the arm has nothing for (frictionloss, equality; islands in
+// one kinematic tree) and its sensors; stepped against the same model as mj_loadXML gives it,
+// all stages on, driven the same way, every position and velocity is equal.
+TEST(ClosedLoop, PlantSkipsStagesTheModelHasNothingForAndStepsTheSame) {
+  const Task task = LoadTask("arm_push.json");
+  auto created = Plant::Create(task, /*drawn=*/false);
+  ASSERT_TRUE(created.ok()) << created.error();
+  Plant& plant = **created;
+  const int skipped = mjDSBL_FRICTIONLOSS | mjDSBL_EQUALITY | mjDSBL_ISLAND | mjDSBL_SENSOR;
+  EXPECT_EQ(plant.model()->opt.disableflags & skipped, skipped);
+
+  char error[500] = "";
+  mjModel* m = mj_loadXML(task.model_path.c_str(), nullptr, error, sizeof error);
+  ASSERT_NE(m, nullptr) << error;
+  EXPECT_EQ(m->opt.disableflags & skipped, 0);
+  auto host = sma::SmaHost::Create(m);
+  ASSERT_TRUE(host.ok()) << host.error();
+  mjData* d = mj_makeData(m);
+  mj_resetData(m, d);
+  (*host)->Reset(d, 5);
+  mj_forward(m, d);
+  plant.Reset(5);
+  int limited_steps = 0;
+  for (int step = 0; step < 5000; ++step) {
+    // Every flexor unit on: the elbow flexes onto its upper limit (100 deg); then off.
+    if (step == 0 || step == 3000) {
+      const double p_on = step == 0 ? 1.0 : 0.0, p_off = 1.0 - p_on;
+      ASSERT_TRUE(plant.Broadcast(0, p_on, p_off).ok());
+      ASSERT_TRUE((*host)->Broadcast(d, plant.bundle_index(0), p_on, p_off).ok());
+    }
+    plant.Step();
+    mj_step(m, d);
+    limited_steps += d->nefc > 0;
+  }
+  EXPECT_GT(limited_steps, 0) << "the limit never acted: the constraint stages went untested";
+  for (int k = 0; k < m->nq; ++k) EXPECT_EQ(plant.data()->qpos[k], d->qpos[k]);
+  for (int k = 0; k < m->nv; ++k) EXPECT_EQ(plant.data()->qvel[k], d->qvel[k]);
+  for (int i = 0; i < plant.num_bundles(); ++i) {
+    EXPECT_EQ(plant.Force(i), (*host)->Force(d, plant.bundle_index(i)));
+  }
+  mj_deleteData(d);
+  host->reset();
+  mj_deleteModel(m);
 }
 
 // The plant's reads of a bundle (kept from one pass after each step) follow every broadcast and
