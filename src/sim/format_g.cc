@@ -99,6 +99,41 @@ bool RoundByScaling(double x, int precision, std::uint64_t* s, int* e) {
   return false;
 }
 
+// The 9 decimal digits of v < 10^9, leading zeros included, at p[0..9). Each pair comes from v by
+// its own constant division: independent of the others, so they overlap in the pipeline where a
+// chain of divisions by 100 waits for each step (the formatter is latency-bound, not
+// instruction-bound).
+void NineDigits(std::uint32_t v, char* p) {
+  p[0] = static_cast<char>('0' + v / 100000000);
+  std::memcpy(p + 1, kDigitPairs + 2 * (v / 1000000 % 100), 2);
+  std::memcpy(p + 3, kDigitPairs + 2 * (v / 10000 % 100), 2);
+  std::memcpy(p + 5, kDigitPairs + 2 * (v / 100 % 100), 2);
+  std::memcpy(p + 7, kDigitPairs + 2 * (v % 100), 2);
+}
+
+// s (exactly `precision` <= 9 digits) x 10^e in %g's fixed form, if its leading digit's exponent
+// X is in -4..precision-1 (else nullptr): the digits, trailing zeros dropped, around the point.
+// Moves are 16 bytes of constant size (one instruction each); out has kFormatGMax bytes.
+char* FixedForm(std::uint64_t s, int e, int precision, char* out) {
+  const int X = e + precision - 1;
+  if (X < -4 || X >= precision) return nullptr;
+  char buf[32] = {};
+  NineDigits(static_cast<std::uint32_t>(s), buf);
+  const char* d = buf + 9 - precision;
+  int n = precision;
+  while (n > 1 && d[n - 1] == '0') --n;  // %g drops trailing zeros
+  if (X < 0) {                           // 0.000ddd
+    std::memcpy(out, "0.000000", 8);
+    std::memcpy(out + 1 - X, d, 16);
+    return out + 1 - X + n;
+  }
+  std::memcpy(out, d, 16);
+  if (n <= X + 1) return out + X + 1;  // an integer (its zeros are digits of s)
+  out[X + 1] = '.';
+  std::memcpy(out + X + 2, d + X + 1, 16);
+  return out + n + 1;
+}
+
 // The general case (and the rare ones the fast path leaves): fmt, which follows printf.
 char* Slow(double x, int precision, char* out) {
   return fmt::format_to(out, "{:.{}g}", x, precision);
@@ -126,7 +161,10 @@ char* FormatG(double x, int precision, char* out) {
   }
   std::uint64_t s;
   int e;
-  if (!RoundByScaling(x, precision, &s, &e)) {
+  const bool scaled = RoundByScaling(x, precision, &s, &e);
+  if (scaled) {
+    if (char* end = FixedForm(s, e, precision, out)) return end;
+  } else {
     const auto dec = fmt::detail::dragonbox::to_decimal(x);
     s = dec.significand;
     e = dec.exponent;
