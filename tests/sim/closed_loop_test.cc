@@ -3,6 +3,7 @@
 // reproducible per seed, a real sweep gives byte-identical reports on 1 and 2 threads, and task
 // fields that do not match the model are reported by name.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
@@ -283,21 +284,18 @@ TEST(ClosedLoop, PlantThatIsNotDrawnStepsLikeTheFullModel) {
   EXPECT_EQ(a.MeanTemperature(0), b.MeanTemperature(0));
 }
 
-// The plant disables MuJoCo stages the arm has nothing for (frictionloss, equality; islands in
-// one kinematic tree) and its sensors; stepped against the same model as mj_loadXML gives it,
-// all stages on, driven the same way, every position and velocity is equal.
-TEST(ClosedLoop, PlantSkipsStagesTheModelHasNothingForAndStepsTheSame) {
-  const Task task = LoadTask("arm_push.json");
+// Steps `task`'s plant and the model as mj_loadXML gives it (every stage on) side by side,
+// driven the same way: every flexor unit on, so the elbow flexes onto its upper limit (100 deg),
+// then off. Every position, velocity and force is equal.
+void ExpectStepsLikeTheModelWithEveryStage(const Task& task) {
   auto created = Plant::Create(task, /*drawn=*/false);
   ASSERT_TRUE(created.ok()) << created.error();
   Plant& plant = **created;
-  const int skipped = mjDSBL_FRICTIONLOSS | mjDSBL_EQUALITY | mjDSBL_ISLAND | mjDSBL_SENSOR;
-  EXPECT_EQ(plant.model()->opt.disableflags & skipped, skipped);
-
   char error[500] = "";
   mjModel* m = mj_loadXML(task.model_path.c_str(), nullptr, error, sizeof error);
   ASSERT_NE(m, nullptr) << error;
-  EXPECT_EQ(m->opt.disableflags & skipped, 0);
+  const int skippable = mjDSBL_FRICTIONLOSS | mjDSBL_EQUALITY | mjDSBL_ISLAND | mjDSBL_SENSOR;
+  EXPECT_EQ(m->opt.disableflags & skippable, 0);
   auto host = sma::SmaHost::Create(m);
   ASSERT_TRUE(host.ok()) << host.error();
   mjData* d = mj_makeData(m);
@@ -307,7 +305,6 @@ TEST(ClosedLoop, PlantSkipsStagesTheModelHasNothingForAndStepsTheSame) {
   plant.Reset(5);
   int limited_steps = 0;
   for (int step = 0; step < 5000; ++step) {
-    // Every flexor unit on: the elbow flexes onto its upper limit (100 deg); then off.
     if (step == 0 || step == 3000) {
       const double p_on = step == 0 ? 1.0 : 0.0, p_off = 1.0 - p_on;
       ASSERT_TRUE(plant.Broadcast(0, p_on, p_off).ok());
@@ -317,7 +314,7 @@ TEST(ClosedLoop, PlantSkipsStagesTheModelHasNothingForAndStepsTheSame) {
     mj_step(m, d);
     limited_steps += d->nefc > 0;
   }
-  EXPECT_GT(limited_steps, 0) << "the limit never acted: the constraint stages went untested";
+  EXPECT_GT(limited_steps, 0) << "no constraint acted: the constraint stages went untested";
   for (int k = 0; k < m->nq; ++k) EXPECT_EQ(plant.data()->qpos[k], d->qpos[k]);
   for (int k = 0; k < m->nv; ++k) EXPECT_EQ(plant.data()->qvel[k], d->qvel[k]);
   for (int i = 0; i < plant.num_bundles(); ++i) {
@@ -326,6 +323,45 @@ TEST(ClosedLoop, PlantSkipsStagesTheModelHasNothingForAndStepsTheSame) {
   mj_deleteData(d);
   host->reset();
   mj_deleteModel(m);
+}
+
+// The plant disables MuJoCo stages the arm has nothing for (frictionloss, equality; islands in
+// one kinematic tree) and its sensors, and steps exactly as the model with every stage on.
+TEST(ClosedLoop, PlantSkipsStagesTheModelHasNothingForAndStepsTheSame) {
+  const Task task = LoadTask("arm_push.json");
+  auto created = Plant::Create(task, /*drawn=*/false);
+  ASSERT_TRUE(created.ok()) << created.error();
+  const int skipped = mjDSBL_FRICTIONLOSS | mjDSBL_EQUALITY | mjDSBL_ISLAND | mjDSBL_SENSOR;
+  EXPECT_EQ((*created)->model()->opt.disableflags & skipped, skipped);
+  ExpectStepsLikeTheModelWithEveryStage(task);
+}
+
+// With dry friction in the elbow, the frictionloss stage stays on, and the plant still steps as
+// the model with every stage on.
+TEST(ClosedLoop, PlantKeepsTheFrictionlossStageOfAModelWithFriction) {
+  Task task = LoadTask("arm_push.json");
+  std::ifstream in(task.model_path);
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string xml = text.str();
+  const std::string joint = "damping=\"0.02\"";
+  ASSERT_NE(xml.find(joint), std::string::npos);
+  xml.replace(xml.find(joint), joint.size(), joint + " frictionloss=\"0.002\"");
+  // The arm model names no file (its textures are builtin): it loads from anywhere.
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("recruit_friction_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  task.model_path = (dir / "elbow_arm_friction.xml").string();
+  {
+    std::ofstream out(task.model_path);
+    out << xml;
+  }
+  auto created = Plant::Create(task, /*drawn=*/false);
+  ASSERT_TRUE(created.ok()) << created.error();
+  EXPECT_EQ((*created)->model()->opt.disableflags & mjDSBL_FRICTIONLOSS, 0);
+  EXPECT_NE((*created)->model()->opt.disableflags & mjDSBL_EQUALITY, 0);
+  ExpectStepsLikeTheModelWithEveryStage(task);
+  std::filesystem::remove_all(dir);
 }
 
 // The plant's reads of a bundle (kept from one pass after each step) follow every broadcast and
