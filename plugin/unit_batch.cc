@@ -301,6 +301,40 @@ inline void Canonical(Vd* xi, Vd* hs, Vd* cs) {
   *cs = Sel(top, Splat(0), Sel(low, Splat(1), *cs));
 }
 
+// Appends base + l for each set bit l of `bits` (a lane mask), lowest first, to list[n..] and
+// returns the new length, without a loop over the bits; writes list[n..n + kAppendWidth).
+#if defined(RECRUIT_SMA_LANES8)
+constexpr int kAppendWidth = 16;  // one 16-lane store (a 256-bit one trips GCC 12's warnings)
+inline int AppendLanes(int* list, int n, int base, int bits) {
+  const __m512i lanes = _mm512_add_epi32(
+      _mm512_set1_epi32(base), _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 0, 0, 0, 0, 0, 0, 0, 0));
+  _mm512_storeu_si512(list + n, _mm512_maskz_compress_epi32(static_cast<__mmask16>(bits), lanes));
+  return n + __builtin_popcount(bits);
+}
+#else
+constexpr int kAppendWidth = kLanes;
+// Each lane mask's set lanes, lowest first, and how many.
+struct LaneLists {
+  int lane[1 << kLanes][kLanes];
+  int count[1 << kLanes];
+};
+constexpr LaneLists MakeLaneLists() {
+  LaneLists t{};
+  for (int m = 0; m < (1 << kLanes); ++m) {
+    for (int l = 0; l < kLanes; ++l) {
+      if ((m >> l) & 1) t.lane[m][t.count[m]++] = l;
+    }
+  }
+  return t;
+}
+constexpr LaneLists kLaneLists = MakeLaneLists();
+
+inline int AppendLanes(int* list, int n, int base, int bits) {
+  for (int l = 0; l < kLanes; ++l) list[n + l] = base + kLaneLists.lane[bits][l];
+  return n + kLaneLists.count[bits];
+}
+#endif
+
 // kLanes consecutive cohorts' fields in the caller's arrays (the tail: fewer, masked).
 struct Block {
   const double* on;
@@ -324,7 +358,7 @@ void AdvanceCohorts(const BatchParams& p, const BatchCohorts& c, int n, double s
   const Vd amb = Splat(p.ambient), rise_A = Splat(p.rise_A), rise_dM = Splat(p.rise_dM);
   const Vd vdecay = Splat(decay);
   alignas(32) double tth[kChunk], g0[kChunk], dg0[kChunk], heat[kChunk];
-  int solve[kChunk + kLanes];
+  int solve[kChunk + kAppendWidth];
   for (int base = 0; base < n; base += kChunk) {
     const int m = n - base < kChunk ? n - base : kChunk;
     int n_solve = 0;
@@ -368,9 +402,7 @@ void AdvanceCohorts(const BatchParams& p, const BatchCohorts& c, int n, double s
       Store(g0 + j, g);
       Store(dg0 + j, dg);
       Store(heat + j, ToVd(is_heat));
-      for (int bits = Bits(tr) & ((1 << count) - 1); bits != 0; bits &= bits - 1) {
-        solve[n_solve++] = j + __builtin_ctz(bits);
-      }
+      n_solve = AppendLanes(solve, n_solve, j, Bits(tr) & ((1 << count) - 1));
     };
     const double* const on = c.on + base;
     double* const T = c.temperature + base;
@@ -385,7 +417,10 @@ void AdvanceCohorts(const BatchParams& p, const BatchCohorts& c, int n, double s
     if (j < m) phase_a(Block{on + j, T + j, xi + j, te + j, hs + j, cs + j}, j, m - j);
     // (B) A short batch repeats its last cohort (same inputs, same result). Batches go through
     // Newton in pairs (their cohorts differ: both are read before either is written).
-    for (int l = n_solve; l % kLanes != 0; ++l) solve[l] = solve[n_solve - 1];
+    if (n_solve % kLanes != 0) {
+      const int last = solve[n_solve - 1];
+      for (int l = 0; l < kLanes; ++l) solve[n_solve + l] = last;  // one store
+    }
     auto prepare = [&](const int* idx, Lanes* L, Vd* g, Vd* dg) __attribute__((always_inline)) {
       // Lane-by-lane loads (faster here than the gather instructions).
 #if defined(RECRUIT_SMA_LANES8)
