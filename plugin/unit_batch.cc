@@ -44,6 +44,7 @@ inline Mask ToMask(Vd v) { return _mm512_movepi64_mask(_mm512_castpd_si512(v)); 
 inline Mask Lt(Vd a, Vd b) { return _mm512_cmp_pd_mask(a, b, _CMP_LT_OQ); }
 inline Mask Le(Vd a, Vd b) { return _mm512_cmp_pd_mask(a, b, _CMP_LE_OQ); }
 inline Mask Ne(Vd a, Vd b) { return _mm512_cmp_pd_mask(a, b, _CMP_NEQ_UQ); }
+inline Mask Eq(Vd a, Vd b) { return _mm512_cmp_pd_mask(a, b, _CMP_EQ_OQ); }
 inline Mask And(Mask a, Mask b) { return static_cast<Mask>(a & b); }
 inline Mask Or(Mask a, Mask b) { return static_cast<Mask>(a | b); }
 inline Mask AndNot(Mask a, Mask b) { return static_cast<Mask>(a & ~b); }  // a & ~b
@@ -67,6 +68,7 @@ inline void Store(double* p, Vd v) { _mm256_storeu_pd(p, v); }
 inline Vd Lt(Vd a, Vd b) { return _mm256_cmp_pd(a, b, _CMP_LT_OQ); }
 inline Vd Le(Vd a, Vd b) { return _mm256_cmp_pd(a, b, _CMP_LE_OQ); }
 inline Vd Ne(Vd a, Vd b) { return _mm256_cmp_pd(a, b, _CMP_NEQ_UQ); }
+inline Vd Eq(Vd a, Vd b) { return _mm256_cmp_pd(a, b, _CMP_EQ_OQ); }
 inline Vd And(Vd a, Vd b) { return _mm256_and_pd(a, b); }
 inline Vd Or(Vd a, Vd b) { return _mm256_or_pd(a, b); }
 inline Vd AndNot(Vd a, Vd b) { return _mm256_andnot_pd(b, a); }  // a & ~b
@@ -88,6 +90,7 @@ inline void Store(double* p, Vd v) { _mm_storeu_pd(p, v); }
 inline Vd Lt(Vd a, Vd b) { return _mm_cmplt_pd(a, b); }
 inline Vd Le(Vd a, Vd b) { return _mm_cmple_pd(a, b); }
 inline Vd Ne(Vd a, Vd b) { return _mm_cmpneq_pd(a, b); }
+inline Vd Eq(Vd a, Vd b) { return _mm_cmpeq_pd(a, b); }
 inline Vd And(Vd a, Vd b) { return _mm_and_pd(a, b); }
 inline Vd Or(Vd a, Vd b) { return _mm_or_pd(a, b); }
 inline Vd AndNot(Vd a, Vd b) { return _mm_andnot_pd(b, a); }  // a & ~b
@@ -111,6 +114,7 @@ inline void Store(double* p, Vd v) { std::memcpy(p, &v, sizeof v); }
 inline Vd Lt(Vd a, Vd b) { return reinterpret_cast<Vd>(a < b); }
 inline Vd Le(Vd a, Vd b) { return reinterpret_cast<Vd>(a <= b); }
 inline Vd Ne(Vd a, Vd b) { return reinterpret_cast<Vd>(a != b); }
+inline Vd Eq(Vd a, Vd b) { return reinterpret_cast<Vd>(a == b); }
 inline Vd Bit(Vi x) { return reinterpret_cast<Vd>(x); }
 inline Vi Int(Vd x) { return reinterpret_cast<Vi>(x); }
 inline Vd And(Vd a, Vd b) { return Bit(Int(a) & Int(b)); }
@@ -134,6 +138,7 @@ inline Mask Lt(Vd a, double b) { return Lt(a, Splat(b)); }
 inline Mask Gt(Vd a, double b) { return Lt(Splat(b), a); }
 inline Mask Le(Vd a, double b) { return Le(a, Splat(b)); }
 inline Mask Ge(Vd a, double b) { return Le(Splat(b), a); }
+inline Mask Eq(Vd a, double b) { return Eq(a, Splat(b)); }
 // |x| by clearing the sign bit (std::abs).
 inline Vd Abs(Vd x) { return AndNot(x, Splat(-0.0)); }
 // std::clamp(v, 0, 1) lane by lane (NaN passes through, as there).
@@ -301,28 +306,38 @@ inline void Canonical(Vd* xi, Vd* hs, Vd* cs) {
   *cs = Sel(top, Splat(0), Sel(low, Splat(1), *cs));
 }
 
-// Appends base + l for each set bit l of `bits` (a lane mask), lowest first, to list[n..] and
-// returns the new length, without a loop over the bits; writes list[n..n + kAppendWidth).
+// Appending the lanes a mask selects, lowest first, without a loop over its bits:
+// AppendLanes appends base + l for each set bit l of `bits` to list[n..] and returns the new
+// length; AppendValues appends those lanes of v to list[n..]. Both write kLanes entries.
 #if defined(RECRUIT_SMA_LANES8)
-constexpr int kAppendWidth = 16;  // one 16-lane store (a 256-bit one trips GCC 12's warnings)
 inline int AppendLanes(int* list, int n, int base, int bits) {
   const __m512i lanes = _mm512_add_epi32(
       _mm512_set1_epi32(base), _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 0, 0, 0, 0, 0, 0, 0, 0));
-  _mm512_storeu_si512(list + n, _mm512_maskz_compress_epi32(static_cast<__mmask16>(bits), lanes));
+  // A masked store of the low 8 (GCC 12 warns on the intrinsics that take the low half).
+  _mm512_mask_storeu_epi32(list + n, 0xff,
+                           _mm512_maskz_compress_epi32(static_cast<__mmask16>(bits), lanes));
   return n + __builtin_popcount(bits);
 }
+inline void AppendValues(double* list, int n, Vd v, int bits) {
+  Store(list + n, _mm512_maskz_compress_pd(static_cast<Mask>(bits), v));
+}
 #else
-constexpr int kAppendWidth = kLanes;
-// Each lane mask's set lanes, lowest first, and how many.
+// Each lane mask's set lanes, lowest first, how many, and (AVX2) the 32-bit halves of those
+// lanes (a permutation of 8 floats that moves them to the front).
 struct LaneLists {
   int lane[1 << kLanes][kLanes];
   int count[1 << kLanes];
+  int halves[1 << kLanes][2 * kLanes];
 };
 constexpr LaneLists MakeLaneLists() {
   LaneLists t{};
   for (int m = 0; m < (1 << kLanes); ++m) {
     for (int l = 0; l < kLanes; ++l) {
       if ((m >> l) & 1) t.lane[m][t.count[m]++] = l;
+    }
+    for (int l = 0; l < kLanes; ++l) {
+      t.halves[m][2 * l] = 2 * t.lane[m][l];
+      t.halves[m][2 * l + 1] = 2 * t.lane[m][l] + 1;
     }
   }
   return t;
@@ -332,6 +347,17 @@ constexpr LaneLists kLaneLists = MakeLaneLists();
 inline int AppendLanes(int* list, int n, int base, int bits) {
   for (int l = 0; l < kLanes; ++l) list[n + l] = base + kLaneLists.lane[bits][l];
   return n + kLaneLists.count[bits];
+}
+inline void AppendValues(double* list, int n, Vd v, int bits) {
+#if defined(__AVX2__)
+  const __m256i perm =
+      _mm256_loadu_si256(reinterpret_cast<const __m256i*>(kLaneLists.halves[bits]));
+  Store(list + n, _mm256_castps_pd(_mm256_permutevar8x32_ps(_mm256_castpd_ps(v), perm)));
+#else
+  alignas(32) double lanes[kLanes];
+  Store(lanes, v);
+  for (int l = 0; l < kLanes; ++l) list[n + l] = lanes[kLaneLists.lane[bits][l]];
+#endif
 }
 #endif
 
@@ -358,7 +384,7 @@ void AdvanceCohorts(const BatchParams& p, const BatchCohorts& c, int n, double s
   const Vd amb = Splat(p.ambient), rise_A = Splat(p.rise_A), rise_dM = Splat(p.rise_dM);
   const Vd vdecay = Splat(decay);
   alignas(32) double tth[kChunk], g0[kChunk], dg0[kChunk], heat[kChunk];
-  int solve[kChunk + kAppendWidth];
+  int solve[kChunk + kLanes];
   for (int base = 0; base < n; base += kChunk) {
     const int m = n - base < kChunk ? n - base : kChunk;
     int n_solve = 0;
@@ -627,24 +653,29 @@ void Observe(const BatchParams& p, const double* count, const double* const* v, 
 // The merge order has no sums: every clone has it (the 8-lane one counts eight ranks at once).
 bool MergeOrder(const double* on, const double* temp, int n, int* order, double* t, int* idx) {
   // Off cohorts' temperatures in t[0..n0), on cohorts' in t[s1..s1 + n1) (s1 = n + kLanes),
-  // each followed by kLanes of +inf (read, never used), with their indices in idx, written
-  // without branches on the data; on values other than 0 and 1, and NaN temperatures, give up.
-  // Scratch: 2 (n + kLanes) each.
+  // each followed by kLanes of +inf (read, never used), with their indices in idx: kLanes
+  // cohorts at a time, appended by lane mask; on values other than 0 and 1, and NaN
+  // temperatures, give up. Scratch: 2 (n + kLanes) each.
   const int s1 = n + kLanes;
-  int n0 = 0, n1 = 0;
-  bool bad = false;
-  for (int j = 0; j < n; ++j) {
-    const bool is_off = on[j] == 0, is_on = on[j] == 1;
-    bad |= !(is_off || is_on) || !(temp[j] == temp[j]);
-    t[n0] = temp[j], idx[n0] = j, n0 += is_off;
-    t[s1 + n1] = temp[j], idx[s1 + n1] = j, n1 += is_on;
+  int n0 = 0, n1 = 0, bad = 0;
+  for (int j = 0; j < n; j += kLanes) {
+    const int rest = n - j, valid = rest >= kLanes ? kAll : (1 << rest) - 1;
+    const Vd o = rest >= kLanes ? Load(on + j) : LoadN(on + j, rest);
+    const Vd x = rest >= kLanes ? Load(temp + j) : LoadN(temp + j, rest);
+    const Mask is_off = Eq(o, 0.0), is_on = Eq(o, 1.0);
+    bad |= ~Bits(And(Or(is_off, is_on), Eq(x, x))) & valid;
+    const int off = Bits(is_off) & valid, on1 = Bits(is_on) & valid;
+    AppendValues(t, n0, x, off);
+    n0 = AppendLanes(idx, n0, j, off);
+    AppendValues(t + s1, n1, x, on1);
+    n1 = AppendLanes(idx + s1, n1, j, on1);
   }
-  if (bad) return false;
+  if (bad != 0) return false;
   for (int l = 0; l < kLanes; ++l) t[n0 + l] = t[s1 + n1 + l] = HUGE_VAL;
   for (int j = 0; j < n; ++j) order[j] = -1;
   // Position = the group's start + how many of its temperatures are lower, counted for kLanes
-  // cohorts at once (the lanes past the group are not used); two cohorts with the same
-  // position tie.
+  // cohorts at once (the lanes past the group are not used), two temperatures per iteration
+  // (the +inf after the group counts for none).
   const Vd one = Splat(1.0);
   for (int g = 0; g < 2; ++g) {
     const double* tg = t + g * s1;
@@ -652,18 +683,20 @@ bool MergeOrder(const double* on, const double* temp, int n, int* order, double*
     const int ng = g == 0 ? n0 : n1, start = g == 0 ? 0 : n0;
     for (int b = 0; b < ng; b += kLanes) {
       const Vd x = Load(tg + b);
-      Vd c = Splat(0);
-      for (int j = 0; j < ng; ++j) c += And(one, Lt(Splat(tg[j]), x));
-      alignas(64) double rank[kLanes];
-      Store(rank, c);
-      for (int l = 0; l < kLanes && b + l < ng; ++l) {
-        const int pos = start + static_cast<int>(rank[l]);
-        bad |= order[pos] >= 0;
-        order[pos] = ig[b + l];
+      Vd c = Splat(0), c2 = Splat(0);
+      for (int j = 0; j < ng; j += 2) {
+        c += And(one, Lt(Splat(tg[j]), x));
+        c2 += And(one, Lt(Splat(tg[j + 1]), x));
       }
+      alignas(64) double rank[kLanes];
+      Store(rank, c + c2);
+      for (int l = 0; l < kLanes && b + l < ng; ++l)
+        order[start + static_cast<int>(rank[l])] = ig[b + l];
     }
   }
-  return !bad;
+  // Each group's ng positions lie in its ng slots: all filled unless two cohorts tie.
+  for (int j = 0; j < n; ++j) bad |= order[j] < 0;
+  return bad == 0;
 }
 
 #ifndef RECRUIT_SMA_LANES8
