@@ -581,30 +581,40 @@ void ObservePass(const BatchParams& p, const double* count, const double* const*
       if (kPeak) peak[r] = MaxOf(t, peak[r]);
     }
   }
-  alignas(32) double a[4][4], top[4];
-  for (int r = 0; r < kRegs; ++r) {
-    for (int f = 0; f < 4; ++f) Store(a[f] + r * kLanes, acc[f][r]);
-    Store(top + r * kLanes, peak[r]);
-  }
-  // The last n - j < 4 cohorts: the sums one by one (as Sums), the tension from masked loads
-  // (as SumTension: missing lanes add count 0 times a tension, +0).
-  for (int f = 0; f < 3; ++f) {
-    for (int l = 0; j + l < n; ++l) a[f][l] += count[j + l] * v[f][j + l];
-  }
+  // The last n - j < 4 cohorts from masked loads, as SumTension: a missing lane adds count 0
+  // times 0 (or a tension), +0, which leaves a partial sum as it is (from +0, never -0).
   double top_tail = 0;
   for (int r = 0; r < kRegs && j + r * kLanes < n; ++r) {
     const int i = j + r * kLanes, rest = n - i;
-    const Vd cnt = rest >= kLanes ? Load(count + i) : LoadN(count + i, rest);
-    const Vd x = rest >= kLanes ? Load(v[2] + i) : LoadN(v[2] + i, rest);
-    const Vd t = TensionOnly(k, x);
-    alignas(32) double f[kLanes], tl[kLanes];
-    Store(f, cnt * t);
-    Store(tl, t);
-    for (int l = 0; l < kLanes; ++l) a[3][r * kLanes + l] += f[l];
-    for (int l = 0; l < kLanes && l < rest; ++l) top_tail = tl[l] > top_tail ? tl[l] : top_tail;
+    auto load = [&](const double* a) { return rest >= kLanes ? Load(a + i) : LoadN(a + i, rest); };
+    const Vd c = load(count), x = load(v[2]), t = TensionOnly(k, x);
+    acc[0][r] += c * load(v[0]);
+    acc[1][r] += c * load(v[1]);
+    acc[2][r] += c * x;
+    acc[3][r] += c * t;
+    if (kPeak) {
+      alignas(32) double tl[kLanes];
+      Store(tl, t);
+      for (int l = 0; l < kLanes && l < rest; ++l) top_tail = tl[l] > top_tail ? tl[l] : top_tail;
+    }
   }
-  for (int f = 0; f < 4; ++f) out[f] = (a[f][0] + a[f][1]) + (a[f][2] + a[f][3]);
+  // out[f] = (a0 + a1) + (a2 + a3) of field f's partial sums.
+#if defined(__AVX__)
+  // In registers: hadd gives two fields' a0 + a1 in its low half and a2 + a3 in its high half.
+  for (int f = 0; f < 4; f += 2) {
+    const __m256d h = _mm256_hadd_pd(acc[f][0], acc[f + 1][0]);
+    _mm_storeu_pd(out + f, _mm_add_pd(_mm256_castpd256_pd128(h), _mm256_extractf128_pd(h, 1)));
+  }
+#else
+  alignas(32) double a[4][4];
+  for (int f = 0; f < 4; ++f) {
+    for (int r = 0; r < kRegs; ++r) Store(a[f] + r * kLanes, acc[f][r]);
+    out[f] = (a[f][0] + a[f][1]) + (a[f][2] + a[f][3]);
+  }
+#endif
   if (kPeak) {
+    alignas(32) double top[4];
+    for (int r = 0; r < kRegs; ++r) Store(top + r * kLanes, peak[r]);
     double m = top_tail;
     for (int l = 0; l < 4 && l < n; ++l) m = top[l] > m ? top[l] : m;
     out[4] = m;
