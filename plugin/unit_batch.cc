@@ -287,9 +287,11 @@ inline void Newton2(const Consts& c, const Lanes& La, const Lanes& Lb, Vd ga, Vd
   for (int it = 0; it < 60; ++it) {
     NewtonStep(a);
     NewtonStep(b);
-    if ((Bits(a.active) | Bits(b.active)) == 0) break;
-    NewtonResidual(c, La, a);
-    NewtonResidual(c, Lb, b);
+    const int live_a = Bits(a.active), live_b = Bits(b.active);
+    if ((live_a | live_b) == 0) break;
+    // A batch whose lanes have all stopped keeps its values: its residual would be discarded.
+    if (live_a != 0) NewtonResidual(c, La, a);
+    if (live_b != 0) NewtonResidual(c, Lb, b);
     if ((Bits(a.active) | Bits(b.active)) == 0) break;
   }
   *xa = a.x;
