@@ -664,11 +664,12 @@ void Observe(const BatchParams& p, const double* count, const double* const* v, 
 
 // The merge order has no sums: every clone has it (the 8-lane one counts eight ranks at once).
 bool MergeOrder(const double* on, const double* temp, int n, int* order, double* t, int* idx) {
-  // Off cohorts' temperatures in t[0..n0), on cohorts' in t[s1..s1 + n1) (s1 = n + kLanes),
-  // each followed by kLanes of +inf (read, never used), with their indices in idx: kLanes
-  // cohorts at a time, appended by lane mask; on values other than 0 and 1, and NaN
-  // temperatures, give up. Scratch: 2 (n + kLanes) each.
-  const int s1 = n + kLanes;
+  // Off cohorts' temperatures in t[0..n0), on cohorts' in t[s1..s1 + n1) (s1 = n + 8), each
+  // followed by 8 of +inf (read, never used), with their indices in idx: kLanes cohorts at a
+  // time, appended by lane mask; on values other than 0 and 1, and NaN temperatures, give up.
+  // Scratch: 2 (n + 8) each.
+  constexpr int kPad = 8;  // >= kLanes (an append's width) and the count's unrolling
+  const int s1 = n + kPad;
   int n0 = 0, n1 = 0, bad = 0;
   for (int j = 0; j < n; j += kLanes) {
     const int rest = n - j, valid = rest >= kLanes ? kAll : (1 << rest) - 1;
@@ -683,27 +684,31 @@ bool MergeOrder(const double* on, const double* temp, int n, int* order, double*
     n1 = AppendLanes(idx + s1, n1, j, on1);
   }
   if (bad != 0) return false;
-  for (int l = 0; l < kLanes; ++l) t[n0 + l] = t[s1 + n1 + l] = HUGE_VAL;
+  for (int l = 0; l < kPad; ++l) t[n0 + l] = t[s1 + n1 + l] = HUGE_VAL;
   for (int j = 0; j < n; ++j) order[j] = -1;
   // Position = the group's start + how many of its temperatures are lower, counted for kLanes
-  // cohorts at once (the lanes past the group are not used), two temperatures per iteration
-  // (the +inf after the group counts for none).
-  const Vd one = Splat(1.0);
+  // cohorts at once (the lanes past the group are not used), four temperatures per iteration
+  // (the +inf after the group counts for none): each comparison's all-ones lanes (integer -1)
+  // subtracted from integer counts.
+  using Counts = long long __attribute__((vector_size(sizeof(Vd))));
+  auto less = [](double a, Vd x) { return reinterpret_cast<Counts>(ToVd(Lt(Splat(a), x))); };
   for (int g = 0; g < 2; ++g) {
     const double* tg = t + g * s1;
     const int* ig = idx + g * s1;
     const int ng = g == 0 ? n0 : n1, start = g == 0 ? 0 : n0;
     for (int b = 0; b < ng; b += kLanes) {
       const Vd x = Load(tg + b);
-      Vd c = Splat(0), c2 = Splat(0);
-      for (int j = 0; j < ng; j += 2) {
-        c += And(one, Lt(Splat(tg[j]), x));
-        c2 += And(one, Lt(Splat(tg[j + 1]), x));
+      Counts c0 = {}, c1 = {};
+      for (int j = 0; j < ng; j += 4) {
+        c0 -= less(tg[j], x);
+        c1 -= less(tg[j + 1], x);
+        c0 -= less(tg[j + 2], x);
+        c1 -= less(tg[j + 3], x);
       }
-      alignas(64) double rank[kLanes];
-      Store(rank, c + c2);
-      for (int l = 0; l < kLanes && b + l < ng; ++l)
-        order[start + static_cast<int>(rank[l])] = ig[b + l];
+      const Counts c = c0 + c1;
+      for (int l = 0; l < kLanes && b + l < ng; ++l) {
+        order[start + static_cast<int>(c[l])] = ig[b + l];
+      }
     }
   }
   // Each group's ng positions lie in its ng slots: all filled unless two cohorts tie.
