@@ -19,6 +19,12 @@ struct MergeKey {
   int index;
 };
 
+// The merge's scratch for more cohorts than fit on the stack.
+struct BigMergeScratch {
+  std::vector<MergeKey> order;
+  std::vector<int> sorted, forward, remap;
+};
+
 Rng LoadRng(const double* words) {
   Rng::State st;
   std::memcpy(st.data(), words, sizeof st);
@@ -160,40 +166,45 @@ void SmaBundle::Merge(double* s) const {
   // parallel on their own mjData).
   constexpr int kSmall = 64;
   MergeKey small_order[kSmall];
-  int small_forward[kSmall], small_remap[kSmall], rank[3 * kSmall + 16];
+  int small_sorted[3 * kSmall + 16], small_forward[kSmall], small_remap[kSmall];
   double t_scratch[2 * kSmall + 16];
-  static thread_local std::vector<MergeKey> big_order;
-  static thread_local std::vector<int> big_forward, big_remap;
-  if (k > kSmall) {
-    big_order.resize(k);
-    big_forward.resize(k);
-    big_remap.resize(k);
-  }
-  MergeKey* const order = k > kSmall ? big_order.data() : small_order;
-  int* const forward = k > kSmall ? big_forward.data() : small_forward;
-  int* const remap = k > kSmall ? big_remap.data() : small_remap;
-  // Sorted by (on, T). Without ties the order is unique, and MergeOrder finds it without the
-  // sort's unpredictable branches (k^2 / 2 comparisons in SIMD lanes: up to 64 cohorts, faster
-  // than the sort); with ties or more cohorts, std::sort as before: keys held by value, whose
-  // moves depend only on the comparisons, so the order of ties is that of sorting the indices.
+  int* sorted = small_sorted;
+  int* forward = small_forward;
+  int* remap = small_remap;
+  // Cohort indices sorted by (on, T). Without ties the order is unique, and MergeOrder finds it
+  // without the sort's unpredictable branches (k^2 / 2 comparisons in SIMD lanes: up to 64
+  // cohorts, faster than the sort); with ties or more cohorts, std::sort as before: keys held by
+  // value, whose moves depend only on the comparisons, so the order of ties is that of sorting
+  // the indices.
   const double *on = Field(s, kOn), *temp = Field(s, kTemp);
-  if (k <= kSmall && UnitModel::MergeOrder(on, temp, k, rank, t_scratch, rank + k)) {
-    for (int j = 0; j < k; ++j) order[j] = {on[rank[j]], temp[rank[j]], rank[j]};
-  } else {
+  if (k > kSmall || !UnitModel::MergeOrder(on, temp, k, sorted, t_scratch, sorted + k)) {
+    MergeKey* order = small_order;
+    if (k > kSmall) {
+      static thread_local BigMergeScratch big;
+      big.order.resize(k);
+      big.sorted.resize(k);
+      big.forward.resize(k);
+      big.remap.resize(k);
+      order = big.order.data();
+      sorted = big.sorted.data();
+      forward = big.forward.data();
+      remap = big.remap.data();
+    }
     for (int j = 0; j < k; ++j) order[j] = {on[j], temp[j], j};
     std::sort(order, order + k, [](const MergeKey& a, const MergeKey& b) {
       if (a.on != b.on) return a.on < b.on;
       return a.temp < b.temp;
     });
+    for (int j = 0; j < k; ++j) sorted[j] = order[j].index;
   }
   bool merged = false;
   std::fill(forward, forward + k, -1);  // representative that absorbed each merged cohort
   double* count = Field(s, kCount);
   double* f[kFields];
   for (int i = 0; i < kFields; ++i) f[i] = Field(s, i);
-  int rep = order[0].index;
+  int rep = sorted[0];
   for (int j = 1; j < k; ++j) {
-    const int r = rep, c = order[j].index;
+    const int r = rep, c = sorted[j];
     const bool same = on[r] == on[c] && std::abs(temp[r] - temp[c]) <= config_.merge_temperature &&
                       std::abs(f[kXi][r] - f[kXi][c]) <= config_.merge_xi &&
                       std::abs(f[kHeatScale][r] - f[kHeatScale][c]) <= config_.merge_xi &&

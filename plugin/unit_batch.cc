@@ -44,6 +44,7 @@ inline Mask ToMask(Vd v) { return _mm512_movepi64_mask(_mm512_castpd_si512(v)); 
 inline Mask Lt(Vd a, Vd b) { return _mm512_cmp_pd_mask(a, b, _CMP_LT_OQ); }
 inline Mask Le(Vd a, Vd b) { return _mm512_cmp_pd_mask(a, b, _CMP_LE_OQ); }
 inline Mask Ne(Vd a, Vd b) { return _mm512_cmp_pd_mask(a, b, _CMP_NEQ_UQ); }
+inline Mask Eq(Vd a, Vd b) { return _mm512_cmp_pd_mask(a, b, _CMP_EQ_OQ); }
 inline Mask And(Mask a, Mask b) { return static_cast<Mask>(a & b); }
 inline Mask Or(Mask a, Mask b) { return static_cast<Mask>(a | b); }
 inline Mask AndNot(Mask a, Mask b) { return static_cast<Mask>(a & ~b); }  // a & ~b
@@ -67,6 +68,7 @@ inline void Store(double* p, Vd v) { _mm256_storeu_pd(p, v); }
 inline Vd Lt(Vd a, Vd b) { return _mm256_cmp_pd(a, b, _CMP_LT_OQ); }
 inline Vd Le(Vd a, Vd b) { return _mm256_cmp_pd(a, b, _CMP_LE_OQ); }
 inline Vd Ne(Vd a, Vd b) { return _mm256_cmp_pd(a, b, _CMP_NEQ_UQ); }
+inline Vd Eq(Vd a, Vd b) { return _mm256_cmp_pd(a, b, _CMP_EQ_OQ); }
 inline Vd And(Vd a, Vd b) { return _mm256_and_pd(a, b); }
 inline Vd Or(Vd a, Vd b) { return _mm256_or_pd(a, b); }
 inline Vd AndNot(Vd a, Vd b) { return _mm256_andnot_pd(b, a); }  // a & ~b
@@ -88,6 +90,7 @@ inline void Store(double* p, Vd v) { _mm_storeu_pd(p, v); }
 inline Vd Lt(Vd a, Vd b) { return _mm_cmplt_pd(a, b); }
 inline Vd Le(Vd a, Vd b) { return _mm_cmple_pd(a, b); }
 inline Vd Ne(Vd a, Vd b) { return _mm_cmpneq_pd(a, b); }
+inline Vd Eq(Vd a, Vd b) { return _mm_cmpeq_pd(a, b); }
 inline Vd And(Vd a, Vd b) { return _mm_and_pd(a, b); }
 inline Vd Or(Vd a, Vd b) { return _mm_or_pd(a, b); }
 inline Vd AndNot(Vd a, Vd b) { return _mm_andnot_pd(b, a); }  // a & ~b
@@ -111,6 +114,7 @@ inline void Store(double* p, Vd v) { std::memcpy(p, &v, sizeof v); }
 inline Vd Lt(Vd a, Vd b) { return reinterpret_cast<Vd>(a < b); }
 inline Vd Le(Vd a, Vd b) { return reinterpret_cast<Vd>(a <= b); }
 inline Vd Ne(Vd a, Vd b) { return reinterpret_cast<Vd>(a != b); }
+inline Vd Eq(Vd a, Vd b) { return reinterpret_cast<Vd>(a == b); }
 inline Vd Bit(Vi x) { return reinterpret_cast<Vd>(x); }
 inline Vi Int(Vd x) { return reinterpret_cast<Vi>(x); }
 inline Vd And(Vd a, Vd b) { return Bit(Int(a) & Int(b)); }
@@ -134,6 +138,7 @@ inline Mask Lt(Vd a, double b) { return Lt(a, Splat(b)); }
 inline Mask Gt(Vd a, double b) { return Lt(Splat(b), a); }
 inline Mask Le(Vd a, double b) { return Le(a, Splat(b)); }
 inline Mask Ge(Vd a, double b) { return Le(Splat(b), a); }
+inline Mask Eq(Vd a, double b) { return Eq(a, Splat(b)); }
 // |x| by clearing the sign bit (std::abs).
 inline Vd Abs(Vd x) { return AndNot(x, Splat(-0.0)); }
 // std::clamp(v, 0, 1) lane by lane (NaN passes through, as there).
@@ -282,9 +287,11 @@ inline void Newton2(const Consts& c, const Lanes& La, const Lanes& Lb, Vd ga, Vd
   for (int it = 0; it < 60; ++it) {
     NewtonStep(a);
     NewtonStep(b);
-    if ((Bits(a.active) | Bits(b.active)) == 0) break;
-    NewtonResidual(c, La, a);
-    NewtonResidual(c, Lb, b);
+    const int live_a = Bits(a.active), live_b = Bits(b.active);
+    if ((live_a | live_b) == 0) break;
+    // A batch whose lanes have all stopped keeps its values: its residual would be discarded.
+    if (live_a != 0) NewtonResidual(c, La, a);
+    if (live_b != 0) NewtonResidual(c, Lb, b);
     if ((Bits(a.active) | Bits(b.active)) == 0) break;
   }
   *xa = a.x;
@@ -300,6 +307,61 @@ inline void Canonical(Vd* xi, Vd* hs, Vd* cs) {
   *hs = Sel(top, Splat(1), AndNot(*hs, low));
   *cs = Sel(top, Splat(0), Sel(low, Splat(1), *cs));
 }
+
+// Appending the lanes a mask selects, lowest first, without a loop over its bits:
+// AppendLanes appends base + l for each set bit l of `bits` to list[n..] and returns the new
+// length; AppendValues appends those lanes of v to list[n..]. Both write kLanes entries.
+#if defined(RECRUIT_SMA_LANES8)
+inline int AppendLanes(int* list, int n, int base, int bits) {
+  const __m512i lanes = _mm512_add_epi32(
+      _mm512_set1_epi32(base), _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 0, 0, 0, 0, 0, 0, 0, 0));
+  // A masked store of the low 8 (GCC 12 warns on the intrinsics that take the low half).
+  _mm512_mask_storeu_epi32(list + n, 0xff,
+                           _mm512_maskz_compress_epi32(static_cast<__mmask16>(bits), lanes));
+  return n + __builtin_popcount(bits);
+}
+inline void AppendValues(double* list, int n, Vd v, int bits) {
+  Store(list + n, _mm512_maskz_compress_pd(static_cast<Mask>(bits), v));
+}
+#else
+// Each lane mask's set lanes, lowest first, how many, and (AVX2) the 32-bit halves of those
+// lanes (a permutation of 8 floats that moves them to the front).
+struct LaneLists {
+  int lane[1 << kLanes][kLanes];
+  int count[1 << kLanes];
+  int halves[1 << kLanes][2 * kLanes];
+};
+constexpr LaneLists MakeLaneLists() {
+  LaneLists t{};
+  for (int m = 0; m < (1 << kLanes); ++m) {
+    for (int l = 0; l < kLanes; ++l) {
+      if ((m >> l) & 1) t.lane[m][t.count[m]++] = l;
+    }
+    for (int l = 0; l < kLanes; ++l) {
+      t.halves[m][2 * l] = 2 * t.lane[m][l];
+      t.halves[m][2 * l + 1] = 2 * t.lane[m][l] + 1;
+    }
+  }
+  return t;
+}
+constexpr LaneLists kLaneLists = MakeLaneLists();
+
+inline int AppendLanes(int* list, int n, int base, int bits) {
+  for (int l = 0; l < kLanes; ++l) list[n + l] = base + kLaneLists.lane[bits][l];
+  return n + kLaneLists.count[bits];
+}
+inline void AppendValues(double* list, int n, Vd v, int bits) {
+#if defined(__AVX2__)
+  const __m256i perm =
+      _mm256_loadu_si256(reinterpret_cast<const __m256i*>(kLaneLists.halves[bits]));
+  Store(list + n, _mm256_castps_pd(_mm256_permutevar8x32_ps(_mm256_castpd_ps(v), perm)));
+#else
+  alignas(32) double lanes[kLanes];
+  Store(lanes, v);
+  for (int l = 0; l < kLanes; ++l) list[n + l] = lanes[kLaneLists.lane[bits][l]];
+#endif
+}
+#endif
 
 // kLanes consecutive cohorts' fields in the caller's arrays (the tail: fewer, masked).
 struct Block {
@@ -368,9 +430,7 @@ void AdvanceCohorts(const BatchParams& p, const BatchCohorts& c, int n, double s
       Store(g0 + j, g);
       Store(dg0 + j, dg);
       Store(heat + j, ToVd(is_heat));
-      for (int bits = Bits(tr) & ((1 << count) - 1); bits != 0; bits &= bits - 1) {
-        solve[n_solve++] = j + __builtin_ctz(bits);
-      }
+      n_solve = AppendLanes(solve, n_solve, j, Bits(tr) & ((1 << count) - 1));
     };
     const double* const on = c.on + base;
     double* const T = c.temperature + base;
@@ -385,7 +445,10 @@ void AdvanceCohorts(const BatchParams& p, const BatchCohorts& c, int n, double s
     if (j < m) phase_a(Block{on + j, T + j, xi + j, te + j, hs + j, cs + j}, j, m - j);
     // (B) A short batch repeats its last cohort (same inputs, same result). Batches go through
     // Newton in pairs (their cohorts differ: both are read before either is written).
-    for (int l = n_solve; l % kLanes != 0; ++l) solve[l] = solve[n_solve - 1];
+    if (n_solve % kLanes != 0) {
+      const int last = solve[n_solve - 1];
+      for (int l = 0; l < kLanes; ++l) solve[n_solve + l] = last;  // one store
+    }
     auto prepare = [&](const int* idx, Lanes* L, Vd* g, Vd* dg) __attribute__((always_inline)) {
       // Lane-by-lane loads (faster here than the gather instructions).
 #if defined(RECRUIT_SMA_LANES8)
@@ -520,30 +583,40 @@ void ObservePass(const BatchParams& p, const double* count, const double* const*
       if (kPeak) peak[r] = MaxOf(t, peak[r]);
     }
   }
-  alignas(32) double a[4][4], top[4];
-  for (int r = 0; r < kRegs; ++r) {
-    for (int f = 0; f < 4; ++f) Store(a[f] + r * kLanes, acc[f][r]);
-    Store(top + r * kLanes, peak[r]);
-  }
-  // The last n - j < 4 cohorts: the sums one by one (as Sums), the tension from masked loads
-  // (as SumTension: missing lanes add count 0 times a tension, +0).
-  for (int f = 0; f < 3; ++f) {
-    for (int l = 0; j + l < n; ++l) a[f][l] += count[j + l] * v[f][j + l];
-  }
+  // The last n - j < 4 cohorts from masked loads, as SumTension: a missing lane adds count 0
+  // times 0 (or a tension), +0, which leaves a partial sum as it is (from +0, never -0).
   double top_tail = 0;
   for (int r = 0; r < kRegs && j + r * kLanes < n; ++r) {
     const int i = j + r * kLanes, rest = n - i;
-    const Vd cnt = rest >= kLanes ? Load(count + i) : LoadN(count + i, rest);
-    const Vd x = rest >= kLanes ? Load(v[2] + i) : LoadN(v[2] + i, rest);
-    const Vd t = TensionOnly(k, x);
-    alignas(32) double f[kLanes], tl[kLanes];
-    Store(f, cnt * t);
-    Store(tl, t);
-    for (int l = 0; l < kLanes; ++l) a[3][r * kLanes + l] += f[l];
-    for (int l = 0; l < kLanes && l < rest; ++l) top_tail = tl[l] > top_tail ? tl[l] : top_tail;
+    auto load = [&](const double* a) { return rest >= kLanes ? Load(a + i) : LoadN(a + i, rest); };
+    const Vd c = load(count), x = load(v[2]), t = TensionOnly(k, x);
+    acc[0][r] += c * load(v[0]);
+    acc[1][r] += c * load(v[1]);
+    acc[2][r] += c * x;
+    acc[3][r] += c * t;
+    if (kPeak) {
+      alignas(32) double tl[kLanes];
+      Store(tl, t);
+      for (int l = 0; l < kLanes && l < rest; ++l) top_tail = tl[l] > top_tail ? tl[l] : top_tail;
+    }
   }
-  for (int f = 0; f < 4; ++f) out[f] = (a[f][0] + a[f][1]) + (a[f][2] + a[f][3]);
+  // out[f] = (a0 + a1) + (a2 + a3) of field f's partial sums.
+#if defined(__AVX__)
+  // In registers: hadd gives two fields' a0 + a1 in its low half and a2 + a3 in its high half.
+  for (int f = 0; f < 4; f += 2) {
+    const __m256d h = _mm256_hadd_pd(acc[f][0], acc[f + 1][0]);
+    _mm_storeu_pd(out + f, _mm_add_pd(_mm256_castpd256_pd128(h), _mm256_extractf128_pd(h, 1)));
+  }
+#else
+  alignas(32) double a[4][4];
+  for (int f = 0; f < 4; ++f) {
+    for (int r = 0; r < kRegs; ++r) Store(a[f] + r * kLanes, acc[f][r]);
+    out[f] = (a[f][0] + a[f][1]) + (a[f][2] + a[f][3]);
+  }
+#endif
   if (kPeak) {
+    alignas(32) double top[4];
+    for (int r = 0; r < kRegs; ++r) Store(top + r * kLanes, peak[r]);
     double m = top_tail;
     for (int l = 0; l < 4 && l < n; ++l) m = top[l] > m ? top[l] : m;
     out[4] = m;
@@ -591,44 +664,56 @@ void Observe(const BatchParams& p, const double* count, const double* const* v, 
 
 // The merge order has no sums: every clone has it (the 8-lane one counts eight ranks at once).
 bool MergeOrder(const double* on, const double* temp, int n, int* order, double* t, int* idx) {
-  // Off cohorts' temperatures in t[0..n0), on cohorts' in t[s1..s1 + n1) (s1 = n + kLanes),
-  // each followed by kLanes of +inf (read, never used), with their indices in idx, written
-  // without branches on the data; on values other than 0 and 1, and NaN temperatures, give up.
-  // Scratch: 2 (n + kLanes) each.
-  const int s1 = n + kLanes;
-  int n0 = 0, n1 = 0;
-  bool bad = false;
-  for (int j = 0; j < n; ++j) {
-    const bool is_off = on[j] == 0, is_on = on[j] == 1;
-    bad |= !(is_off || is_on) || !(temp[j] == temp[j]);
-    t[n0] = temp[j], idx[n0] = j, n0 += is_off;
-    t[s1 + n1] = temp[j], idx[s1 + n1] = j, n1 += is_on;
+  // Off cohorts' temperatures in t[0..n0), on cohorts' in t[s1..s1 + n1) (s1 = n + 8), each
+  // followed by 8 of +inf (read, never used), with their indices in idx: kLanes cohorts at a
+  // time, appended by lane mask; on values other than 0 and 1, and NaN temperatures, give up.
+  // Scratch: 2 (n + 8) each.
+  constexpr int kPad = 8;  // >= kLanes (an append's width) and the count's unrolling
+  const int s1 = n + kPad;
+  int n0 = 0, n1 = 0, bad = 0;
+  for (int j = 0; j < n; j += kLanes) {
+    const int rest = n - j, valid = rest >= kLanes ? kAll : (1 << rest) - 1;
+    const Vd o = rest >= kLanes ? Load(on + j) : LoadN(on + j, rest);
+    const Vd x = rest >= kLanes ? Load(temp + j) : LoadN(temp + j, rest);
+    const Mask is_off = Eq(o, 0.0), is_on = Eq(o, 1.0);
+    bad |= ~Bits(And(Or(is_off, is_on), Eq(x, x))) & valid;
+    const int off = Bits(is_off) & valid, on1 = Bits(is_on) & valid;
+    AppendValues(t, n0, x, off);
+    n0 = AppendLanes(idx, n0, j, off);
+    AppendValues(t + s1, n1, x, on1);
+    n1 = AppendLanes(idx + s1, n1, j, on1);
   }
-  if (bad) return false;
-  for (int l = 0; l < kLanes; ++l) t[n0 + l] = t[s1 + n1 + l] = HUGE_VAL;
+  if (bad != 0) return false;
+  for (int l = 0; l < kPad; ++l) t[n0 + l] = t[s1 + n1 + l] = HUGE_VAL;
   for (int j = 0; j < n; ++j) order[j] = -1;
   // Position = the group's start + how many of its temperatures are lower, counted for kLanes
-  // cohorts at once (the lanes past the group are not used); two cohorts with the same
-  // position tie.
-  const Vd one = Splat(1.0);
+  // cohorts at once (the lanes past the group are not used), four temperatures per iteration
+  // (the +inf after the group counts for none): each comparison's all-ones lanes (integer -1)
+  // subtracted from integer counts.
+  using Counts = long long __attribute__((vector_size(sizeof(Vd))));
+  auto less = [](double a, Vd x) { return reinterpret_cast<Counts>(ToVd(Lt(Splat(a), x))); };
   for (int g = 0; g < 2; ++g) {
     const double* tg = t + g * s1;
     const int* ig = idx + g * s1;
     const int ng = g == 0 ? n0 : n1, start = g == 0 ? 0 : n0;
     for (int b = 0; b < ng; b += kLanes) {
       const Vd x = Load(tg + b);
-      Vd c = Splat(0);
-      for (int j = 0; j < ng; ++j) c += And(one, Lt(Splat(tg[j]), x));
-      alignas(64) double rank[kLanes];
-      Store(rank, c);
+      Counts c0 = {}, c1 = {};
+      for (int j = 0; j < ng; j += 4) {
+        c0 -= less(tg[j], x);
+        c1 -= less(tg[j + 1], x);
+        c0 -= less(tg[j + 2], x);
+        c1 -= less(tg[j + 3], x);
+      }
+      const Counts c = c0 + c1;
       for (int l = 0; l < kLanes && b + l < ng; ++l) {
-        const int pos = start + static_cast<int>(rank[l]);
-        bad |= order[pos] >= 0;
-        order[pos] = ig[b + l];
+        order[start + static_cast<int>(c[l])] = ig[b + l];
       }
     }
   }
-  return !bad;
+  // Each group's ng positions lie in its ng slots: all filled unless two cohorts tie.
+  for (int j = 0; j < n; ++j) bad |= order[j] < 0;
+  return bad == 0;
 }
 
 #ifndef RECRUIT_SMA_LANES8

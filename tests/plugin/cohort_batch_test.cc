@@ -146,6 +146,32 @@ TEST_P(BatchedCohorts, SwitchingTrajectoriesAreBitIdenticalToScalarUpdate) {
   EXPECT_GT(solved_steps, 10000);
 }
 
+// Every pattern of transforming lanes in a SIMD batch (a cohort of each 8-cohort group
+// transforms where the group's bit is set, all 256 patterns; 2, 4 and 8 lanes divide 8), then a
+// partial tail: each transforming cohort is solved, and only those.
+TEST_P(BatchedCohorts, EveryPatternOfTransformingLanesIsSolved) {
+  const UnitModel m = MakeModel(config());
+  const double stretch = m.params().prestretch;
+  const double decay = m.DecayFactor(1e-3);
+  // At rest and off nothing changes; on and hot inside the heating window, xi falls.
+  UnitState still = RestState(m, stretch), hot = still;
+  hot.temperature = m.params().Af + 5;
+  UnitState a = still, b = hot;
+  AdvanceUnitWithDecay(m, a, false, stretch, decay);
+  AdvanceUnitWithDecay(m, b, true, stretch, decay);
+  ASSERT_EQ(a.xi, still.xi);
+  ASSERT_NE(b.xi, hot.xi);
+  for (int n : {8 * 256, 8 * 256 + 5}) {
+    Soa soa(n);
+    for (int j = 0; j < n; ++j) {
+      const bool transforms = ((j / 8) >> (j % 8)) & 1 || j >= 8 * 256;
+      soa.on[j] = transforms ? 1 : 0;
+      soa.Set(j, transforms ? hot : still);
+    }
+    ASSERT_TRUE(StepMatchesScalar(m, soa, stretch, decay, isa())) << "n " << n;
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(
     Units, BatchedCohorts,
     ::testing::Combine(::testing::Values("",                          // datasheet wire unit
