@@ -153,11 +153,9 @@ void Plant::Step() {
   TrackPeaks();
 }
 
-const sma::SmaBundle::Telemetry& Plant::Observed(int i) const {
-  if (!observed_valid_[i]) {
-    observed_[i] = host_->Observe(data_.get(), bundles_[i]);
-    observed_valid_[i] = true;
-  }
+const sma::SmaBundle::Telemetry& Plant::ObserveNow(int i) const {
+  observed_[i] = host_->Observe(data_.get(), bundles_[i]);
+  observed_valid_[i] = true;
   return observed_[i];
 }
 

@@ -73,7 +73,11 @@ class Plant {
   // cohorts after each step or broadcast, bit for bit what the separate reads give. A run reads
   // them several times a step (measurement, telemetry, peaks): one pass, ~280 instructions for
   // 60 units (callgrind, arm_push), instead of four.
-  const sma::SmaBundle::Telemetry& Observed(int i) const;
+  // The kept pass is read inline; only a new pass is a call.
+  const sma::SmaBundle::Telemetry& Observed(int i) const {
+    return observed_valid_[i] ? observed_[i] : ObserveNow(i);
+  }
+  const sma::SmaBundle::Telemetry& ObserveNow(int i) const;
   void ForgetObserved() { observed_valid_.assign(bundles_.size(), false); }
 
   const Task* task_ = nullptr;
