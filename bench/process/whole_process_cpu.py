@@ -2,10 +2,11 @@
 """Whole-process CPU of two `recruit` binaries, alternated run by run.
 
 For each task, runs `BINARY simulate --task models/tasks/TASK.json --seed 3 --out TMP` N times
-with each binary in turn and prints a Markdown row: the median CPU time of the child (user + sys,
-getrusage), the simulated seconds per CPU second (x real time) and the ratio OLD / NEW.
-Alternating the two binaries makes the ratio robust to the shared machine's drift
-(docs/benchmarks.md, "Issue 15, session 5").
+with each binary in turn, which one goes first alternating, and prints a Markdown row: the median
+CPU time of the child (user + sys, getrusage), the simulated seconds per CPU second (x real time)
+and the ratio OLD / NEW. Alternating the two binaries makes the ratio robust to the shared
+machine's drift (docs/benchmarks.md, "Issue 15, session 5"), and alternating their order to the
+second run's ~1 % penalty ("Issue 15, session 6").
 
 Usage, from the repository root:
     python3 bench/process/whole_process_cpu.py OLD NEW N TASK [TASK ...]
@@ -40,9 +41,15 @@ def main(argv):
             duration = json.load(f)["duration"]
         old_cpu, new_cpu = [], []
         with tempfile.TemporaryDirectory() as out:
-            for _ in range(runs):
-                old_cpu.append(child_cpu(old, task, out))
-                new_cpu.append(child_cpu(new, task, out))
+            for i in range(runs):
+                # ABBA order: the binary run second in a pair measured ~1 % slower, whichever it
+                # was (docs/benchmarks.md, "Issue 15, session 6"); alternating cancels that.
+                if i % 2 == 0:
+                    old_cpu.append(child_cpu(old, task, out))
+                    new_cpu.append(child_cpu(new, task, out))
+                else:
+                    new_cpu.append(child_cpu(new, task, out))
+                    old_cpu.append(child_cpu(old, task, out))
         a, b = statistics.median(old_cpu), statistics.median(new_cpu)
         print(f"| {task} | {duration:.0f} s | {a * 1000:.1f} ms ({duration / a:.0f}x) | "
               f"{b * 1000:.1f} ms ({duration / b:.0f}x) | {a / b:.2f} |")
