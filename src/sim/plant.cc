@@ -8,7 +8,18 @@
 namespace recruit::sim {
 namespace {
 
-// Builtin textures at 1 x 1 pixel, no camera, no light.
+// True if a sensor of `spec` names an object of `type` (a frame sensor on a camera, a camera
+// projection): that object must stay for the model to compile.
+bool SensorNames(mjSpec* spec, mjtObj type) {
+  for (mjsElement* e = mjs_firstElement(spec, mjOBJ_SENSOR); e != nullptr;
+       e = mjs_nextElement(spec, e)) {
+    const mjsSensor* s = mjs_asSensor(e);
+    if (s->objtype == type || s->reftype == type) return true;
+  }
+  return false;
+}
+
+// Builtin textures at 1 x 1 pixel; no camera and no light, unless a sensor names one.
 void LeaveOutWhatOnlyRendersRead(mjSpec* spec) {
   for (mjsElement* e = mjs_firstElement(spec, mjOBJ_TEXTURE); e != nullptr;
        e = mjs_nextElement(spec, e)) {
@@ -17,6 +28,7 @@ void LeaveOutWhatOnlyRendersRead(mjSpec* spec) {
   }
   std::vector<mjsElement*> unseen;
   for (mjtObj type : {mjOBJ_CAMERA, mjOBJ_LIGHT}) {
+    if (SensorNames(spec, type)) continue;
     for (mjsElement* e = mjs_firstElement(spec, type); e != nullptr; e = mjs_nextElement(spec, e)) {
       unseen.push_back(e);
     }

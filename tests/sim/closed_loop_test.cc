@@ -336,32 +336,49 @@ TEST(ClosedLoop, PlantSkipsStagesTheModelHasNothingForAndStepsTheSame) {
   ExpectStepsLikeTheModelWithEveryStage(task);
 }
 
+// A copy of arm_push's model with `from` replaced by `to`, in a fresh temporary folder (the model
+// names no file: its textures are builtin), removed with the object; `task` points at it.
+struct EditedArm {
+  Task task = LoadTask("arm_push.json");
+  std::filesystem::path dir;
+  EditedArm(const std::string& from, const std::string& to) {
+    std::ifstream in(task.model_path);
+    std::stringstream text;
+    text << in.rdbuf();
+    std::string xml = text.str();
+    const size_t at = xml.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    if (at != std::string::npos) xml.replace(at, from.size(), to);
+    static int made = 0;
+    dir = std::filesystem::temp_directory_path() /
+          ("recruit_arm_" + std::to_string(::getpid()) + "_" + std::to_string(made++));
+    std::filesystem::create_directories(dir);
+    task.model_path = (dir / "elbow_arm.xml").string();
+    std::ofstream(task.model_path) << xml;
+  }
+  ~EditedArm() { std::filesystem::remove_all(dir); }
+};
+
 // With dry friction in the elbow, the frictionloss stage stays on, and the plant still steps as
 // the model with every stage on.
 TEST(ClosedLoop, PlantKeepsTheFrictionlossStageOfAModelWithFriction) {
-  Task task = LoadTask("arm_push.json");
-  std::ifstream in(task.model_path);
-  std::stringstream text;
-  text << in.rdbuf();
-  std::string xml = text.str();
-  const std::string joint = "damping=\"0.02\"";
-  ASSERT_NE(xml.find(joint), std::string::npos);
-  xml.replace(xml.find(joint), joint.size(), joint + " frictionloss=\"0.002\"");
-  // The arm model names no file (its textures are builtin): it loads from anywhere.
-  const std::filesystem::path dir =
-      std::filesystem::temp_directory_path() / ("recruit_friction_" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
-  task.model_path = (dir / "elbow_arm_friction.xml").string();
-  {
-    std::ofstream out(task.model_path);
-    out << xml;
-  }
-  auto created = Plant::Create(task, /*drawn=*/false);
+  const EditedArm arm("damping=\"0.02\"", "damping=\"0.02\" frictionloss=\"0.002\"");
+  auto created = Plant::Create(arm.task, /*drawn=*/false);
   ASSERT_TRUE(created.ok()) << created.error();
   EXPECT_EQ((*created)->model()->opt.disableflags & mjDSBL_FRICTIONLOSS, 0);
   EXPECT_NE((*created)->model()->opt.disableflags & mjDSBL_EQUALITY, 0);
-  ExpectStepsLikeTheModelWithEveryStage(task);
-  std::filesystem::remove_all(dir);
+  ExpectStepsLikeTheModelWithEveryStage(arm.task);
+}
+
+// A run that draws nothing keeps the cameras when a sensor names one (the model would not compile
+// without it), and still leaves out the lights.
+TEST(ClosedLoop, PlantKeepsTheCamerasASensorNames) {
+  const EditedArm arm(
+      "<sensor>", "<sensor>\n    <framepos name=\"eye\" objtype=\"camera\" objname=\"render\"/>");
+  auto created = Plant::Create(arm.task, /*drawn=*/false);
+  ASSERT_TRUE(created.ok()) << created.error();
+  EXPECT_GE((*created)->model()->ncam, 1);
+  EXPECT_EQ((*created)->model()->nlight, 0);
 }
 
 // The plant's reads of a bundle (kept from one pass after each step) follow every broadcast and
