@@ -8,18 +8,25 @@
 namespace recruit::sim {
 namespace {
 
-// True if a sensor of `spec` names an object of `type` (a frame sensor on a camera, a camera
-// projection): that object must stay for the model to compile.
-bool SensorNames(mjSpec* spec, mjtObj type) {
+// True if a sensor (a frame sensor on a camera, a camera projection) or a custom tuple of `spec`
+// names an object of `type`: that object must stay, for the model to compile (a sensor) or to
+// keep its tuple (deleting an object drops the tuples that name it).
+bool SomethingNames(mjSpec* spec, mjtObj type) {
   for (mjsElement* e = mjs_firstElement(spec, mjOBJ_SENSOR); e != nullptr;
        e = mjs_nextElement(spec, e)) {
     const mjsSensor* s = mjs_asSensor(e);
     if (s->objtype == type || s->reftype == type) return true;
   }
+  for (mjsElement* e = mjs_firstElement(spec, mjOBJ_TUPLE); e != nullptr;
+       e = mjs_nextElement(spec, e)) {
+    for (int t : *mjs_asTuple(e)->objtype) {
+      if (t == type) return true;
+    }
+  }
   return false;
 }
 
-// Builtin textures at 1 x 1 pixel; no camera and no light, unless a sensor names one.
+// Builtin textures at 1 x 1 pixel; no camera and no light, unless something names one.
 void LeaveOutWhatOnlyRendersRead(mjSpec* spec) {
   for (mjsElement* e = mjs_firstElement(spec, mjOBJ_TEXTURE); e != nullptr;
        e = mjs_nextElement(spec, e)) {
@@ -28,7 +35,7 @@ void LeaveOutWhatOnlyRendersRead(mjSpec* spec) {
   }
   std::vector<mjsElement*> unseen;
   for (mjtObj type : {mjOBJ_CAMERA, mjOBJ_LIGHT}) {
-    if (SensorNames(spec, type)) continue;
+    if (SomethingNames(spec, type)) continue;
     for (mjsElement* e = mjs_firstElement(spec, type); e != nullptr; e = mjs_nextElement(spec, e)) {
       unseen.push_back(e);
     }

@@ -371,14 +371,24 @@ TEST(ClosedLoop, PlantKeepsTheFrictionlossStageOfAModelWithFriction) {
 }
 
 // A run that draws nothing keeps the cameras when a sensor names one (the model would not compile
-// without it), and still leaves out the lights.
-TEST(ClosedLoop, PlantKeepsTheCamerasASensorNames) {
-  const EditedArm arm(
+// without it) or a custom tuple does (deleting the camera would drop the tuple), and still
+// leaves out the lights.
+TEST(ClosedLoop, PlantKeepsTheCamerasTheModelNames) {
+  const EditedArm sensed(
       "<sensor>", "<sensor>\n    <framepos name=\"eye\" objtype=\"camera\" objname=\"render\"/>");
-  auto created = Plant::Create(arm.task, /*drawn=*/false);
+  auto created = Plant::Create(sensed.task, /*drawn=*/false);
   ASSERT_TRUE(created.ok()) << created.error();
   EXPECT_GE((*created)->model()->ncam, 1);
   EXPECT_EQ((*created)->model()->nlight, 0);
+
+  const EditedArm listed("<sensor>",
+                         "<custom><tuple name=\"views\"><element objtype=\"camera\" "
+                         "objname=\"render\"/></tuple></custom>\n  <sensor>");
+  created = Plant::Create(listed.task, /*drawn=*/false);
+  ASSERT_TRUE(created.ok()) << created.error();
+  EXPECT_GE((*created)->model()->ncam, 1);
+  EXPECT_EQ((*created)->model()->nlight, 0);
+  EXPECT_EQ((*created)->model()->ntuple, 1);
 }
 
 // The plant's reads of a bundle (kept from one pass after each step) follow every broadcast and
