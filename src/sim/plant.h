@@ -24,7 +24,7 @@ class Plant {
   // Loads task.model_path (timestep overridden by task.timestep when > 0) and finds the task's
   // bundles, joint and bodies; errors name the task file's field. Without `drawn` (nothing
   // will draw the model) its builtin textures are made 1 pixel and its cameras and lights are
-  // left out; the physics is the same.
+  // left out (unless a sensor or a custom tuple names one); the physics is the same.
   static Result<std::unique_ptr<Plant>> Create(const Task& task, bool drawn = true);
 
   // Every unit off and cold (the units' streams seeded by `seed`), the model at rest, forces
