@@ -95,7 +95,9 @@ Result<std::unique_ptr<Plant>> Plant::Create(const Task& task, bool drawn) {
   // project's arm and bench give cmp-identical runs either way).
   if (!HasFrictionLoss(m)) m->opt.disableflags |= mjDSBL_FRICTIONLOSS;
   if (m->neq == 0) m->opt.disableflags |= mjDSBL_EQUALITY;
-  if (m->ntree <= 1) m->opt.disableflags |= mjDSBL_ISLAND;
+  if (m->ntree <= 1 && !(m->opt.enableflags & mjENBL_SLEEP)) {  // sleeping works on islands
+    m->opt.disableflags |= mjDSBL_ISLAND;
+  }
   auto host = sma::SmaHost::Create(m);
   if (!host.ok()) return Error{where + ".model: " + host.error()};
   p->host_ = std::move(host).value();
