@@ -370,6 +370,16 @@ TEST(ClosedLoop, PlantKeepsTheFrictionlossStageOfAModelWithFriction) {
   ExpectStepsLikeTheModelWithEveryStage(arm.task);
 }
 
+// Island discovery stays on in a model that enables sleeping, which works on islands.
+TEST(ClosedLoop, PlantKeepsIslandsWhenTheModelSleeps) {
+  const EditedArm arm("<flag contact=\"disable\"/>",
+                      "<flag contact=\"disable\" sleep=\"enable\"/>");
+  auto created = Plant::Create(arm.task, /*drawn=*/false);
+  ASSERT_TRUE(created.ok()) << created.error();
+  EXPECT_NE((*created)->model()->opt.enableflags & mjENBL_SLEEP, 0);
+  EXPECT_EQ((*created)->model()->opt.disableflags & mjDSBL_ISLAND, 0);
+}
+
 // A run that draws nothing keeps the cameras when a sensor names one (the model would not compile
 // without it) or a custom tuple does (deleting the camera would drop the tuple), and still
 // leaves out the lights.
