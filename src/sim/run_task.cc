@@ -219,10 +219,9 @@ Status ControlBundle(Channel& ch, Plant& plant, int i, double force_ref, BundleT
   return Status::Ok();
 }
 
-// The per-step telemetry observers see. `force0`: bundle 0's force when already computed this
-// step (the measured force of a force task; a sum over the units), else NaN. `heat`: only the
-// drawing observers use it (another pass over the units).
-void FillTelemetry(const Plant& plant, double reference, double measured, double force0, bool heat,
+// The per-step telemetry observers see (the plant keeps each bundle's reads from one pass).
+// `heat`: only the drawing observers use it (another pass over the units).
+void FillTelemetry(const Plant& plant, double reference, double measured, bool heat,
                    const std::vector<Channel>& channels, TelemetrySample& sample) {
   sample.time = plant.time();
   sample.reference = reference;
@@ -231,7 +230,7 @@ void FillTelemetry(const Plant& plant, double reference, double measured, double
   for (int i = 0; i < plant.num_bundles(); ++i) {
     const int b = plant.bundle_index(i);
     BundleTelemetry& bt = sample.bundles[i];
-    bt.force = i == 0 && !std::isnan(force0) ? force0 : plant.Force(i);
+    bt.force = plant.Force(i);
     bt.true_on = channels[i].switches.last();
     bt.on_fraction = static_cast<double>(bt.true_on) / plant.num_units(i);
     bt.mean_temperature = plant.MeanTemperature(i);
@@ -404,9 +403,7 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
       for (int i = 0; i < nb; ++i) channels[i].switches.Add(plant.OnCount(i));
     }
     if (!observers.empty()) {
-      FillTelemetry(plant, r, y,
-                    task.tracked == Tracked::kForce ? y : std::numeric_limits<double>::quiet_NaN(),
-                    draws, channels, sample);
+      FillTelemetry(plant, r, y, draws, channels, sample);
       for (StepObserver* o : observers) {
         if (Status st = o->OnStep(plant.model(), plant.data(), sample); !st.ok()) {
           return Error{st.error()};
