@@ -42,6 +42,15 @@ FilterModel RandomModel(int m, Rng& rng, bool process_noise) {
   return f;
 }
 
+// RandomModel driven by broadcasts of the m-state heating chain (p_on = 0.5).
+FilterModel HeatingChainModel(int m, Rng& rng, bool process_noise) {
+  FilterModel f = RandomModel(m, rng, process_noise);
+  f.transition = TransitionSource::kBroadcast;
+  f.broadcast = BroadcastTransitionModel::HeatingChain(m, 0.5);
+  f.state_names = f.broadcast.state_names;
+  return f;
+}
+
 // A random column-stochastic m x m matrix with 1 to 3 nonzeros per column at random rows.
 Eigen::SparseMatrix<double> RandomSparseStochastic(int m, Rng& rng) {
   std::vector<Eigen::Triplet<double>> entries;
@@ -212,10 +221,7 @@ TEST(EstimationKalmanSparse, HeatingChainIsAValidSparseBroadcastModel) {
 template <int M>
 void BroadcastMatchesDense(int m, CovarianceMode mode, uint64_t seed, bool avx) {
   Rng rng(seed);
-  FilterModel f = RandomModel(m, rng, false);
-  f.transition = TransitionSource::kBroadcast;
-  f.broadcast = BroadcastTransitionModel::HeatingChain(m, 0.5);
-  f.state_names = f.broadcast.state_names;
+  const FilterModel f = HeatingChainModel(m, rng, false);
   auto sparse = PopulationKalmanFilterT<M, 1>::Create(f, mode);
   auto dense = PopulationKalmanFilterT<M, 1>::Create(f, mode);
   ASSERT_TRUE(sparse.ok()) << sparse.error();
@@ -272,10 +278,7 @@ bool BitIdentical(const F& a, const F& b) {
 template <int M>
 void AvxMatchesBaselineBitwise(int m, CovarianceMode mode, bool process_noise, uint64_t seed) {
   Rng rng(seed);
-  FilterModel f = RandomModel(m, rng, process_noise);
-  f.transition = TransitionSource::kBroadcast;
-  f.broadcast = BroadcastTransitionModel::HeatingChain(m, 0.5);
-  f.state_names = f.broadcast.state_names;
+  const FilterModel f = HeatingChainModel(m, rng, process_noise);
   auto base = PopulationKalmanFilterT<M, 1>::Create(f, mode);
   auto avx = PopulationKalmanFilterT<M, 1>::Create(f, mode);
   ASSERT_TRUE(base.ok()) << base.error();
