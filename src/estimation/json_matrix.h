@@ -20,7 +20,7 @@ inline constexpr int kMaxJsonDepth = 64;
 
 // Parses JSON `text` read from `path`. Errors are messages, never exceptions: malformed JSON
 // (line, column), a number too large for a double (e.g. 1e999) and nesting deeper than
-// kMaxJsonDepth (checked by a SAX pass before any tree is built, so that a 70,000-deep document
+// kMaxJsonDepth (checked as the tree is built, level by level, so that a 70,000-deep document
 // cannot exhaust the stack) each name the file and the field path (e.g.
 // "transition.interior[1][0]"), with the offending text shortened (ShortValue).
 Result<nlohmann::json> ParseJson(const std::string& text, const std::string& path);

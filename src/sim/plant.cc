@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cstdio>
 #include <limits>
+#include <set>
+#include <string>
 #include <vector>
 
 namespace recruit::sim {
@@ -26,6 +28,82 @@ bool SomethingNames(mjSpec* spec, mjtObj type) {
   return false;
 }
 
+// Every name another element refers to, whatever its type: tendon wraps and their side sites,
+// contact pairs, sensors, actuator transmissions, equality constraints (custom tuples: see
+// SomethingNames).
+std::set<std::string> NamesReferredTo(mjSpec* spec) {
+  std::set<std::string> names;
+  // Through mjs_getString: MuJoCo's wheel is built with another C++ library, whose strings
+  // this one cannot read.
+  auto add = [&names](const mjString* s) {
+    const char* c = s != nullptr ? mjs_getString(s) : nullptr;
+    if (c != nullptr && *c != 0) names.insert(c);
+  };
+  auto each = [spec](mjtObj type, auto&& f) {
+    for (mjsElement* e = mjs_firstElement(spec, type); e != nullptr; e = mjs_nextElement(spec, e)) {
+      f(e);
+    }
+  };
+  each(mjOBJ_TENDON, [&](mjsElement* e) {
+    const mjsTendon* t = mjs_asTendon(e);
+    for (int i = 0; i < mjs_getWrapNum(t); ++i) {
+      const mjsWrap* w = mjs_getWrap(t, i);
+      if (mjsElement* target = mjs_getWrapTarget(w)) add(mjs_getName(target));
+      if (mjsSite* side = mjs_getWrapSideSite(w)) add(mjs_getName(side->element));
+    }
+  });
+  each(mjOBJ_PAIR, [&](mjsElement* e) {
+    add(mjs_asPair(e)->geomname1);
+    add(mjs_asPair(e)->geomname2);
+  });
+  each(mjOBJ_SENSOR, [&](mjsElement* e) {
+    add(mjs_asSensor(e)->objname);
+    add(mjs_asSensor(e)->refname);
+  });
+  each(mjOBJ_ACTUATOR, [&](mjsElement* e) {
+    const mjsActuator* a = mjs_asActuator(e);
+    add(a->target);
+    add(a->refsite);
+    add(a->slidersite);
+  });
+  each(mjOBJ_EQUALITY, [&](mjsElement* e) {
+    add(mjs_asEquality(e)->name1);
+    add(mjs_asEquality(e)->name2);
+  });
+  return names;
+}
+
+// The world's geoms that no contact can reach and the sites, wherever they are, that nothing
+// names: MuJoCo places each at every step (3 of the arm's 16 frames, ~1 % of its step), for
+// renders only. A world geom has no mass that moves and a site none at all, so the dynamics are
+// the same to the bit (test PlantSkipsStagesTheModelHasNothingForAndStepsTheSame).
+void LeaveOutStaticDecor(mjSpec* spec) {
+  const std::set<std::string> named = NamesReferredTo(spec);
+  auto unnamed = [&named](mjsElement* e) {
+    return named.count(mjs_getString(mjs_getName(e))) == 0;
+  };
+  const bool no_contact = (spec->option.disableflags & mjDSBL_CONTACT) != 0;
+  const mjsBody* world = mjs_findBody(spec, "world");
+  std::vector<mjsElement*> decor;
+  for (mjsElement* e = mjs_firstElement(spec, mjOBJ_GEOM); e != nullptr;
+       e = mjs_nextElement(spec, e)) {
+    const mjsGeom* g = mjs_asGeom(e);
+    const bool collides = !no_contact && (g->contype != 0 || g->conaffinity != 0);
+    if (!collides && mjs_getParent(e) == world && unnamed(e)) decor.push_back(e);
+  }
+  for (mjsElement* e = mjs_firstElement(spec, mjOBJ_SITE); e != nullptr;
+       e = mjs_nextElement(spec, e)) {
+    if (unnamed(e)) decor.push_back(e);
+  }
+  // A tuple names its elements by type (SomethingNames); deleting one would drop the tuple.
+  const bool geoms_listed = SomethingNames(spec, mjOBJ_GEOM),
+             sites_listed = SomethingNames(spec, mjOBJ_SITE);
+  for (mjsElement* e : decor) {
+    const bool listed = e->elemtype == mjOBJ_GEOM ? geoms_listed : sites_listed;
+    if (!listed) mjs_delete(spec, e);
+  }
+}
+
 // Builtin textures at 1 x 1 pixel; no camera and no light, unless something names one.
 void LeaveOutWhatOnlyRendersRead(mjSpec* spec) {
   for (mjsElement* e = mjs_firstElement(spec, mjOBJ_TEXTURE); e != nullptr;
@@ -41,6 +119,7 @@ void LeaveOutWhatOnlyRendersRead(mjSpec* spec) {
     }
   }
   for (mjsElement* e : unseen) mjs_delete(spec, e);
+  LeaveOutStaticDecor(spec);
 }
 
 // The model at `path`; without `drawn` (a run that draws nothing), every builtin texture (a
@@ -58,6 +137,9 @@ mjModel* LoadPlantModel(const std::string& path, bool drawn, char* error, int er
   mjModel* m = mj_compile(spec, nullptr);
   if (m == nullptr) std::snprintf(error, error_size, "%s", mjs_getError(spec));
   mj_deleteSpec(spec);
+  // A model that fails to compile without what only renders read (a reference this file does
+  // not know of) is loaded whole: its error, if any, is then the model's own.
+  if (m == nullptr && !drawn) return LoadPlantModel(path, true, error, error_size);
   return m;
 }
 

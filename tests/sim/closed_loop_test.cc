@@ -401,6 +401,60 @@ TEST(ClosedLoop, PlantKeepsTheCamerasTheModelNames) {
   EXPECT_EQ((*created)->model()->ntuple, 1);
 }
 
+bool Has(const Plant& p, mjtObj type, const char* name) {
+  return mj_name2id(p.model(), type, name) >= 0;
+}
+
+// A run that draws nothing leaves out the world's geoms no contact can reach (the arm's floor,
+// with contacts off, and its mount) and the sites nothing names (the hand); it keeps the wrapping
+// pulley, the tendons' sites and side sites. It steps as the whole model all the same
+// (PlantSkipsStagesTheModelHasNothingForAndStepsTheSame).
+TEST(ClosedLoop, PlantLeavesOutTheWorldGeomsAndSitesNothingReaches) {
+  const Task task = LoadTask("arm_push.json");
+  auto full = Plant::Create(task, /*drawn=*/true);
+  auto bare = Plant::Create(task, /*drawn=*/false);
+  ASSERT_TRUE(full.ok() && bare.ok());
+  for (const char* geom : {"floor", "mount", "humerus", "elbow_pulley"}) {
+    EXPECT_TRUE(Has(**full, mjOBJ_GEOM, geom)) << geom;
+  }
+  EXPECT_TRUE(Has(**full, mjOBJ_SITE, "hand"));
+  EXPECT_FALSE(Has(**bare, mjOBJ_GEOM, "floor"));
+  EXPECT_FALSE(Has(**bare, mjOBJ_GEOM, "mount"));
+  EXPECT_FALSE(Has(**bare, mjOBJ_SITE, "hand"));
+  // Geoms of a body that is not the world keep their mass in it (and the upper arm's sets the
+  // point the tree's inertias are taken about): they stay.
+  EXPECT_TRUE(Has(**bare, mjOBJ_GEOM, "humerus"));
+  EXPECT_TRUE(Has(**bare, mjOBJ_GEOM, "elbow_pulley"));
+  for (const char* site :
+       {"flexor_origin", "under_pulley", "behind_pulley", "extensor_insertion"}) {
+    EXPECT_TRUE(Has(**bare, mjOBJ_SITE, site)) << site;
+  }
+}
+
+// With contacts on, the floor can collide and stays; a site a sensor names stays, and so does a
+// world geom a contact pair names.
+TEST(ClosedLoop, PlantKeepsTheGeomsAContactReachesAndTheSitesSomethingNames) {
+  const EditedArm contacts("<flag contact=\"disable\"/>", "");
+  auto created = Plant::Create(contacts.task, /*drawn=*/false);
+  ASSERT_TRUE(created.ok()) << created.error();
+  EXPECT_TRUE(Has(**created, mjOBJ_GEOM, "floor"));
+  EXPECT_FALSE(Has(**created, mjOBJ_GEOM, "mount"));
+
+  const EditedArm sensed("<sensor>",
+                         "<sensor>\n    <framepos name=\"hand\" objtype=\"site\" "
+                         "objname=\"hand\"/>");
+  created = Plant::Create(sensed.task, /*drawn=*/false);
+  ASSERT_TRUE(created.ok()) << created.error();
+  EXPECT_TRUE(Has(**created, mjOBJ_SITE, "hand"));
+
+  const EditedArm paired(
+      "<tendon>", "<contact><pair geom1=\"mount\" geom2=\"payload\"/></contact>\n  <tendon>");
+  created = Plant::Create(paired.task, /*drawn=*/false);
+  ASSERT_TRUE(created.ok()) << created.error();
+  EXPECT_TRUE(Has(**created, mjOBJ_GEOM, "mount"));
+  EXPECT_FALSE(Has(**created, mjOBJ_GEOM, "floor"));
+}
+
 // The plant's reads of a bundle (kept from one pass after each step) follow every broadcast and
 // step: each equals the host's separate read of the same mjData at that moment.
 TEST(ClosedLoop, PlantReadsFollowBroadcastsAndSteps) {
