@@ -8,8 +8,12 @@ and the ratio OLD / NEW. Alternating the two binaries makes the ratio robust to 
 machine's drift (docs/benchmarks.md, "Issue 15, session 5"), and alternating their order to the
 second run's ~1 % penalty ("Issue 15, session 6").
 
+With --fresh each run writes into a new empty folder; by default every run of a task writes
+over the previous run's outputs, as a user repeating a run does (replacing a 2-5 MB CSV costs
+2-5 %: docs/benchmarks.md, "Issue 15, session 6").
+
 Usage, from the repository root:
-    python3 bench/process/whole_process_cpu.py OLD NEW N TASK [TASK ...]
+    python3 bench/process/whole_process_cpu.py [--fresh] OLD NEW N TASK [TASK ...]
 """
 import json
 import resource
@@ -19,8 +23,10 @@ import sys
 import tempfile
 
 
-def child_cpu(binary, task, out):
-    """CPU seconds (user + sys) of one `simulate` run of `task`."""
+def child_cpu(binary, task, out, fresh=False):
+    """CPU seconds (user + sys) of one `simulate` run of `task` (into a new subfolder if fresh)."""
+    if fresh:
+        out = tempfile.mkdtemp(dir=out)
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     subprocess.run([binary, "simulate", "--task", f"models/tasks/{task}.json", "--seed", "3",
                     "--out", out], check=True, stdout=subprocess.DEVNULL,
@@ -30,6 +36,8 @@ def child_cpu(binary, task, out):
 
 
 def main(argv):
+    fresh = "--fresh" in argv
+    argv = [a for a in argv if a != "--fresh"]
     if len(argv) < 5:
         sys.exit(__doc__)
     old, new, runs, tasks = argv[1], argv[2], int(argv[3]), argv[4:]
@@ -45,11 +53,11 @@ def main(argv):
                 # ABBA order: the binary run second in a pair measured ~1 % slower, whichever it
                 # was (docs/benchmarks.md, "Issue 15, session 6"); alternating cancels that.
                 if i % 2 == 0:
-                    old_cpu.append(child_cpu(old, task, out))
-                    new_cpu.append(child_cpu(new, task, out))
+                    old_cpu.append(child_cpu(old, task, out, fresh))
+                    new_cpu.append(child_cpu(new, task, out, fresh))
                 else:
-                    new_cpu.append(child_cpu(new, task, out))
-                    old_cpu.append(child_cpu(old, task, out))
+                    new_cpu.append(child_cpu(new, task, out, fresh))
+                    old_cpu.append(child_cpu(old, task, out, fresh))
         a, b = statistics.median(old_cpu), statistics.median(new_cpu)
         print(f"| {task} | {duration:.0f} s | {a * 1000:.1f} ms ({duration / a:.0f}x) | "
               f"{b * 1000:.1f} ms ({duration / b:.0f}x) | {a / b:.2f} |")
