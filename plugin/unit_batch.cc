@@ -245,6 +245,18 @@ inline NewtonLanes NewtonStart(const Lanes& L, Vd g, Vd dg) {
   return s;
 }
 
+// Every lane's mask (the comparison's all-ones result).
+inline Mask AllLanes() {
+  const Vd z = Splat(0);
+  return Le(z, z);
+}
+
+// The mask of lanes 0 .. count - 1.
+inline Mask ValidLanes(int count) {
+  alignas(64) static constexpr double kIndex[8] = {0, 1, 2, 3, 4, 5, 6, 7};
+  return Lt(Load(kIndex), Splat(count));
+}
+
 // The bracket update and the Newton (or bisection) step of the active lanes.
 inline void NewtonStep(NewtonLanes& s) {
   const Mask pos = Gt(s.g, 0.0);
@@ -267,8 +279,10 @@ inline void NewtonResidual(const Consts& c, const Lanes& L, NewtonLanes& s) {
   s.active = AndNot(s.active, Lt(Abs(s.g), 1e-13));
 }
 
-inline Vd Newton(const Consts& c, const Lanes& L, Vd g, Vd dg) {
+// Lanes outside `solving` start stopped: they keep x = xi_n, and the loop ends with the others.
+inline Vd Newton(const Consts& c, const Lanes& L, Vd g, Vd dg, Mask solving = AllLanes()) {
   NewtonLanes s = NewtonStart(L, g, dg);
+  s.active = solving;
   for (int it = 0; it < 60; ++it) {
     NewtonStep(s);
     if (Bits(s.active) == 0) break;
@@ -369,6 +383,109 @@ struct Block {
   double *temperature, *xi, *t_eff, *heat_scale, *cool_scale;
 };
 
+// The thermal step and the constants of the update, broadcast to every lane.
+struct StepConsts {
+  Consts k;
+  Vd amb, rise_A, rise_dM, decay;
+};
+
+// (A) for one block of cohorts: the thermal step, the branch, the residual at xi_n, whether
+// the cohort transforms, and its values if it does not.
+struct PhaseA {
+  Vd xi0, hs0, cs0, T0, t_th, te0, g, dg;
+  Mask is_heat, tr;
+  Vd x, h, cl;  // xi, heat_scale, cool_scale of a cohort that does not transform
+};
+
+inline PhaseA ThermalStepAndTest(const StepConsts& sc, Vd on, Vd T0, Vd xi0, Vd te_prev, Vd hs0,
+                                 Vd cs0) {
+  const Consts& k = sc.k;
+  PhaseA a;
+  a.xi0 = xi0, a.hs0 = hs0, a.cs0 = cs0, a.T0 = T0;
+  const Vd t_ss = Sel(Ne(on, Splat(0)), sc.amb + (sc.rise_A + xi0 * sc.rise_dM), sc.amb);
+  a.t_th = t_ss + (T0 - t_ss) * sc.decay;
+  Vd dfdx0;
+  const Vd f0 = LaneTension(k, xi0, &dfdx0);
+  const Vd te_h0 = a.t_th - k.pn_h * f0;
+  a.is_heat = Ge(te_h0, te_prev);
+  a.te0 = Sel(a.is_heat, te_h0, a.t_th - k.pn_c * f0);
+  const Vd pn = Sel(a.is_heat, k.pn_h, k.pn_c);
+  Vd slope;
+  const Vd mv = MajorCurve(a.te0, Sel(a.is_heat, k.As, k.Mf), Sel(a.is_heat, k.Af, k.Ms),
+                           Sel(a.is_heat, k.heat_rate, k.cool_rate), &slope);
+  a.g = Sel(a.is_heat, xi0 - hs0 * mv, xi0 - 1.0 + cs0 * (1.0 - mv));
+  a.dg = 1.0 - Sel(a.is_heat, hs0, cs0) * slope * (k.latent - pn * dfdx0);
+  a.tr = Sel(a.is_heat, Gt(a.g, 1e-12), Lt(a.g, -1e-12));
+  a.x = xi0, a.h = hs0, a.cl = cs0;
+  Canonical(&a.x, &a.h, &a.cl);
+  return a;
+}
+
+// The per-lane inputs of a solve from xi_n, T after the thermal step, the scales and the branch.
+inline Lanes MakeLanes(const Consts& k, Mask heat, Vd xi0, Vd tth, Vd hs, Vd cs) {
+  Lanes L;
+  L.heat = heat;
+  L.xi0 = xi0;
+  L.tth = tth;
+  L.hs = hs;
+  L.cs = cs;
+  L.pn = Sel(L.heat, k.pn_h, k.pn_c);
+  L.scale = Sel(L.heat, L.hs, L.cs);
+  L.t0 = Sel(L.heat, k.As, k.Mf);
+  L.t1 = Sel(L.heat, k.Af, k.Ms);
+  L.rate = Sel(L.heat, k.heat_rate, k.cool_rate);
+  return L;
+}
+
+// A solved cohort's new fields.
+struct Solved {
+  Vd T, xi, t_eff, hs, cs;
+};
+
+inline Solved FinishSolve(const Consts& k, const Lanes& L, Vd x) {
+  // T_eff at the solution; the opposite branch's scale restarts there (proportional rule).
+  const Vd t_eff = (L.tth + k.latent * (x - L.xi0)) - L.pn * TensionOnly(k, x);
+  Vd unused;
+  const Vd other = MajorCurve(t_eff, Sel(L.heat, k.Mf, k.As), Sel(L.heat, k.Ms, k.Af),
+                              Sel(L.heat, k.cool_rate, k.heat_rate), &unused);
+  // Heating: cool_scale = (1 - x) / (1 - M-); cooling: heat_scale = x / M+ (one division).
+  const Vd ratio = Clamp01(Sel(L.heat, 1.0 - x, x) / Sel(L.heat, 1.0 - other, other));
+  Vd cl = Sel(L.heat, Sel(Lt(other, 1.0), ratio, Splat(1)), L.cs);
+  Vd h = Sel(L.heat, L.hs, Sel(Gt(other, 0.0), ratio, Splat(1)));
+  Canonical(&x, &h, &cl);
+  return {L.tth + k.latent * (x - L.xi0), x, t_eff, h, cl};
+}
+
+// All n <= kLanes cohorts in one block (an arm's bundle has about four): phase A's values stay in
+// registers and the transforming lanes are solved where they are, the others stopped, without
+// the gather through memory that batches many cohorts. Lane by lane the same operations.
+inline void AdvanceOneBlock(const StepConsts& sc, const Block& b, int count) {
+  auto load = [count](const double* p) { return count == kLanes ? Load(p) : LoadN(p, count); };
+  auto store = [count](double* p, Vd v) {
+    if (count == kLanes) {
+      Store(p, v);
+    } else {
+      StoreN(p, v, count);
+    }
+  };
+  const PhaseA a = ThermalStepAndTest(sc, load(b.on), load(b.temperature), load(b.xi),
+                                      load(b.t_eff), load(b.heat_scale), load(b.cool_scale));
+  Solved out{a.t_th + sc.k.latent * (a.x - a.xi0), a.x, a.te0, a.h, a.cl};
+  // The lanes past `count` hold zeros: they must not keep the solve going.
+  const Mask tr = And(a.tr, ValidLanes(count));
+  if (Bits(tr) != 0) {
+    const Lanes L = MakeLanes(sc.k, a.is_heat, a.xi0, a.t_th, a.hs0, a.cs0);
+    const Solved s = FinishSolve(sc.k, L, Newton(sc.k, L, a.g, a.dg, tr));
+    out = {Sel(tr, s.T, out.T), Sel(tr, s.xi, out.xi), Sel(tr, s.t_eff, out.t_eff),
+           Sel(tr, s.hs, out.hs), Sel(tr, s.cs, out.cs)};
+  }
+  store(b.temperature, out.T);
+  store(b.xi, out.xi);
+  store(b.t_eff, out.t_eff);
+  store(b.heat_scale, out.hs);
+  store(b.cool_scale, out.cs);
+}
+
 #pragma GCC diagnostic pop
 
 }  // namespace
@@ -382,9 +499,15 @@ struct Block {
 void AdvanceCohorts(const BatchParams& p, const BatchCohorts& c, int n, double stretch,
                     double decay) {
   constexpr int kChunk = 64;
-  const Consts k = MakeConsts(p, stretch);
-  const Vd amb = Splat(p.ambient), rise_A = Splat(p.rise_A), rise_dM = Splat(p.rise_dM);
-  const Vd vdecay = Splat(decay);
+  const StepConsts sc{MakeConsts(p, stretch), Splat(p.ambient), Splat(p.rise_A), Splat(p.rise_dM),
+                      Splat(decay)};
+  const Consts& k = sc.k;
+  if (n <= kLanes) {
+    if (n > 0) {
+      AdvanceOneBlock(sc, Block{c.on, c.temperature, c.xi, c.t_eff, c.heat_scale, c.cool_scale}, n);
+    }
+    return;
+  }
   alignas(32) double tth[kChunk], g0[kChunk], dg0[kChunk], heat[kChunk];
   int solve[kChunk + kLanes];
   for (int base = 0; base < n; base += kChunk) {
@@ -401,36 +524,20 @@ void AdvanceCohorts(const BatchParams& p, const BatchCohorts& c, int n, double s
           StoreN(p, v, count);
         }
       };
-      const Vd xi0 = load(b.xi), hs0 = load(b.heat_scale), cs0 = load(b.cool_scale);
-      const Vd T0 = load(b.temperature);
-      const Vd t_ss = Sel(Ne(load(b.on), Splat(0)), amb + (rise_A + xi0 * rise_dM), amb);
-      const Vd t_th = t_ss + (T0 - t_ss) * vdecay;
-      Vd dfdx0;
-      const Vd f0 = LaneTension(k, xi0, &dfdx0);
-      const Vd te_h0 = t_th - k.pn_h * f0;
-      const Mask is_heat = Ge(te_h0, load(b.t_eff));
-      const Vd te0 = Sel(is_heat, te_h0, t_th - k.pn_c * f0);
-      const Vd pn = Sel(is_heat, k.pn_h, k.pn_c);
-      Vd slope;
-      const Vd mv = MajorCurve(te0, Sel(is_heat, k.As, k.Mf), Sel(is_heat, k.Af, k.Ms),
-                               Sel(is_heat, k.heat_rate, k.cool_rate), &slope);
-      const Vd g = Sel(is_heat, xi0 - hs0 * mv, xi0 - 1.0 + cs0 * (1.0 - mv));
-      const Vd dg = 1.0 - Sel(is_heat, hs0, cs0) * slope * (k.latent - pn * dfdx0);
-      const Mask tr = Sel(is_heat, Gt(g, 1e-12), Lt(g, -1e-12));
+      const PhaseA a = ThermalStepAndTest(sc, load(b.on), load(b.temperature), load(b.xi),
+                                          load(b.t_eff), load(b.heat_scale), load(b.cool_scale));
       // Cohorts that do not transform keep xi_n and are finished here; the others keep their
       // old values until (B).
-      Vd x = xi0, h = hs0, cl = cs0;
-      Canonical(&x, &h, &cl);
-      store(b.temperature, Sel(tr, T0, t_th + k.latent * (x - xi0)));
-      store(b.xi, Sel(tr, xi0, x));
-      store(b.t_eff, te0);
-      store(b.heat_scale, Sel(tr, hs0, h));
-      store(b.cool_scale, Sel(tr, cs0, cl));
-      Store(tth + j, t_th);
-      Store(g0 + j, g);
-      Store(dg0 + j, dg);
-      Store(heat + j, ToVd(is_heat));
-      n_solve = AppendLanes(solve, n_solve, j, Bits(tr) & ((1 << count) - 1));
+      store(b.temperature, Sel(a.tr, a.T0, a.t_th + k.latent * (a.x - a.xi0)));
+      store(b.xi, Sel(a.tr, a.xi0, a.x));
+      store(b.t_eff, a.te0);
+      store(b.heat_scale, Sel(a.tr, a.hs0, a.h));
+      store(b.cool_scale, Sel(a.tr, a.cs0, a.cl));
+      Store(tth + j, a.t_th);
+      Store(g0 + j, a.g);
+      Store(dg0 + j, a.dg);
+      Store(heat + j, ToVd(a.is_heat));
+      n_solve = AppendLanes(solve, n_solve, j, Bits(a.tr) & ((1 << count) - 1));
     };
     const double* const on = c.on + base;
     double* const T = c.temperature + base;
@@ -465,36 +572,18 @@ void AdvanceCohorts(const BatchParams& p, const BatchCohorts& c, int n, double s
 #else
       auto gather = [&](const double* a) { return Vd{a[idx[0]], a[idx[1]]}; };
 #endif
-      L->heat = ToMask(gather(heat));
-      L->xi0 = gather(xi);
-      L->tth = gather(tth);
-      L->hs = gather(hs);
-      L->cs = gather(cs);
-      L->pn = Sel(L->heat, k.pn_h, k.pn_c);
-      L->scale = Sel(L->heat, L->hs, L->cs);
-      L->t0 = Sel(L->heat, k.As, k.Mf);
-      L->t1 = Sel(L->heat, k.Af, k.Ms);
-      L->rate = Sel(L->heat, k.heat_rate, k.cool_rate);
+      *L = MakeLanes(k, ToMask(gather(heat)), gather(xi), gather(tth), gather(hs), gather(cs));
       *g = gather(g0);
       *dg = gather(dg0);
     };
     auto finish = [&](const int* idx, const Lanes& L, Vd x) __attribute__((always_inline)) {
-      // T_eff at the solution; the opposite branch's scale restarts there (proportional rule).
-      const Vd t_eff = (L.tth + k.latent * (x - L.xi0)) - L.pn * TensionOnly(k, x);
-      Vd unused;
-      const Vd other = MajorCurve(t_eff, Sel(L.heat, k.Mf, k.As), Sel(L.heat, k.Ms, k.Af),
-                                  Sel(L.heat, k.cool_rate, k.heat_rate), &unused);
-      // Heating: cool_scale = (1 - x) / (1 - M-); cooling: heat_scale = x / M+ (one division).
-      const Vd ratio = Clamp01(Sel(L.heat, 1.0 - x, x) / Sel(L.heat, 1.0 - other, other));
-      Vd cl = Sel(L.heat, Sel(Lt(other, 1.0), ratio, Splat(1)), L.cs);
-      Vd h = Sel(L.heat, L.hs, Sel(Gt(other, 0.0), ratio, Splat(1)));
-      Canonical(&x, &h, &cl);
+      const Solved s = FinishSolve(k, L, x);
       alignas(64) double out[5][kLanes];
-      Store(out[0], L.tth + k.latent * (x - L.xi0));
-      Store(out[1], x);
-      Store(out[2], t_eff);
-      Store(out[3], h);
-      Store(out[4], cl);
+      Store(out[0], s.T);
+      Store(out[1], s.xi);
+      Store(out[2], s.t_eff);
+      Store(out[3], s.hs);
+      Store(out[4], s.cs);
       for (int l = 0; l < kLanes; ++l) {
         const int i = idx[l];
         T[i] = out[0][l];

@@ -15,7 +15,9 @@ class StepObserver {
   virtual Status OnStep(const mjModel* m, const mjData* d, const TelemetrySample& sample) = 0;
   // Called once when the run ends normally (flush, finish the file).
   virtual Status Finish() { return Status::Ok(); }
-  // True if it draws the model: only then are the model's textures generated at full size.
+  // True if it draws the model: only then does the run load it whole (textures at full size,
+  // cameras, lights, the world's non-colliding geoms and the sites nothing names: see
+  // sim/plant.cc, LoadPlantModel).
   virtual bool Draws() const { return false; }
 };
 

@@ -172,6 +172,32 @@ TEST_P(BatchedCohorts, EveryPatternOfTransformingLanesIsSolved) {
   }
 }
 
+// At most a batch of cohorts (an arm's bundle has about four), solved where they are: for each
+// count from 1 to 8 every pattern of transforming cohorts is solved, and only those.
+TEST_P(BatchedCohorts, EveryPatternOfTransformingCohortsInOneBatchIsSolved) {
+  const UnitModel m = MakeModel(config());
+  const double stretch = m.params().prestretch;
+  const double decay = m.DecayFactor(1e-3);
+  UnitState still = RestState(m, stretch), hot = still;
+  hot.temperature = m.params().Af + 5;
+  for (int n = 1; n <= 8; ++n) {
+    for (int pattern = 0; pattern < (1 << n); ++pattern) {
+      Soa soa(n);
+      for (int j = 0; j < n; ++j) {
+        const bool transforms = (pattern >> j) & 1;
+        soa.on[j] = transforms ? 1 : 0;
+        soa.Set(j, transforms ? hot : still);
+      }
+      const std::vector<double> xi_before = soa.xi;
+      ASSERT_TRUE(StepMatchesScalar(m, soa, stretch, decay, isa()))
+          << "n " << n << " pattern " << pattern;
+      for (int j = 0; j < n; ++j) {
+        EXPECT_EQ(soa.xi[j] != xi_before[j], ((pattern >> j) & 1) != 0) << "n " << n << " j " << j;
+      }
+    }
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(
     Units, BatchedCohorts,
     ::testing::Combine(::testing::Values("",                          // datasheet wire unit
