@@ -397,8 +397,9 @@ struct PhaseA {
   Vd x, h, cl;  // xi, heat_scale, cool_scale of a cohort that does not transform
 };
 
-inline PhaseA ThermalStepAndTest(const StepConsts& sc, Vd on, Vd T0, Vd xi0, Vd te_prev, Vd hs0,
-                                 Vd cs0) {
+__attribute__((always_inline)) inline PhaseA ThermalStepAndTest(const StepConsts& sc, Vd on, Vd T0,
+                                                                Vd xi0, Vd te_prev, Vd hs0,
+                                                                Vd cs0) {
   const Consts& k = sc.k;
   PhaseA a;
   a.xi0 = xi0, a.hs0 = hs0, a.cs0 = cs0, a.T0 = T0;
@@ -422,7 +423,8 @@ inline PhaseA ThermalStepAndTest(const StepConsts& sc, Vd on, Vd T0, Vd xi0, Vd 
 }
 
 // The per-lane inputs of a solve from xi_n, T after the thermal step, the scales and the branch.
-inline Lanes MakeLanes(const Consts& k, Mask heat, Vd xi0, Vd tth, Vd hs, Vd cs) {
+__attribute__((always_inline)) inline Lanes MakeLanes(const Consts& k, Mask heat, Vd xi0, Vd tth,
+                                                      Vd hs, Vd cs) {
   Lanes L;
   L.heat = heat;
   L.xi0 = xi0;
@@ -442,7 +444,7 @@ struct Solved {
   Vd T, xi, t_eff, hs, cs;
 };
 
-inline Solved FinishSolve(const Consts& k, const Lanes& L, Vd x) {
+__attribute__((always_inline)) inline Solved FinishSolve(const Consts& k, const Lanes& L, Vd x) {
   // T_eff at the solution; the opposite branch's scale restarts there (proportional rule).
   const Vd t_eff = (L.tth + k.latent * (x - L.xi0)) - L.pn * TensionOnly(k, x);
   Vd unused;
