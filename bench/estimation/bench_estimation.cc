@@ -12,6 +12,9 @@
 //    AVX without FMA, the reference of the sparse step's AVX kernels);
 //  - BM_ChainStep<M>/<path>: the heating / cooling chain, dense A, sparse A with the kernels
 //    the filter picks (AVX where the CPU has it), sparse A with the baseline kernels;
+//  - BM_ParseFilterModel/<path>: reading an identified model's JSON text (16 KB, what
+//    `recruit simulate` does for each bundle at start-up): 0 = json_io::ParseJson (one pass that
+//    checks and builds the tree), 1 = nlohmann::json::parse alone, the reference;
 //  - BM_Estimator/<kind>/m: time per step of the extended Kalman filter, the exact filter
 //    (every step a new A, and a constant, cached A) and a particle filter with the smallest
 //    particle count whose RMSE is within 5 % of the Kalman filter's (found by a calibration
@@ -20,11 +23,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <map>
+#include <sstream>
 #include <vector>
 
 #include "common/rng.h"
 #include "estimation/exact_filter.h"
+#include "estimation/json_matrix.h"
 #include "estimation/particle_filter.h"
 #include "estimation/population_chain.h"
 #include "estimation/population_kalman_filter.h"
@@ -454,6 +460,24 @@ BENCHMARK(BM_EstimatorParticle)
     ->Args({2, 100})
     ->Args({3, 100})
     ->Unit(benchmark::kMicrosecond);
+
+void BM_ParseFilterModel(benchmark::State& state) {
+  std::ifstream in(RECRUIT_SOURCE_DIR "/models/identified/flexor_4b2b9e8fdcf19d9b_dt1_m20.json");
+  std::stringstream text;
+  text << in.rdbuf();
+  const std::string json = text.str();
+  for (auto _ : state) {
+    if (state.range(0) == 0) {
+      auto j = json_io::ParseJson(json, "model.json");
+      benchmark::DoNotOptimize(j);
+    } else {
+      auto j = nlohmann::json::parse(json);
+      benchmark::DoNotOptimize(j);
+    }
+  }
+  state.SetBytesProcessed(static_cast<std::int64_t>(state.iterations() * json.size()));
+}
+BENCHMARK(BM_ParseFilterModel)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 }  // namespace recruit
