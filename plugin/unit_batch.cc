@@ -422,6 +422,27 @@ __attribute__((always_inline)) inline PhaseA ThermalStepAndTest(const StepConsts
   return a;
 }
 
+// A block's first `count` lanes: all kLanes as full vectors, fewer (the tail) masked, with no
+// access beyond them (the other lanes load as 0 and are not stored).
+inline Vd LoadLanes(const double* p, int count) {
+  return count == kLanes ? Load(p) : LoadN(p, count);
+}
+inline void StoreLanes(double* p, Vd v, int count) {
+  if (count == kLanes) {
+    Store(p, v);
+  } else {
+    StoreN(p, v, count);
+  }
+}
+
+// ThermalStepAndTest of a block's `count` cohorts.
+__attribute__((always_inline)) inline PhaseA BlockStepAndTest(const StepConsts& sc, const Block& b,
+                                                              int count) {
+  return ThermalStepAndTest(sc, LoadLanes(b.on, count), LoadLanes(b.temperature, count),
+                            LoadLanes(b.xi, count), LoadLanes(b.t_eff, count),
+                            LoadLanes(b.heat_scale, count), LoadLanes(b.cool_scale, count));
+}
+
 // The per-lane inputs of a solve from xi_n, T after the thermal step, the scales and the branch.
 __attribute__((always_inline)) inline Lanes MakeLanes(const Consts& k, Mask heat, Vd xi0, Vd tth,
                                                       Vd hs, Vd cs) {
@@ -462,16 +483,7 @@ __attribute__((always_inline)) inline Solved FinishSolve(const Consts& k, const 
 // registers and the transforming lanes are solved where they are, the others stopped, without
 // the gather through memory that batches many cohorts. Lane by lane the same operations.
 inline void AdvanceOneBlock(const StepConsts& sc, const Block& b, int count) {
-  auto load = [count](const double* p) { return count == kLanes ? Load(p) : LoadN(p, count); };
-  auto store = [count](double* p, Vd v) {
-    if (count == kLanes) {
-      Store(p, v);
-    } else {
-      StoreN(p, v, count);
-    }
-  };
-  const PhaseA a = ThermalStepAndTest(sc, load(b.on), load(b.temperature), load(b.xi),
-                                      load(b.t_eff), load(b.heat_scale), load(b.cool_scale));
+  const PhaseA a = BlockStepAndTest(sc, b, count);
   Solved out{a.t_th + sc.k.latent * (a.x - a.xi0), a.x, a.te0, a.h, a.cl};
   // The lanes past `count` hold zeros: they must not keep the solve going.
   const Mask tr = And(a.tr, ValidLanes(count));
@@ -481,11 +493,11 @@ inline void AdvanceOneBlock(const StepConsts& sc, const Block& b, int count) {
     out = {Sel(tr, s.T, out.T), Sel(tr, s.xi, out.xi), Sel(tr, s.t_eff, out.t_eff),
            Sel(tr, s.hs, out.hs), Sel(tr, s.cs, out.cs)};
   }
-  store(b.temperature, out.T);
-  store(b.xi, out.xi);
-  store(b.t_eff, out.t_eff);
-  store(b.heat_scale, out.hs);
-  store(b.cool_scale, out.cs);
+  StoreLanes(b.temperature, out.T, count);
+  StoreLanes(b.xi, out.xi, count);
+  StoreLanes(b.t_eff, out.t_eff, count);
+  StoreLanes(b.heat_scale, out.hs, count);
+  StoreLanes(b.cool_scale, out.cs, count);
 }
 
 #pragma GCC diagnostic pop
@@ -518,23 +530,14 @@ void AdvanceCohorts(const BatchParams& p, const BatchCohorts& c, int n, double s
     // (A) on cohorts base + j .. base + j + kLanes - 1; `valid` has the bits of real lanes.
     // The block's `count` lanes are real cohorts (kLanes but at the tail); others are zeros.
     auto phase_a = [&](const Block& b, int j, int count) __attribute__((always_inline)) {
-      auto load = [count](const double* p) { return count == kLanes ? Load(p) : LoadN(p, count); };
-      auto store = [count](double* p, Vd v) {
-        if (count == kLanes) {
-          Store(p, v);
-        } else {
-          StoreN(p, v, count);
-        }
-      };
-      const PhaseA a = ThermalStepAndTest(sc, load(b.on), load(b.temperature), load(b.xi),
-                                          load(b.t_eff), load(b.heat_scale), load(b.cool_scale));
+      const PhaseA a = BlockStepAndTest(sc, b, count);
       // Cohorts that do not transform keep xi_n and are finished here; the others keep their
       // old values until (B).
-      store(b.temperature, Sel(a.tr, a.T0, a.t_th + k.latent * (a.x - a.xi0)));
-      store(b.xi, Sel(a.tr, a.xi0, a.x));
-      store(b.t_eff, a.te0);
-      store(b.heat_scale, Sel(a.tr, a.hs0, a.h));
-      store(b.cool_scale, Sel(a.tr, a.cs0, a.cl));
+      StoreLanes(b.temperature, Sel(a.tr, a.T0, a.t_th + k.latent * (a.x - a.xi0)), count);
+      StoreLanes(b.xi, Sel(a.tr, a.xi0, a.x), count);
+      StoreLanes(b.t_eff, a.te0, count);
+      StoreLanes(b.heat_scale, Sel(a.tr, a.hs0, a.h), count);
+      StoreLanes(b.cool_scale, Sel(a.tr, a.cs0, a.cl), count);
       Store(tth + j, a.t_th);
       Store(g0 + j, a.g);
       Store(dg0 + j, a.dg);

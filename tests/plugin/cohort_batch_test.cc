@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <functional>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -146,29 +147,55 @@ TEST_P(BatchedCohorts, SwitchingTrajectoriesAreBitIdenticalToScalarUpdate) {
   EXPECT_GT(solved_steps, 10000);
 }
 
+// Cohorts at rest and off, which do not change, or on and hot inside the heating window, whose
+// xi falls: Step(n, transforms) sets cohort j hot where transforms(j), advances all n by one
+// batched step, and checks it against the scalar update and that exactly those cohorts moved.
+struct StillOrHot {
+  explicit StillOrHot(const UnitModel& model)
+      : m(model), stretch(m.params().prestretch), decay(m.DecayFactor(1e-3)) {
+    still = RestState(m, stretch);
+    hot = still;
+    hot.temperature = m.params().Af + 5;
+  }
+  ::testing::AssertionResult Step(int n, const std::function<bool(int)>& transforms,
+                                  UnitModel::Isa isa) const {
+    Soa soa(n);
+    for (int j = 0; j < n; ++j) {
+      soa.on[j] = transforms(j) ? 1 : 0;
+      soa.Set(j, transforms(j) ? hot : still);
+    }
+    const std::vector<double> xi_before = soa.xi;
+    if (!StepMatchesScalar(m, soa, stretch, decay, isa)) {
+      return ::testing::AssertionFailure() << "not the scalar update";
+    }
+    for (int j = 0; j < n; ++j) {
+      if ((soa.xi[j] != xi_before[j]) != transforms(j)) {
+        return ::testing::AssertionFailure()
+               << "cohort " << j << (transforms(j) ? " not" : "") << " solved";
+      }
+    }
+    return ::testing::AssertionSuccess();
+  }
+  const UnitModel& m;
+  double stretch, decay;
+  UnitState still, hot;
+};
+
 // Every pattern of transforming lanes in a SIMD batch (a cohort of each 8-cohort group
 // transforms where the group's bit is set, all 256 patterns; 2, 4 and 8 lanes divide 8), then a
 // partial tail: each transforming cohort is solved, and only those.
 TEST_P(BatchedCohorts, EveryPatternOfTransformingLanesIsSolved) {
   const UnitModel m = MakeModel(config());
-  const double stretch = m.params().prestretch;
-  const double decay = m.DecayFactor(1e-3);
-  // At rest and off nothing changes; on and hot inside the heating window, xi falls.
-  UnitState still = RestState(m, stretch), hot = still;
-  hot.temperature = m.params().Af + 5;
-  UnitState a = still, b = hot;
-  AdvanceUnitWithDecay(m, a, false, stretch, decay);
-  AdvanceUnitWithDecay(m, b, true, stretch, decay);
-  ASSERT_EQ(a.xi, still.xi);
-  ASSERT_NE(b.xi, hot.xi);
+  const StillOrHot cohorts(m);
+  UnitState a = cohorts.still, b = cohorts.hot;
+  AdvanceUnitWithDecay(m, a, false, cohorts.stretch, cohorts.decay);
+  AdvanceUnitWithDecay(m, b, true, cohorts.stretch, cohorts.decay);
+  ASSERT_EQ(a.xi, cohorts.still.xi);
+  ASSERT_NE(b.xi, cohorts.hot.xi);
   for (int n : {8 * 256, 8 * 256 + 5}) {
-    Soa soa(n);
-    for (int j = 0; j < n; ++j) {
-      const bool transforms = ((j / 8) >> (j % 8)) & 1 || j >= 8 * 256;
-      soa.on[j] = transforms ? 1 : 0;
-      soa.Set(j, transforms ? hot : still);
-    }
-    ASSERT_TRUE(StepMatchesScalar(m, soa, stretch, decay, isa())) << "n " << n;
+    EXPECT_TRUE(cohorts.Step(
+        n, [](int j) { return (((j / 8) >> (j % 8)) & 1) != 0 || j >= 8 * 256; }, isa()))
+        << "n " << n;
   }
 }
 
@@ -176,24 +203,12 @@ TEST_P(BatchedCohorts, EveryPatternOfTransformingLanesIsSolved) {
 // count from 1 to 8 every pattern of transforming cohorts is solved, and only those.
 TEST_P(BatchedCohorts, EveryPatternOfTransformingCohortsInOneBatchIsSolved) {
   const UnitModel m = MakeModel(config());
-  const double stretch = m.params().prestretch;
-  const double decay = m.DecayFactor(1e-3);
-  UnitState still = RestState(m, stretch), hot = still;
-  hot.temperature = m.params().Af + 5;
+  const StillOrHot cohorts(m);
   for (int n = 1; n <= 8; ++n) {
     for (int pattern = 0; pattern < (1 << n); ++pattern) {
-      Soa soa(n);
-      for (int j = 0; j < n; ++j) {
-        const bool transforms = (pattern >> j) & 1;
-        soa.on[j] = transforms ? 1 : 0;
-        soa.Set(j, transforms ? hot : still);
-      }
-      const std::vector<double> xi_before = soa.xi;
-      ASSERT_TRUE(StepMatchesScalar(m, soa, stretch, decay, isa()))
+      ASSERT_TRUE(cohorts.Step(
+          n, [pattern](int j) { return ((pattern >> j) & 1) != 0; }, isa()))
           << "n " << n << " pattern " << pattern;
-      for (int j = 0; j < n; ++j) {
-        EXPECT_EQ(soa.xi[j] != xi_before[j], ((pattern >> j) & 1) != 0) << "n " << n << " j " << j;
-      }
     }
   }
 }
