@@ -515,7 +515,7 @@ int RunMergeCommand(const SweepArgs& a) {
 
 // The options shared by `sweep` and `sweep merge` (the sweep's definition must be the same).
 void AddDefinitionOptions(CLI::App* cmd, SweepArgs* a) {
-  auto track = [cmd, a](CLI::Option* o, const std::string& name) {
+  auto track = [a](CLI::Option* o, const std::string& name) {
     o->each([a, name](const std::string&) { a->given.insert(name); });
     return o;
   };
