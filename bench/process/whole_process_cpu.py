@@ -4,7 +4,8 @@
 For each task, runs `BINARY simulate --task models/tasks/TASK.json --seed 3 --out TMP` N times
 with each binary in turn, which one goes first alternating, and prints a Markdown row: the median
 CPU time of the child (user + sys, getrusage), the simulated seconds per CPU second (x real time)
-and the ratio OLD / NEW. Alternating the two binaries makes the ratio robust to the shared
+at the median and at the fastest run, and OLD / NEW as the ratio of the medians and as the median
+of the pairs' ratios. Alternating the two binaries makes the ratio robust to the shared
 machine's drift (docs/benchmarks.md, "Issue 15, session 5"), and alternating their order to the
 second run's ~1 % penalty ("Issue 15, session 6").
 
@@ -41,8 +42,8 @@ def main(argv):
     if len(argv) < 5:
         sys.exit(__doc__)
     old, new, runs, tasks = argv[1], argv[2], int(argv[3]), argv[4:]
-    print("| task | simulated | before: CPU (x real time) | after: CPU (x real time) | "
-          "before / after |")
+    print("| task | simulated | before: CPU (x real time), fastest | "
+          "after: CPU (x real time), fastest | before / after: medians, pairs |")
     print("|---|---|---|---|---|")
     for task in tasks:
         with open(f"models/tasks/{task}.json") as f:
@@ -59,8 +60,12 @@ def main(argv):
                     new_cpu.append(child_cpu(new, task, out, fresh))
                     old_cpu.append(child_cpu(old, task, out, fresh))
         a, b = statistics.median(old_cpu), statistics.median(new_cpu)
-        print(f"| {task} | {duration:.0f} s | {a * 1000:.1f} ms ({duration / a:.0f}x) | "
-              f"{b * 1000:.1f} ms ({duration / b:.0f}x) | {a / b:.2f} |")
+        # The host's speed drifts run to run: a pair's two runs are a second apart, so the median
+        # of the pairs' ratios follows the drift more closely than the ratio of the medians.
+        pairs = statistics.median(o / n for o, n in zip(old_cpu, new_cpu))
+        print(f"| {task} | {duration:.0f} s | {a * 1000:.1f} ms ({duration / a:.0f}x), "
+              f"{duration / min(old_cpu):.0f}x | {b * 1000:.1f} ms ({duration / b:.0f}x), "
+              f"{duration / min(new_cpu):.0f}x | {a / b:.3f}, {pairs:.3f} |")
 
 
 if __name__ == "__main__":
