@@ -10,15 +10,10 @@
 namespace recruit::sim {
 namespace {
 
-// True if a sensor (a frame sensor on a camera, a camera projection) or a custom tuple of `spec`
-// names an object of `type`: that object must stay, for the model to compile (a sensor) or to
-// keep its tuple (deleting an object drops the tuples that name it).
-bool SomethingNames(mjSpec* spec, mjtObj type) {
-  for (mjsElement* e = mjs_firstElement(spec, mjOBJ_SENSOR); e != nullptr;
-       e = mjs_nextElement(spec, e)) {
-    const mjsSensor* s = mjs_asSensor(e);
-    if (s->objtype == type || s->reftype == type) return true;
-  }
+// True if a custom tuple of `spec` lists an object of `type`: deleting an object drops the
+// tuples that name it. (The wheel's C++ library is not this one; a vector of ints has the same
+// layout in both.)
+bool TupleLists(mjSpec* spec, mjtObj type) {
   for (mjsElement* e = mjs_firstElement(spec, mjOBJ_TUPLE); e != nullptr;
        e = mjs_nextElement(spec, e)) {
     for (int t : *mjs_asTuple(e)->objtype) {
@@ -28,9 +23,21 @@ bool SomethingNames(mjSpec* spec, mjtObj type) {
   return false;
 }
 
+// True if a sensor (a frame sensor on a camera, a camera projection) or a custom tuple of `spec`
+// names an object of `type`: that object must stay, for the model to compile (a sensor) or to
+// keep its tuple.
+bool SomethingNames(mjSpec* spec, mjtObj type) {
+  for (mjsElement* e = mjs_firstElement(spec, mjOBJ_SENSOR); e != nullptr;
+       e = mjs_nextElement(spec, e)) {
+    const mjsSensor* s = mjs_asSensor(e);
+    if (s->objtype == type || s->reftype == type) return true;
+  }
+  return TupleLists(spec, type);
+}
+
 // Every name another element refers to, whatever its type: tendon wraps and their side sites,
 // contact pairs, sensors, actuator transmissions, equality constraints (custom tuples: see
-// SomethingNames).
+// TupleLists).
 std::set<std::string> NamesReferredTo(mjSpec* spec) {
   std::set<std::string> names;
   // Through mjs_getString: MuJoCo's wheel is built with another C++ library, whose strings
@@ -95,9 +102,9 @@ void LeaveOutStaticDecor(mjSpec* spec) {
        e = mjs_nextElement(spec, e)) {
     if (unnamed(e)) decor.push_back(e);
   }
-  // A tuple names its elements by type (SomethingNames); deleting one would drop the tuple.
-  const bool geoms_listed = SomethingNames(spec, mjOBJ_GEOM),
-             sites_listed = SomethingNames(spec, mjOBJ_SITE);
+  // A tuple's elements are kept by type (TupleLists); sensors are among the names above.
+  const bool geoms_listed = TupleLists(spec, mjOBJ_GEOM),
+             sites_listed = TupleLists(spec, mjOBJ_SITE);
   for (mjsElement* e : decor) {
     const bool listed = e->elemtype == mjOBJ_GEOM ? geoms_listed : sites_listed;
     if (!listed) mjs_delete(spec, e);

@@ -23,8 +23,10 @@ class Plant {
  public:
   // Loads task.model_path (timestep overridden by task.timestep when > 0) and finds the task's
   // bundles, joint and bodies; errors name the task file's field. Without `drawn` (nothing
-  // will draw the model) its builtin textures are made 1 pixel and its cameras and lights are
-  // left out (unless a sensor or a custom tuple names one); the physics is the same.
+  // will draw the model) its builtin textures are made 1 pixel, and its cameras and lights, the
+  // world's geoms no contact reaches and the sites nothing names are left out (what a sensor,
+  // a tendon, an actuator, a pair, an equality or a custom tuple names stays); the physics is
+  // the same.
   static Result<std::unique_ptr<Plant>> Create(const Task& task, bool drawn = true);
 
   // Every unit off and cold (the units' streams seeded by `seed`), the model at rest, forces

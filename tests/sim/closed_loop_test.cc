@@ -421,8 +421,7 @@ TEST(ClosedLoop, PlantLeavesOutTheWorldGeomsAndSitesNothingReaches) {
   EXPECT_FALSE(Has(**bare, mjOBJ_GEOM, "floor"));
   EXPECT_FALSE(Has(**bare, mjOBJ_GEOM, "mount"));
   EXPECT_FALSE(Has(**bare, mjOBJ_SITE, "hand"));
-  // Geoms of a body that is not the world keep their mass in it (and the upper arm's sets the
-  // point the tree's inertias are taken about): they stay.
+  // Geoms of a body that is not the world are part of its inertia: they stay.
   EXPECT_TRUE(Has(**bare, mjOBJ_GEOM, "humerus"));
   EXPECT_TRUE(Has(**bare, mjOBJ_GEOM, "elbow_pulley"));
   for (const char* site :
@@ -432,7 +431,7 @@ TEST(ClosedLoop, PlantLeavesOutTheWorldGeomsAndSitesNothingReaches) {
 }
 
 // With contacts on, the floor can collide and stays; a site a sensor names stays, and so does a
-// world geom a contact pair names.
+// world geom a sensor or a contact pair names (the others still go).
 TEST(ClosedLoop, PlantKeepsTheGeomsAContactReachesAndTheSitesSomethingNames) {
   const EditedArm contacts("<flag contact=\"disable\"/>", "");
   auto created = Plant::Create(contacts.task, /*drawn=*/false);
@@ -446,6 +445,15 @@ TEST(ClosedLoop, PlantKeepsTheGeomsAContactReachesAndTheSitesSomethingNames) {
   created = Plant::Create(sensed.task, /*drawn=*/false);
   ASSERT_TRUE(created.ok()) << created.error();
   EXPECT_TRUE(Has(**created, mjOBJ_SITE, "hand"));
+
+  // A sensor on one world geom keeps that one only.
+  const EditedArm framed("<sensor>",
+                         "<sensor>\n    <framepos name=\"mount\" objtype=\"geom\" "
+                         "objname=\"mount\"/>");
+  created = Plant::Create(framed.task, /*drawn=*/false);
+  ASSERT_TRUE(created.ok()) << created.error();
+  EXPECT_TRUE(Has(**created, mjOBJ_GEOM, "mount"));
+  EXPECT_FALSE(Has(**created, mjOBJ_GEOM, "floor"));
 
   const EditedArm paired(
       "<tendon>", "<contact><pair geom1=\"mount\" geom2=\"payload\"/></contact>\n  <tendon>");
