@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <limits>
+#include <optional>
 #include <set>
 #include <string>
 #include <vector>
@@ -161,6 +162,58 @@ bool HasFrictionLoss(const mjModel* m) {
   return false;
 }
 
+// True if a contact can be made: contacts are on and a pair is listed, a flex exists, or some
+// geom's contype meets some geom's conaffinity (MuJoCo's filter, at its widest).
+bool CanContact(const mjModel* m) {
+  if (m->opt.disableflags & mjDSBL_CONTACT) return false;
+  int contype = 0, conaffinity = 0;
+  for (int i = 0; i < m->ngeom; ++i) {
+    contype |= m->geom_contype[i];
+    conaffinity |= m->geom_conaffinity[i];
+  }
+  return m->npair > 0 || m->nflex > 0 || (contype & conaffinity) != 0;
+}
+
+// The limited joints whose limits are the only constraint rows MuJoCo can make in `m`, or
+// nullopt if another kind can be made (contacts, equalities, dry friction, tendon or ball
+// limits) or the integrator evaluates more than the step's starting state (RK4). A step that
+// starts with all of them clear of their limits then makes no row; sleeping and the discrete
+// integrator are left alone.
+std::optional<std::vector<int>> LimitsThatAloneConstrain(const mjModel* m) {
+  const int off = m->opt.disableflags;
+  const bool one_pass = m->opt.integrator == mjINT_EULER || m->opt.integrator == mjINT_IMPLICIT ||
+                        m->opt.integrator == mjINT_IMPLICITFAST;
+  if ((off & mjDSBL_CONSTRAINT) || !one_pass || (m->opt.enableflags & mjENBL_SLEEP) ||
+      CanContact(m) || (!(off & mjDSBL_EQUALITY) && m->neq > 0) ||
+      (!(off & mjDSBL_FRICTIONLOSS) && HasFrictionLoss(m))) {
+    return std::nullopt;
+  }
+  std::vector<int> joints;
+  if (off & mjDSBL_LIMIT) return joints;
+  for (int i = 0; i < m->ntendon; ++i) {
+    if (m->tendon_limited[i]) return std::nullopt;
+  }
+  for (int j = 0; j < m->njnt; ++j) {
+    if (!m->jnt_limited[j]) continue;
+    if (m->jnt_type[j] != mjJNT_HINGE && m->jnt_type[j] != mjJNT_SLIDE) return std::nullopt;
+    joints.push_back(j);
+  }
+  return joints;
+}
+
+// True if a joint of `joints` at `qpos` is at or past a limit (within its margin), by MuJoCo's
+// own test (mj_instantiateLimit); a NaN counts as reached.
+bool AnyLimitReached(const mjModel* m, const std::vector<int>& joints, const mjtNum* qpos) {
+  for (int j : joints) {
+    const mjtNum value = qpos[m->jnt_qposadr[j]];
+    for (int side = -1; side <= 1; side += 2) {
+      const mjtNum dist = side * (m->jnt_range[2 * j + (side + 1) / 2] - value);
+      if (!(dist >= m->jnt_margin[j])) return true;
+    }
+  }
+  return false;
+}
+
 }  // namespace
 
 Result<std::unique_ptr<Plant>> Plant::Create(const Task& task, bool drawn) {
@@ -186,6 +239,12 @@ Result<std::unique_ptr<Plant>> Plant::Create(const Task& task, bool drawn) {
   if (m->neq == 0) m->opt.disableflags |= mjDSBL_EQUALITY;
   if (m->ntree <= 1 && !(m->opt.enableflags & mjENBL_SLEEP)) {  // sleeping works on islands
     m->opt.disableflags |= mjDSBL_ISLAND;
+  }
+  // A bad state makes mj_step reset to qpos0 and go on from there: the gate holds only if
+  // qpos0 is clear of the limits too.
+  if (auto joints = LimitsThatAloneConstrain(m); joints && !AnyLimitReached(m, *joints, m->qpos0)) {
+    p->gated_limits_ = std::move(*joints);
+    p->gated_ = true;
   }
   auto host = sma::SmaHost::Create(m);
   if (!host.ok()) return Error{where + ".model: " + host.error()};
@@ -258,7 +317,16 @@ void Plant::Reset(std::uint64_t seed) {
 void Plant::Step() {
   ApplyPayloads();
   ApplyPushes();
-  mj_step(model_.get(), data_.get());
+  mjModel* m = model_.get();
+  // Joint limits the only rows there can be, and none reached: MuJoCo's constraint stage would
+  // make no row and leave qacc = qacc_smooth, as it does disabled. Visiting it anyway was 5 % of
+  // an arm step (docs/benchmarks.md).
+  const int flags = m->opt.disableflags;
+  if (gated_ && !AnyLimitReached(m, gated_limits_, data_->qpos)) {
+    m->opt.disableflags |= mjDSBL_CONSTRAINT;
+  }
+  mj_step(m, data_.get());
+  m->opt.disableflags = flags;
   ForgetObserved();
   TrackPeaks();
 }

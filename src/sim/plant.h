@@ -32,11 +32,14 @@ class Plant {
   // Every unit off and cold (the units' streams seeded by `seed`), the model at rest, forces
   // computed; the payloads due at t = 0 applied.
   void Reset(std::uint64_t seed);
-  // The disturbances due at the current time (payload changes, pushes), then one physics step.
+  // The disturbances due at the current time (payload changes, pushes), then one physics step
+  // (without MuJoCo's constraint stage when it can make no row: the step is the same).
   void Step();
   // After a step: a NaN in qpos is an error naming the time (the simulation diverged).
   Status CheckFinite() const;
 
+  // True if steps clear of every joint limit skip MuJoCo's constraint stage (Step).
+  bool skips_constraints_off_limits() const { return gated_; }
   const mjModel* model() const { return model_.get(); }
   mjData* data() const { return data_.get(); }
   const sma::SmaHost& host() const { return *host_; }
@@ -90,6 +93,9 @@ class Plant {
   int qadr_ = -1, dadr_ = -1;
   std::vector<int> push_body_, payload_body_;
   std::vector<bool> payload_done_;
+  // Whether a step clear of every joint limit skips the constraint stage, and those joints.
+  bool gated_ = false;
+  std::vector<int> gated_limits_;
   std::vector<double> peak_temperature_, peak_stress_;
   mutable std::vector<sma::SmaBundle::Telemetry> observed_;  // a cache: see Observed
   mutable std::vector<unsigned char> observed_valid_;

@@ -286,7 +286,8 @@ TEST(ClosedLoop, PlantThatIsNotDrawnStepsLikeTheFullModel) {
 
 // Steps `task`'s plant and the model as mj_loadXML gives it (every stage on) side by side,
 // driven the same way: every flexor unit on, so the elbow flexes onto its upper limit (100 deg),
-// then off. Every position, velocity and force is equal.
+// then off. Every acceleration, position, velocity and force is equal, at every step: those on
+// the limit and those clear of it (which the plant may step without the constraint stage).
 void ExpectStepsLikeTheModelWithEveryStage(const Task& task) {
   auto created = Plant::Create(task, /*drawn=*/false);
   ASSERT_TRUE(created.ok()) << created.error();
@@ -303,7 +304,7 @@ void ExpectStepsLikeTheModelWithEveryStage(const Task& task) {
   (*host)->Reset(d, 5);
   mj_forward(m, d);
   plant.Reset(5);
-  int limited_steps = 0;
+  int limited_steps = 0, clear_steps = 0;
   for (int step = 0; step < 5000; ++step) {
     if (step == 0 || step == 3000) {
       const double p_on = step == 0 ? 1.0 : 0.0, p_off = 1.0 - p_on;
@@ -312,9 +313,15 @@ void ExpectStepsLikeTheModelWithEveryStage(const Task& task) {
     }
     plant.Step();
     mj_step(m, d);
-    limited_steps += d->nefc > 0;
+    limited_steps += d->nl > 0;
+    clear_steps += d->nl == 0;
+    for (int k = 0; k < m->nv; ++k) {
+      ASSERT_EQ(plant.data()->qacc[k], d->qacc[k]) << "step " << step;
+      ASSERT_EQ(plant.data()->qfrc_constraint[k], d->qfrc_constraint[k]) << "step " << step;
+    }
   }
-  EXPECT_GT(limited_steps, 0) << "no constraint acted: the constraint stages went untested";
+  EXPECT_GT(limited_steps, 0) << "no limit acted: the constraint stages went untested";
+  EXPECT_GT(clear_steps, 0) << "always on a limit: the steps without constraints went untested";
   for (int k = 0; k < m->nq; ++k) EXPECT_EQ(plant.data()->qpos[k], d->qpos[k]);
   for (int k = 0; k < m->nv; ++k) EXPECT_EQ(plant.data()->qvel[k], d->qvel[k]);
   for (int i = 0; i < plant.num_bundles(); ++i) {
@@ -368,6 +375,43 @@ TEST(ClosedLoop, PlantKeepsTheFrictionlossStageOfAModelWithFriction) {
   EXPECT_EQ((*created)->model()->opt.disableflags & mjDSBL_FRICTIONLOSS, 0);
   EXPECT_NE((*created)->model()->opt.disableflags & mjDSBL_EQUALITY, 0);
   ExpectStepsLikeTheModelWithEveryStage(arm.task);
+}
+
+// Clear of its limits, a step skips the constraint stage only where nothing but a hinge's or a
+// slide's limit can make a row, and the integrator evaluates only the step's start; each plant
+// still steps as the model with every stage on.
+TEST(ClosedLoop, PlantSkipsTheConstraintStageOnlyWhereNoRowCanBeMadeOffTheLimits) {
+  const Task arm = LoadTask("arm_push.json");
+  auto created = Plant::Create(arm, /*drawn=*/false);
+  ASSERT_TRUE(created.ok()) << created.error();
+  EXPECT_TRUE((*created)->skips_constraints_off_limits());
+  created = Plant::Create(LoadTask("isometric_paper.json"), /*drawn=*/false);  // no limit at all
+  ASSERT_TRUE(created.ok()) << created.error();
+  EXPECT_TRUE((*created)->skips_constraints_off_limits());
+
+  struct Case {
+    const char* what;
+    std::string from, to;
+    bool skips;
+  };
+  const Case cases[] = {
+      {"implicitfast integrator", "integrator=\"Euler\"", "integrator=\"implicitfast\"", true},
+      {"RK4 evaluates mid-step states", "integrator=\"Euler\"", "integrator=\"RK4\"", false},
+      {"contacts on: the floor can collide", "<flag contact=\"disable\"/>", "", false},
+      {"a tendon limit", "<spatial name=\"flexor\"",
+       "<spatial name=\"flexor\" limited=\"true\" range=\"0.2 0.35\"", false},
+      {"qpos0 within the elbow's margin", "damping=\"0.02\"", "damping=\"0.02\" margin=\"0.01\"",
+       false},
+      {"dry friction", "damping=\"0.02\"", "damping=\"0.02\" frictionloss=\"0.002\"", false},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.what);
+    const EditedArm edited(c.from, c.to);
+    created = Plant::Create(edited.task, /*drawn=*/false);
+    ASSERT_TRUE(created.ok()) << created.error();
+    EXPECT_EQ((*created)->skips_constraints_off_limits(), c.skips);
+    ExpectStepsLikeTheModelWithEveryStage(edited.task);
+  }
 }
 
 // Island discovery stays on in a model that enables sleeping, which works on islands.
