@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <string>
 
+#include "common/cpu_features.h"
 #include "common/short_text.h"
 #include "plugin/unit_batch.h"
 
@@ -370,10 +371,9 @@ struct CpuFeatures {
   bool avx2 = false, avx512 = false;
   CpuFeatures() {
 #ifdef RECRUIT_SMA_AVX2_CLONE
-    __builtin_cpu_init();
-    avx2 = __builtin_cpu_supports("avx2");
+    avx2 = CpuRunsAvx2();
 #ifdef RECRUIT_SMA_AVX512_CLONE
-    avx512 = avx2 && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq");
+    avx512 = avx2 && CpuRunsAvx512FDq();
 #endif
 #endif
   }

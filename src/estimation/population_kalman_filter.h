@@ -48,6 +48,7 @@
 #include <immintrin.h>
 #endif
 
+#include "common/cpu_features.h"
 #include "common/result.h"
 #include "estimation/filter_model.h"
 #include "estimation/population_chain.h"
@@ -271,10 +272,7 @@ namespace avx {
 
 // Whether this CPU and its operating system run AVX (checked once per process).
 inline bool CpuHasAvx() {
-  static const bool has = [] {
-    __builtin_cpu_init();  // in case this runs before the run-time library's constructor
-    return __builtin_cpu_supports("avx") != 0;
-  }();
+  static const bool has = CpuRunsAvx();
   return has;
 }
 #else

@@ -1,0 +1,35 @@
+// The vector instruction sets this process may use: the CPU has them and the operating system
+// saves their registers. Read from what the C library found when the process started, so no
+// CPUID of our own: in a virtual machine every CPUID traps to the hypervisor, and libgcc's
+// __builtin_cpu_supports ran about ten of them at start-up in each library that used it.
+#pragma once
+
+#if defined(__x86_64__) && defined(__has_include)
+#if __has_include(<sys/platform/x86.h>)
+#include <sys/platform/x86.h>
+#define RECRUIT_CPU_FROM_LIBC 1
+#endif
+#endif
+
+namespace recruit {
+
+#if defined(RECRUIT_CPU_FROM_LIBC)
+inline bool CpuRunsAvx() { return CPU_FEATURE_ACTIVE(AVX); }
+inline bool CpuRunsAvx2() { return CPU_FEATURE_ACTIVE(AVX2); }
+inline bool CpuRunsAvx512FDq() {
+  return CPU_FEATURE_ACTIVE(AVX512F) && CPU_FEATURE_ACTIVE(AVX512DQ);
+}
+#elif defined(__x86_64__)
+inline bool CpuRunsAvx() { return __builtin_cpu_init(), __builtin_cpu_supports("avx") != 0; }
+inline bool CpuRunsAvx2() { return __builtin_cpu_init(), __builtin_cpu_supports("avx2") != 0; }
+inline bool CpuRunsAvx512FDq() {
+  return __builtin_cpu_init(),
+         __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq");
+}
+#else
+inline bool CpuRunsAvx() { return false; }
+inline bool CpuRunsAvx2() { return false; }
+inline bool CpuRunsAvx512FDq() { return false; }
+#endif
+
+}  // namespace recruit
