@@ -54,7 +54,9 @@ TEST(Ticks, RandomRangesGetRoundTicksThatCoverThem) {
       const double read = std::strtod(t.labels[i].c_str(), nullptr);
       ASSERT_NEAR(read, t.values[i], 1e-6 * t.step) << "label " << t.labels[i];
       ASSERT_FALSE(IsNegativeZero(t.labels[i])) << t.labels[i];
-      if (i > 0) ASSERT_NE(t.labels[i], t.labels[i - 1]);
+      if (i > 0) {
+        ASSERT_NE(t.labels[i], t.labels[i - 1]);
+      }
     }
   }
 }
