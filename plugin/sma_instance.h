@@ -72,7 +72,7 @@ class SmaInstance {
   static constexpr int kNextBroadcastSlot = 0;
 
   // Parses and validates the instance's config and actuators. Errors name the actuator, the
-  // config key, its value and what is allowed.
+  // config key, its value and what is allowed. Null (no units) inside a fit check's scratch data.
   static Result<std::unique_ptr<SmaInstance>> Create(const mjModel* m, int instance);
   // plugin_state doubles the instance needs (0 when its config is invalid: Create reports it).
   // Called by the compiler before the actuators' transmissions are filled in: reads only the
