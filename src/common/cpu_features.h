@@ -6,7 +6,16 @@
 
 #if defined(__x86_64__) && defined(__has_include)
 #if __has_include(<sys/platform/x86.h>)
+// glibc 2.36's header declares its functions with C's _Bool, which clang's C++ does not know.
+#if defined(__cplusplus) && !defined(_Bool)
+#define _Bool bool
+#define RECRUIT_UNDEF_BOOL 1
+#endif
 #include <sys/platform/x86.h>
+#if defined(RECRUIT_UNDEF_BOOL)
+#undef _Bool
+#undef RECRUIT_UNDEF_BOOL
+#endif
 #define RECRUIT_CPU_FROM_LIBC 1
 #endif
 #endif
