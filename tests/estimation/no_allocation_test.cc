@@ -114,8 +114,8 @@ static_assert(sizeof(PopulationKalmanFilterT<20, 1>) >= 4 * 20 * 20 * sizeof(dou
 // malloc calls in 100 steps of the controller's sequence on the dynamic-size filter
 // (src/control/kalman_estimator.cc: SetOutput with an H that changes every step, Update,
 // PredictBroadcast), after one warm-up step. Large p_off drives counts below zero at times, so
-// the simplex projection runs too.
-long MallocsPerDynamicSteps(int m, CovarianceMode mode) {
+// the simplex projection runs too. (Unused where malloc cannot be counted: sanitizers.)
+[[maybe_unused]] long MallocsPerDynamicSteps(int m, CovarianceMode mode) {
   const FilterModel f = ChainModel(m);
   auto kf = PopulationKalmanFilter::Create(f, mode);
   EXPECT_TRUE(kf.ok()) << kf.error();
@@ -136,7 +136,7 @@ long MallocsPerDynamicSteps(int m, CovarianceMode mode) {
 
 // The same through MakeCountFilter's Kalman adapter (what `recruit filter` runs: fixed size for
 // m = 20, dynamic for m = 50), with MeanAndVariance as the streamed output reads it.
-long MallocsPerCountFilterSteps(int m) {
+[[maybe_unused]] long MallocsPerCountFilterSteps(int m) {
   const FilterModel f = ChainModel(m);
   auto cf = MakeCountFilter(f, CountFilterOptions{});
   EXPECT_TRUE(cf.ok()) << cf.error();
