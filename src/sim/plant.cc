@@ -324,6 +324,7 @@ void Plant::Step() {
   const int flags = m->opt.disableflags;
   if (gated_ && !AnyLimitReached(m, gated_limits_, data_->qpos)) {
     m->opt.disableflags |= mjDSBL_CONSTRAINT;
+    ++skipped_;
   }
   mj_step(m, data_.get());
   m->opt.disableflags = flags;

@@ -38,8 +38,10 @@ class Plant {
   // After a step: a NaN in qpos is an error naming the time (the simulation diverged).
   Status CheckFinite() const;
 
-  // True if steps clear of every joint limit skip MuJoCo's constraint stage (Step).
+  // True if steps clear of every joint limit skip MuJoCo's constraint stage (Step), and how many
+  // steps since Create did.
   bool skips_constraints_off_limits() const { return gated_; }
+  long constraint_stages_skipped() const { return skipped_; }
   const mjModel* model() const { return model_.get(); }
   mjData* data() const { return data_.get(); }
   const sma::SmaHost& host() const { return *host_; }
@@ -96,6 +98,7 @@ class Plant {
   // Whether a step clear of every joint limit skips the constraint stage, and those joints.
   bool gated_ = false;
   std::vector<int> gated_limits_;
+  long skipped_ = 0;
   std::vector<double> peak_temperature_, peak_stress_;
   mutable std::vector<sma::SmaBundle::Telemetry> observed_;  // a cache: see Observed
   mutable std::vector<unsigned char> observed_valid_;

@@ -322,6 +322,9 @@ void ExpectStepsLikeTheModelWithEveryStage(const Task& task) {
   }
   EXPECT_GT(limited_steps, 0) << "no limit acted: the constraint stages went untested";
   EXPECT_GT(clear_steps, 0) << "always on a limit: the steps without constraints went untested";
+  // The plant skipped the stage at exactly the steps where it made no limit row.
+  EXPECT_EQ(plant.constraint_stages_skipped(),
+            plant.skips_constraints_off_limits() ? clear_steps : 0);
   for (int k = 0; k < m->nq; ++k) EXPECT_EQ(plant.data()->qpos[k], d->qpos[k]);
   for (int k = 0; k < m->nv; ++k) EXPECT_EQ(plant.data()->qvel[k], d->qvel[k]);
   for (int i = 0; i < plant.num_bundles(); ++i) {
@@ -402,6 +405,8 @@ TEST(ClosedLoop, PlantSkipsTheConstraintStageOnlyWhereNoRowCanBeMadeOffTheLimits
        "<spatial name=\"flexor\" limited=\"true\" range=\"0.2 0.35\"", false},
       {"qpos0 within the elbow's margin", "damping=\"0.02\"", "damping=\"0.02\" margin=\"0.01\"",
        false},
+      {"a margin, qpos0 clear of it", "range=\"0 100\" damping=\"0.02\"",
+       "range=\"-10 100\" damping=\"0.02\" margin=\"0.05\"", true},
       {"dry friction", "damping=\"0.02\"", "damping=\"0.02\" frictionloss=\"0.002\"", false},
   };
   for (const Case& c : cases) {
