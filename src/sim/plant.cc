@@ -11,12 +11,20 @@
 namespace recruit::sim {
 namespace {
 
+// The elements of `type` in `spec`, collected first so that a caller may delete them.
+std::vector<mjsElement*> Elements(mjSpec* spec, mjtObj type) {
+  std::vector<mjsElement*> all;
+  for (mjsElement* e = mjs_firstElement(spec, type); e != nullptr; e = mjs_nextElement(spec, e)) {
+    all.push_back(e);
+  }
+  return all;
+}
+
 // True if a custom tuple of `spec` lists an object of `type`: deleting an object drops the
 // tuples that name it. (The wheel's C++ library is not this one; a vector of ints has the same
 // layout in both.)
 bool TupleLists(mjSpec* spec, mjtObj type) {
-  for (mjsElement* e = mjs_firstElement(spec, mjOBJ_TUPLE); e != nullptr;
-       e = mjs_nextElement(spec, e)) {
+  for (mjsElement* e : Elements(spec, mjOBJ_TUPLE)) {
     for (int t : *mjs_asTuple(e)->objtype) {
       if (t == type) return true;
     }
@@ -28,8 +36,7 @@ bool TupleLists(mjSpec* spec, mjtObj type) {
 // names an object of `type`: that object must stay, for the model to compile (a sensor) or to
 // keep its tuple.
 bool SomethingNames(mjSpec* spec, mjtObj type) {
-  for (mjsElement* e = mjs_firstElement(spec, mjOBJ_SENSOR); e != nullptr;
-       e = mjs_nextElement(spec, e)) {
+  for (mjsElement* e : Elements(spec, mjOBJ_SENSOR)) {
     const mjsSensor* s = mjs_asSensor(e);
     if (s->objtype == type || s->reftype == type) return true;
   }
@@ -47,37 +54,32 @@ std::set<std::string> NamesReferredTo(mjSpec* spec) {
     const char* c = s != nullptr ? mjs_getString(s) : nullptr;
     if (c != nullptr && *c != 0) names.insert(c);
   };
-  auto each = [spec](mjtObj type, auto&& f) {
-    for (mjsElement* e = mjs_firstElement(spec, type); e != nullptr; e = mjs_nextElement(spec, e)) {
-      f(e);
-    }
-  };
-  each(mjOBJ_TENDON, [&](mjsElement* e) {
+  for (mjsElement* e : Elements(spec, mjOBJ_TENDON)) {
     const mjsTendon* t = mjs_asTendon(e);
     for (int i = 0; i < mjs_getWrapNum(t); ++i) {
       const mjsWrap* w = mjs_getWrap(t, i);
       if (mjsElement* target = mjs_getWrapTarget(w)) add(mjs_getName(target));
       if (mjsSite* side = mjs_getWrapSideSite(w)) add(mjs_getName(side->element));
     }
-  });
-  each(mjOBJ_PAIR, [&](mjsElement* e) {
+  }
+  for (mjsElement* e : Elements(spec, mjOBJ_PAIR)) {
     add(mjs_asPair(e)->geomname1);
     add(mjs_asPair(e)->geomname2);
-  });
-  each(mjOBJ_SENSOR, [&](mjsElement* e) {
+  }
+  for (mjsElement* e : Elements(spec, mjOBJ_SENSOR)) {
     add(mjs_asSensor(e)->objname);
     add(mjs_asSensor(e)->refname);
-  });
-  each(mjOBJ_ACTUATOR, [&](mjsElement* e) {
+  }
+  for (mjsElement* e : Elements(spec, mjOBJ_ACTUATOR)) {
     const mjsActuator* a = mjs_asActuator(e);
     add(a->target);
     add(a->refsite);
     add(a->slidersite);
-  });
-  each(mjOBJ_EQUALITY, [&](mjsElement* e) {
+  }
+  for (mjsElement* e : Elements(spec, mjOBJ_EQUALITY)) {
     add(mjs_asEquality(e)->name1);
     add(mjs_asEquality(e)->name2);
-  });
+  }
   return names;
 }
 
@@ -93,14 +95,12 @@ void LeaveOutStaticDecor(mjSpec* spec) {
   const bool no_contact = (spec->option.disableflags & mjDSBL_CONTACT) != 0;
   const mjsBody* world = mjs_findBody(spec, "world");
   std::vector<mjsElement*> decor;
-  for (mjsElement* e = mjs_firstElement(spec, mjOBJ_GEOM); e != nullptr;
-       e = mjs_nextElement(spec, e)) {
+  for (mjsElement* e : Elements(spec, mjOBJ_GEOM)) {
     const mjsGeom* g = mjs_asGeom(e);
     const bool collides = !no_contact && (g->contype != 0 || g->conaffinity != 0);
     if (!collides && mjs_getParent(e) == world && unnamed(e)) decor.push_back(e);
   }
-  for (mjsElement* e = mjs_firstElement(spec, mjOBJ_SITE); e != nullptr;
-       e = mjs_nextElement(spec, e)) {
+  for (mjsElement* e : Elements(spec, mjOBJ_SITE)) {
     if (unnamed(e)) decor.push_back(e);
   }
   // A tuple's elements are kept by type (TupleLists); sensors are among the names above.
@@ -114,19 +114,14 @@ void LeaveOutStaticDecor(mjSpec* spec) {
 
 // Builtin textures at 1 x 1 pixel; no camera and no light, unless something names one.
 void LeaveOutWhatOnlyRendersRead(mjSpec* spec) {
-  for (mjsElement* e = mjs_firstElement(spec, mjOBJ_TEXTURE); e != nullptr;
-       e = mjs_nextElement(spec, e)) {
+  for (mjsElement* e : Elements(spec, mjOBJ_TEXTURE)) {
     mjsTexture* t = mjs_asTexture(e);
     if (t->builtin != mjBUILTIN_NONE) t->width = t->height = 1;
   }
-  std::vector<mjsElement*> unseen;
   for (mjtObj type : {mjOBJ_CAMERA, mjOBJ_LIGHT}) {
     if (SomethingNames(spec, type)) continue;
-    for (mjsElement* e = mjs_firstElement(spec, type); e != nullptr; e = mjs_nextElement(spec, e)) {
-      unseen.push_back(e);
-    }
+    for (mjsElement* e : Elements(spec, type)) mjs_delete(spec, e);
   }
-  for (mjsElement* e : unseen) mjs_delete(spec, e);
   LeaveOutStaticDecor(spec);
 }
 
@@ -242,10 +237,8 @@ Result<std::unique_ptr<Plant>> Plant::Create(const Task& task, bool drawn) {
   }
   // A bad state makes mj_step reset to qpos0 and go on from there: the gate holds only if
   // qpos0 is clear of the limits too.
-  if (auto joints = LimitsThatAloneConstrain(m); joints && !AnyLimitReached(m, *joints, m->qpos0)) {
-    p->gated_limits_ = std::move(*joints);
-    p->gated_ = true;
-  }
+  p->gate_ = LimitsThatAloneConstrain(m);
+  if (p->gate_ && AnyLimitReached(m, *p->gate_, m->qpos0)) p->gate_.reset();
   auto host = sma::SmaHost::Create(m);
   if (!host.ok()) return Error{where + ".model: " + host.error()};
   p->host_ = std::move(host).value();
@@ -322,7 +315,7 @@ void Plant::Step() {
   // make no row and leave qacc = qacc_smooth, as it does disabled. Visiting it anyway was 5 % of
   // an arm step (docs/benchmarks.md).
   const int flags = m->opt.disableflags;
-  if (gated_ && !AnyLimitReached(m, gated_limits_, data_->qpos)) {
+  if (gate_ && !AnyLimitReached(m, *gate_, data_->qpos)) {
     m->opt.disableflags |= mjDSBL_CONSTRAINT;
     ++skipped_;
   }

@@ -9,6 +9,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -40,7 +41,7 @@ class Plant {
 
   // True if steps clear of every joint limit skip MuJoCo's constraint stage (Step), and how many
   // steps since Create did.
-  bool skips_constraints_off_limits() const { return gated_; }
+  bool skips_constraints_off_limits() const { return gate_.has_value(); }
   long constraint_stages_skipped() const { return skipped_; }
   const mjModel* model() const { return model_.get(); }
   mjData* data() const { return data_.get(); }
@@ -95,9 +96,8 @@ class Plant {
   int qadr_ = -1, dadr_ = -1;
   std::vector<int> push_body_, payload_body_;
   std::vector<bool> payload_done_;
-  // Whether a step clear of every joint limit skips the constraint stage, and those joints.
-  bool gated_ = false;
-  std::vector<int> gated_limits_;
+  // The joints a step must start clear of to skip the constraint stage; none if it never does.
+  std::optional<std::vector<int>> gate_;
   long skipped_ = 0;
   std::vector<double> peak_temperature_, peak_stress_;
   mutable std::vector<sma::SmaBundle::Telemetry> observed_;  // a cache: see Observed
