@@ -80,8 +80,12 @@ int RunSimulate(const SimulateArgs& a) {
             << "\n  switching " << m.switching_rate << " /unit/s, estimator RMSE "
             << m.estimator_rmse << " units, mean NEES " << m.mean_nees << "\n  " << result->duration
             << " s simulated in " << result->wall_seconds << " s ("
-            << result->duration / result->wall_seconds << "x real time)\n  wrote " << csv << " and "
-            << summary << "\n";
+            << result->duration / result->wall_seconds << "x real time"
+            << (result->identification_seconds > 0
+                    ? ", after " + std::to_string(result->identification_seconds) +
+                          " s identifying filter models"
+                    : std::string())
+            << ")\n  wrote " << csv << " and " << summary << "\n";
   return exit_code::kOk;
 }
 

@@ -56,11 +56,15 @@ void RecruitmentController::Reset() {
   last_ = Broadcast{};
 }
 
+double RecruitmentController::OnUnitForce(double tendon_length) const {
+  return on_force_ && std::isfinite(tendon_length) ? on_force_->Force(0, tendon_length)
+                                                   : params_.unit_force;
+}
+
 Broadcast RecruitmentController::Step(double reference_force, double measured_force,
                                       double tendon_length) {
   estimator_->Observe(measured_force, tendon_length);
-  unit_force_ = on_force_ && std::isfinite(tendon_length) ? on_force_->Force(0, tendon_length)
-                                                          : params_.unit_force;
+  unit_force_ = OnUnitForce(tendon_length);
   // Where no on unit can pull (a slack tendon) no count reaches the reference: ask for all.
   target_on_ = unit_force_ > 0 ? reference_force / unit_force_
                                : (reference_force > 0 ? params_.num_units : 0.0);

@@ -49,6 +49,8 @@ class RecruitmentController {
   double target_on() const { return target_on_; }
   // Settled force of one on unit at the last Step's tendon length (N).
   double unit_force() const { return unit_force_; }
+  // Settled force of one on unit at `tendon_length` (N): what Step would target with.
+  double OnUnitForce(double tendon_length) const;
   double estimated_on() const { return estimated_on_; }
   double estimated_on_variance() const { return estimated_on_variance_; }
   const Broadcast& last_broadcast() const { return last_; }

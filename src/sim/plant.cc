@@ -243,20 +243,8 @@ Result<std::unique_ptr<Plant>> Plant::Create(const Task& task, bool drawn) {
   if (!host.ok()) return Error{where + ".model: " + host.error()};
   p->host_ = std::move(host).value();
 
-  for (const std::string* name : {&task.agonist, &task.antagonist}) {
-    if (name->empty()) continue;
-    const int b = p->host_->BundleIndex(*name);
-    if (b < 0) {
-      std::string have;
-      for (int i = 0; i < p->host_->num_bundles(); ++i) {
-        have += (i ? ", " : "") + p->host_->bundle_name(i);
-      }
-      return Error{where + "." + (name == &task.agonist ? "agonist" : "antagonist") + ": '" +
-                   *name + "' is not an SMA bundle of '" + task.model_path +
-                   "'; bundles: " + (have.empty() ? "none" : have)};
-    }
-    p->bundles_.push_back(b);
-  }
+  if (Status st = p->FindBundles(task, where); !st.ok()) return Error{st.error()};
+  if (Status st = p->FindJoints(task, where); !st.ok()) return Error{st.error()};
   if (!task.joint.empty()) {
     const int joint = mj_name2id(m, mjOBJ_JOINT, task.joint.c_str());
     if (joint < 0) {
@@ -287,9 +275,126 @@ Result<std::unique_ptr<Plant>> Plant::Create(const Task& task, bool drawn) {
   p->body_mass0_.assign(m->body_mass, m->body_mass + m->nbody);
   p->body_inertia0_.assign(m->body_inertia, m->body_inertia + 3 * m->nbody);
   p->data_.reset(mj_makeData(m));
+  if (!p->joints_.empty()) p->scratch_.reset(mj_makeData(m));
   p->observed_.resize(p->bundles_.size());
   p->ForgetObserved();
   return p;
+}
+
+Status Plant::FindBundles(const Task& task, const std::string& where) {
+  std::string have;
+  for (int i = 0; i < host_->num_bundles(); ++i) have += (i ? ", " : "") + host_->bundle_name(i);
+  auto find = [&](const std::string& name, const std::string& field) -> Status {
+    const int b = host_->BundleIndex(name);
+    if (b < 0) {
+      return Error{where + "." + field + ": '" + name + "' is not an SMA bundle of '" +
+                   task.model_path + "'; bundles: " + (have.empty() ? "none" : have)};
+    }
+    bundles_.push_back(b);
+    return Status::Ok();
+  };
+  if (!task.auto_loop) {
+    for (const std::string* name : {&task.agonist, &task.antagonist}) {
+      if (name->empty()) continue;
+      if (Status st = find(*name, name == &task.agonist ? "agonist" : "antagonist"); !st.ok()) {
+        return st;
+      }
+    }
+    return Status::Ok();
+  }
+  if (task.bundles.empty()) {  // every bundle of the model
+    for (int b = 0; b < host_->num_bundles(); ++b) bundles_.push_back(b);
+    if (bundles_.empty())
+      return Error{where + ".model: '" + task.model_path + "' has no SMA bundle"};
+    return Status::Ok();
+  }
+  for (size_t i = 0; i < task.bundles.size(); ++i) {
+    if (Status st = find(task.bundles[i], "bundles[" + std::to_string(i) + "]"); !st.ok()) {
+      return st;
+    }
+  }
+  return Status::Ok();
+}
+
+Status Plant::FindJoints(const Task& task, const std::string& where) {
+  const mjModel* m = model_.get();
+  auto hinge = [&](const std::string& name, const std::string& field) -> Result<int> {
+    const int joint = mj_name2id(m, mjOBJ_JOINT, name.c_str());
+    if (joint < 0) {
+      return Error{where + "." + field + ": no joint '" + name + "' in '" + task.model_path + "'"};
+    }
+    if (m->jnt_type[joint] != mjJNT_HINGE) {
+      return Error{where + "." + field + ": '" + name + "' must be a hinge"};
+    }
+    return joint;
+  };
+  if (!task.joint.empty()) {
+    auto joint = hinge(task.joint, task.auto_loop ? "joints[0].joint" : "joint");
+    if (!joint.ok()) return Error{joint.error()};
+    qadr_ = m->jnt_qposadr[*joint];
+    dadr_ = m->jnt_dofadr[*joint];
+  }
+  if (!task.auto_loop) return Status::Ok();
+  for (size_t j = 0; j < task.joints.size(); ++j) {
+    auto joint = hinge(task.joints[j].joint, "joints[" + std::to_string(j) + "].joint");
+    if (!joint.ok()) return Error{joint.error()};
+    joints_.push_back(*joint);
+  }
+  return Status::Ok();
+}
+
+Eigen::MatrixXd Plant::MomentArms() const {
+  const mjModel* m = model_.get();
+  const mjData* d = data_.get();
+  Eigen::MatrixXd arms = Eigen::MatrixXd::Zero(num_joints(), num_bundles());
+  for (int i = 0; i < num_bundles(); ++i) {
+    const int out = m->actuator_outadr[host_->actuator_id(bundles_[i])];
+    for (int k = 0; k < d->moment_rownnz[out]; ++k) {
+      const int adr = d->moment_rowadr[out] + k;
+      for (int j = 0; j < num_joints(); ++j) {
+        if (d->moment_colind[adr] == m->jnt_dofadr[joints_[j]]) {
+          arms(j, i) = -d->actuator_moment[adr];
+        }
+      }
+    }
+  }
+  return arms;
+}
+
+void Plant::PoseScratch(const Eigen::VectorXd& q) const {
+  const mjModel* m = model_.get();
+  mjData* s = scratch_.get();
+  std::copy(data_->qpos, data_->qpos + m->nq, s->qpos);
+  for (int j = 0; j < num_joints(); ++j) s->qpos[m->jnt_qposadr[joints_[j]]] = q[j];
+  std::fill(s->qvel, s->qvel + m->nv, 0.0);
+  std::fill(s->qacc, s->qacc + m->nv, 0.0);
+  std::fill(s->qfrc_applied, s->qfrc_applied + m->nv, 0.0);
+  std::fill(s->xfrc_applied, s->xfrc_applied + 6 * m->nbody, 0.0);
+}
+
+Eigen::VectorXd Plant::StaticTorque(const Eigen::VectorXd& q) const {
+  mjModel* m = model_.get();
+  PoseScratch(q);
+  // Without constraint rows: a limit the pose touches would otherwise take part of the load.
+  const int flags = m->opt.disableflags;
+  m->opt.disableflags |= mjDSBL_CONSTRAINT;
+  mj_inverse(m, scratch_.get());
+  m->opt.disableflags = flags;
+  Eigen::VectorXd tau(num_joints());
+  for (int j = 0; j < num_joints(); ++j) {
+    tau[j] = scratch_->qfrc_inverse[m->jnt_dofadr[joints_[j]]];
+  }
+  return tau;
+}
+
+double Plant::JointInertia(int j, const Eigen::VectorXd& q) const {
+  const mjModel* m = model_.get();
+  PoseScratch(q);
+  mj_fwdPosition(m, scratch_.get());
+  std::vector<mjtNum> full(static_cast<size_t>(m->nv) * m->nv);
+  mj_fullM(m, scratch_.get(), full.data());
+  const int dof = m->jnt_dofadr[joints_[j]];
+  return full[static_cast<size_t>(dof) * m->nv + dof];
 }
 
 void Plant::Reset(std::uint64_t seed) {

@@ -7,6 +7,7 @@
 
 #include <mujoco/mujoco.h>
 
+#include <Eigen/Core>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -68,12 +69,33 @@ class Plant {
   double angle() const { return qadr_ >= 0 ? data_->qpos[qadr_] : 0.0; }
   double angular_velocity() const { return dadr_ >= 0 ? data_->qvel[dadr_] : 0.0; }
 
+  // The driven joints of a self-tuned angle task (Task::joints), in the task's order.
+  int num_joints() const { return static_cast<int>(joints_.size()); }
+  const std::string& joint_name(int j) const { return task_->joints[j].joint; }
+  double JointAngle(int j) const { return data_->qpos[model_->jnt_qposadr[joints_[j]]]; }
+  double JointVelocity(int j) const { return data_->qvel[model_->jnt_dofadr[joints_[j]]]; }
+  // joints x bundles: the torque (N m) on driven joint j per newton of bundle i's tension at
+  // the pose of the last step (MuJoCo's actuator moment; a bundle pulls, so minus the moment).
+  Eigen::MatrixXd MomentArms() const;
+  // The torque each driven joint needs to hold the limb still with the driven joints at `q`
+  // (the others where they are now): gravity, payloads and springs, from MuJoCo's inverse
+  // dynamics with zero velocity and acceleration and no constraint rows.
+  Eigen::VectorXd StaticTorque(const Eigen::VectorXd& q) const;
+  // Driven joint j's inertia (mass-matrix diagonal, armature included) with the driven joints at
+  // `q`, and its damping.
+  double JointInertia(int j, const Eigen::VectorXd& q) const;
+  double JointDamping(int j) const { return model_->dof_damping[model_->jnt_dofadr[joints_[j]]]; }
+  // The limb's position at `q`, velocities zero, on the scratch data (for StaticTorque).
+  void PoseScratch(const Eigen::VectorXd& q) const;
+
   // Hottest unit and most stressed wire of bundle i since Reset.
   double peak_temperature(int i) const { return peak_temperature_[i]; }
   double peak_wire_stress(int i) const { return peak_stress_[i]; }
 
  private:
   Plant() = default;
+  Status FindBundles(const Task& task, const std::string& where);
+  Status FindJoints(const Task& task, const std::string& where);
   void ApplyPayloads();
   void ApplyPushes();
   void TrackPeaks();
@@ -94,6 +116,8 @@ class Plant {
   std::unique_ptr<sma::SmaHost> host_;
   std::vector<int> bundles_;
   int qadr_ = -1, dadr_ = -1;
+  std::vector<int> joints_;  // driven joints' ids (self-tuned angle tasks)
+  DataPtr scratch_;          // for the inverse dynamics of StaticTorque and JointInertia
   std::vector<int> push_body_, payload_body_;
   std::vector<bool> payload_done_;
   // The joints a step must start clear of to skip the constraint stage; none if it never does.

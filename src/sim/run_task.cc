@@ -14,10 +14,13 @@
 #include "sim/force_sensor.h"
 
 #if RECRUIT_CONTROL_AVAILABLE && RECRUIT_SMA_AVAILABLE
+#include "control/kalman_estimator.h"
 #include "control/recruitment_controller.h"
+#include "estimation/filter_model.h"
 #include "identification/model_cache.h"
 #include "identification/plant_record.h"
 #include "plugin/sma_host.h"
+#include "sim/joint_loop.h"
 #include "sim/metrics_stream.h"
 #include "sim/plant.h"
 #define RECRUIT_SIM_CLOSED_LOOP 1
@@ -71,6 +74,7 @@ nlohmann::json RunSummary::ToJson() const {
   j["physics_steps"] = physics_steps;
   j["control_instants"] = control_instants;
   j["wall_seconds"] = wall_seconds;
+  j["identification_seconds"] = identification_seconds;
   const RunMetrics& m = metrics;
   j["metrics"] = {{"tracking_rmse", m.tracking_rmse},
                   {"iae", m.iae},
@@ -85,7 +89,8 @@ nlohmann::json RunSummary::ToJson() const {
                   {"estimator_within3", m.estimator_within3},
                   {"num_steps", m.num_steps}};
   nlohmann::json steps_json = nlohmann::json::array();
-  for (const auto& s : steps) {
+  for (size_t k = 0; k < steps.size(); ++k) {
+    const StepResponse& s = steps[k];
     steps_json.push_back({{"time", s.step.time},
                           {"from", s.step.from},
                           {"to", s.step.to},
@@ -93,8 +98,22 @@ nlohmann::json RunSummary::ToJson() const {
                           {"overshoot", s.overshoot},
                           {"settling_time", s.settling_time},
                           {"settled", s.settled}});
+    if (k < step_joints.size()) steps_json.back()["joint"] = step_joints[k];
   }
   j["steps"] = steps_json;
+  if (!joints.empty()) {
+    nlohmann::json js = nlohmann::json::array();
+    for (const JointSummary& x : joints) {
+      js.push_back({{"joint", x.joint},
+                    {"tracking_rmse", x.tracking_rmse},
+                    {"iae", x.iae},
+                    {"max_overshoot", x.max_overshoot},
+                    {"settled_fraction", x.settled_fraction},
+                    {"num_steps", x.num_steps}});
+    }
+    j["joints"] = js;
+    j["loop_designs"] = loop_designs;
+  }
   nlohmann::json bundles_json = nlohmann::json::array();
   for (const auto& b : bundles) {
     bundles_json.push_back({{"actuator", b.actuator},
@@ -129,9 +148,36 @@ struct Channel {
   SwitchingCounter switches;        // on-count after each broadcast
 };
 
+// The filter model file of bundle i for `spec`: the task's (its "{bundle}" replaced by the
+// bundle's actuator name), else the one identified on this bundle for this dT, from the model
+// search path, else identified now and cached (identification/model_cache.h). `identify_s`
+// accumulates the time spent identifying.
+Result<std::string> BundleModelFile(const Task& task, const ControllerSettings& settings,
+                                    const Plant& plant, int i, const RunOptions& options,
+                                    const control::EstimatorSpec& spec, double& identify_s) {
+  const sma::SmaHost& host = plant.host();
+  const int b = plant.bundle_index(i);
+  std::string file = spec.model_file;
+  const std::string key = "{bundle}";
+  for (size_t at; (at = file.find(key)) != std::string::npos;) {
+    file.replace(at, key.size(), host.bundle_name(b));
+  }
+  if (!file.empty()) return file;
+  control::ModelRequest req{task.model_path, host.bundle_name(b),
+                            control::PlantRecord(host, b, task.model_path), settings.dT,
+                            spec.num_states};
+  auto found = control::FindOrIdentifyModel(req, /*identify=*/false, nullptr);
+  if (found.ok() || !options.identify_missing_models) return found;
+  // Not on the search path: identified now; the time it takes is reported apart.
+  const auto start = std::chrono::steady_clock::now();
+  found = control::FindOrIdentifyModel(req, true, options.quiet ? nullptr : stderr);
+  identify_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return found;
+}
+
 Result<std::vector<Channel> > MakeChannels(const Task& task, const ControllerSettings& settings,
                                            const Plant& plant, const RunOptions& options,
-                                           const std::string& where) {
+                                           const std::string& where, double& identify_s) {
   auto spec = control::EstimatorSpec::Parse(settings.estimator, "extended", settings.filter_model,
                                             20, settings.force_noise_std);
   if (!spec.ok()) return Error{where + ".controller.estimator: " + spec.error()};
@@ -150,20 +196,9 @@ Result<std::vector<Channel> > MakeChannels(const Task& task, const ControllerSet
     control::EstimatorSpec bundle_spec = *spec;
     bundle_spec.sensor_variance = task.sensor.Variance();
     bundle_spec.plant = control::PlantRecord(host, b, task.model_path);
-    // "{bundle}" in the model file name stands for the bundle's actuator name, so that each
-    // bundle of a limb gets the model identified on it.
-    const std::string key = "{bundle}";
-    for (size_t at; (at = bundle_spec.model_file.find(key)) != std::string::npos;) {
-      bundle_spec.model_file.replace(at, key.size(), host.bundle_name(b));
-    }
-    // No model named: the one identified on this bundle for this dT, from the model search path,
-    // else identified now and cached (identification/model_cache.h).
-    if (bundle_spec.kind == control::EstimatorKind::kKalmanAugmented &&
-        bundle_spec.model_file.empty()) {
-      control::ModelRequest req{task.model_path, host.bundle_name(b), bundle_spec.plant,
-                                settings.dT, bundle_spec.num_states};
-      auto file = control::FindOrIdentifyModel(req, options.identify_missing_models,
-                                               options.quiet ? nullptr : stderr);
+    if (bundle_spec.kind == control::EstimatorKind::kKalmanAugmented ||
+        !bundle_spec.model_file.empty()) {
+      auto file = BundleModelFile(task, settings, plant, i, options, bundle_spec, identify_s);
       if (!file) return Error{where + ".controller: " + file.error()};
       bundle_spec.model_file = *file;
     }
@@ -180,11 +215,55 @@ Result<std::vector<Channel> > MakeChannels(const Task& task, const ControllerSet
   return channels;
 }
 
+// Each bundle's tension step response under the law (control/actuator_response.h), predicted on
+// the chain identified for it: the Kalman estimator's own model, else the identified one.
+Result<std::vector<control::ActuatorResponse> > ActuatorResponses(
+    const Task& task, const ControllerSettings& settings, const Plant& plant,
+    const std::vector<Channel>& channels, const RunOptions& options, double& identify_s) {
+  std::vector<control::ActuatorResponse> out;
+  for (int i = 0; i < plant.num_bundles(); ++i) {
+    const auto* kalman =
+        dynamic_cast<const control::KalmanOnCountEstimator*>(&channels[i].controller.estimator());
+    FilterModel model;
+    if (kalman != nullptr) {
+      model = kalman->model();
+    } else {
+      control::EstimatorSpec spec;
+      spec.model_file = settings.filter_model;
+      auto file = BundleModelFile(task, settings, plant, i, options, spec, identify_s);
+      if (!file) return Error{file.error()};
+      auto loaded = FilterModel::FromJson(*file);
+      if (!loaded) return Error{loaded.error()};
+      model = std::move(loaded).value();
+    }
+    if (model.transition != TransitionSource::kBroadcast || model.H.rows() < 1) {
+      return Error{"bundle '" + plant.bundle_name(i) +
+                   "': the self-tuned loop needs a broadcast chain model with a force row"};
+    }
+    const Eigen::VectorXd h = model.H.row(0).transpose();
+    auto r = control::PredictActuatorResponse(
+        model.broadcast, std::vector<double>(h.data(), h.data() + h.size()), settings.lambda);
+    if (!r) return Error{"bundle '" + plant.bundle_name(i) + "': " + r.error()};
+    out.push_back(std::move(r).value());
+  }
+  return out;
+}
+
 // The force reference of each bundle at a control instant: the task's force reference for a
 // force task; for an angle task the outer loop's net force, split into agonist and antagonist
 // on top of their tone.
-void ForceReferences(const Task& task, AngleLoop& loop, const Plant& plant, double t, double dT,
+void ForceReferences(const Task& task, AngleLoop& loop, JointLoops* joints, const Plant& plant,
+                     const std::vector<Channel>& channels, double t, double dT,
                      std::vector<double>& force_ref) {
+  if (joints != nullptr) {
+    // Each bundle's capacity: every unit on, at its tendon's present length.
+    std::vector<double> capacity(plant.num_bundles());
+    for (int i = 0; i < plant.num_bundles(); ++i) {
+      capacity[i] = plant.num_units(i) * channels[i].controller.OnUnitForce(plant.TendonLength(i));
+    }
+    joints->Step(t, plant, capacity, force_ref);
+    return;
+  }
   const double r = task.reference(t);
   if (task.tracked == Tracked::kForce) {
     force_ref[0] = r;
@@ -298,6 +377,82 @@ void Summarize(const Task& task, const Plant& plant, const SignalMetrics& sig,
   }
 }
 
+JointSummary ScoreJoint(const std::string& joint, const SignalMetrics& sig, double t_end,
+                        std::vector<StepResponse>& steps) {
+  JointSummary js;
+  js.joint = joint;
+  js.tracking_rmse = sig.TrackingRmse();
+  js.iae = sig.IntegralAbsoluteError(t_end);
+  steps = sig.StepResponses();
+  js.num_steps = static_cast<int>(steps.size());
+  int settled = 0;
+  for (const StepResponse& st : steps) {
+    js.max_overshoot = std::max(js.max_overshoot, st.overshoot);
+    settled += st.settled ? 1 : 0;
+  }
+  if (!steps.empty()) js.settled_fraction = static_cast<double>(settled) / steps.size();
+  return js;
+}
+
+nlohmann::json DesignJson(const JointDesignRecord& r) {
+  const control::LoopDesign& d = r.design;
+  return {{"joint", r.joint},
+          {"reference", r.reference},
+          {"inertia", r.dynamics.inertia},
+          {"damping", r.dynamics.damping},
+          {"stiffness", r.dynamics.stiffness},
+          {"actuator_t63", r.actuator_t63},
+          {"kp", d.gains.kp},
+          {"ki", d.gains.ki},
+          {"kd", d.gains.kd},
+          {"predicted_overshoot", d.nominal.overshoot},
+          {"predicted_settling_time", d.nominal.settling_time},
+          {"robust_overshoot", d.robust.overshoot},
+          {"robust_settled", d.robust.settled},
+          {"meets", d.meets}};
+}
+
+// Several driven joints: each scored on its own reference, and the run's metrics over all of
+// their steps (RMSE: the root mean square over joints).
+void SummarizeJoints(const Task& task, const Plant& plant, const SignalMetrics& first,
+                     const std::vector<SignalMetrics>& more, const JointLoops& loops,
+                     RunSummary& s) {
+  const double t_end = plant.time() + plant.timestep();
+  std::vector<StepResponse> all, steps;
+  std::vector<std::string> names;
+  double sq = 0, iae = 0, tv = 0;
+  for (int j = 0; j < plant.num_joints(); ++j) {
+    const SignalMetrics& sig = j == 0 ? first : more[j - 1];
+    s.joints.push_back(ScoreJoint(plant.joint_name(j), sig, t_end, steps));
+    sq += s.joints.back().tracking_rmse * s.joints.back().tracking_rmse;
+    iae += s.joints.back().iae;
+    tv += sig.ExcessTotalVariation();
+    for (const StepResponse& st : steps) {
+      all.push_back(st);
+      names.push_back(plant.joint_name(j));
+    }
+  }
+  s.loop_designs = nlohmann::json::array();
+  for (const JointDesignRecord& r : loops.designs()) s.loop_designs.push_back(DesignJson(r));
+  if (plant.num_joints() < 2) return;  // the one joint's metrics are already the run's
+  RunMetrics& mt = s.metrics;
+  mt.tracking_rmse = std::sqrt(sq / plant.num_joints());
+  mt.iae = iae;
+  mt.oscillation = tv;
+  mt.num_steps = static_cast<int>(all.size());
+  mt.overshoot = mt.max_overshoot = mt.settling_time = mt.settled_fraction = 0;
+  int settled = 0;
+  for (const StepResponse& st : all) {
+    mt.overshoot += st.overshoot / all.size();
+    mt.max_overshoot = std::max(mt.max_overshoot, st.overshoot);
+    mt.settling_time += st.settling_time / all.size();
+    settled += st.settled ? 1 : 0;
+  }
+  if (!all.empty()) mt.settled_fraction = static_cast<double>(settled) / all.size();
+  s.steps = std::move(all);
+  s.step_joints = std::move(names);
+}
+
 // Progress on stderr, at most about 5 updates per second of wall time.
 class Progress {
  public:
@@ -328,6 +483,45 @@ class Progress {
 
 }  // namespace
 
+Result<std::vector<JointDesignRecord> > DesignTaskLoops(const Task& task,
+                                                        const RunOptions& options) {
+  const std::string where = task.source.empty() ? task.name : task.source;
+  if (!task.auto_loop) {
+    return Error{where + ".outer_loop: only a task with \"outer_loop\": \"auto\" designs its loop"};
+  }
+  const ControllerSettings settings = EffectiveSettings(task, options);
+  auto plant_or = Plant::Create(task, /*drawn=*/false);
+  if (!plant_or.ok()) return Error{plant_or.error()};
+  Plant& plant = **plant_or;
+  plant.Reset(options.seed);
+  double identify_s = 0;
+  auto channels = MakeChannels(task, settings, plant, options, where, identify_s);
+  if (!channels.ok()) return Error{channels.error()};
+  auto responses = ActuatorResponses(task, settings, plant, *channels, options, identify_s);
+  if (!responses) return Error{where + ".outer_loop: " + responses.error()};
+  auto loops = JointLoops::Create(task, plant, std::move(responses).value(), settings.dT);
+  if (!loops) return Error{where + ".outer_loop: " + loops.error()};
+  const double duration = options.duration ? *options.duration : task.duration;
+  std::vector<JointDesignRecord> out;
+  for (int j = 0; j < plant.num_joints(); ++j) {
+    std::vector<double> times{0};
+    for (const ReferenceStep& st : task.joints[j].reference.Steps(duration)) {
+      times.push_back(st.time);
+    }
+    std::vector<double> done;
+    for (double t : times) {
+      Eigen::VectorXd r(plant.num_joints());
+      for (int k = 0; k < plant.num_joints(); ++k) r[k] = task.joints[k].reference(t + 1e-9);
+      if (std::find(done.begin(), done.end(), r[j]) != done.end()) continue;
+      done.push_back(r[j]);
+      auto rec = loops->Design(plant, j, r);
+      if (!rec) return Error{where + ": " + rec.error()};
+      out.push_back(std::move(rec).value());
+    }
+  }
+  return out;
+}
+
 // The block diagram: at each control instant (every dT) the outer loop sets each bundle's force
 // reference, its load cell and encoder are sampled and its controller broadcasts; then the plant
 // steps (disturbances, physics) and the signals are recorded.
@@ -349,12 +543,26 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
   if (!plant_or.ok()) return Error{plant_or.error()};
   Plant& plant = **plant_or;
   plant.Reset(options.seed);
-  auto channels_or = MakeChannels(task, settings, plant, options, where);
+  double identify_s = 0;  // time spent identifying filter models, left out of wall_seconds
+  auto channels_or = MakeChannels(task, settings, plant, options, where, identify_s);
   if (!channels_or.ok()) return Error{channels_or.error()};
   std::vector<Channel>& channels = *channels_or;
   const int nb = plant.num_bundles();
   AngleLoop angle_loop;
   if (task.outer) angle_loop.gains = *task.outer;
+  std::optional<JointLoops> joint_loops;
+  if (task.auto_loop) {
+    auto responses = ActuatorResponses(task, settings, plant, channels, options, identify_s);
+    if (!responses) return Error{where + ".outer_loop: " + responses.error()};
+    auto loops = JointLoops::Create(task, plant, std::move(responses).value(), settings.dT);
+    if (!loops) return Error{where + ".outer_loop: " + loops.error()};
+    joint_loops = std::move(loops).value();
+  }
+  // Joints after the first score against their own references (the first is `measured`).
+  std::vector<SignalMetrics> more_joints;
+  for (int j = 1; j < plant.num_joints(); ++j) {
+    more_joints.emplace_back(task.joints[j].reference.Steps(duration), task.settle_band);
+  }
 
   TelemetrySample sample;
   sample.reference_unit = task.tracked == Tracked::kForce ? "N" : "rad";
@@ -382,7 +590,8 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
     if (sample.control_instant) {
       ++control_instants;
       next_control = control_instants * settings.dT;
-      ForceReferences(task, angle_loop, plant, t, settings.dT, force_ref);
+      ForceReferences(task, angle_loop, joint_loops ? &*joint_loops : nullptr, plant, channels, t,
+                      settings.dT, force_ref);
       for (int i = 0; i < nb; ++i) {
         if (Status st = ControlBundle(channels[i], plant, i, force_ref[i], sample.bundles[i]);
             !st.ok()) {
@@ -397,6 +606,10 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
     const double y = measured();
     const double r = task.reference(plant.time());
     sig.Add(plant.time(), r, y);
+    for (int j = 1; j < plant.num_joints(); ++j) {
+      more_joints[j - 1].Add(plant.time(), task.joints[j].reference(plant.time()),
+                             plant.JointAngle(j));
+    }
     // Units switch only when a broadcast reaches them, so the on-counts change only at control
     // instants: counted there (after the broadcast took effect) for the switching rate.
     if (sample.control_instant) {
@@ -429,9 +642,12 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
   s.control_instants = control_instants;
   s.unit = sample.reference_unit;
   Summarize(task, plant, sig, channels, s);
+  if (joint_loops) SummarizeJoints(task, plant, sig, more_joints, *joint_loops, s);
+  s.identification_seconds = identify_s;
   for (const std::string& w : s.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
   s.wall_seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count() -
+      identify_s;
   return s;
 }
 #endif

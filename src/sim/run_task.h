@@ -60,13 +60,24 @@ struct BundleSummary {
   double max_wire_stress = 0;    // Pa, the limit
 };
 
+// One driven joint's scores (self-tuned angle tasks).
+struct JointSummary {
+  std::string joint;
+  double tracking_rmse = 0;  // rad
+  double iae = 0;            // rad s
+  double max_overshoot = 0;  // fraction of the step
+  double settled_fraction = 0;
+  int num_steps = 0;
+};
+
 struct RunSummary {
   std::string task;
   std::string estimator;
   double dT = 0, lambda = 0;
   std::uint64_t seed = 0;
-  double duration = 0;      // simulated s
-  double wall_seconds = 0;  // s
+  double duration = 0;                // simulated s
+  double wall_seconds = 0;            // s, the run itself (identification left out)
+  double identification_seconds = 0;  // s spent identifying filter models before the run
   long physics_steps = 0;
   long control_instants = 0;
   std::string unit;                    // "N" or "rad"
@@ -75,12 +86,22 @@ struct RunSummary {
   SensorParams sensor;                 // the load cell the controllers read
   std::vector<std::string> warnings;   // limits exceeded, also printed on stderr
   std::vector<StepResponse> steps;
+  std::vector<std::string> step_joints;  // the joint of each step (several-joint tasks)
+  std::vector<JointSummary> joints;      // self-tuned angle tasks: per driven joint
+  nlohmann::json loop_designs;           // self-tuned angle tasks: each design made (JSON)
 
   nlohmann::json ToJson() const;
 };
 
 // The effective settings after applying `options` to the task's defaults.
 ControllerSettings EffectiveSettings(const Task& task, const RunOptions& options);
+
+// The self-tuned loop's designs for a task (`recruit tune-loop`): for each driven joint, at the
+// pose of every reference value it steps to (the other joints at their references then), the
+// model it was designed on, the gains and the predicted step response. Angle tasks with
+// "outer_loop": "auto" only.
+struct JointDesignRecord;
+Result<std::vector<JointDesignRecord>> DesignTaskLoops(const Task& task, const RunOptions& options);
 
 Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
                            const std::vector<StepObserver*>& observers = {});

@@ -1,5 +1,6 @@
 #include "sim/task.h"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <set>
@@ -81,11 +82,90 @@ std::string Resolve(const std::string& path, const std::string& source) {
   return (fs::path(source).parent_path() / path).lexically_normal().string();
 }
 
+// A reference in the unit the file states (N for force tasks; deg, the default, or rad for
+// angle tasks), returned in N or rad.
+Result<Reference> ReadReference(const json& r, const std::string& where, Tracked tracked) {
+  std::string unit = tracked == Tracked::kForce ? "N" : "deg";
+  if (r.is_object() && r.contains("unit")) {
+    if (!r["unit"].is_string()) return Error{where + ".unit: must be a string"};
+    unit = r["unit"];
+  }
+  double scale = 1;
+  if (tracked == Tracked::kForce) {
+    if (unit != "N") return Error{where + ".unit: '" + unit + "' for a force task; allowed: N"};
+  } else if (unit == "deg") {
+    scale = M_PI / 180;
+  } else if (unit != "rad") {
+    return Error{where + ".unit: '" + unit + "' for an angle task; allowed: deg, rad"};
+  }
+  json body = r;
+  if (body.is_object()) body.erase("unit");
+  auto ref = Reference::FromJson(body, where, scale);
+  if (!ref.ok()) return Error{ref.error()};
+  if (tracked == Tracked::kForce && ref->MinValue() < 0) {
+    return Error{where + ": a force reference must be >= 0 N (a bundle can only pull)"};
+  }
+  return ref;
+}
+
 #define RECRUIT_TRY(expr)                   \
   do {                                      \
     Status _s = (expr);                     \
     if (!_s.ok()) return Error{_s.error()}; \
   } while (0)
+
+// The several-joint form: "joints": [{"joint", "reference"}, ...] and optional "bundles"; the
+// one-joint fields are not allowed beside it.
+Status ReadJointsForm(const json& j, const std::string& file, Task& task) {
+  if (task.tracked != Tracked::kAngle) {
+    return Error{file + ".joints: only angle tasks drive joints (tracked is 'force')"};
+  }
+  for (const char* key : {"joint", "reference", "agonist", "antagonist"}) {
+    if (j.contains(key)) {
+      return Error{file + "." + key + ": not with 'joints' (each joint has its own reference)"};
+    }
+  }
+  const json& js = j["joints"];
+  if (!js.is_array() || js.empty() || js.size() > 64) {
+    return Error{file + ".joints: must be an array of 1 to 64 objects {\"joint\", \"reference\"}"};
+  }
+  for (size_t i = 0; i < js.size(); ++i) {
+    const std::string where = file + ".joints[" + std::to_string(i) + "]";
+    if (!js[i].is_object()) return Error{where + ": must be an object"};
+    RECRUIT_TRY(CheckKeys(js[i], {"joint", "reference"}, where));
+    DrivenJoint d;
+    RECRUIT_TRY(String(js[i], "joint", where, &d.joint, true));
+    for (const DrivenJoint& other : task.joints) {
+      if (other.joint == d.joint) return Error{where + ".joint: '" + d.joint + "' is listed twice"};
+    }
+    if (!js[i].contains("reference")) return Error{where + ": missing field 'reference'"};
+    auto ref = ReadReference(js[i]["reference"], where + ".reference", Tracked::kAngle);
+    if (!ref.ok()) return Error{ref.error()};
+    d.reference = std::move(ref).value();
+    task.joints.push_back(std::move(d));
+  }
+  task.joint = task.joints[0].joint;
+  task.reference = task.joints[0].reference;
+  if (j.contains("bundles")) {
+    const json& bs = j["bundles"];
+    if (!bs.is_array() || bs.empty() || bs.size() > 256) {
+      return Error{file + ".bundles: must be an array of 1 to 256 actuator names"};
+    }
+    for (size_t i = 0; i < bs.size(); ++i) {
+      const std::string where = file + ".bundles[" + std::to_string(i) + "]";
+      if (!bs[i].is_string() || bs[i].get<std::string>().empty()) {
+        return Error{where + ": must be a non-empty string, got " + ShortText(bs[i].dump(), 60)};
+      }
+      const std::string name = bs[i];
+      if (std::find(task.bundles.begin(), task.bundles.end(), name) != task.bundles.end()) {
+        return Error{where + ": '" + name + "' is listed twice"};
+      }
+      task.bundles.push_back(name);
+    }
+    task.agonist = task.bundles[0];
+  }
+  return Status::Ok();
+}
 
 }  // namespace
 
@@ -101,11 +181,12 @@ Result<Task> Task::FromJsonText(const std::string& text, const std::string& sour
   if (!parsed.ok()) return Error{parsed.error()};
   json j = std::move(parsed).value();
   if (!j.is_object()) return Error{file + ": the task must be a JSON object"};
-  RECRUIT_TRY(CheckKeys(j,
-                        {"name", "description", "model", "tracked", "agonist", "antagonist",
-                         "joint", "duration", "timestep", "reference", "controller", "sensor",
-                         "outer_loop", "pushes", "payloads", "settle_band"},
-                        file));
+  RECRUIT_TRY(
+      CheckKeys(j,
+                {"name", "description", "model", "tracked", "agonist", "antagonist", "joint",
+                 "duration", "timestep", "reference", "controller", "sensor", "outer_loop",
+                 "pushes", "payloads", "settle_band", "joints", "bundles", "co_contraction"},
+                file));
   Task task;
   task.source = source;
   RECRUIT_TRY(String(j, "name", file, &task.name, true));
@@ -129,12 +210,19 @@ Result<Task> Task::FromJsonText(const std::string& text, const std::string& sour
   } else {
     return Error{file + ".tracked: unknown '" + tracked + "'; allowed: force, angle"};
   }
-  RECRUIT_TRY(String(j, "agonist", file, &task.agonist, true));
-  RECRUIT_TRY(String(j, "antagonist", file, &task.antagonist, false));
-  if (task.antagonist == task.agonist) {
-    return Error{file + ".antagonist: must differ from 'agonist' ('" + task.agonist + "')"};
+  if (j.contains("joints")) {
+    RECRUIT_TRY(ReadJointsForm(j, file, task));
+  } else {
+    RECRUIT_TRY(String(j, "agonist", file, &task.agonist, true));
+    RECRUIT_TRY(String(j, "antagonist", file, &task.antagonist, false));
+    if (task.antagonist == task.agonist) {
+      return Error{file + ".antagonist: must differ from 'agonist' ('" + task.agonist + "')"};
+    }
+    RECRUIT_TRY(String(j, "joint", file, &task.joint, task.tracked == Tracked::kAngle));
+    if (j.contains("bundles")) {
+      return Error{file + ".bundles: only with 'joints' (this task names 'agonist')"};
+    }
   }
-  RECRUIT_TRY(String(j, "joint", file, &task.joint, task.tracked == Tracked::kAngle));
   RECRUIT_TRY(Number(j, "duration", file, &task.duration, true, 0, 1e6, true,
                      "seconds, 0 < duration <= 1e6"));
   RECRUIT_TRY(Number(j, "timestep", file, &task.timestep, false, 1e-5, 0.05, false,
@@ -142,32 +230,11 @@ Result<Task> Task::FromJsonText(const std::string& text, const std::string& sour
   RECRUIT_TRY(Number(j, "settle_band", file, &task.settle_band, false, 0, 1, true,
                      "a fraction of the step size, 0 < settle_band <= 1"));
 
-  // Reference, in the unit the file states.
-  if (!j.contains("reference")) return Error{file + ": missing field 'reference'"};
-  {
-    const json& r = j["reference"];
-    const std::string where = file + ".reference";
-    std::string unit = task.tracked == Tracked::kForce ? "N" : "deg";
-    if (r.is_object() && r.contains("unit")) {
-      if (!r["unit"].is_string()) return Error{where + ".unit: must be a string"};
-      unit = r["unit"];
-    }
-    double scale = 1;
-    if (task.tracked == Tracked::kForce) {
-      if (unit != "N") return Error{where + ".unit: '" + unit + "' for a force task; allowed: N"};
-    } else if (unit == "deg") {
-      scale = M_PI / 180;
-    } else if (unit != "rad") {
-      return Error{where + ".unit: '" + unit + "' for an angle task; allowed: deg, rad"};
-    }
-    json body = r;
-    if (body.is_object()) body.erase("unit");
-    auto ref = Reference::FromJson(body, where, scale);
+  if (!j.contains("joints")) {
+    if (!j.contains("reference")) return Error{file + ": missing field 'reference'"};
+    auto ref = ReadReference(j["reference"], file + ".reference", task.tracked);
     if (!ref.ok()) return Error{ref.error()};
     task.reference = std::move(ref).value();
-    if (task.tracked == Tracked::kForce && task.reference.MinValue() < 0) {
-      return Error{where + ": a force reference must be >= 0 N (a bundle can only pull)"};
-    }
   }
 
   if (j.contains("controller")) {
@@ -191,7 +258,16 @@ Result<Task> Task::FromJsonText(const std::string& text, const std::string& sour
     task.sensor = *sensor;
   }
 
-  if (j.contains("outer_loop")) {
+  if (j.contains("outer_loop") && j["outer_loop"] == "auto") {
+    if (task.tracked != Tracked::kAngle) {
+      return Error{file + ".outer_loop: only angle tasks have an outer loop (tracked is 'force')"};
+    }
+    task.auto_loop = true;
+  } else if (j.contains("outer_loop")) {
+    if (!task.joints.empty()) {
+      return Error{file +
+                   ".outer_loop: a task with 'joints' designs its own loop; allowed: \"auto\""};
+    }
     const json& o = j["outer_loop"];
     const std::string where = file + ".outer_loop";
     if (task.tracked != Tracked::kAngle) {
@@ -211,8 +287,23 @@ Result<Task> Task::FromJsonText(const std::string& text, const std::string& sour
       return Error{where + ".tone: must not exceed max_force"};
     }
     task.outer = loop;
-  } else if (task.tracked == Tracked::kAngle) {
-    return Error{file + ": missing field 'outer_loop' (an angle task needs the PI gains kp, ki)"};
+  } else if (task.tracked == Tracked::kAngle && task.joints.empty()) {
+    return Error{file + ": missing field 'outer_loop' (\"auto\", or the PI gains kp, ki)"};
+  } else {
+    task.auto_loop = task.tracked == Tracked::kAngle;  // the joints form's default
+  }
+  if (task.auto_loop && task.joints.empty()) {
+    // The one-joint form: its joint and reference, served by its agonist and antagonist.
+    task.joints.push_back({task.joint, task.reference});
+    task.bundles.push_back(task.agonist);
+    if (!task.antagonist.empty()) task.bundles.push_back(task.antagonist);
+  }
+  if (j.contains("co_contraction")) {
+    if (!task.auto_loop) {
+      return Error{file + ".co_contraction: only with \"outer_loop\": \"auto\""};
+    }
+    RECRUIT_TRY(Number(j, "co_contraction", file, &task.co_contraction, false, 0, 0.5, false,
+                       "a fraction of each bundle's capacity, 0 <= co_contraction <= 0.5"));
   }
 
   if (j.contains("pushes")) {

@@ -55,6 +55,12 @@ struct Payload {
   double time = 0;
 };
 
+// One joint an angle task drives, with its own reference (rad).
+struct DrivenJoint {
+  std::string joint;  // a hinge
+  Reference reference;
+};
+
 struct Task {
   std::string name;
   std::string description;
@@ -71,7 +77,16 @@ struct Task {
   // The load cell every bundle's force is read through (noise, resolution, held over dT); the
   // default is an exact sensor. Separate from the filter's own R (controller.force_noise_std).
   SensorParams sensor;
-  std::optional<OuterLoop> outer;
+  std::optional<OuterLoop> outer;  // hand-set gains (one joint, agonist/antagonist)
+  // The self-tuned loop ("outer_loop": "auto", control/loop_design.h): each driven joint's
+  // torque demand from gains designed on the model, shared among the bundles that cross it
+  // (control/torque_allocation.h). `joints` lists the driven joints (the one-joint form's
+  // `joint` and `reference` become its one entry) and `bundles` the bundles that serve them
+  // (empty: every bundle of the model).
+  bool auto_loop = false;
+  std::vector<DrivenJoint> joints;
+  std::vector<std::string> bundles;
+  double co_contraction = 0.05;  // least tension of each bundle, fraction of its capacity
   std::vector<Push> pushes;
   std::vector<Payload> payloads;
   double settle_band = 0.10;  // fraction of each step's size used for settling time

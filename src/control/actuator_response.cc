@@ -1,0 +1,94 @@
+#include "control/actuator_response.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "control/broadcast.h"
+
+namespace recruit::control {
+namespace {
+
+// One sampling period of the expected chain: the law's broadcast for `target` (a fraction of the
+// units on), then the chain's transition.
+void Advance(const BroadcastTransitionModel& chain, double target_on, double lambda,
+             Eigen::VectorXd& x) {
+  double on = 0;
+  for (int i = 0; i < chain.num_states(); ++i) on += chain.is_on[i] ? x[i] : 0.0;
+  const Broadcast b = ExpectationLaw(target_on, on, 1.0, lambda);
+  x = chain.Matrix(b.p_on, b.p_off) * x;
+}
+
+}  // namespace
+
+double ActuatorResponse::At(double t) const {
+  if (s.empty()) return 1;
+  const double k = t / dT;
+  if (k <= 0) return s.front();
+  const size_t i = static_cast<size_t>(k);
+  if (i + 1 >= s.size()) return s.back();
+  const double f = k - i;
+  return s[i] + f * (s[i + 1] - s[i]);
+}
+
+double ActuatorResponse::TimeTo(double fraction) const {
+  for (size_t i = 1; i < s.size(); ++i) {
+    if (s[i] >= fraction) {
+      const double f = (fraction - s[i - 1]) / (s[i] - s[i - 1]);
+      return (i - 1 + f) * dT;
+    }
+  }
+  return s.size() * dT;
+}
+
+Result<ActuatorResponse> PredictActuatorResponse(const BroadcastTransitionModel& chain,
+                                                 const std::vector<double>& force, double lambda,
+                                                 double from, double to, int max_samples) {
+  const int m = chain.num_states();
+  if (static_cast<int>(force.size()) != m) {
+    return Error{"actuator response: the force row has " + std::to_string(force.size()) +
+                 " entries for a chain of " + std::to_string(m) + " states"};
+  }
+  if (!(chain.dt > 0) || !(lambda > 0 && lambda <= 1) || !(from > 0 && from < 1) ||
+      !(to > 0 && to < 1) || from == to) {
+    return Error{"actuator response: needs dt > 0, 0 < lambda <= 1 and two distinct fractions"};
+  }
+  // The settled force of a unit held on: the largest state force (the settled on state).
+  const double unit_force = *std::max_element(force.begin(), force.end());
+  if (!(unit_force > 0)) return Error{"actuator response: no state of the chain pulls"};
+  const Eigen::Map<const Eigen::VectorXd> h(force.data(), m);
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(m);
+  x[0] = 1;
+  // Settle at `from` (the law's count target is the force target over one settled unit's).
+  double before = 0;
+  for (int k = 0; k < 20 * max_samples; ++k) {
+    Advance(chain, from, lambda, x);
+    const double y = h.dot(x);
+    if (k > 10 && std::abs(y - before) < 1e-12 * unit_force) break;
+    before = y;
+  }
+  const double y0 = h.dot(x);
+  ActuatorResponse r;
+  r.dT = chain.dt;
+  r.s.push_back(0);
+  // The force the step ends at, from the same chain settled at `to` (not assumed linear).
+  Eigen::VectorXd settled = x;
+  double prev = 0;
+  for (int k = 0; k < 20 * max_samples; ++k) {
+    Advance(chain, to, lambda, settled);
+    const double y = h.dot(settled);
+    if (k > 10 && std::abs(y - prev) < 1e-12 * unit_force) break;
+    prev = y;
+  }
+  const double y1 = h.dot(settled);
+  if (std::abs(y1 - y0) < 1e-9 * unit_force) {
+    return Error{"actuator response: the chain's force does not follow its on-count"};
+  }
+  for (int k = 1; k <= max_samples; ++k) {
+    Advance(chain, to, lambda, x);
+    r.s.push_back((h.dot(x) - y0) / (y1 - y0));
+    if (k > 2 && std::abs(1 - r.s.back()) < 1e-4 && std::abs(1 - r.s[k - 1]) < 1e-4) break;
+  }
+  return r;
+}
+
+}  // namespace recruit::control

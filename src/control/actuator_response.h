@@ -1,0 +1,36 @@
+// The mean response of a bundle's tension to a step of its force reference, under the
+// expectation law at sampling period dT and gain lambda, predicted from the bundle's identified
+// population chain (the Kalman filter's model: its broadcast transition model and the force of
+// one unit in each state). The outer loop's design (control/loop_design.h) is made on it.
+#pragma once
+
+#include <vector>
+
+#include "common/result.h"
+#include "estimation/broadcast_transition_model.h"
+
+namespace recruit::control {
+
+struct ActuatorResponse {
+  double dT = 0;  // s, between samples
+  // s[k]: the fraction of a step of the force reference that the tension has made k sampling
+  // periods after it (s[0] = 0; tends to 1).
+  std::vector<double> s;
+
+  // Linear interpolation between samples; 1 after the last.
+  double At(double t) const;
+  // The first time the response reaches `fraction` (linear between samples).
+  double TimeTo(double fraction) const;
+};
+
+// The chain's expected state (fractions of units per state) starts settled at `from` of the
+// settled on-force, the reference then steps to `to` (both in (0, 1)); the expectation law acts
+// on the chain's own on-fraction (a perfect estimate). `force` gives one unit's tension in each
+// state (the model's H row at the working length). Stops when the remaining error is below
+// 1e-4 of the step, or after `max_samples`.
+Result<ActuatorResponse> PredictActuatorResponse(const BroadcastTransitionModel& chain,
+                                                 const std::vector<double>& force, double lambda,
+                                                 double from = 0.25, double to = 0.5,
+                                                 int max_samples = 1000);
+
+}  // namespace recruit::control

@@ -1,0 +1,127 @@
+#include "control/loop_design.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <unsupported/Eigen/MatrixFunctions>
+
+namespace recruit::control {
+namespace {
+
+constexpr int kSubsteps = 20;  // mechanics steps per sampling period
+
+// Exact discretisation of I qddot + b qdot + k q = tau over h with tau held: z' = Phi z + Gam tau.
+struct Discrete {
+  Eigen::Matrix2d phi;
+  Eigen::Vector2d gam;
+};
+
+Discrete Discretise(const JointDynamics& j, double h) {
+  Eigen::Matrix3d m = Eigen::Matrix3d::Zero();
+  m(0, 1) = 1;
+  m(1, 0) = -j.stiffness / j.inertia;
+  m(1, 1) = -j.damping / j.inertia;
+  m(1, 2) = 1 / j.inertia;
+  const Eigen::Matrix3d e = (m * h).exp();
+  return {e.topLeftCorner<2, 2>(), e.topRightCorner<2, 1>()};
+}
+
+// Settling (the last time outside the band, on the fine samples) and overshoot of y -> 1.
+void Score(const std::vector<double>& t, const std::vector<double>& y, const LoopTarget& target,
+           PredictedStep& out) {
+  double last_out = 0, peak = -std::numeric_limits<double>::infinity();
+  bool ends_in = true;
+  for (size_t i = 0; i < y.size(); ++i) {
+    peak = std::max(peak, y[i]);
+    const bool in = std::isfinite(y[i]) && std::abs(y[i] - 1) <= target.band;
+    if (!in) last_out = t[i];
+    ends_in = in;
+  }
+  out.overshoot = std::isfinite(peak) ? std::max(0.0, peak - 1) : 1e9;
+  out.settled = ends_in && last_out < target.hold;
+  out.settling_time = out.settled ? last_out : target.hold;
+  out.final_error = y.empty() || !std::isfinite(y.back()) ? 1e9 : std::abs(y.back() - 1);
+}
+
+double Penalty(const LoopDesign& d, const LoopTarget& target) {
+  auto one = [&](const PredictedStep& p, double allowed) {
+    return p.settling_time + (p.settled ? 0 : target.hold) +
+           target.hold * std::min(p.final_error, 10.0) +
+           10 * target.hold * std::max(0.0, p.overshoot - allowed);
+  };
+  return one(d.nominal, target.overshoot) + 0.25 * one(d.robust, 0.25);
+}
+
+}  // namespace
+
+PredictedStep PredictStep(const JointDynamics& joint, const ActuatorResponse& act, double dT,
+                          const LoopGains& gains, const LoopTarget& target,
+                          double actuator_slowdown, double gain_scale) {
+  const double h = dT / kSubsteps;
+  const Discrete dis = Discretise(joint, h);
+  const int instants = static_cast<int>(std::ceil(target.hold / dT - 1e-9));
+  // Deviation from the new reference: the limb starts at rest one step below it, held there by
+  // the static torque of that pose (-k relative to the reference's).
+  Eigen::Vector2d z(-1, 0);
+  std::vector<double> u{-joint.stiffness};  // the demand before the step, then at each instant
+  double integral = 0;
+  PredictedStep out;
+  std::vector<double> t_fine, y_fine;
+  for (int n = 0; n < instants; ++n) {
+    const double e = -z[0];
+    integral += e * dT;
+    u.push_back(gain_scale * (gains.kp * e + gains.ki * integral - gains.kd * z[1]));
+    out.time.push_back(n * dT);
+    out.angle.push_back(z[0] + 1);
+    for (int s = 0; s < kSubsteps; ++s) {
+      const double t = n * dT + (s + 0.5) * h;
+      // Each change of the demand moves the tension along the bundle's step response.
+      double tau = u[0];
+      for (int i = 1; i <= n + 1; ++i) {
+        tau += (u[i] - u[i - 1]) * act.At((t - (i - 1) * dT) / actuator_slowdown);
+      }
+      z = dis.phi * z + dis.gam * tau;
+      t_fine.push_back(n * dT + (s + 1) * h);
+      y_fine.push_back(z[0] + 1);
+    }
+  }
+  Score(t_fine, y_fine, target, out);
+  return out;
+}
+
+Result<LoopDesign> DesignJointLoop(const JointDynamics& joint, const ActuatorResponse& act,
+                                   double dT, const LoopTarget& target) {
+  if (!(joint.inertia > 0) || !(joint.damping >= 0) || !std::isfinite(joint.stiffness)) {
+    return Error{"loop design: the joint needs inertia > 0, damping >= 0, finite stiffness"};
+  }
+  if (act.s.size() < 2 || !(dT > 0) || !(target.hold > dT)) {
+    return Error{"loop design: needs an actuator response, dT > 0 and a hold longer than dT"};
+  }
+  // Scales: the actuator's time to 63 % and a stiffness the loop must at least match.
+  const double t63 = std::max(act.TimeTo(0.63), dT);
+  const double k_ref =
+      std::max({std::abs(joint.stiffness), joint.damping / t63, joint.inertia / (t63 * t63)});
+  LoopDesign best;
+  double best_penalty = std::numeric_limits<double>::infinity();
+  for (double a : {0.0, 0.125, 0.25, 0.5, 1.0, 2.0, 4.0, 8.0}) {
+    for (double b : {0.02, 0.04, 0.08, 0.15, 0.3, 0.6, 1.2, 2.4}) {
+      for (double c : {0.0, 0.05, 0.2}) {
+        LoopDesign d;
+        d.gains = {a * k_ref, b * k_ref / t63, c * k_ref * t63};
+        d.nominal = PredictStep(joint, act, dT, d.gains, target);
+        d.robust = PredictStep(joint, act, dT, d.gains, target, 1.5, 1.5);
+        d.meets = d.nominal.settled && d.nominal.overshoot <= target.overshoot &&
+                  d.robust.settled && d.robust.overshoot <= 0.25;
+        // Among designs that meet the target the fastest; ties to the smaller gains (the grid
+        // runs from small to large, and only a strictly better one replaces).
+        const double penalty = d.meets ? d.nominal.settling_time : 1e6 + Penalty(d, target);
+        if (penalty < best_penalty - 1e-9) best_penalty = penalty, best = d;
+      }
+    }
+  }
+  best.note =
+      best.meets ? "meets the target" : "no gain on the grid meets the target: the closest is used";
+  return best;
+}
+
+}  // namespace recruit::control

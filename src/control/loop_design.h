@@ -1,0 +1,67 @@
+// The outer loop of a driven joint, designed from the model instead of tuned by hand
+// (docs/controller.md, "The self-tuned outer loop").
+//
+// Each control instant (every dT) the joint's torque demand is
+//   tau = tau_static(r) + kp e + ki sum(e dT) - kd qdot,   e = r - q,
+// with tau_static(r) the torque that holds the limb still at the reference (MuJoCo's inverse
+// dynamics: gravity, payload, passive springs). The design model about the reference is the
+// joint's linearised mechanics  I qddot + b qdot + k q = tau_act  and the bundles' tension
+// response (control/actuator_response.h) between the demand and tau_act. The gains are chosen
+// on a grid by simulating that model: the fastest settling into the band with the stated
+// overshoot, that also keeps settling (overshoot <= 25 %) with the actuator 1.5x slower and the
+// loop gain 1.5x higher (robustness to the model's errors).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "common/result.h"
+#include "control/actuator_response.h"
+
+namespace recruit::control {
+
+// The joint about the reference pose.
+struct JointDynamics {
+  double inertia = 0;    // kg m^2 (mass matrix diagonal + armature), > 0
+  double damping = 0;    // N m s/rad, >= 0
+  double stiffness = 0;  // N m/rad: d tau_static / dq (gravity, springs); may be <= 0
+};
+
+struct LoopGains {
+  double kp = 0;  // N m/rad
+  double ki = 0;  // N m/(rad s)
+  double kd = 0;  // N m s/rad, on the measured velocity
+};
+
+// What the design asks of a step response.
+struct LoopTarget {
+  double overshoot = 0.05;  // fraction of the step
+  double band = 0.10;       // settling band, fraction of the step
+  double hold = 20;         // s, time a step has to settle
+};
+
+struct PredictedStep {
+  double overshoot = 0;      // fraction of the step
+  double settling_time = 0;  // s (the hold when it never settles)
+  bool settled = false;
+  double final_error = 0;           // |angle - 1| at the end of the hold
+  std::vector<double> time, angle;  // at the control instants; angle as a fraction of the step
+};
+
+struct LoopDesign {
+  LoopGains gains;
+  PredictedStep nominal;  // the design model
+  PredictedStep robust;   // actuator 1.5x slower, loop gain 1.5x
+  bool meets = false;     // both meet the target (else the best found, with a reason)
+  std::string note;
+};
+
+// The design model's response to a unit step of the reference.
+PredictedStep PredictStep(const JointDynamics& joint, const ActuatorResponse& act, double dT,
+                          const LoopGains& gains, const LoopTarget& target,
+                          double actuator_slowdown = 1, double gain_scale = 1);
+
+Result<LoopDesign> DesignJointLoop(const JointDynamics& joint, const ActuatorResponse& act,
+                                   double dT, const LoopTarget& target);
+
+}  // namespace recruit::control

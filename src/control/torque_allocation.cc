@@ -1,0 +1,98 @@
+#include "control/torque_allocation.h"
+
+#include <Eigen/Cholesky>
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+namespace recruit::control {
+namespace {
+
+// 1 / s_j^2 per joint (0 for a joint no bundle moves).
+Eigen::VectorXd JointWeights(const AllocationProblem& p) {
+  Eigen::VectorXd w(p.arms.rows());
+  for (int j = 0; j < p.arms.rows(); ++j) {
+    const double span = p.arms.row(j).cwiseAbs().dot(p.cap);
+    w[j] = span > 0 ? 1.0 / (span * span) : 0.0;
+  }
+  return w;
+}
+
+enum Bound : char { kFree, kLower, kUpper };
+
+// The minimum over the free variables with the others held: Q_FF x_F = c_F - Q_FB x_B.
+Eigen::VectorXd FreeMinimum(const Eigen::MatrixXd& Q, const Eigen::VectorXd& c,
+                            const std::vector<Bound>& state, const Eigen::VectorXd& x) {
+  std::vector<int> free;
+  for (int i = 0; i < static_cast<int>(state.size()); ++i) {
+    if (state[i] == kFree) free.push_back(i);
+  }
+  Eigen::VectorXd out = x;
+  if (free.empty()) return out;
+  const int nf = static_cast<int>(free.size());
+  Eigen::MatrixXd qff(nf, nf);
+  Eigen::VectorXd rhs(nf);
+  for (int a = 0; a < nf; ++a) {
+    rhs[a] = c[free[a]];
+    for (int i = 0; i < x.size(); ++i) {
+      if (state[i] != kFree) rhs[a] -= Q(free[a], i) * x[i];
+    }
+    for (int b = 0; b < nf; ++b) qff(a, b) = Q(free[a], free[b]);
+  }
+  const Eigen::VectorXd sol = qff.llt().solve(rhs);
+  for (int a = 0; a < nf; ++a) out[free[a]] = sol[a];
+  return out;
+}
+
+}  // namespace
+
+double AllocationCost(const AllocationProblem& p, const Eigen::VectorXd& tensions, double eps) {
+  const Eigen::VectorXd w = JointWeights(p);
+  const Eigen::VectorXd r = p.arms * tensions - p.torque;
+  return r.cwiseProduct(r).dot(w) + eps * tensions.cwiseQuotient(p.cap).squaredNorm();
+}
+
+Eigen::VectorXd AllocateTensions(const AllocationProblem& p, double eps) {
+  const int nb = static_cast<int>(p.cap.size());
+  const Eigen::VectorXd w = JointWeights(p);
+  // The cost is (1/2) x'Qx - c'x + const with Q = 2 (A'WA + eps D^-2), c = 2 A'W torque.
+  Eigen::MatrixXd Q = p.arms.transpose() * w.asDiagonal() * p.arms;
+  for (int b = 0; b < nb; ++b) Q(b, b) += eps / (p.cap[b] * p.cap[b]);
+  const Eigen::VectorXd c = p.arms.transpose() * w.asDiagonal() * p.torque;
+  // Start at the floor, every variable held there.
+  Eigen::VectorXd x = p.floor;
+  std::vector<Bound> state(nb, kLower);
+  for (int iter = 0; iter < 50 * (nb + 1); ++iter) {
+    const Eigen::VectorXd target = FreeMinimum(Q, c, state, x);
+    // The longest step towards it that stays inside the box; a variable that stops it is held.
+    double alpha = 1;
+    int blocking = -1;
+    for (int i = 0; i < nb; ++i) {
+      if (state[i] != kFree || target[i] == x[i]) continue;
+      const double limit = target[i] < x[i] ? p.floor[i] : p.cap[i];
+      const double a = (limit - x[i]) / (target[i] - x[i]);
+      if (a < alpha) alpha = a, blocking = i;
+    }
+    x += alpha * (target - x);
+    if (blocking >= 0) {
+      x[blocking] = target[blocking] < x[blocking] ? p.floor[blocking] : p.cap[blocking];
+      state[blocking] = x[blocking] == p.floor[blocking] ? kLower : kUpper;
+      continue;
+    }
+    // At the free minimum: release the held variable whose gradient points most into the box.
+    const Eigen::VectorXd grad = Q * x - c;
+    int release = -1;
+    double best = 0;
+    for (int i = 0; i < nb; ++i) {
+      const double into = state[i] == kLower ? -grad[i] : state[i] == kUpper ? grad[i] : 0;
+      if (into > best * (1 + 1e-12) && into > 1e-14 * std::abs(c[i]) + 1e-300) {
+        best = into, release = i;
+      }
+    }
+    if (release < 0) break;  // the KKT conditions hold
+    state[release] = kFree;
+  }
+  return x.cwiseMax(p.floor).cwiseMin(p.cap);
+}
+
+}  // namespace recruit::control

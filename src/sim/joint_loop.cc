@@ -1,0 +1,126 @@
+#include "sim/joint_loop.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "control/torque_allocation.h"
+
+namespace recruit::sim {
+namespace {
+
+constexpr double kStiffnessStep = 1e-3;  // rad, for d tau_static / dq
+
+}  // namespace
+
+double ShortestHold(const Reference& reference, double duration) {
+  double shortest = duration;
+  for (const ReferenceStep& s : reference.Steps(duration)) {
+    shortest = std::min(shortest, s.end - s.time);
+  }
+  return shortest;
+}
+
+Result<JointLoops> JointLoops::Create(const Task& task, const Plant& plant,
+                                      std::vector<control::ActuatorResponse> responses, double dT) {
+  if (static_cast<int>(responses.size()) != plant.num_bundles()) {
+    return Error{"joint loops: one actuator response per bundle is needed"};
+  }
+  JointLoops loops;
+  loops.task_ = &task;
+  loops.responses_ = std::move(responses);
+  loops.dT_ = dT;
+  loops.target_.band = task.settle_band;
+  // The hold a step has to settle in: the shortest of the task's steps, at most 60 s (a longer
+  // hold would only allow a slower design).
+  double hold = 60;
+  for (const DrivenJoint& d : task.joints) {
+    hold = std::min(hold, ShortestHold(d.reference, task.duration));
+  }
+  loops.target_.hold = std::max(hold, 4 * dT);
+  loops.gains_.resize(plant.num_joints());
+  loops.integral_.assign(plant.num_joints(), 0.0);
+  loops.tensions_.assign(plant.num_bundles(), 0.0);
+  return loops;
+}
+
+Result<JointDesignRecord> JointLoops::Design(const Plant& plant, int j,
+                                             const Eigen::VectorXd& r) const {
+  JointDesignRecord rec;
+  rec.joint = plant.joint_name(j);
+  rec.reference = r[j];
+  Eigen::VectorXd up = r, down = r;
+  up[j] += kStiffnessStep;
+  down[j] -= kStiffnessStep;
+  rec.dynamics.stiffness =
+      (plant.StaticTorque(up)[j] - plant.StaticTorque(down)[j]) / (2 * kStiffnessStep);
+  rec.dynamics.inertia = plant.JointInertia(j, r);
+  rec.dynamics.damping = plant.JointDamping(j);
+  // The slowest bundle that moves this joint sets the actuator's response.
+  const Eigen::MatrixXd arms = plant.MomentArms();
+  const control::ActuatorResponse* slowest = nullptr;
+  for (int i = 0; i < plant.num_bundles(); ++i) {
+    if (arms(j, i) == 0) continue;
+    const double t63 = responses_[i].TimeTo(0.63);
+    if (slowest == nullptr || t63 > rec.actuator_t63)
+      slowest = &responses_[i], rec.actuator_t63 = t63;
+  }
+  if (slowest == nullptr) {
+    return Error{"joint '" + rec.joint + "': no bundle of the task crosses it"};
+  }
+  auto d = control::DesignJointLoop(rec.dynamics, *slowest, dT_, target_);
+  if (!d.ok()) return Error{"joint '" + rec.joint + "': " + d.error()};
+  rec.design = std::move(d).value();
+  return rec;
+}
+
+void JointLoops::Step(double t, const Plant& plant, const std::vector<double>& capacity,
+                      std::vector<double>& force_ref) {
+  const int nj = plant.num_joints(), nb = plant.num_bundles();
+  Eigen::VectorXd r(nj);
+  for (int j = 0; j < nj; ++j) r[j] = task_->joints[j].reference(t);
+  // Gains for this pose: designed once per reference value (a step's target).
+  std::vector<control::LoopGains> gains(nj);
+  for (int j = 0; j < nj; ++j) {
+    auto it = gains_[j].find(r[j]);
+    if (it == gains_[j].end()) {
+      auto rec = Design(plant, j, r);
+      control::LoopGains g;  // no bundle crosses the joint: feedforward only
+      if (rec.ok()) {
+        g = rec->design.gains;
+        designs_.push_back(std::move(rec).value());
+      }
+      it = gains_[j].emplace(r[j], g).first;
+    }
+    gains[j] = it->second;
+  }
+  const Eigen::VectorXd feedforward = plant.StaticTorque(r);
+  control::AllocationProblem p;
+  p.arms = plant.MomentArms();
+  p.torque.resize(nj);
+  Eigen::VectorXd trial(nj);
+  for (int j = 0; j < nj; ++j) {
+    const double e = r[j] - plant.JointAngle(j);
+    trial[j] = integral_[j] + e * dT_;
+    p.torque[j] = feedforward[j] + gains[j].kp * e + gains[j].ki * trial[j] -
+                  gains[j].kd * plant.JointVelocity(j);
+  }
+  p.cap.resize(nb);
+  p.floor.resize(nb);
+  for (int i = 0; i < nb; ++i) {
+    p.cap[i] = std::max(capacity[i], 1e-9);
+    p.floor[i] = task_->co_contraction * p.cap[i];
+  }
+  const Eigen::VectorXd tensions = control::AllocateTensions(p);
+  const Eigen::VectorXd achieved = p.arms * tensions;
+  for (int j = 0; j < nj; ++j) {
+    // Anti-windup: the integral grows only while the bundles can still deliver what it asks.
+    const double e = r[j] - plant.JointAngle(j);
+    const double span = p.arms.row(j).cwiseAbs().dot(p.cap);
+    const double short_by = p.torque[j] - achieved[j];
+    const bool saturated = std::abs(short_by) > 1e-3 * span && short_by * e > 0;
+    if (!saturated) integral_[j] = trial[j];
+  }
+  for (int i = 0; i < nb; ++i) force_ref[i] = tensions[i];
+}
+
+}  // namespace recruit::sim

@@ -1,0 +1,104 @@
+#include "control/loop_design.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace recruit::control {
+namespace {
+
+ActuatorResponse TwoState(double dT, double lambda) {
+  return *PredictActuatorResponse(BroadcastTransitionModel::TwoState(dT), {0, 1}, lambda);
+}
+
+// No gains, a joint far faster than the bundles: the limb follows the feedforward's tension,
+// so the angle (as a fraction of the step) is the bundles' response itself.
+TEST(LoopDesign, WithoutFeedbackAQuasiStaticJointFollowsTheBundlesResponse) {
+  const ActuatorResponse act = TwoState(0.5, 0.3);
+  const JointDynamics joint{1e-6, 0.01, 1.0};  // mechanical time constant b/k = 10 ms
+  LoopTarget target;
+  target.hold = 10;
+  const PredictedStep p = PredictStep(joint, act, 0.5, LoopGains{}, target);
+  ASSERT_EQ(p.angle.size(), 20u);
+  for (size_t k = 1; k < p.angle.size(); ++k) {
+    EXPECT_NEAR(p.angle[k], act.At(k * 0.5), 0.02) << k;
+  }
+}
+
+// PredictStep against a fine fixed-step RK4 integration of the same closed loop.
+TEST(LoopDesign, PredictionMatchesAFineRk4IntegrationOfTheSameLoop) {
+  const ActuatorResponse act = TwoState(1.0, 0.2);
+  const JointDynamics joint{0.003, 0.02, 0.1};
+  const LoopGains g{0.1, 0.02, 0.03};
+  LoopTarget target;
+  target.hold = 30;
+  const PredictedStep p = PredictStep(joint, act, 1.0, g, target);
+  // Reference: q'' = (tau - b q' - k q) / I, tau from the demands through the response.
+  const double h = 1e-4;
+  double q = -1, v = 0, integral = 0;
+  std::vector<double> u{-joint.stiffness};
+  for (int n = 0; n < 30; ++n) {
+    EXPECT_NEAR(q + 1, p.angle[n], 2e-3) << "instant " << n;
+    integral += -q;
+    u.push_back(g.kp * -q + g.ki * integral - g.kd * v);
+    auto tau = [&](double t) {
+      double x = u[0];
+      for (int i = 1; i <= n + 1; ++i) x += (u[i] - u[i - 1]) * act.At(t - (i - 1));
+      return x;
+    };
+    for (int s = 0; s < 10000; ++s) {
+      const double t = n + s * h;
+      auto f = [&](double qq, double vv, double tt) {
+        return (tau(tt) - joint.damping * vv - joint.stiffness * qq) / joint.inertia;
+      };
+      const double k1q = v, k1v = f(q, v, t);
+      const double k2q = v + 0.5 * h * k1v,
+                   k2v = f(q + 0.5 * h * k1q, v + 0.5 * h * k1v, t + h / 2);
+      const double k3q = v + 0.5 * h * k2v,
+                   k3v = f(q + 0.5 * h * k2q, v + 0.5 * h * k2v, t + h / 2);
+      const double k4q = v + h * k3v, k4v = f(q + h * k3q, v + h * k3v, t + h);
+      q += h / 6 * (k1q + 2 * k2q + 2 * k3q + k4q);
+      v += h / 6 * (k1v + 2 * k2v + 2 * k3v + k4v);
+    }
+  }
+}
+
+TEST(LoopDesign, TheDesignMeetsItsTargetInItsOwnPredictionAndBeatsNoFeedback) {
+  const ActuatorResponse act = TwoState(1.0, 0.2);
+  const JointDynamics joint{0.003, 0.02, 0.1};
+  LoopTarget target;
+  target.hold = 20;
+  auto d = DesignJointLoop(joint, act, 1.0, target);
+  ASSERT_TRUE(d.ok()) << d.error();
+  EXPECT_TRUE(d->meets) << d->note;
+  EXPECT_LE(d->nominal.overshoot, target.overshoot);
+  EXPECT_TRUE(d->nominal.settled);
+  EXPECT_LE(d->robust.overshoot, 0.25);
+  const PredictedStep open = PredictStep(joint, act, 1.0, LoopGains{}, target);
+  EXPECT_LT(d->nominal.settling_time, open.settling_time);
+}
+
+TEST(LoopDesign, AnUnstableStaticPoseStillGetsAStabilisingDesign) {
+  // Gravity pushing away from the pose (k < 0): without feedback the limb falls.
+  const ActuatorResponse act = TwoState(0.5, 0.5);
+  const JointDynamics joint{0.003, 0.05, -0.02};
+  LoopTarget target;
+  target.hold = 20;
+  auto d = DesignJointLoop(joint, act, 0.5, target);
+  ASSERT_TRUE(d.ok());
+  EXPECT_TRUE(d->nominal.settled) << d->gains.kp << " " << d->gains.ki << " " << d->gains.kd << " "
+                                  << d->nominal.overshoot << " " << d->nominal.settling_time;
+  EXPECT_FALSE(PredictStep(joint, act, 0.5, LoopGains{}, target).settled);
+}
+
+TEST(LoopDesign, BadInputsAreRefused) {
+  const ActuatorResponse act = TwoState(1.0, 0.2);
+  LoopTarget target;
+  EXPECT_FALSE(DesignJointLoop({0, 0.1, 0.1}, act, 1.0, target).ok());
+  EXPECT_FALSE(DesignJointLoop({0.1, -1, 0.1}, act, 1.0, target).ok());
+  target.hold = 0.5;
+  EXPECT_FALSE(DesignJointLoop({0.1, 0.1, 0.1}, act, 1.0, target).ok());
+}
+
+}  // namespace
+}  // namespace recruit::control
