@@ -55,7 +55,8 @@ int main(int argc, char** argv) {
     void (*add)(CLI::App&, int&);
   } commands[] = {{"filter", cli::AddFilterCommand},     {"identify", cli::AddIdentifyCommand},
                   {"simulate", cli::AddSimulateCommand}, {"sweep", cli::AddSweepCommand},
-                  {"render", cli::AddRenderCommand},     {"plot", cli::AddPlotCommand}};
+                  {"render", cli::AddRenderCommand},     {"plot", cli::AddPlotCommand},
+                  {"attach", cli::AddAttachCommand}};
   const std::string first = argc > 1 ? argv[1] : "";
   bool named = false;
   for (const auto& c : commands) named |= first == c.name;
