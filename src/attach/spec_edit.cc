@@ -219,6 +219,8 @@ void RebaseAssetDirs(mjSpec* spec, const std::string& input_path, const std::str
                 Rebase(Str(spec->compiler.meshdir), in_dir, out_dir).c_str());
   mjs_setString(spec->compiler.texturedir,
                 Rebase(Str(spec->compiler.texturedir), in_dir, out_dir).c_str());
+  // The spec now compiles as the written file will load: from the output's folder.
+  mjs_setString(spec->modelfiledir, (out_dir.string() + "/").c_str());
 }
 
 Result<std::string> SaveXmlString(const mjSpec* spec) {
