@@ -37,7 +37,11 @@ class SmaHost {
   // Steady tension of one unit held on at the reference length (N).
   double SettledUnitForce(int b) const { return Act(b).settled_force; }
   // Tendon length (m) at which a unit's extension is its prestretch.
-  double ref_length(int b) const { return Act(b).ref_length; }
+  double ref_length(int b) const { return Act(b).ref_length / Act(b).gear; }
+  // Transmission ratio of bundle b's actuator (gear): the unit extension is
+  // prestretch + gear (L - ref_length) for tendon length L, and the tendon's tension is gear x
+  // the bundle's (Force).
+  double gear(int b) const { return Act(b).gear; }
 
   // Every unit of every bundle off, cold, at the current tendon lengths; bundle b's stream
   // seeded with Rng::DeriveSeed(seed, b). Keeps qpos, qvel and time; ends with mj_forward.
@@ -50,7 +54,7 @@ class SmaHost {
 
   // Ground truth and telemetry.
   int OnCount(const mjData* d, int b) const { return bundle(b).OnCount(State(d, b)); }
-  double Force(const mjData* d, int b) const;  // tension (N) at the current tendon length
+  double Force(const mjData* d, int b) const;  // bundle tension (N) at the current tendon length
   // OnCount, Force, MeanTemperature, MeanXi, and the peak-relevant MaxTemperature and
   // MaxWireStress (SmaBundle) of bundle b in one pass, each bit for bit the same value: for run
   // loops that read several of them after every step.

@@ -14,6 +14,7 @@
 #include <utility>
 
 #include "common/rng.h"
+#include "plugin/tendon_range.h"
 
 namespace recruit::sma {
 namespace {
@@ -84,9 +85,11 @@ Status CheckActuator(const mjModel* m, int a, const std::string& where) {
     return Error{where + Transmission(m, a) +
                  " is invalid: must act on a tendon (tendon=\"...\"): a bundle pulls a tendon"};
   }
-  if (m->actuator_gear[6 * a] != 1) {
-    return Error{where + "gear=" + Fmt("%g", m->actuator_gear[6 * a]) +
-                 " is invalid: must be 1 (the bundle's tension is the actuator force)"};
+  const double gear = m->actuator_gear[6 * a];
+  if (!(gear > 0 && std::isfinite(gear))) {
+    return Error{where + "gear=" + Fmt("%g", gear) +
+                 " is invalid: must be > 0 (a transmission ratio: the units stretch gear x the "
+                 "tendon's length change and the tendon gets gear x their tension)"};
   }
   if (m->actuator_dyntype[a] != mjDYN_NONE || m->actuator_actnum[a] != 0) {
     return Error{where +
@@ -106,129 +109,6 @@ struct FitGuard {
   FitGuard() { in_fit_check = true; }
   ~FitGuard() { in_fit_check = false; }
 };
-
-// Limited hinge and slide joints whose motion changes tendon t's length (probed at both limits
-// and the middle, every other joint at qpos0).
-std::vector<int> TendonJoints(const mjModel* m, mjData* d, int t) {
-  auto length = [&] {
-    mj_kinematics(m, d);
-    mj_comPos(m, d);
-    mj_tendon(m, d);
-    return d->ten_length[t];
-  };
-  mju_copy(d->qpos, m->qpos0, m->nq);
-  const double l0 = length();
-  std::vector<int> joints;
-  for (int j = 0; j < m->njnt; ++j) {
-    const int type = m->jnt_type[j];
-    if ((type != mjJNT_HINGE && type != mjJNT_SLIDE) || !m->jnt_limited[j]) continue;
-    const int q = m->jnt_qposadr[j];
-    bool moves = false;
-    for (double f : {0.0, 0.5, 1.0}) {
-      d->qpos[q] = m->jnt_range[2 * j] + f * (m->jnt_range[2 * j + 1] - m->jnt_range[2 * j]);
-      moves = moves || std::abs(length() - l0) > 1e-9;
-    }
-    d->qpos[q] = m->qpos0[q];
-    if (moves) joints.push_back(j);
-  }
-  return joints;
-}
-
-// The extremes of a smooth length(x) over x in [0, 1]: 33 points (the ends and the middle among
-// them), then each interior grid extreme refined by golden-section search between its
-// neighbours to 1e-6 of the range. Most tendons are monotone in one joint: 33 kinematics passes
-// where a 257-point grid took 257 and was less exact about an interior extreme.
-template <typename Length>
-std::pair<double, double> LengthRangeOverOneJoint(Length length) {
-  constexpr int kPoints = 33;
-  double v[kPoints];
-  for (int i = 0; i < kPoints; ++i) v[i] = length(i / double(kPoints - 1));
-  double lo = *std::min_element(v, v + kPoints), hi = *std::max_element(v, v + kPoints);
-  const double h = 1.0 / (kPoints - 1), g = 0.5 * (std::sqrt(5.0) - 1);
-  for (int i = 1; i + 1 < kPoints; ++i) {
-    for (double sign : {1.0, -1.0}) {  // +1: a minimum, -1: a maximum
-      // Strict on the left: a plateau is refined once, not at each of its points.
-      if (!(sign * v[i] < sign * v[i - 1] && sign * v[i] <= sign * v[i + 1])) continue;
-      double a = (i - 1) * h, b = (i + 1) * h;
-      double c = b - g * (b - a), e = a + g * (b - a);
-      double fc = sign * length(c), fe = sign * length(e);
-      while (b - a > 1e-6) {
-        if (fc < fe) {
-          b = e, e = c, fe = fc, c = b - g * (b - a), fc = sign * length(c);
-        } else {
-          a = c, c = e, fc = fe, e = a + g * (b - a), fe = sign * length(e);
-        }
-      }
-      if (sign > 0) {
-        lo = std::min({lo, fc, fe});
-      } else {
-        hi = std::max({hi, -fc, -fe});
-      }
-    }
-  }
-  return {lo, hi};
-}
-
-// Tendon t's length range over the joints' ranges. One joint: LengthRangeOverOneJoint. More: a
-// grid with an odd number of points per joint (so the limits and the middle are on it), 65 x 65
-// for two, up to ~4096 in all; beyond 6 joints 4096 seeded random points plus the all-low and
-// all-high corners.
-std::pair<double, double> LengthRange(const mjModel* m, mjData* d, int t,
-                                      const std::vector<int>& joints) {
-  const int n = static_cast<int>(joints.size());
-  double lo = INFINITY, hi = -INFINITY;
-  auto sample = [&](const std::vector<double>& f) {
-    mju_copy(d->qpos, m->qpos0, m->nq);
-    for (int i = 0; i < n; ++i) {
-      const int j = joints[i];
-      d->qpos[m->jnt_qposadr[j]] =
-          m->jnt_range[2 * j] + f[i] * (m->jnt_range[2 * j + 1] - m->jnt_range[2 * j]);
-    }
-    mj_kinematics(m, d);
-    mj_comPos(m, d);
-    mj_tendon(m, d);
-    lo = std::min(lo, d->ten_length[t]);
-    hi = std::max(hi, d->ten_length[t]);
-  };
-  std::vector<double> f(n, 0.0);
-  if (n == 1) {
-    std::tie(lo, hi) = LengthRangeOverOneJoint([&](double x) {
-      f[0] = x;
-      sample(f);
-      return d->ten_length[t];
-    });
-  } else if (n <= 6) {
-    const int points = std::clamp(static_cast<int>(std::pow(4096.0, 1.0 / n)) | 1, 3, 257);
-    std::vector<int> idx(n, 0);
-    while (true) {
-      for (int i = 0; i < n; ++i) f[i] = idx[i] / double(points - 1);
-      sample(f);
-      int i = 0;
-      while (i < n && ++idx[i] == points) idx[i++] = 0;
-      if (i == n) break;
-    }
-  } else {
-    Rng rng(1);
-    for (int s = 0; s < 4096; ++s) {
-      for (int i = 0; i < n; ++i) f[i] = s < 2 ? double(s) : rng.Uniform();
-      sample(f);
-    }
-  }
-  return {lo, hi};
-}
-
-std::string JointRanges(const mjModel* m, const std::vector<int>& joints) {
-  std::string s;
-  for (int j : joints) {
-    const bool hinge = m->jnt_type[j] == mjJNT_HINGE;
-    const double k = hinge ? 180 / mjPI : 1000;
-    const char* name = mj_id2name(m, mjOBJ_JOINT, j);
-    s += (s.empty() ? "" : ", ") + std::string(name != nullptr ? name : "#" + std::to_string(j)) +
-         " " + Fmt("%.4g", k * m->jnt_range[2 * j]) + ".." +
-         Fmt("%.4g", k * m->jnt_range[2 * j + 1]) + (hinge ? " deg" : " mm");
-  }
-  return s;
-}
 
 }  // namespace
 
@@ -278,23 +158,31 @@ std::vector<TendonFit> SmaInstance::Fit(const mjModel* m) const {
     TendonFit f;
     const UnitModel& unit = a.model.unit();
     const int n = a.model.num_units();
-    const std::vector<int> joints = TendonJoints(m, d, a.tendon);
-    f.joints = static_cast<int>(joints.size());
+    const TendonRange range = SampleTendonRange(m, d, a.tendon);
+    f.joints = static_cast<int>(range.joints.size());
+    f.gear = a.gear;
     f.stroke = unit.recoverable_stretch();
     f.on_force = n * a.settled_force;
     f.rated_stress = a.model.limits().max_wire_stress;
     if (f.joints > 0) {
-      std::tie(f.length_min, f.length_max) = LengthRange(m, d, a.tendon, joints);
-      f.joint_ranges = JointRanges(m, joints);
+      f.length_min = range.length_min;
+      f.length_max = range.length_max;
+      f.joint_ranges = JointRangeText(m, range.joints, range.usable_lo, range.usable_hi);
+      for (const TendonJump& jump : range.jumps) {
+        f.jumps += (f.jumps.empty() ? "" : "; ") + JumpText(m, jump);
+      }
+      f.num_jumps = static_cast<int>(range.jumps.size());
+      // The units work in actuator length (gear x tendon length).
       const double prestretch = a.model.config().unit.prestretch;
-      f.stretch_min = prestretch + (f.length_min - a.ref_length);
-      f.stretch_max = prestretch + (f.length_max - a.ref_length);
+      f.stretch_min = prestretch + (a.gear * f.length_min - a.ref_length);
+      f.stretch_max = prestretch + (a.gear * f.length_max - a.ref_length);
       const double off = unit.Tension(1.0, f.stretch_max);
       f.off_force = n * off;
       f.off_stress = unit.WireStress(off);
       const double segment = f.stroke / a.model.config().unit.series;
-      f.series_needed = std::max(1, static_cast<int>(std::ceil(f.excursion() / segment - 1e-9)));
-      f.prestretch_needed = f.series_needed * segment - (f.length_max - a.ref_length);
+      f.series_needed =
+          std::max(1, static_cast<int>(std::ceil(a.gear * f.excursion() / segment - 1e-9)));
+      f.prestretch_needed = f.series_needed * segment - (a.gear * f.length_max - a.ref_length);
     }
     fits.push_back(f);
   }
@@ -303,14 +191,20 @@ std::vector<TendonFit> SmaInstance::Fit(const mjModel* m) const {
 }
 
 std::string SmaInstance::FitWarning(const mjModel* m, int k, const TendonFit& f) const {
-  if (f.fits()) return "";
+  if (f.fits() && f.num_jumps == 0) return "";
   const SmaActuator& a = actuators_[k];
   auto mm = [](double v) { return Fmt("%.1f", 1000 * v); };
   // Short: mj_loadXML keeps about 500 characters of warnings for all bundles together.
-  std::string w = "recruit.sma actuator '" + ActuatorName(m, a.actuator) + "': tendon excursion " +
-                  mm(f.excursion()) + " mm over " + f.joint_ranges.substr(0, 40) +
-                  ", unit stroke " + mm(f.stroke) + " mm, extension " + mm(f.stretch_min) + ".." +
-                  mm(f.stretch_max) + " mm:";
+  std::string w = "recruit.sma actuator '" + ActuatorName(m, a.actuator) + "': ";
+  if (f.num_jumps > 0) {
+    w += "tendon path jumps at " + f.jumps.substr(0, 60) + ": usable " +
+         f.joint_ranges.substr(0, 40) + ";";
+    if (f.fits()) return w;
+    w += " ";
+  }
+  w += "tendon excursion " + mm(f.excursion()) + " mm over " + f.joint_ranges.substr(0, 40) +
+       (f.gear != 1 ? " (gear " + Fmt("%g", f.gear) + ")" : "") + ", unit stroke " + mm(f.stroke) +
+       " mm, extension " + mm(f.stretch_min) + ".." + mm(f.stretch_max) + " mm:";
   if (f.blocks()) {
     w += " off units pull " + Fmt("%.3g", f.off_force) + " N (" + Fmt("%.0f", f.off_stress / 1e6) +
          " MPa): will block the joint;";
@@ -355,7 +249,11 @@ Result<std::unique_ptr<SmaInstance>> SmaInstance::Build(const mjModel* m, int in
     if (!bundle.ok()) return Error{where + bundle.error()};
     SmaActuator act{a, m->actuator_trnid[2 * a], BundleIndexOf(m, a), offset, 0,
                     0, std::move(bundle).value()};
-    act.ref_length = std::isnan(cfg->ref_length) ? m->actuator_length0[a] : cfg->ref_length;
+    // In actuator length (gear x tendon length), as the units see it; ref_length is a tendon
+    // length.
+    act.gear = m->actuator_gear[6 * a];
+    act.ref_length =
+        std::isnan(cfg->ref_length) ? m->actuator_length0[a] : act.gear * cfg->ref_length;
     act.settled_force = act.model.SettledOnTension(cfg->unit.prestretch);
     offset += kSlots + act.model.state_size();
     p->actuators_.push_back(std::move(act));

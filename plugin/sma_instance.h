@@ -31,13 +31,15 @@ inline constexpr const char* kBroadcastPeriodKey = "broadcast_period";
 inline constexpr int kSensorValues = 4;  // on count, tension (N), mean T (C), mean xi
 
 struct SmaActuator {
-  int actuator = -1;         // actuator id
-  int tendon = -1;           // tendon id
-  int bundle = -1;           // index among all recruit.sma actuators of the model (seed stream)
-  int offset = 0;            // start of this actuator's slots in the instance's plugin_state
-  double ref_length = 0;     // tendon length (m) at which a unit's extension is its prestretch
+  int actuator = -1;  // actuator id
+  int tendon = -1;    // tendon id
+  int bundle = -1;    // index among all recruit.sma actuators of the model (seed stream)
+  int offset = 0;     // start of this actuator's slots in the instance's plugin_state
+  // Actuator length (m, gear x tendon length) at which a unit's extension is its prestretch.
+  double ref_length = 0;
   double settled_force = 0;  // steady tension of one unit held on at the prestretch (N)
   SmaBundle model;
+  double gear = 1;  // transmission: units stretch gear x the tendon's change, pull it gear x
 };
 
 // How a bundle fits its tendon over the joint limits (issue 9 item 8): the tendon's length
@@ -45,8 +47,11 @@ struct SmaActuator {
 // (other joints at qpos0), against the units' stroke and forces.
 struct TendonFit {
   int joints = 0;            // limited hinge/slide joints that move the tendon (0: no check)
-  std::string joint_ranges;  // e.g. "elbow 0..120 deg", for messages
-  double length_min = 0;     // tendon length range (m)
+  std::string joint_ranges;  // usable ranges, e.g. "elbow 0..113.9 deg", for messages
+  int num_jumps = 0;         // tendon-path jumps found (plugin/tendon_range.h)
+  std::string jumps;         // e.g. "elbow at 114 deg (376.0 -> 211.0 mm)"
+  double gear = 1;           // the actuator's transmission ratio
+  double length_min = 0;     // tendon length range over the usable ranges (m)
   double length_max = 0;
   double stretch_min = 0;  // unit extension at length_min / length_max (m)
   double stretch_max = 0;
@@ -98,7 +103,7 @@ class SmaInstance {
   void Advance(const mjModel* m, mjData* d) const;  // ctrl broadcasts, then one timestep
   void Sensor(const mjModel* m, mjData* d) const;   // kSensorValues per actuator
 
-  // Unit extension (m) of actuator k at tendon length `length`.
+  // Unit extension (m) of actuator k at actuator length `length` (gear x tendon length).
   double Stretch(int k, double length) const {
     const SmaActuator& a = actuators_[k];
     return a.model.config().unit.prestretch + (length - a.ref_length);
@@ -113,7 +118,7 @@ class SmaInstance {
     return d
         ->plugin_state[m->plugin_stateadr[instance_] + actuators_[k].offset + kNextBroadcastSlot];
   }
-  // Current length of actuator k's tendon (m).
+  // Current actuator length of `actuator` (m, gear x its tendon's length).
   static double Length(const mjModel* m, const mjData* d, int actuator) {
     return d->actuator_length[m->actuator_outadr[actuator]];
   }

@@ -18,7 +18,8 @@ esac
 
 MUJOCO_VERSION=4.0.0  # keep in step with RECRUIT_MUJOCO_VERSION in CMakeLists.txt
 PY_PACKAGES=("mujoco==${MUJOCO_VERSION}" "numpy" "pytest" "filterpy" "pybind11" "scikit-build-core"
-  "matplotlib")
+  "matplotlib"
+  "myo-sim==0.2.3")  # test data: MyoSuite elbow and finger models (tests/attach); import myo_sim
 
 DEMO_PACKAGES=(
   build-essential cmake ninja-build pkg-config ccache

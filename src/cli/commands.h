@@ -14,5 +14,6 @@ void AddSweepCommand(CLI::App& app, int& exit_code);     // sweep_command.cc
 void AddRenderCommand(CLI::App& app, int& exit_code);    // render_command.cc
 void AddPlotCommand(CLI::App& app, int& exit_code);      // plot_command.cc
 void AddTuneLoopCommand(CLI::App& app, int& exit_code);  // tune_loop_command.cc
+void AddAttachCommand(CLI::App& app, int& exit_code);    // attach_command.cc
 
 }  // namespace recruit::cli

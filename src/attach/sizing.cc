@@ -1,0 +1,151 @@
+#include "attach/sizing.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace recruit::attach {
+namespace {
+
+std::string Num(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
+}
+
+// The unit for diameter d with the geometry chosen, its current and coupling spring set so that
+// a held-on wire settles at limits.steady_temperature and pulls design_stress x area when the
+// segment is stretched by its whole stroke (the tendon's longest, off units just taut).
+Result<sma::UnitModel> DesignUnit(double d, double length, int series, const SizingLimits& limits) {
+  sma::UnitParams p;
+  p.wire_diameter = d;
+  p.wire_length = length;
+  p.series = series;
+  p.parallel = 1;
+  const double area = 0.25 * M_PI * d * d;
+  const double k_hot = limits.design_stress * area / (p.eps_L * length);  // wire + spring
+  const double k_wire = p.E_A * area / length;
+  p.series_spring = 1.0 / (1.0 / k_hot - 1.0 / k_wire);
+  p.prestretch = series * p.eps_L * length;
+  // Current: bisection on the steady on-temperature (monotone in the current).
+  double lo = 1e-4, hi = 20;
+  for (int i = 0; i < 60; ++i) {
+    p.current = 0.5 * (lo + hi);
+    auto u = sma::UnitModel::Create(p);
+    if (!u.ok()) return Error{u.error()};
+    (u->on_temperature() > limits.steady_temperature ? hi : lo) = p.current;
+  }
+  // Never above Dynalloy's 1 s contraction current; a wire that then settles too cool to
+  // transform fully under the design stress is refused (SizeBundle takes a thicker one).
+  p.current = std::min(lo, sma::UnitLimits::ForWire(d).max_current);
+  auto unit = sma::UnitModel::Create(p);
+  if (unit.ok() && unit->on_temperature() < p.Af + limits.design_stress / p.C_A + 10) {
+    return Error{"too cool at the datasheet current"};
+  }
+  return unit;
+}
+
+}  // namespace
+
+const std::vector<double>& StockDiameters() {
+  static const std::vector<double> d = {0.025e-3, 0.038e-3, 0.05e-3, 0.076e-3, 0.1e-3,  0.127e-3,
+                                        0.15e-3,  0.2e-3,   0.25e-3, 0.3e-3,   0.38e-3, 0.51e-3};
+  return d;
+}
+
+std::vector<std::pair<std::string, std::string>> BundleDesign::ConfigPairs() const {
+  return {{"units", std::to_string(units)},
+          {"wire_diameter", Num(unit.wire_diameter)},
+          {"wire_length", Num(unit.wire_length)},
+          {"series", std::to_string(unit.series)},
+          {"parallel", std::to_string(unit.parallel)},
+          {"current", Num(unit.current)},
+          {"series_spring", Num(unit.series_spring)},
+          {"prestretch", Num(unit.prestretch)}};
+}
+
+Result<BundleDesign> SizeBundle(const SizingInput& in, const SizingLimits& limits) {
+  const std::string where = "sizing bundle '" + in.name + "': ";
+  if (!(std::isfinite(in.peak_force) && in.peak_force > 0)) {
+    return Error{where + "peak force " + Num(in.peak_force) + " N is invalid: must be > 0"};
+  }
+  if (!(std::isfinite(in.excursion) && in.excursion >= 0 && std::isfinite(in.length_min) &&
+        std::isfinite(in.length_max) && std::isfinite(in.ref_length))) {
+    return Error{where + "tendon excursion " + Num(in.excursion) + " m is invalid"};
+  }
+  BundleDesign out;
+  const double eps_L = sma::UnitParams{}.eps_L;
+  // Wire per unit for the stroke, then a transmission when it exceeds the credible length.
+  const double max_unit = limits.max_series * limits.max_segment_length;
+  double needed = in.excursion / (limits.stroke_use * eps_L);
+  if (needed > max_unit) {
+    out.gear = std::floor(100 * max_unit / needed) / 100;
+    if (out.gear <= 0) out.gear = 0.01;
+    char buf[160];
+    std::snprintf(buf, sizeof buf,
+                  "lever/pulley ratio %.2f (actuator gear %.2f): the units move %.2f x the tendon "
+                  "and pull it with %.2f x their tension",
+                  out.gear, out.gear, out.gear, out.gear);
+    out.transmission = buf;
+    out.notes.push_back("stroke: " + Num(1000 * in.excursion) + " mm of tendon would need " +
+                        Num(needed) + " m of wire per unit (> " + Num(max_unit) +
+                        " m): transmission " + Num(out.gear));
+  }
+  needed *= out.gear;
+  int series = 1;
+  double length = 0.1;
+  if (in.excursion > 0) {
+    series = std::max(1, static_cast<int>(std::ceil(needed / limits.max_segment_length - 1e-9)));
+    length = std::max(limits.min_segment_length, std::ceil(needed / series / 0.005 - 1e-9) * 0.005);
+  } else {
+    out.notes.push_back("the tendon does not move over the joint ranges: default 0.1 m wire");
+  }
+  const double l_mid = 0.5 * (in.length_min + in.length_max);
+  // Diameter: the thinnest stock wire whose bundle needs at most 2 wires per segment within
+  // max_units units (fast cooling, and enough units for the controller's resolution).
+  const std::vector<double>& stock = StockDiameters();
+  for (std::size_t i = 0; i < stock.size(); ++i) {
+    auto unit = DesignUnit(stock[i], length, series, limits);
+    if (!unit.ok()) {
+      if (i + 1 < stock.size()) continue;
+      return Error{where + unit.error()};
+    }
+    const double s_mid = unit->params().prestretch - out.gear * (in.length_max - l_mid);
+    const double per_wire = out.gear * unit->Tension(0.0, s_mid);
+    const int wires = static_cast<int>(std::ceil(in.peak_force / per_wire - 1e-9));
+    const int parallel = (wires + limits.max_units - 1) / limits.max_units;
+    if (parallel > 2 && i + 1 < stock.size()) continue;
+    sma::UnitParams p = unit->params();
+    p.parallel = parallel;
+    out.units = (wires + parallel - 1) / parallel;
+    p.prestretch = series * eps_L * length - out.gear * (in.length_max - in.ref_length);
+    out.unit = p;
+    break;
+  }
+  auto u = sma::UnitModel::Create(out.unit);
+  if (!u.ok()) return Error{where + u.error()};
+  const sma::UnitLimits datasheet = sma::UnitLimits::ForWire(out.unit.wire_diameter);
+  auto stretch = [&](double l) { return out.unit.prestretch + out.gear * (l - in.ref_length); };
+  const double n = out.units;
+  out.force_mid = out.gear * n * u->Tension(0.0, stretch(l_mid));
+  out.force_short = out.gear * n * u->Tension(0.0, stretch(in.length_min));
+  const double long_tension = u->Tension(0.0, stretch(in.length_max));
+  out.force_long = out.gear * n * long_tension;
+  out.peak_stress = u->WireStress(long_tension);
+  out.steady_temperature = u->on_temperature();
+  out.max_current = datasheet.max_current;
+  if (out.unit.current > datasheet.max_current) {
+    out.notes.push_back("current " + Num(out.unit.current) + " A above the datasheet's " +
+                        Num(datasheet.max_current) + " A");
+  }
+  out.stroke = u->recoverable_stretch();
+  const double wires = n * out.unit.parallel * out.unit.series;
+  out.wire_total = wires * out.unit.wire_length;
+  out.mass = out.unit.density * 0.25 * M_PI * std::pow(out.unit.wire_diameter, 2) * out.wire_total;
+  out.power = wires * u->HeatingPower(true, 0.0);
+  out.time_constant = u->time_constant();
+  out.cooling_time = datasheet.cooling_time;
+  return out;
+}
+
+}  // namespace recruit::attach

@@ -1,0 +1,338 @@
+// recruit attach (src/attach) and the jump-aware tendon range (plugin/tendon_range): the written
+// model loads with MuJoCo's own loader and keeps every other element, the sizing against closed
+// forms, path jumps against a dense sweep, the gear transmission against its closed form.
+#include "attach/attach.h"
+
+#include <gtest/gtest.h>
+#include <mujoco/mujoco.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <string>
+
+#include "attach/sizing.h"
+#include "common/mujoco_load.h"
+#include "plugin/sma_host.h"
+#include "plugin/sma_plugin.h"
+#include "plugin/tendon_range.h"
+
+namespace recruit::attach {
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kSrc = RECRUIT_SOURCE_DIR;
+
+std::string TempDir(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("recruit_attach_test_" + name);
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir.string();
+}
+
+ModelPtr Load(const std::string& path) {
+  sma::RegisterSmaPlugin();
+  auto m = LoadModel(path);
+  EXPECT_TRUE(m.ok()) << m.error();
+  return m.ok() ? std::move(m).value() : nullptr;
+}
+
+// The original compiled without lengthrange computation (what attach probes).
+ModelPtr LoadPlain(const std::string& path) {
+  char error[1000] = "";
+  mjSpec* s = mj_parseXML(path.c_str(), nullptr, error, sizeof error);
+  EXPECT_NE(s, nullptr) << error;
+  s->compiler.LRopt.mode = mjLRMODE_NONE;
+  ModelPtr m(mj_compile(s, nullptr));
+  mj_deleteSpec(s);
+  return m;
+}
+
+TEST(Attach, TwoJointArmAllMusclesLoadsAndKeepsEverythingElse) {
+  const std::string in = kSrc + "/models/arm2j_muscle.xml";
+  const std::string dir = TempDir("arm2j");
+  AttachOptions o;
+  o.model = in;
+  o.muscles = {"all"};
+  o.output = dir + "/arm2j_sma.xml";
+  o.task = dir + "/task.json";
+  auto r = Attach(o);
+  ASSERT_TRUE(r.ok()) << r.error();
+  ModelPtr before = Load(in);
+  ModelPtr after = Load(o.output);  // MuJoCo's own loader, plugin registered
+  ASSERT_TRUE(before && after);
+  EXPECT_EQ(after->nbody, before->nbody);
+  EXPECT_EQ(after->njnt, before->njnt);
+  EXPECT_EQ(after->ngeom, before->ngeom);
+  EXPECT_EQ(after->nsite, before->nsite);
+  EXPECT_EQ(after->ntendon, before->ntendon);
+  EXPECT_EQ(after->nu, before->nu);
+  EXPECT_EQ(after->nsensor, before->nsensor + 6);
+  for (int b = 0; b < before->nbody; ++b) EXPECT_EQ(after->body_mass[b], before->body_mass[b]);
+  for (int j = 0; j < before->njnt; ++j) {
+    // mj_saveXML writes 6 significant digits (the compiled radians of a degree model).
+    EXPECT_NEAR(after->jnt_range[2 * j], before->jnt_range[2 * j], 1e-5);
+    EXPECT_EQ(after->dof_damping[j], before->dof_damping[j]);
+  }
+  EXPECT_EQ(after->opt.timestep, before->opt.timestep);
+  ASSERT_EQ(r->bundles.size(), 6u);
+  for (const BundleReport& b : r->bundles) {
+    const int a = mj_name2id(after.get(), mjOBJ_ACTUATOR, b.name.c_str());
+    const int a0 = mj_name2id(before.get(), mjOBJ_ACTUATOR, b.name.c_str());
+    ASSERT_GE(a, 0);
+    EXPECT_EQ(after->actuator_trnid[2 * a], before->actuator_trnid[2 * a0]) << b.name;
+    EXPECT_GE(after->actuator_plugin[a], 0);
+    EXPECT_EQ(after->actuator_dyntype[a], mjDYN_NONE);  // not the inherited muscle default
+    EXPECT_EQ(after->actuator_actnum[a], 0);
+    EXPECT_EQ(after->actuator_gear[6 * a], b.design.gear);
+    EXPECT_GE(mj_name2id(after.get(), mjOBJ_SENSOR, b.sensor.c_str()), 0);
+  }
+  // The host sees the bundles with the designed sizes.
+  auto host = sma::SmaHost::Create(after.get());
+  ASSERT_TRUE(host.ok()) << host.error();
+  EXPECT_EQ((*host)->num_bundles(), 6);
+  EXPECT_TRUE(fs::exists(o.task));
+}
+
+TEST(Attach, OtherActuatorsKeepTheirParameters) {
+  const std::string in = kSrc + "/models/arm2j_muscle.xml";
+  const std::string dir = TempDir("arm2j_ef");
+  AttachOptions o;
+  o.model = in;
+  o.muscles = {"EF", "EE"};
+  o.output = dir + "/out.xml";
+  auto r = Attach(o);
+  ASSERT_TRUE(r.ok()) << r.error();
+  ModelPtr before = Load(in), after = Load(o.output);
+  ASSERT_TRUE(before && after);
+  for (const char* name : {"SF", "SE", "BF", "BE"}) {
+    const int a = mj_name2id(after.get(), mjOBJ_ACTUATOR, name);
+    const int a0 = mj_name2id(before.get(), mjOBJ_ACTUATOR, name);
+    EXPECT_EQ(after->actuator_dyntype[a], before->actuator_dyntype[a0]);
+    EXPECT_EQ(after->actuator_gaintype[a], before->actuator_gaintype[a0]);
+    for (int k = 0; k < mjNGAIN; ++k) {
+      EXPECT_EQ(after->actuator_gainprm[mjNGAIN * a + k],
+                before->actuator_gainprm[mjNGAIN * a0 + k]);
+    }
+    EXPECT_NEAR(after->actuator_lengthrange[2 * a], before->actuator_lengthrange[2 * a0], 1e-5);
+    EXPECT_NEAR(after->actuator_lengthrange[2 * a + 1], before->actuator_lengthrange[2 * a0 + 1],
+                1e-5);
+  }
+}
+
+TEST(Attach, BadInputIsRefusedAndNothingIsWritten) {
+  const std::string in = kSrc + "/models/arm2j_muscle.xml";
+  const std::string dir = TempDir("bad");
+  AttachOptions o;
+  o.model = in;
+  o.output = dir + "/out.xml";
+  o.muscles = {"biceps"};
+  auto r = Attach(o);
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.error().find("'biceps' does not exist"), std::string::npos) << r.error();
+  EXPECT_NE(r.error().find("SF, SE"), std::string::npos) << r.error();
+  o.model = kSrc + "/tests/attach/data/jump_arm.xml";
+  o.muscles = {"elbow_motor"};
+  r = Attach(o);
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.error().find("does not act on a tendon"), std::string::npos) << r.error();
+  o.muscles = {"ext"};
+  o.output = o.model;
+  r = Attach(o);
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.error().find("refusing to overwrite"), std::string::npos) << r.error();
+  o.model = dir + "/missing.xml";
+  o.output = dir + "/out.xml";
+  r = Attach(o);
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.error().find("cannot open"), std::string::npos);
+  EXPECT_TRUE(fs::is_empty(dir));
+}
+
+TEST(Attach, OtherMusclesFailingLengthrangeAreNamedAndFixedFromJoints) {
+  const std::string in = kSrc + "/tests/attach/data/jump_arm.xml";
+  const std::string dir = TempDir("lr");
+  AttachOptions o;
+  o.model = in;
+  o.muscles = {"flx"};
+  o.output = dir + "/out.xml";
+  auto r = Attach(o);
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.error().find("muscle(s) ext"), std::string::npos) << r.error();
+  EXPECT_NE(r.error().find("--lengthrange-from-joints"), std::string::npos);
+  EXPECT_TRUE(fs::is_empty(dir));
+  o.lengthrange_from_joints = true;
+  r = Attach(o);
+  ASSERT_TRUE(r.ok()) << r.error();
+  ASSERT_EQ(r->lengthranges.size(), 1u);
+  EXPECT_EQ(r->lengthranges[0].actuator, "ext");
+  ModelPtr m = Load(o.output);
+  ASSERT_TRUE(m);
+  const int a = mj_name2id(m.get(), mjOBJ_ACTUATOR, "ext");
+  // 6 significant digits in the written MJCF.
+  EXPECT_NEAR(m->actuator_lengthrange[2 * a], r->lengthranges[0].lo, 1e-6);
+  EXPECT_NEAR(m->actuator_lengthrange[2 * a + 1], r->lengthranges[0].hi, 1e-6);
+}
+
+// Jumps against a dense independent sweep of the same joint.
+TEST(TendonRange, FindsThePathJumpAndSizesOnTheUsableSide) {
+  ModelPtr m = LoadPlain(kSrc + "/tests/attach/data/jump_arm.xml");
+  ASSERT_TRUE(m);
+  DataPtr d(mj_makeData(m.get()));
+  const int t = mj_name2id(m.get(), mjOBJ_TENDON, "ext");
+  const sma::TendonRange r = sma::SampleTendonRange(m.get(), d.get(), t);
+  ASSERT_EQ(r.jumps.size(), 1u);
+  const double at = r.jumps[0].at;
+  // Dense sweep: the largest step between neighbours is where the jump is.
+  const int n = 20001;
+  double lo = INFINITY, hi = -INFINITY, biggest = 0, where = 0, prev = 0;
+  for (int i = 0; i < n; ++i) {
+    const double q = m->jnt_range[1] * i / (n - 1);
+    d->qpos[0] = q;
+    mj_kinematics(m.get(), d.get());
+    mj_comPos(m.get(), d.get());
+    mj_tendon(m.get(), d.get());
+    const double l = d->ten_length[t];
+    if (i > 0 && std::abs(l - prev) > biggest) biggest = std::abs(l - prev), where = q;
+    if (q < at) lo = std::min(lo, l), hi = std::max(hi, l);
+    prev = l;
+  }
+  EXPECT_NEAR(at, where, m->jnt_range[1] / (n - 1));
+  EXPECT_GT(std::abs(r.jumps[0].after - r.jumps[0].before), 0.9 * biggest);
+  EXPECT_NEAR(r.usable_hi[0], at, 1e-6);
+  EXPECT_EQ(r.usable_lo[0], 0.0);
+  EXPECT_NEAR(r.length_min, lo, 1e-6);
+  EXPECT_NEAR(r.length_max, hi, 1e-6);
+  // The smooth flexor has none.
+  const sma::TendonRange f =
+      sma::SampleTendonRange(m.get(), d.get(), mj_name2id(m.get(), mjOBJ_TENDON, "flx"));
+  EXPECT_TRUE(f.jumps.empty());
+}
+
+// Sizing: closed forms of the straight wire in series with its coupling spring.
+TEST(Sizing, MatchesForceWithinLimitsAndCoversTheStroke) {
+  for (double force : {5.0, 40.0, 600.0}) {
+    for (double excursion : {0.01, 0.03, 0.08}) {
+      SizingInput in{"b", force, excursion, 0.2, 0.2 + excursion, 0.2 + 0.4 * excursion};
+      auto d = SizeBundle(in);
+      ASSERT_TRUE(d.ok()) << d.error();
+      const sma::UnitParams& u = d->unit;
+      // Force at full recruitment mid-range: at least the request, within 5 %.
+      EXPECT_GE(d->force_mid, force);
+      EXPECT_LE(d->force_mid, 1.05 * force) << force << " " << excursion;
+      // Closed form of a hot segment at the tendon's longest: stretched by eps_L L.
+      const double area = 0.25 * M_PI * u.wire_diameter * u.wire_diameter;
+      const double k = 1 / (1 / u.series_spring + u.wire_length / (u.E_A * area));
+      const double wire_force = k * u.eps_L * u.wire_length;
+      EXPECT_NEAR(d->peak_stress, wire_force / area, 1e-6 * d->peak_stress);
+      EXPECT_LE(d->peak_stress, 172e6);
+      EXPECT_NEAR(d->force_long, d->gear * d->units * u.parallel * wire_force,
+                  1e-9 * d->force_long);
+      EXPECT_LE(d->steady_temperature, 120);
+      EXPECT_LE(u.current, d->max_current);
+      // The stroke covers the excursion through the transmission, with the credible length.
+      EXPECT_GE(d->stroke + 1e-12, d->gear * excursion / SizingLimits{}.stroke_use);
+      EXPECT_LE(u.wire_length * u.series, 1.0 + 1e-9);
+      EXPECT_NEAR(d->wire_total, d->units * u.parallel * u.series * u.wire_length, 1e-9);
+    }
+  }
+}
+
+// gear g: extension = prestretch + g (L - L_ref); the tendon gets g x the bundle's tension.
+TEST(Gear, IsATransmissionWithTheClosedForm) {
+  const char* xml = R"(<mujoco>
+  <extension><plugin plugin="recruit.sma"><instance name="u">
+    <config key="units" value="10"/></instance></plugin></extension>
+  <worldbody><site name="a" pos="0 0 0"/>
+    <body pos="0.3 0 0"><joint name="s" type="slide" axis="1 0 0" range="-0.05 0.05"/>
+      <geom size="0.01" mass="1"/><site name="b"/></body></worldbody>
+  <tendon><spatial name="t"><site site="a"/><site site="b"/></spatial></tendon>
+  <actuator><plugin name="p" instance="u" tendon="t" gear="0.5" ctrlrange="-1 1"/></actuator>
+</mujoco>)";
+  sma::RegisterSmaPlugin();
+  auto m = LoadModelFromString(xml);
+  ASSERT_TRUE(m.ok()) << m.error();
+  DataPtr d(mj_makeData(m->get()));
+  auto host = sma::SmaHost::Create(m->get());
+  ASSERT_TRUE(host.ok()) << host.error();
+  const sma::SmaHost& h = **host;
+  EXPECT_EQ(h.gear(0), 0.5);
+  EXPECT_NEAR(h.ref_length(0), 0.3, 1e-12);  // a tendon length
+  h.Reset(d.get(), 1);
+  ASSERT_TRUE(h.Broadcast(d.get(), 0, 1, 0).ok());
+  for (int i = 0; i < 1000; ++i) mj_step(m->get(), d.get());
+  d->qpos[0] = 0.02;
+  d->qvel[0] = 0;
+  mj_forward(m->get(), d.get());
+  const double prestretch = h.bundle(0).config().unit.prestretch;
+  EXPECT_NEAR(h.Stretch(d.get(), 0), prestretch + 0.5 * (d->ten_length[0] - 0.3), 1e-12);
+  const double tension = h.Force(d.get(), 0);
+  EXPECT_GT(tension, 0);
+  EXPECT_NEAR(d->actuator_force[0], -tension, 1e-12);
+  // Joint force = gear x actuator force x tendon moment (1 on this slide).
+  EXPECT_NEAR(d->qfrc_actuator[0], -0.5 * tension, 1e-9);
+}
+
+TEST(Gear, NonPositiveGearIsRefused) {
+  const char* xml = R"(<mujoco>
+  <extension><plugin plugin="recruit.sma"><instance name="u"/></plugin></extension>
+  <worldbody><site name="a"/><body pos="0.3 0 0"><joint type="slide" axis="1 0 0"
+    range="-0.05 0.05"/><geom size="0.01"/><site name="b"/></body></worldbody>
+  <tendon><spatial name="t"><site site="a"/><site site="b"/></spatial></tendon>
+  <actuator><plugin name="p" instance="u" tendon="t" gear="-2"/></actuator>
+</mujoco>)";
+  sma::RegisterSmaPlugin();
+  auto m = LoadModelFromString(xml);
+  ASSERT_FALSE(m.ok());
+  EXPECT_NE(m.error().find("gear=-2 is invalid: must be > 0"), std::string::npos) << m.error();
+}
+
+// MyoSuite's models through the installed myo-sim package (a test dependency).
+std::string MyoSimDir() {
+  FILE* p = popen((kSrc + "/.venv/bin/python -c \"import myo_sim, os; "
+                          "print(os.path.dirname(myo_sim.__file__))\" 2>/dev/null")
+                      .c_str(),
+                  "r");
+  if (p == nullptr) return "";
+  char buf[512] = "";
+  const bool got = fgets(buf, sizeof buf, p) != nullptr;
+  pclose(p);
+  std::string s = got ? buf : "";
+  while (!s.empty() && (s.back() == '\n' || s.back() == '\r')) s.pop_back();
+  return s;
+}
+
+TEST(Attach, MyoSuiteElbowAndFingerLoadFromTheirNewFolder) {
+  const std::string myo = MyoSimDir();
+  if (myo.empty()) GTEST_SKIP() << "myo_sim not installed (pip install myo-sim==0.2.3)";
+  for (const char* rel : {"/models/legacy/elbow/myoelbow_1dof6muscles.xml",
+                          "/models/legacy/finger/myofinger_v0.xml"}) {
+    const std::string dir = TempDir(fs::path(rel).stem().string());
+    AttachOptions o;
+    o.model = myo + rel;
+    o.muscles = {"all"};
+    o.output = dir + "/sub/out.xml";
+    fs::create_directories(dir + "/sub");
+    auto r = Attach(o);
+    ASSERT_TRUE(r.ok()) << r.error();
+    ModelPtr before = Load(o.model), after = Load(o.output);
+    ASSERT_TRUE(before && after);
+    EXPECT_EQ(after->nmesh, before->nmesh);
+    EXPECT_EQ(after->nbody, before->nbody);
+    EXPECT_EQ(after->nu, before->nu);
+    for (const BundleReport& b : r->bundles) {
+      EXPECT_GE(b.design.force_mid, b.peak_force) << rel << " " << b.name;
+      EXPECT_LE(b.design.peak_stress, 172e6);
+      const int a = mj_name2id(after.get(), mjOBJ_ACTUATOR, b.name.c_str());
+      EXPECT_EQ(after->actuator_trnid[2 * a], b.tendon_id);
+    }
+    if (std::string(rel).find("elbow") != std::string::npos) {
+      EXPECT_EQ(r->bundles.size(), 6u);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace recruit::attach
