@@ -42,6 +42,13 @@ class SmaHost {
   // prestretch + gear (L - ref_length) for tendon length L, and the tendon's tension is gear x
   // the bundle's (Force).
   double gear(int b) const { return Act(b).gear; }
+  // Bundle b's length coordinate, in which its units stretch one for one: gear x its tendon's
+  // length (the actuator length), and the value of it at which a unit's extension is its
+  // prestretch. With gear 1 these are the tendon's length and ref_length.
+  double UnitLength(const mjData* d, int b) const {
+    return Act(b).gear * d->ten_length[Act(b).tendon];
+  }
+  double unit_ref_length(int b) const { return Act(b).ref_length; }
 
   // Every unit of every bundle off, cold, at the current tendon lengths; bundle b's stream
   // seeded with Rng::DeriveSeed(seed, b). Keeps qpos, qvel and time; ends with mj_forward.

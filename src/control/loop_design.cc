@@ -9,6 +9,10 @@ namespace recruit::control {
 namespace {
 
 constexpr int kSubsteps = 20;  // mechanics steps per sampling period
+// The static torque error the integral must remove within the hold, as a fraction of the
+// reference stiffness times the step (measured on the elbow arm's reach-and-hold over 6 seeds at
+// dT 1 and 0.5: 0.25 settled 63 % of steps, 0.5 87-90 %).
+constexpr double kFeedforwardError = 0.5;
 
 // Exact discretisation of I qddot + b qdot + k q = tau over h with tau held: z' = Phi z + Gam tau.
 struct Discrete {
@@ -49,14 +53,14 @@ double Penalty(const LoopDesign& d, const LoopTarget& target) {
            target.hold * std::min(p.final_error, 10.0) +
            10 * target.hold * std::max(0.0, p.overshoot - allowed);
   };
-  return one(d.nominal, target.overshoot) + 0.25 * one(d.robust, 0.25);
+  return one(d.nominal, target.overshoot) + 0.25 * one(d.robust, 0.25) + 0.25 * one(d.offset, 0.25);
 }
 
 }  // namespace
 
 PredictedStep PredictStep(const JointDynamics& joint, const ActuatorResponse& act, double dT,
                           const LoopGains& gains, const LoopTarget& target,
-                          double actuator_slowdown, double gain_scale) {
+                          double actuator_slowdown, double gain_scale, double feedforward_error) {
   const double h = dT / kSubsteps;
   const Discrete dis = Discretise(joint, h);
   const int instants = static_cast<int>(std::ceil(target.hold / dT - 1e-9));
@@ -70,7 +74,8 @@ PredictedStep PredictStep(const JointDynamics& joint, const ActuatorResponse& ac
   for (int n = 0; n < instants; ++n) {
     const double e = -z[0];
     integral += e * dT;
-    u.push_back(gain_scale * (gains.kp * e + gains.ki * integral - gains.kd * z[1]));
+    u.push_back(gain_scale * (gains.kp * e + gains.ki * integral - gains.kd * z[1]) -
+                feedforward_error);
     out.time.push_back(n * dT);
     out.angle.push_back(z[0] + 1);
     for (int s = 0; s < kSubsteps; ++s) {
@@ -110,8 +115,10 @@ Result<LoopDesign> DesignJointLoop(const JointDynamics& joint, const ActuatorRes
         d.gains = {a * k_ref, b * k_ref / t63, c * k_ref * t63};
         d.nominal = PredictStep(joint, act, dT, d.gains, target);
         d.robust = PredictStep(joint, act, dT, d.gains, target, 1.5, 1.5);
+        d.offset = PredictStep(joint, act, dT, d.gains, target, 1, 1, kFeedforwardError * k_ref);
         d.meets = d.nominal.settled && d.nominal.overshoot <= target.overshoot &&
-                  d.robust.settled && d.robust.overshoot <= 0.25;
+                  d.robust.settled && d.robust.overshoot <= 0.25 && d.offset.settled &&
+                  d.offset.overshoot <= 0.25;
         // Among designs that meet the target the fastest; ties to the smaller gains (the grid
         // runs from small to large, and only a strictly better one replaces).
         const double penalty = d.meets ? d.nominal.settling_time : 1e6 + Penalty(d, target);

@@ -9,7 +9,8 @@
 // response (control/actuator_response.h) between the demand and tau_act. The gains are chosen
 // on a grid by simulating that model: the fastest settling into the band with the stated
 // overshoot, that also keeps settling (overshoot <= 25 %) with the actuator 1.5x slower and the
-// loop gain 1.5x higher (robustness to the model's errors).
+// loop gain 1.5x higher, and when the static torque of the new pose is off by half the
+// step's (an error only the integral removes: the bundles' force model, the estimate's bias).
 #pragma once
 
 #include <string>
@@ -52,14 +53,17 @@ struct LoopDesign {
   LoopGains gains;
   PredictedStep nominal;  // the design model
   PredictedStep robust;   // actuator 1.5x slower, loop gain 1.5x
+  PredictedStep offset;   // the feedforward off by half the step's static torque
   bool meets = false;     // both meet the target (else the best found, with a reason)
   std::string note;
 };
 
-// The design model's response to a unit step of the reference.
+// The design model's response to a unit step of the reference; `feedforward_error` (N m) is
+// taken off every demand from the step on.
 PredictedStep PredictStep(const JointDynamics& joint, const ActuatorResponse& act, double dT,
                           const LoopGains& gains, const LoopTarget& target,
-                          double actuator_slowdown = 1, double gain_scale = 1);
+                          double actuator_slowdown = 1, double gain_scale = 1,
+                          double feedforward_error = 0);
 
 Result<LoopDesign> DesignJointLoop(const JointDynamics& joint, const ActuatorResponse& act,
                                    double dT, const LoopTarget& target);

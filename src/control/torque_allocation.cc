@@ -3,6 +3,7 @@
 #include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 namespace recruit::control {
@@ -93,6 +94,38 @@ Eigen::VectorXd AllocateTensions(const AllocationProblem& p, double eps) {
     state[release] = kFree;
   }
   return x.cwiseMax(p.floor).cwiseMin(p.cap);
+}
+
+Eigen::VectorXd RoundToUnits(const AllocationProblem& p, const Eigen::VectorXd& tensions,
+                             const Eigen::VectorXd& unit_force, const Eigen::VectorXi& units,
+                             double eps) {
+  const int nb = static_cast<int>(tensions.size());
+  const int reach = nb <= 4 ? 1 : 0;  // candidates beyond floor and ceiling
+  std::vector<std::vector<double>> choices(nb);
+  for (int b = 0; b < nb; ++b) {
+    if (!(unit_force[b] > 0)) {
+      choices[b] = {tensions[b]};  // no unit pulls here: leave it
+      continue;
+    }
+    const double n = tensions[b] / unit_force[b];
+    const int lo = std::max(0, static_cast<int>(std::floor(n)) - reach);
+    const int hi = std::min(units[b], static_cast<int>(std::ceil(n)) + reach);
+    for (int k = lo; k <= hi; ++k) choices[b].push_back(k * unit_force[b]);
+    if (choices[b].empty()) choices[b] = {tensions[b]};
+  }
+  // Every combination (at most 4^4 or 2^nb), in a fixed order; ties keep the first.
+  Eigen::VectorXd x(nb), best = tensions;
+  double best_cost = std::numeric_limits<double>::infinity();
+  std::vector<size_t> pick(nb, 0);
+  while (true) {
+    for (int b = 0; b < nb; ++b) x[b] = choices[b][pick[b]];
+    const double cost = AllocationCost(p, x, eps);
+    if (cost < best_cost) best_cost = cost, best = x;
+    int b = 0;
+    while (b < nb && ++pick[b] == choices[b].size()) pick[b++] = 0;
+    if (b == nb) break;
+  }
+  return best;
 }
 
 }  // namespace recruit::control

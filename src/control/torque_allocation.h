@@ -26,6 +26,16 @@ struct AllocationProblem {
 // problem is strictly convex, so its one minimum does not depend on where the search starts.
 Eigen::VectorXd AllocateTensions(const AllocationProblem& p, double eps = 1e-8);
 
+// The tensions as whole numbers of on units: bundle b pulls `unit_force[b]` (N) per unit on, so
+// a controller can hold only multiples of it. Among the counts near each bundle's continuous
+// count (from one below its floor to one above its ceiling for up to four bundles, floor or
+// ceiling beyond that; never below 0 or above `units[b]`), the combination with the least cost
+// above. A limb's bundles with different unit forces then resolve the demand more finely than
+// any one of them: the self-tuned loop's residual error is not one unit's worth.
+Eigen::VectorXd RoundToUnits(const AllocationProblem& p, const Eigen::VectorXd& tensions,
+                             const Eigen::VectorXd& unit_force, const Eigen::VectorXi& units,
+                             double eps = 1e-8);
+
 // The objective above, for tests and reports.
 double AllocationCost(const AllocationProblem& p, const Eigen::VectorXd& tensions,
                       double eps = 1e-8);

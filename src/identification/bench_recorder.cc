@@ -118,15 +118,15 @@ Result<BenchRecording> RecordBench(const std::string& model_path, const std::str
   log.dT = dT;
   // Forces and sensors at t = 0 (nothing is on yet).
   mj_forward(m.get(), d.get());
-  rec.tendon_length = d->ten_length[p.tendon_id(b)];
+  rec.tendon_length = p.UnitLength(d.get(), b);
   rec.stretch = p.Stretch(d.get(), b);
   rec.pose = pose.text;
-  rec.geometry = {p.bundle(b).config().unit, p.ref_length(b)};
+  rec.geometry = {p.bundle(b).config().unit, p.unit_ref_length(b)};
   std::vector<char> was_on(p.num_units(b));
   for (int k = 0; k < excitation.size(); ++k) {
     log.time.push_back(k * dT);
     log.force.push_back(p.Force(d.get(), b));
-    rec.lengths.push_back(d->ten_length[p.tendon_id(b)]);
+    rec.lengths.push_back(p.UnitLength(d.get(), b));
     log.true_on.push_back(p.OnCount(d.get(), b));
     log.p_on.push_back(excitation.p_on[k]);
     log.p_off.push_back(excitation.p_off[k]);

@@ -21,10 +21,11 @@ namespace recruit::control {
 
 struct BenchRecording {
   SwitchingLog log;
-  double unit_force = 0;        // N, the plugin's settled force of one unit (SettledUnitForce)
-  double timestep = 0;          // s, the model's physics timestep
-  nlohmann::json plant;         // the bundle it was recorded on (identification/plant_record.h)
-  double tendon_length = 0;     // m, held (the bundle's tendon at the recorded pose, at t = 0)
+  double unit_force = 0;     // N, the plugin's settled force of one unit (SettledUnitForce)
+  double timestep = 0;       // s, the model's physics timestep
+  nlohmann::json plant;      // the bundle it was recorded on (identification/plant_record.h)
+  double tendon_length = 0;  // m, held: the bundle's length coordinate (gear x its tendon's length,
+                             // SmaHost::UnitLength) at the recorded pose, at t = 0
   std::vector<double> lengths;  // m, the tendon's length at each sample
   double stretch = 0;           // m, the units' extension there
   std::string pose;             // e.g. "elbow 0.0 deg", empty when nothing was held

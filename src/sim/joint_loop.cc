@@ -9,6 +9,7 @@ namespace recruit::sim {
 namespace {
 
 constexpr double kStiffnessStep = 1e-3;  // rad, for d tau_static / dq
+constexpr double kLimitMargin = 0.03;    // of a joint's range: the loop's reference stays inside
 
 }  // namespace
 
@@ -18,6 +19,21 @@ double ShortestHold(const Reference& reference, double duration) {
     shortest = std::min(shortest, s.end - s.time);
   }
   return shortest;
+}
+
+Eigen::VectorXd JointLoops::LoopReference(const Plant& plant, double t) const {
+  Eigen::VectorXd r(plant.num_joints());
+  for (int j = 0; j < plant.num_joints(); ++j) {
+    r[j] = task_->joints[j].reference(t);
+    // Not into a limit: a reference at the end of the range would have the bundles press the
+    // limb against it (and the loop's integral wind up there).
+    double lo, hi;
+    if (plant.JointRange(j, &lo, &hi)) {
+      const double margin = kLimitMargin * (hi - lo);
+      r[j] = std::clamp(r[j], lo + margin, hi - margin);
+    }
+  }
+  return r;
 }
 
 Result<JointLoops> JointLoops::Create(const Task& task, const Plant& plant,
@@ -76,8 +92,7 @@ Result<JointDesignRecord> JointLoops::Design(const Plant& plant, int j,
 void JointLoops::Step(double t, const Plant& plant, const std::vector<double>& capacity,
                       std::vector<double>& force_ref) {
   const int nj = plant.num_joints(), nb = plant.num_bundles();
-  Eigen::VectorXd r(nj);
-  for (int j = 0; j < nj; ++j) r[j] = task_->joints[j].reference(t);
+  const Eigen::VectorXd r = LoopReference(plant, t);
   // Gains for this pose: designed once per reference value (a step's target).
   std::vector<control::LoopGains> gains(nj);
   for (int j = 0; j < nj; ++j) {
@@ -110,7 +125,16 @@ void JointLoops::Step(double t, const Plant& plant, const std::vector<double>& c
     p.cap[i] = std::max(capacity[i], 1e-9);
     p.floor[i] = task_->co_contraction * p.cap[i];
   }
-  const Eigen::VectorXd tensions = control::AllocateTensions(p);
+  Eigen::VectorXd tensions = control::AllocateTensions(p);
+  // Whole units: each bundle's controller holds whole on-counts, so the demand is met by the
+  // combination of counts that comes nearest it (control::RoundToUnits).
+  Eigen::VectorXd unit_force(nb);
+  Eigen::VectorXi units(nb);
+  for (int i = 0; i < nb; ++i) {
+    units[i] = plant.num_units(i);
+    unit_force[i] = capacity[i] / units[i];
+  }
+  tensions = control::RoundToUnits(p, tensions, unit_force, units);
   const Eigen::VectorXd achieved = p.arms * tensions;
   for (int j = 0; j < nj; ++j) {
     // Anti-windup: the integral grows only while the bundles can still deliver what it asks.

@@ -41,6 +41,8 @@ class JointLoops {
 
   // Every design made so far, in the order made.
   const std::vector<JointDesignRecord>& designs() const { return designs_; }
+  // The driven joints' references at t, kept 3 % of each limited joint's range inside it.
+  Eigen::VectorXd LoopReference(const Plant& plant, double t) const;
   // Designs the loop of joint j for the reference value r (the other joints at theirs).
   Result<JointDesignRecord> Design(const Plant& plant, int j, const Eigen::VectorXd& r) const;
 

@@ -56,7 +56,9 @@ class Plant {
   const std::string& bundle_name(int i) const { return host_->bundle_name(bundles_[i]); }
   int num_units(int i) const { return host_->num_units(bundles_[i]); }
   double Force(int i) const { return Observed(i).tension; }  // exact, N
-  double TendonLength(int i) const { return data_->ten_length[host_->tendon_id(bundles_[i])]; }
+  // Bundle i's length coordinate (gear x tendon length, SmaHost::UnitLength): what the joint
+  // encoders give the controller, and the length its unit force map reads.
+  double UnitLength(int i) const { return host_->UnitLength(data_.get(), bundles_[i]); }
   int OnCount(int i) const { return Observed(i).on_count; }
   double MeanTemperature(int i) const { return Observed(i).mean_temperature; }  // C
   Status Broadcast(int i, double p_on, double p_off) {
@@ -84,6 +86,13 @@ class Plant {
   // Driven joint j's inertia (mass-matrix diagonal, armature included) with the driven joints at
   // `q`, and its damping.
   double JointInertia(int j, const Eigen::VectorXd& q) const;
+  // Driven joint j's range, when it is limited.
+  bool JointRange(int j, double* lo, double* hi) const {
+    if (!model_->jnt_limited[joints_[j]]) return false;
+    *lo = model_->jnt_range[2 * joints_[j]];
+    *hi = model_->jnt_range[2 * joints_[j] + 1];
+    return true;
+  }
   double JointDamping(int j) const { return model_->dof_damping[model_->jnt_dofadr[joints_[j]]]; }
   // The limb's position at `q`, velocities zero, on the scratch data (for StaticTorque).
   void PoseScratch(const Eigen::VectorXd& q) const;

@@ -191,7 +191,7 @@ Result<std::vector<Channel> > MakeChannels(const Task& task, const ControllerSet
     p.dT = settings.dT;
     p.lambda = settings.lambda;
     // The estimator and the target follow the tendon's length (the joint encoder's reading).
-    p.geometry = control::UnitGeometry{host.bundle(b).config().unit, host.ref_length(b)};
+    p.geometry = control::UnitGeometry{host.bundle(b).config().unit, host.unit_ref_length(b)};
     // A model identified on another plant (unit, geometry) is refused with both named.
     control::EstimatorSpec bundle_spec = *spec;
     bundle_spec.sensor_variance = task.sensor.Variance();
@@ -259,7 +259,7 @@ void ForceReferences(const Task& task, AngleLoop& loop, JointLoops* joints, cons
     // Each bundle's capacity: every unit on, at its tendon's present length.
     std::vector<double> capacity(plant.num_bundles());
     for (int i = 0; i < plant.num_bundles(); ++i) {
-      capacity[i] = plant.num_units(i) * channels[i].controller.OnUnitForce(plant.TendonLength(i));
+      capacity[i] = plant.num_units(i) * channels[i].controller.OnUnitForce(plant.UnitLength(i));
     }
     joints->Step(t, plant, capacity, force_ref);
     return;
@@ -285,7 +285,7 @@ Status ControlBundle(Channel& ch, Plant& plant, int i, double force_ref, BundleT
   // The a-posteriori estimate is of the state at this instant, before its broadcast.
   const int on_before = plant.OnCount(i);
   const double sensed = ch.sensor.SampleAndHold(plant.Force(i));
-  const control::Broadcast bc = ch.controller.Step(force_ref, sensed, plant.TendonLength(i));
+  const control::Broadcast bc = ch.controller.Step(force_ref, sensed, plant.UnitLength(i));
   if (Status st = plant.Broadcast(i, bc.p_on, bc.p_off); !st.ok()) return st;
   const double var = ch.controller.estimated_on_variance();
   bt.estimated_on = ch.controller.estimated_on();
@@ -510,8 +510,7 @@ Result<std::vector<JointDesignRecord> > DesignTaskLoops(const Task& task,
     }
     std::vector<double> done;
     for (double t : times) {
-      Eigen::VectorXd r(plant.num_joints());
-      for (int k = 0; k < plant.num_joints(); ++k) r[k] = task.joints[k].reference(t + 1e-9);
+      const Eigen::VectorXd r = loops->LoopReference(plant, t + 1e-9);
       if (std::find(done.begin(), done.end(), r[j]) != done.end()) continue;
       done.push_back(r[j]);
       auto rec = loops->Design(plant, j, r);

@@ -236,7 +236,7 @@ TEST(EnginePlugin, CompileErrorNamesActuatorKeyAndValue) {
       {"joint transmission",
        bench("", "joint=\"load_cell\""),
        {"biceps", "joint='load_cell'", "must act on a tendon"}},
-      {"gear", bench("", "tendon=\"bundle\"", "gear=\"2\""), {"biceps", "gear=2", "must be 1"}},
+      {"gear", bench("", "tendon=\"bundle\"", "gear=\"-2\""), {"biceps", "gear=-2", "must be > 0"}},
   };
   for (const BadCase& c : cases) {
     SCOPED_TRACE(c.label);
