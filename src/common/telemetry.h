@@ -26,6 +26,12 @@ struct BundleTelemetry {
   double p_on = 0, p_off = 0;  // the bundle's last broadcast
 };
 
+// A driven joint after the first of a several-joint task (the first is `reference`/`angle`).
+struct JointTelemetry {
+  std::string joint;
+  double reference = 0, angle = 0;  // rad
+};
+
 struct TelemetrySample {
   double time = 0;             // s
   double reference = 0;        // the tracked quantity's reference (N or rad, see `reference_unit`)
@@ -33,7 +39,8 @@ struct TelemetrySample {
   std::string reference_unit;  // "N" or "rad"
   double angle = 0;            // joint angle of the limb's main joint, rad (0 on a bench)
   double p_on = 0, p_off = 0;  // last broadcast (of the first bundle; each bundle has its own)
-  bool control_instant = false;  // true on steps where the controller broadcast
+  bool control_instant = false;        // true on steps where the controller broadcast
+  std::vector<JointTelemetry> joints;  // the other driven joints (several-joint tasks)
   std::vector<BundleTelemetry> bundles;
 };
 

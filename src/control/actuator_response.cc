@@ -91,4 +91,19 @@ Result<ActuatorResponse> PredictActuatorResponse(const BroadcastTransitionModel&
   return r;
 }
 
+ActuatorResponse FirstOrderActuatorResponse(double dT, double lambda, double tau, int max_samples) {
+  ActuatorResponse r;
+  r.dT = dT;
+  r.s.push_back(0);
+  const double decay = tau > 0 ? std::exp(-dT / tau) : 0.0;
+  double count = 0, force = 0;
+  for (int k = 1; k <= max_samples; ++k) {
+    count += lambda * (1 - count);  // the broadcast at instant k - 1, held until k
+    force = count + (force - count) * decay;
+    r.s.push_back(force);
+    if (1 - force < 1e-4) break;
+  }
+  return r;
+}
+
 }  // namespace recruit::control

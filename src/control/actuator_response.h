@@ -33,4 +33,10 @@ Result<ActuatorResponse> PredictActuatorResponse(const BroadcastTransitionModel&
                                                  double from = 0.25, double to = 0.5,
                                                  int max_samples = 1000);
 
+// Without a usable chain: the expected on-count's approach under the law, 1 - (1 - lambda)^k at
+// the control instants (held between them), through a first-order thermal lag of time constant
+// `tau` (s; the unit's, UnitModel::time_constant).
+ActuatorResponse FirstOrderActuatorResponse(double dT, double lambda, double tau,
+                                            int max_samples = 1000);
+
 }  // namespace recruit::control

@@ -50,7 +50,7 @@ void Score(const std::vector<double>& t, const std::vector<double>& y, const Loo
 double Penalty(const LoopDesign& d, const LoopTarget& target) {
   auto one = [&](const PredictedStep& p, double allowed) {
     return p.settling_time + (p.settled ? 0 : target.hold) +
-           target.hold * std::min(p.final_error, 10.0) +
+           target.hold * std::min(p.final_error, 1e6) +
            10 * target.hold * std::max(0.0, p.overshoot - allowed);
   };
   return one(d.nominal, target.overshoot) + 0.25 * one(d.robust, 0.25) + 0.25 * one(d.offset, 0.25);

@@ -19,6 +19,8 @@ Eigen::VectorXd JointWeights(const AllocationProblem& p) {
   return w;
 }
 
+double Price(const AllocationProblem& p, int b) { return p.price.size() > 0 ? p.price[b] : 1.0; }
+
 enum Bound : char { kFree, kLower, kUpper };
 
 // The minimum over the free variables with the others held: Q_FF x_F = c_F - Q_FB x_B.
@@ -50,7 +52,12 @@ Eigen::VectorXd FreeMinimum(const Eigen::MatrixXd& Q, const Eigen::VectorXd& c,
 double AllocationCost(const AllocationProblem& p, const Eigen::VectorXd& tensions, double eps) {
   const Eigen::VectorXd w = JointWeights(p);
   const Eigen::VectorXd r = p.arms * tensions - p.torque;
-  return r.cwiseProduct(r).dot(w) + eps * tensions.cwiseQuotient(p.cap).squaredNorm();
+  double share = 0;
+  for (int b = 0; b < tensions.size(); ++b) {
+    const double x = Price(p, b) * tensions[b] / p.cap[b];
+    share += x * x;
+  }
+  return r.cwiseProduct(r).dot(w) + eps * share;
 }
 
 Eigen::VectorXd AllocateTensions(const AllocationProblem& p, double eps) {
@@ -58,7 +65,10 @@ Eigen::VectorXd AllocateTensions(const AllocationProblem& p, double eps) {
   const Eigen::VectorXd w = JointWeights(p);
   // The cost is (1/2) x'Qx - c'x + const with Q = 2 (A'WA + eps D^-2), c = 2 A'W torque.
   Eigen::MatrixXd Q = p.arms.transpose() * w.asDiagonal() * p.arms;
-  for (int b = 0; b < nb; ++b) Q(b, b) += eps / (p.cap[b] * p.cap[b]);
+  for (int b = 0; b < nb; ++b) {
+    const double price = Price(p, b);
+    Q(b, b) += eps * price * price / (p.cap[b] * p.cap[b]);
+  }
   const Eigen::VectorXd c = p.arms.transpose() * w.asDiagonal() * p.torque;
   // Start at the floor, every variable held there.
   Eigen::VectorXd x = p.floor;

@@ -15,13 +15,17 @@ struct AllocationProblem {
   Eigen::VectorXd torque;  // per joint, N m: the demand
   Eigen::VectorXd floor;   // per bundle, N: least tension (co-contraction), 0 <= floor <= cap
   Eigen::VectorXd cap;     // per bundle, N: capacity, > 0
+  // per bundle, > 0 (empty: all 1): the price of its share; a slower bundle priced higher is
+  // left the smaller share of a demand the others can meet.
+  Eigen::VectorXd price;
 };
 
-// Minimizes  sum_j ((arms T - torque)_j / s_j)^2 + eps sum_b (T_b / cap_b)^2
+// Minimizes  sum_j ((arms T - torque)_j / s_j)^2 + eps sum_b (price_b T_b / cap_b)^2
 // subject to floor <= T <= cap, with s_j = sum_b |arms_jb| cap_b (joint j's torque span; a joint
 // no bundle moves is left out). The first term meets the demands where the bundles can; the
 // small second one shares a joint's demand among the bundles that cross it in proportion to
-// their moment arms and the square of their capacities, and makes the solution unique.
+// their moment arms and the square of their capacities over their prices, and makes the
+// solution unique.
 // A primal active-set method for the box-constrained quadratic (finite; exact to rounding): the
 // problem is strictly convex, so its one minimum does not depend on where the search starts.
 Eigen::VectorXd AllocateTensions(const AllocationProblem& p, double eps = 1e-8);

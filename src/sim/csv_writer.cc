@@ -20,6 +20,7 @@ Status CsvStepWriter::OnStep(const mjModel*, const mjData*, const TelemetrySampl
   if (!file_.ok()) return Error{file_.error()};
   if (!header_written_) {
     std::string header = "time,reference,measured,angle";
+    for (const auto& j : s.joints) header += fmt::format(",{0}.reference,{0}.angle", j.joint);
     for (const auto& b : s.bundles) {
       for (const char* col : {"force", "force_reference", "true_on", "estimated_on",
                               "estimated_on_std", "p_on", "p_off", "mean_temperature"}) {
@@ -38,8 +39,8 @@ Status CsvStepWriter::OnStep(const mjModel*, const mjData*, const TelemetrySampl
   // (references, estimates, broadcasts): a column equal to its last value reuses its text, and
   // one equal to the number formatted just before in the row (an angle task's measured value and
   // angle, a force task's measured value and force) copies that one's.
-  Reserve(8 + (4 + 8 * s.bundles.size()) * kFormatGMax);
-  cache_.resize(4 + 7 * s.bundles.size());
+  Reserve(8 + (4 + 2 * s.joints.size() + 8 * s.bundles.size()) * kFormatGMax);
+  cache_.resize(4 + 2 * s.joints.size() + 7 * s.bundles.size());
   char* p = buffer_.data() + used_;
   Column* col = cache_.data();
   const Column* last = nullptr;  // the number formatted last in this row
@@ -71,6 +72,12 @@ Status CsvStepWriter::OnStep(const mjModel*, const mjData*, const TelemetrySampl
   num(s.measured, 9);
   comma();
   num(s.angle, 9);
+  for (const auto& j : s.joints) {
+    comma();
+    num(j.reference, 9);
+    comma();
+    num(j.angle, 9);
+  }
   for (const auto& b : s.bundles) {
     comma();
     num(b.force, 9);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "control/torque_allocation.h"
 
@@ -56,6 +57,16 @@ Result<JointLoops> JointLoops::Create(const Task& task, const Plant& plant,
   loops.gains_.resize(plant.num_joints());
   loops.integral_.assign(plant.num_joints(), 0.0);
   loops.tensions_.assign(plant.num_bundles(), 0.0);
+  // Slower bundles are priced by how much slower they are than the fastest: the fast ones take
+  // a joint's demand where they can, the slow ones what only they can give.
+  double fastest = std::numeric_limits<double>::infinity();
+  for (const control::ActuatorResponse& r : loops.responses_) {
+    fastest = std::min(fastest, r.TimeTo(0.63));
+  }
+  loops.price_.resize(plant.num_bundles());
+  for (int i = 0; i < plant.num_bundles(); ++i) {
+    loops.price_[i] = loops.responses_[i].TimeTo(0.63) / fastest;
+  }
   return loops;
 }
 
@@ -71,19 +82,22 @@ Result<JointDesignRecord> JointLoops::Design(const Plant& plant, int j,
       (plant.StaticTorque(up)[j] - plant.StaticTorque(down)[j]) / (2 * kStiffnessStep);
   rec.dynamics.inertia = plant.JointInertia(j, r);
   rec.dynamics.damping = plant.JointDamping(j);
-  // The slowest bundle that moves this joint sets the actuator's response.
+  // The response of the joint's torque: the allocation gives a demand to the fastest bundles
+  // that can meet it, so the slower of the fastest bundle on each side sets it.
   const Eigen::MatrixXd arms = plant.MomentArms();
-  const control::ActuatorResponse* slowest = nullptr;
+  const control::ActuatorResponse* side[2] = {nullptr, nullptr};  // flexing, extending
   for (int i = 0; i < plant.num_bundles(); ++i) {
     if (arms(j, i) == 0) continue;
-    const double t63 = responses_[i].TimeTo(0.63);
-    if (slowest == nullptr || t63 > rec.actuator_t63)
-      slowest = &responses_[i], rec.actuator_t63 = t63;
+    const control::ActuatorResponse*& s = side[arms(j, i) > 0 ? 0 : 1];
+    if (s == nullptr || responses_[i].TimeTo(0.63) < s->TimeTo(0.63)) s = &responses_[i];
   }
-  if (slowest == nullptr) {
-    return Error{"joint '" + rec.joint + "': no bundle of the task crosses it"};
+  const control::ActuatorResponse* act = side[0];
+  if (act == nullptr || (side[1] != nullptr && side[1]->TimeTo(0.63) > act->TimeTo(0.63))) {
+    act = side[1];
   }
-  auto d = control::DesignJointLoop(rec.dynamics, *slowest, dT_, target_);
+  if (act == nullptr) return Error{"joint '" + rec.joint + "': no bundle of the task crosses it"};
+  rec.actuator_t63 = act->TimeTo(0.63);
+  auto d = control::DesignJointLoop(rec.dynamics, *act, dT_, target_);
   if (!d.ok()) return Error{"joint '" + rec.joint + "': " + d.error()};
   rec.design = std::move(d).value();
   return rec;
@@ -121,6 +135,7 @@ void JointLoops::Step(double t, const Plant& plant, const std::vector<double>& c
   }
   p.cap.resize(nb);
   p.floor.resize(nb);
+  p.price = price_;
   for (int i = 0; i < nb; ++i) {
     p.cap[i] = std::max(capacity[i], 1e-9);
     p.floor[i] = task_->co_contraction * p.cap[i];

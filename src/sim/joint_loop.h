@@ -23,7 +23,7 @@ struct JointDesignRecord {
   std::string joint;
   double reference = 0;  // rad
   control::JointDynamics dynamics;
-  double actuator_t63 = 0;  // s, the slowest crossing bundle's time to 63 % of a step
+  double actuator_t63 = 0;  // s, the design's bundle response: its time to 63 % of a step
   control::LoopDesign design;
 };
 
@@ -54,6 +54,7 @@ class JointLoops {
   std::vector<std::map<double, control::LoopGains>> gains_;  // per joint, by reference value
   std::vector<double> integral_;                             // rad s, per joint
   std::vector<double> tensions_;                             // N, the last allocation
+  Eigen::VectorXd price_;  // per bundle: its time to 63 % over the fastest bundle's
   std::vector<JointDesignRecord> designs_;
 };
 

@@ -243,8 +243,14 @@ Result<std::vector<control::ActuatorResponse> > ActuatorResponses(
     const Eigen::VectorXd h = model.H.row(0).transpose();
     auto r = control::PredictActuatorResponse(
         model.broadcast, std::vector<double>(h.data(), h.data() + h.size()), settings.lambda);
-    if (!r) return Error{"bundle '" + plant.bundle_name(i) + "': " + r.error()};
-    out.push_back(std::move(r).value());
+    if (r) {
+      out.push_back(std::move(r).value());
+    } else {
+      // A chain whose force does not follow its count (a poor identification): the law's
+      // approach through the unit's own thermal lag.
+      const double tau = plant.host().bundle(plant.bundle_index(i)).unit().time_constant();
+      out.push_back(control::FirstOrderActuatorResponse(settings.dT, settings.lambda, tau));
+    }
   }
   return out;
 }
@@ -566,6 +572,7 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
   TelemetrySample sample;
   sample.reference_unit = task.tracked == Tracked::kForce ? "N" : "rad";
   sample.bundles.resize(nb);
+  for (int j = 1; j < plant.num_joints(); ++j) sample.joints.push_back({plant.joint_name(j)});
   for (int i = 0; i < nb; ++i) {
     sample.bundles[i].actuator = plant.bundle_name(i);
     sample.bundles[i].tendon_id = plant.host().tendon_id(plant.bundle_index(i));
@@ -606,8 +613,10 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
     const double r = task.reference(plant.time());
     sig.Add(plant.time(), r, y);
     for (int j = 1; j < plant.num_joints(); ++j) {
-      more_joints[j - 1].Add(plant.time(), task.joints[j].reference(plant.time()),
-                             plant.JointAngle(j));
+      JointTelemetry& jt = sample.joints[j - 1];
+      jt.reference = task.joints[j].reference(plant.time());
+      jt.angle = plant.JointAngle(j);
+      more_joints[j - 1].Add(plant.time(), jt.reference, jt.angle);
     }
     // Units switch only when a broadcast reaches them, so the on-counts change only at control
     // instants: counted there (after the broadcast took effect) for the switching rate.
