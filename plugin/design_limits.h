@@ -24,10 +24,11 @@ struct AlloyDomain {
   // Recoverable (transformation) strain of polycrystalline NiTi: at most 8 % for a single cycle
   // (SMA Inc., NiTi Smart Sheet; Special Metals SMC-017).
   static constexpr double kMaxStrain = 0.08;
-  // Shortest wire, in wire diameters: below about 100 d the conduction into the terminals
-  // (conduction length sqrt(k d / (4 h)), about 18 d for 0.1 mm wire with k = 18 W/(m K))
-  // cools most of the wire, which the lumped thermal model does not describe.
-  static constexpr double kMinLengthPerDiameter = 100;
+  // Shortest wire, in wire diameters: heat conducts into the terminals over the conduction
+  // length sqrt(k d / (4 h)), 12-18 d for 0.5-0.1 mm wire in still air (k = 18 W/(m K)); a wire
+  // shorter than 20 d is held near its terminals' temperature all along, which the lumped
+  // thermal model does not describe.
+  static constexpr double kMinLengthPerDiameter = 20;
 };
 
 // The steady state of one unit of a configuration, at its reference extension `prestretch` (a
