@@ -49,8 +49,8 @@ struct SteadyState {
   double peak_stress() const { return on_stress > off_stress ? on_stress : off_stress; }
 };
 
-// The steady state of `p` (all zero when UnitModel::Create refuses it). Without
-// `with_cooling_time` cooling_time stays 0 (about 40 times faster: the check at every load).
+// The steady state of `p` (the defaults above when UnitModel::Create refuses it). Without
+// `with_cooling_time` cooling_time stays 0 (the refusal check at every load skips it).
 SteadyState Evaluate(const UnitParams& p, bool with_cooling_time = true);
 SteadyState Evaluate(const BundleConfig& c);
 
@@ -59,8 +59,9 @@ SteadyState Evaluate(const BundleConfig& c);
 double CurrentForTemperature(const UnitParams& p, double t);
 
 // The long-life limits of c's wire (UnitLimits::ForWire: 120 C, 172 MPa, Dynalloy's cooling time
-// for its diameter) that its steady state exceeds, one text each, e.g. "steady 211 C when on,
-// above the long-life 120 C: current=0.289 holds it at 120 C". Empty when none is exceeded.
+// for its diameter) that its steady state exceeds, one text each, e.g. "steady 211 C when on
+// (0.15 mm wire at 0.4 A), above the long-life 120 C: current=0.289 holds it there". Empty when
+// none is exceeded.
 // The model cools the default unit 2.2 times slower than Dynalloy's table says, so a cooling
 // time counts as exceeded above 2.5 times the datasheet's.
 std::vector<std::string> DesignWarnings(const BundleConfig& c);
