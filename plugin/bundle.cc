@@ -2,7 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
+#include <cstdint>
 #include <numeric>
 #include <vector>
 
@@ -25,14 +25,23 @@ struct BigMergeScratch {
   std::vector<int> sorted, forward, remap;
 };
 
-Rng LoadRng(const double* words) {
+// The stream's four 64-bit words as eight 32-bit halves (low, high), each an integer-valued
+// double: exact and finite, so the block survives NaN checks, text and float64 round trips.
+Rng LoadRng(const double* halves) {
   Rng::State st;
-  std::memcpy(st.data(), words, sizeof st);
+  for (int w = 0; w < 4; ++w) {
+    st[w] = static_cast<std::uint64_t>(halves[2 * w]) |
+            static_cast<std::uint64_t>(halves[2 * w + 1]) << 32;
+  }
   return Rng::FromState(st);
 }
 
-void StoreRng(const Rng& rng, double* words) {
-  std::memcpy(words, rng.state().data(), sizeof(Rng::State));
+void StoreRng(const Rng& rng, double* halves) {
+  for (int w = 0; w < 4; ++w) {
+    const std::uint64_t x = rng.state()[w];
+    halves[2 * w] = static_cast<double>(x & 0xFFFFFFFFu);
+    halves[2 * w + 1] = static_cast<double>(x >> 32);
+  }
 }
 
 }  // namespace

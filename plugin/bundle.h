@@ -1,6 +1,6 @@
 // SmaBundle: N identical SMA units pulling one tendon, with each unit's on/off state machine.
 // MuJoCo-free: every mutable quantity lives in a caller-owned block of doubles (the plugin puts
-// it in mjData.userdata), so copying the block forks the bundle exactly.
+// it in mjData.plugin_state), so copying the block forks the bundle exactly.
 //
 // Units with identical state form a cohort (count + state); per-step cost scales with the number
 // of cohorts, not units. A broadcast splits a cohort when some of its units switch; cohorts whose
@@ -101,12 +101,14 @@ class SmaBundle {
  private:
   // Summary from the sums of UnitModel::Observe (on, temperature, xi, tension) over k cohorts.
   Summary FromSums(const double* sum, int k) const;
-  // Header: magic, 4 random-stream words, cohort count, update counter, pending time (s), the
-  // kept tension (flag 1 when kept, extension (m), tension (N); all 0 when none), 1 reserved
-  // (so that the cohort fields start 32 bytes after the block, as before).
-  static constexpr int kHeader = 12;
-  static constexpr int kMagicSlot = 0, kRngSlot = 1, kCohortCountSlot = 5, kCounterSlot = 6,
-                       kPendingSlot = 7, kKeptSlot = 8, kKeptStretchSlot = 9, kKeptTensionSlot = 10;
+  // Header: magic, the random stream's 4 words as 8 exact 32-bit halves (low, high), cohort
+  // count, update counter, pending time (s), the kept tension (flag 1 when kept, extension (m),
+  // tension (N); all 0 when none), 1 reserved (so that the cohort fields start 128 bytes after
+  // the block). Every slot is a finite number.
+  static constexpr int kHeader = 16;
+  static constexpr int kMagicSlot = 0, kRngSlot = 1, kCohortCountSlot = 9, kCounterSlot = 10,
+                       kPendingSlot = 11, kKeptSlot = 12, kKeptStretchSlot = 13,
+                       kKeptTensionSlot = 14;
   // Cohorts as a structure of arrays: field f of cohort j at kHeader + f * N + j (N = units,
   // the most cohorts there can be), so the batched update loads four cohorts' values at once.
   static constexpr int kFields = 7;

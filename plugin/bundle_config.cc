@@ -5,10 +5,11 @@
 #include <cstdio>
 #include <cstdlib>
 #include <functional>
-#include <set>
+#include <map>
 #include <sstream>
 
 #include "common/short_text.h"
+#include "plugin/design_limits.h"
 
 namespace recruit::sma {
 namespace {
@@ -32,7 +33,7 @@ const std::vector<Key>& NumericKeys() {
       {"wire_diameter", 0, 0.01, true, "m", UNIT_FIELD(wire_diameter)},
       {"wire_length", 0, 10, true, "m", UNIT_FIELD(wire_length)},
       {"coil_diameter", 0, 0.1, true, "m", UNIT_FIELD(coil_diameter)},
-      {"turns", 0, 1e5, true, "", UNIT_FIELD(turns)},
+      {"turns", 1, 1e5, false, "", UNIT_FIELD(turns)},  // a coil has at least one turn
       {"series", 1, 1000, false, "", [](BundleConfig& c, double v) { c.unit.series = int(v); }},
       {"parallel", 1, 1000, false, "", [](BundleConfig& c, double v) { c.unit.parallel = int(v); }},
       {"series_spring", 0, 1e9, false, "N/m (0 = rigid)", UNIT_FIELD(series_spring)},
@@ -58,7 +59,7 @@ const std::vector<Key>& NumericKeys() {
       {"E_M", 0, 1e12, true, "Pa", UNIT_FIELD(E_M)},
       {"G_A", 0, 1e12, true, "Pa", UNIT_FIELD(G_A)},
       {"G_M", 0, 1e12, true, "Pa", UNIT_FIELD(G_M)},
-      {"eps_L", 0, 0.2, true, "", UNIT_FIELD(eps_L)},
+      {"eps_L", 0, AlloyDomain::kMaxStrain, true, "", UNIT_FIELD(eps_L)},  // NiTi: <= 8 %
       {"ref_length", 0, 1e3, true, "m", [](BundleConfig& c, double v) { c.ref_length = v; }},
       {"merge_temperature", 0, 10, false, "C",
        [](BundleConfig& c, double v) { c.merge_temperature = v; }},
@@ -69,6 +70,96 @@ const std::vector<Key>& NumericKeys() {
 }
 
 #undef UNIT_FIELD
+
+// "current=100 wire_diameter=1e-9" for the keys among `keys` that the configuration gave, as
+// written; the keys' names with "(defaults)" when it gave none of them.
+std::string Given(const std::map<std::string, std::string>& given,
+                  std::initializer_list<const char*> keys) {
+  std::string s, names;
+  for (const char* k : keys) {
+    names += (names.empty() ? "" : ", ") + std::string(k);
+    const auto it = given.find(k);
+    if (it != given.end()) s += (s.empty() ? "" : " ") + it->first + "=" + Short(it->second);
+  }
+  return s.empty() ? names + " (defaults)" : s;
+}
+
+std::string Num(const char* format, double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, format, v);
+  return buf;
+}
+
+// The alloy's domain (design_limits.h, AlloyDomain; plugin/README.md "Limits"): geometry that
+// can exist, an ambient at which the cold wire is martensite, and a steady state below the
+// temperature, stress and strain NiTi survives. Messages name the keys given (and values).
+Status CheckDomain(const BundleConfig& c, const std::map<std::string, std::string>& given,
+                   const std::string& where) {
+  const UnitParams& p = c.unit;
+  const bool spring = p.law == ForceLaw::kSpring;
+  if ((spring || given.count("coil_diameter")) && !(p.coil_diameter > p.wire_diameter)) {
+    return Error{where + Given(given, {"coil_diameter", "wire_diameter"}) +
+                 ": the mean coil diameter " + GText(p.coil_diameter) +
+                 " m must exceed the wire diameter " + GText(p.wire_diameter) +
+                 " m (a coil's bore is D - d)"};
+  }
+  const double length = spring ? 3.14159265358979323846 * p.coil_diameter * p.turns : p.wire_length;
+  const double min_length = AlloyDomain::kMinLengthPerDiameter * p.wire_diameter;
+  if (length < min_length) {
+    return Error{where +
+                 (spring ? Given(given, {"turns", "coil_diameter", "wire_diameter"})
+                         : Given(given, {"wire_length", "wire_diameter"})) +
+                 ": the wire is " + GText(length) + " m long, shorter than " +
+                 GText(AlloyDomain::kMinLengthPerDiameter) + " wire diameters (" +
+                 GText(min_length) +
+                 " m): its terminals would cool most of it, outside the lumped thermal model"};
+  }
+  if (!(p.ambient < p.As)) {
+    return Error{where + Given(given, {"ambient", "As"}) + ": ambient " + GText(p.ambient) +
+                 " C must be below As " + GText(p.As) +
+                 " C: an unheated wire would contract by itself"};
+  }
+  const SteadyState s = Evaluate(p, false);
+  if (!(s.on_temperature <= AlloyDomain::kMaxTemperature)) {
+    return Error{where +
+                 Given(given, {"current", "wire_diameter", "resistivity_A", "resistivity_M", "h",
+                               "emissivity", "ambient"}) +
+                 ": the wire settles at " + Num("%.3g", s.on_temperature) + " C when on, above " +
+                 Num("%.0f", AlloyDomain::kMaxTemperature) +
+                 " C where NiTi anneals and loses its trained memory; current <= " +
+                 Num("%.3g", CurrentForTemperature(p, AlloyDomain::kMaxTemperature)) +
+                 " A keeps it below"};
+  }
+  if (!(s.peak_stress() <= AlloyDomain::kMaxStress)) {
+    return Error{where +
+                 Given(given, {"prestretch", "prestrain", "series", "series_spring", "wire_length",
+                               "wire_diameter", "coil_diameter", "turns", "E_A", "E_M", "G_A",
+                               "G_M", "current", "C_A", "As", "Af"}) +
+                 ": the wire stress reaches " + Num("%.4g", s.peak_stress() / 1e6) + " MPa " +
+                 (s.on_stress >= s.off_stress ? "held on" : "off") +
+                 " at the reference extension, above NiTi's martensite yield strength " +
+                 Num("%.0f", AlloyDomain::kMaxStress / 1e6) + " MPa (deforms plastically)"};
+  }
+  if (!(s.off_strain <= AlloyDomain::kMaxStrain)) {
+    return Error{where +
+                 Given(given, {"prestretch", "prestrain", "series", "series_spring", "wire_length",
+                               "E_M", "G_M", "eps_L"}) +
+                 ": the off wire is strained " + Num("%.3g", 100 * s.off_strain) +
+                 " % at the reference extension, beyond NiTi's recoverable " +
+                 Num("%.0f", 100 * AlloyDomain::kMaxStrain) + " %"};
+  }
+  if (p.current > 0 && !(s.on_xi < 0.99)) {
+    return Error{where +
+                 Given(given, {"current", "ambient", "wire_diameter", "h", "emissivity",
+                               "resistivity_M", "As", "Af", "prestretch", "prestrain", "series",
+                               "series_spring", "E_A", "G_A", "C_A"}) +
+                 ": a unit held on settles at " + Num("%.3g", s.on_temperature) +
+                 " C and never contracts (its effective temperature stays below As " + GText(p.As) +
+                 " C); current >= " + Num("%.3g", CurrentForTemperature(p, p.Af)) +
+                 " A reaches Af unloaded (current=0: units that never heat)"};
+  }
+  return Status::Ok();
+}
 
 }  // namespace
 
@@ -85,7 +176,10 @@ Result<BundleConfig> BundleConfig::FromText(const std::string& actuator, const s
   std::vector<std::pair<std::string, std::string>> pairs;
   while (in >> token) {
     const auto eq = token.find('=');
-    if (eq == std::string::npos || eq == 0 || eq + 1 == token.size()) {
+    if (eq != std::string::npos && eq > 0 && eq + 1 == token.size()) {
+      return Error{where + Short(token) + " has no value: give one, or leave the key out"};
+    }
+    if (eq == std::string::npos || eq == 0) {
       return Error{where + "'" + Short(token) + "' is not key=value"};
     }
     pairs.emplace_back(token.substr(0, eq), token.substr(eq + 1));
@@ -98,11 +192,13 @@ Result<BundleConfig> BundleConfig::FromPairs(
     const std::vector<std::pair<std::string, std::string>>& pairs) {
   BundleConfig c;
   c.actuator = actuator;
-  std::set<std::string> seen;
+  std::map<std::string, std::string> given;  // key -> value as written
   double prestrain = std::nan("");
   for (const auto& [key, value] : pairs) {
     if (value.empty()) continue;  // an unset MJCF config key: keep the default
-    if (!seen.insert(key).second) return Error{where + "key '" + key + "' given twice"};
+    if (!given.emplace(key, value).second) {
+      return Error{where + "key '" + Short(key) + "' given twice"};
+    }
     if (key == "law") {
       if (value == "wire") {
         c.unit.law = ForceLaw::kWire;
@@ -145,7 +241,7 @@ Result<BundleConfig> BundleConfig::FromPairs(
     }
   }
   if (!std::isnan(prestrain)) {
-    if (seen.count("prestretch")) {
+    if (given.count("prestretch")) {
       return Error{where + "give prestrain or prestretch, not both"};
     }
     if (c.unit.law != ForceLaw::kWire) {
@@ -155,6 +251,8 @@ Result<BundleConfig> BundleConfig::FromPairs(
   }
   auto check = UnitModel::Create(c.unit);
   if (!check.ok()) return Error{where + check.error()};
+  Status domain = CheckDomain(c, given, where);
+  if (!domain.ok()) return Error{domain.error()};
   return c;
 }
 

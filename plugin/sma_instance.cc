@@ -14,6 +14,7 @@
 #include <utility>
 
 #include "common/rng.h"
+#include "plugin/design_limits.h"
 #include "plugin/tendon_range.h"
 
 namespace recruit::sma {
@@ -140,6 +141,11 @@ Result<std::unique_ptr<SmaInstance>> SmaInstance::Create(const mjModel* m, int i
   if (in_fit_check) return std::unique_ptr<SmaInstance>();
   auto p = Build(m, instance, true);
   if (p.ok() && FirstCheck(m, instance)) {
+    // Design check (issue 26 item 3): one warning per bundle past a long-life limit.
+    for (const SmaActuator& a : (*p)->actuators()) {
+      const std::string w = DesignWarning(a.model.config());
+      if (!w.empty()) mju_warning("recruit.sma %s", w.c_str());
+    }
     const std::vector<TendonFit> fits = (*p)->Fit(m);
     for (int k = 0; k < static_cast<int>(fits.size()); ++k) {
       const std::string w = (*p)->FitWarning(m, k, fits[k]);

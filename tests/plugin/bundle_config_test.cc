@@ -67,8 +67,8 @@ INSTANTIATE_TEST_SUITE_P(
     AllFields, BundleConfigRejects,
     ::testing::Values(
         BadCase{"curent=0.2", "unknown key 'curent' (allowed: law, units,"},
-        BadCase{"units", "'units' is not key=value"},
-        BadCase{"units=", "'units=' is not key=value"}, BadCase{"=3", "'=3' is not key=value"},
+        BadCase{"units", "'units' is not key=value"}, BadCase{"units=", "units= has no value"},
+        BadCase{"=3", "'=3' is not key=value"},
         BadCase{"units=0", "units=0 is out of range: must be in [1, 1e+06]"},
         BadCase{"units=2.5", "units=2.5 must be a whole number"},
         BadCase{"current=abc", "current=abc is not a finite number"},

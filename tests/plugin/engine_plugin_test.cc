@@ -32,8 +32,9 @@ using testing::PluginState;
 using testing::SameBits;
 
 constexpr int kSlots = 2;  // per actuator before the bundle's block (plugin/README.md)
-// SmaBundle header: magic, 4 RNG words, cohorts, counter, pending, kept tension (3), reserved
-constexpr int kHeader = 12;
+// SmaBundle header: magic, 8 RNG halves, cohorts, counter, pending, kept tension (3), reserved
+constexpr int kHeader = 16;
+constexpr int kRngHalves = 8;
 
 ModelPtr MustLoad(const std::string& xml) {
   auto m = Load(xml);
@@ -373,15 +374,15 @@ TEST(EnginePlugin, BundlesAndModelsNeverShareState) {
   EXPECT_GT(Truth(m.get(), d.get(), 0, 0), 0);
   // the other bundle drew nothing and switched nothing: same stream words, same unit states
   const double* b1 = Block(m.get(), d.get(), 1, 0, n);
-  EXPECT_TRUE(SameBits(b0.data() + 1, b1 + 1, 4));
+  EXPECT_TRUE(SameBits(b0.data() + 1, b1 + 1, kRngHalves));
   EXPECT_EQ(Truth(m.get(), d.get(), 1, 0), 0);
   EXPECT_TRUE(SameBits(b0.data() + kHeader, b1 + kHeader, n - kHeader));
   // Same config and seed, different bundle index: different streams.
   mj_resetData(m.get(), d.get());
   d->ctrl[0] = d->ctrl[1] = 0.3;
   mj_step(m.get(), d.get());
-  EXPECT_FALSE(
-      SameBits(Block(m.get(), d.get(), 0, 0, n) + 1, Block(m.get(), d.get(), 1, 0, n) + 1, 4));
+  EXPECT_FALSE(SameBits(Block(m.get(), d.get(), 0, 0, n) + 1, Block(m.get(), d.get(), 1, 0, n) + 1,
+                        kRngHalves));
   EXPECT_FALSE(SameBits(Block(m.get(), d.get(), 0, 0, n) + kHeader + 7 * 40,
                         Block(m.get(), d.get(), 1, 0, n) + kHeader + 7 * 40, 40));
 
