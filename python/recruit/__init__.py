@@ -59,7 +59,13 @@ if _recruit.mujoco_version() != _mujoco.mj_versionString():
         f"{_mujoco.mj_versionString()} is imported; install the mujoco version recruit was "
         "built with")
 
-__version__ = "0.2.0"
+from ._version import __version__  # noqa: E402  (the CMake project version)
+
+_h = _recruit.mujoco_header_version()  # mjVERSION_HEADER: major * 1e6 + minor * 1e3 + patch
+MUJOCO_BUILD_VERSION = f"{_h // 1000000}.{_h // 1000 % 1000}.{_h % 1000}"
+"""The MuJoCo release whose headers recruit was compiled against."""
+MUJOCO_VERSION = _mujoco.mj_versionString()
+"""The MuJoCo release running (the libmujoco loaded; equal to mujoco.__version__)."""
 
 PathLike = Union[str, "_os.PathLike[str]"]
 
@@ -294,4 +300,4 @@ def aggregate(runs: Mapping[str, Any], max_overshoot: float = 0.10,
 
 __all__ = ["FilterModel", "KalmanFilter", "ExactFilter", "ParticleFilter", "Bundles",
            "Controller", "expectation_law", "filter_log", "simulate", "sweep", "aggregate",
-           "PLUGIN_LIBRARY"]
+           "PLUGIN_LIBRARY", "MUJOCO_BUILD_VERSION", "MUJOCO_VERSION"]

@@ -1,6 +1,8 @@
 // recruit: command-line front end. Subcommands are registered from their own files. One error
 // policy for all of them (cli/errors.h, docs/reliability.md): exit 0 ok, 2 usage, 3 bad input,
 // 4 I/O, 5 internal; temporary files are removed on SIGINT/SIGTERM.
+#include <mujoco/mujoco.h>
+
 #include <exception>
 #include <iostream>
 #include <new>
@@ -10,6 +12,7 @@
 #include "cli/commands.h"
 #include "cli/errors.h"
 #include "common/atomic_file.h"
+#include "common/version.h"
 
 namespace {
 
@@ -36,6 +39,17 @@ class TeeBuf : public std::streambuf {
   std::string text_;
 };
 
+// `recruit --version`: this build's version and the MuJoCo it was compiled against (its header)
+// and runs with (the libmujoco loaded). mjVERSION_HEADER is major * 1e6 + minor * 1e3 + patch.
+std::string VersionText() {
+  const int h = mjVERSION_HEADER;
+  std::ostringstream s;
+  s << "recruit " << recruit::ProjectVersion() << " (" << recruit::CodeVersion() << ")\n"
+    << "MuJoCo built against " << h / 1000000 << "." << h / 1000 % 1000 << "." << h % 1000
+    << " (mjVERSION_HEADER " << h << "), running " << mj_versionString();
+  return s.str();
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -47,6 +61,8 @@ int main(int argc, char** argv) {
       "Exit codes (all commands): 0 ok, 2 usage (bad option or value), 3 bad input file content, "
       "4 I/O (cannot read or write), 5 internal error. See docs/reliability.md."};
   app.require_subcommand(1);
+  app.set_version_flag("--version", VersionText,
+                       "Print the version of recruit and MuJoCo and exit");
   int exit_code = 0;
   // When the first argument names a command, only that one is built: building all six, with
   // their options and validators, was ~3 % of the CPU of a short run's start.
@@ -63,6 +79,11 @@ int main(int argc, char** argv) {
   for (const auto& c : commands) named |= first == c.name;
   for (const auto& c : commands) {
     if (!named || first == c.name) c.add(app, exit_code);
+  }
+  if (argc == 1) {  // no command: the help, not an error
+    app.name("recruit");
+    std::cout << app.help();
+    return 0;
   }
   TeeBuf tee(std::cerr.rdbuf());
   std::streambuf* old = std::cerr.rdbuf(&tee);

@@ -81,10 +81,23 @@ namespace {
 
 double RowHeight(const FigureLayout& f) { return 1.4 * f.font_px; }
 
-// The y range of a panel: fixed, or from the data (0..1 when there is none).
+// The y range of a panel: fixed, or from the data (0..1 when there is none). When every series
+// is >= 0 (counts, forces), a band (an estimate's +- 2 sd) does not take the axis below zero:
+// the axis starts at 0 and the band is clipped there.
 Range YRangeOf(const Axes& a) {
   if (a.y_range) return *a.y_range;
-  return DataRangeY(a).value_or(Range{0, 1});
+  std::optional<Range> r = DataRangeY(a);
+  if (!r) return Range{0, 1};
+  bool any = false, nonnegative = true;
+  for (const Series& s : a.series) {
+    for (double y : s.y) {
+      if (!std::isfinite(y)) continue;
+      any = true;
+      nonnegative = nonnegative && y >= 0;
+    }
+  }
+  if (any && nonnegative && r->lo < 0) r->lo = 0;
+  return *r;
 }
 
 TickSet YTicksFor(const Axes& a, double data_h, double font_px) {

@@ -165,6 +165,7 @@ void TelemetryPlots::Configure(const TelemetrySample& s) {
     panels_.push_back(std::move(forces));
   }
   Panel counts = make_panel("units on");
+  counts.counts = true;
   for (int b = 0; b < nb; ++b) {
     const std::string name = nb > 1 ? s.bundles[b].actuator : "true";
     counts.lines.push_back({name, Rgb(kBundleRgb[b]), LineStyle::kStairs, {}, {}});
@@ -281,6 +282,12 @@ std::vector<TelemetryPlots::PanelBoxes> TelemetryPlots::Layout(mjrRect area,
   return boxes;
 }
 
+double TelemetryPlots::UnitToRow(const mjvFigure& fig, double unit) {
+  const double d0 = fig.yaxisdata[0], d1 = fig.yaxisdata[1];
+  const double frac = d1 > d0 ? (unit - d0) / (d1 - d0) : unit;
+  return fig.yaxispixel[0] + frac * (fig.yaxispixel[1] - fig.yaxispixel[0]);
+}
+
 std::vector<std::string> TelemetryPlots::XTickLabels(const mjvFigure& fig) {
   std::vector<std::string> labels;
   const int axis = 0;
@@ -343,12 +350,15 @@ void TelemetryPlots::Prepare(mjrRect area, const TextMetrics& text) {
         hi = std::max(hi, b.hi[i]);
       }
     }
+    if (panel.counts) lo = 0;  // counts are >= 0; the band's lower edge is clipped at 0
     if (!(hi > lo)) hi = lo + 1;
     const int plot_h = box.height - 4 * ch;
     const int target_y = std::clamp(plot_h / (2 * ch), 2, 5);
     const plot::TickSet ticks = plot::MakeTicks(lo, hi, target_y);
     panel.y_ticks = ticks.values;
     panel.y_labels = ticks.labels;
+    panel.y_axis = {ticks.lo, ticks.hi};
+    const AxisMap& ymap = panel.y_axis;
     for (const std::string& l : ticks.labels) {
       if (l.size() > widest.size()) widest = l;
     }
@@ -364,8 +374,9 @@ void TelemetryPlots::Prepare(mjrRect area, const TextMetrics& text) {
       std::snprintf(f->yformat, sizeof(f->yformat), " ");
       f->range[0][0] = static_cast<float>(x_start);
       f->range[0][1] = static_cast<float>(x_end);
-      f->range[1][0] = static_cast<float>(ticks.lo);
-      f->range[1][1] = static_cast<float>(ticks.hi);
+      // y values go in mapped to [0, 1] (AxisMap): mjr_figure keeps that range as given.
+      f->range[1][0] = 0.f;
+      f->range[1][1] = 1.f;
       f->gridsize[0] = static_cast<int>(x_ticks_.size());
       f->gridsize[1] = static_cast<int>(ticks.values.size());
       for (int i = 0; i < mjMAXLINE; ++i) f->linepnt[i] = 0;
@@ -391,8 +402,8 @@ void TelemetryPlots::Prepare(mjrRect area, const TextMetrics& text) {
           while (j < v.x.size() && v.x[j] <= t0) prev = v.y[j++];
           // Each dash holds the value at its start: a jump shows as a gap, not a slant.
           const double y0 = prev;
-          xy.insert(xy.end(), {static_cast<float>(t0), static_cast<float>(y0),
-                               static_cast<float>(t1), static_cast<float>(y0)});
+          const auto u0 = static_cast<float>(ymap.ToUnit(y0));
+          xy.insert(xy.end(), {static_cast<float>(t0), u0, static_cast<float>(t1), u0});
         }
         SetData(dash, dashed, xy);
         std::memcpy(dash->linergb[dashed], l.rgb.data(), sizeof(float) * 3);
@@ -401,10 +412,10 @@ void TelemetryPlots::Prepare(mjrRect area, const TextMetrics& text) {
         for (size_t k = 0; k < v.x.size(); ++k) {
           if (l.style == LineStyle::kStairs && k > 0 && v.y[k] != v.y[k - 1]) {
             xy.push_back(static_cast<float>(v.x[k]));
-            xy.push_back(static_cast<float>(v.y[k - 1]));
+            xy.push_back(static_cast<float>(ymap.ToUnit(v.y[k - 1])));
           }
           xy.push_back(static_cast<float>(v.x[k]));
-          xy.push_back(static_cast<float>(v.y[k]));
+          xy.push_back(static_cast<float>(ymap.ToUnit(v.y[k])));
         }
         SetData(fig, solid, xy);
         std::memcpy(fig->linergb[solid], l.rgb.data(), sizeof(float) * 3);
@@ -460,14 +471,12 @@ void TelemetryPlots::DrawBands(const Panel& p, const mjrContext* con) const {
   (void)con;
   const mjvFigure& f = *p.fig;
   const double x0 = f.xaxisdata[0], x1 = f.xaxisdata[1];
-  const double y0 = f.yaxisdata[0], y1 = f.yaxisdata[1];
   const int px0 = f.xaxispixel[0], px1 = f.xaxispixel[1];
   const int py0 = f.yaxispixel[0], py1 = f.yaxispixel[1];
-  if (!(x1 > x0) || !(y1 > y0) || px1 <= px0 || py1 <= py0) return;
+  if (!(x1 > x0) || !(f.yaxisdata[1] > f.yaxisdata[0]) || px1 <= px0 || py1 <= py0) return;
   auto to_px = [&](double x) { return px0 + (x - x0) / (x1 - x0) * (px1 - px0); };
-  auto to_py = [&](double y) {
-    return py0 + (std::clamp(y, y0, y1) - y0) / (y1 - y0) * (py1 - py0);
-  };
+  // Through the panel's axis map, clipped to the axis, like the curves.
+  auto to_py = [&](double y) { return UnitToRow(f, std::clamp(p.y_axis.ToUnit(y), 0.0, 1.0)); };
   for (const PlotBand& b : p.bands) {
     // One rectangle per 2-pixel column: the envelope of the samples in it.
     const int cols = (px1 - px0 + 1) / 2;
@@ -502,7 +511,9 @@ void TelemetryPlots::DrawYLabels(const Panel& p, const mjrContext* con,
   if (n < 2) return;
   const int ch = text.char_height;
   for (int i = 0; i < n; ++i) {
-    const double y = f.yaxispixel[0] + (f.yaxispixel[1] - f.yaxispixel[0]) * i / (n - 1.0);
+    // Where the curves put the tick's value (the grid line of tick i when mjr_figure keeps the
+    // [0, 1] range it was given).
+    const double y = UnitToRow(f, p.y_axis.ToUnit(p.y_ticks[i]));
     const int w = text.width(p.y_labels[i]);
     const int row = ch + ch / 4;
     mjr_label({f.xaxispixel[0] - ch / 3 - w, static_cast<int>(std::lround(y)) - row / 2, w, row},
@@ -524,8 +535,20 @@ void TelemetryPlots::Draw(mjrRect area, const mjrContext* con) {
     panel.fig->gridwidth = std::max(1.f, line_px / 2);
     panel.dash->gridwidth = panel.fig->gridwidth;
     DrawLegend(panel, boxes[p].legend, con, text, line_px);
-    mjr_figure(boxes[p].figure, panel.fig.get(), con);
+    // Bands under the lines: the pane and grid first (no lines), the bands, then the same
+    // figure again with transparent backgrounds for its lines.
+    mjvFigure* fig = panel.fig.get();
+    int linepnt[mjMAXLINE];
+    std::memcpy(linepnt, fig->linepnt, sizeof(linepnt));
+    std::fill(fig->linepnt, fig->linepnt + mjMAXLINE, 0);
+    mjr_figure(boxes[p].figure, fig, con);
     DrawBands(panel, con);
+    std::memcpy(fig->linepnt, linepnt, sizeof(linepnt));
+    const float figure_alpha = fig->figurergba[3], pane_alpha = fig->panergba[3];
+    fig->figurergba[3] = fig->panergba[3] = 0.f;
+    mjr_figure(boxes[p].figure, fig, con);
+    fig->figurergba[3] = figure_alpha;
+    fig->panergba[3] = pane_alpha;
     DrawYLabels(panel, con, text);
     mjr_figure(boxes[p].figure, panel.dash.get(), con);
   }

@@ -3,7 +3,8 @@
 //   - force task: force and its reference (N); angle task: joint angle and its reference (deg),
 //     then each bundle's force with the force reference its controller tracks (N);
 //   - each bundle's true on-count (solid stairs) and the estimator's count (dashed, lighter) with
-//     the filter's estimated_on +- 2 estimated_on_std band (translucent).
+//     the filter's estimated_on +- 2 estimated_on_std band (translucent, under the lines); the
+//     count axis starts at zero.
 // Rules (tests/render/telemetry_plots_test.cc): the legend sits in its own strip above each
 // panel, never over data; ticks are integer multiples of a 1-2-5 x 10^k step with the units in
 // the panel title; the whole window is kept however long it is (each line is thinned to fit
@@ -30,6 +31,17 @@ struct PlotLine {
   std::array<float, 3> rgb{};
   LineStyle style = LineStyle::kSolid;
   std::deque<double> t, y;  // the window's samples (non-finite values left out)
+};
+
+// A panel's y axis, shared by everything drawn on it: values map linearly to [0, 1], bottom to
+// top of the pane. The curves go to mjvFigure already mapped, with the range [0, 1], because
+// MuJoCo 4's mjr_figure widens a y range to multiples of 10^floor(log10(span)) (e.g.
+// [-50, 50] to [-100, 100]) and would draw the curves on another scale than the labels; [0, 1]
+// it keeps. The labels and bands are placed through the same map.
+struct AxisMap {
+  double lo = 0, hi = 1;  // the first and last tick
+  double ToUnit(double v) const { return (v - lo) / (hi - lo); }
+  double FromUnit(double u) const { return lo + u * (hi - lo); }
 };
 
 struct PlotBand {
@@ -79,6 +91,11 @@ class TelemetryPlots {
   const std::vector<double>& y_ticks(int panel) const { return panels_[panel].y_ticks; }
   // The y tick labels of the last Prepare (drawn by this class).
   const std::vector<std::string>& y_labels(int panel) const { return panels_[panel].y_labels; }
+  // The y axis of the last Prepare (the ticks' range) that the figure's y values are mapped by.
+  const AxisMap& y_axis(int panel) const { return panels_[panel].y_axis; }
+  // The pixel row (bottom-left origin) where a drawn figure puts the mapped value `unit`, from
+  // what mjr_figure reports (yaxisdata, yaxispixel): the labels and bands use it.
+  static double UnitToRow(const mjvFigure& fig, double unit);
   // The x tick labels mjr_figure prints: evenly spaced values between the range ends,
   // interpolated in float and formatted with the figure's xformat.
   static std::vector<std::string> XTickLabels(const mjvFigure& fig);
@@ -93,7 +110,9 @@ class TelemetryPlots {
     std::unique_ptr<mjvFigure> fig, dash;
     std::vector<double> y_ticks;
     std::vector<std::string> y_labels;
+    AxisMap y_axis;
     bool include_zero = true;
+    bool counts = false;  // unit counts: the axis starts at zero (a band below it is clipped)
   };
   void Configure(const TelemetrySample& s);
   void Drop(double start);

@@ -50,7 +50,7 @@ usage_same_code_everywhere)  # an unknown option and a missing input: 2 for ever
   done
   expect 2 "$RECRUIT" simulate --task /no/such/task.json
   expect 2 "$RECRUIT" filter --model /no/such.json --log /no/such.csv --out x.csv
-  expect 2 "$RECRUIT"
+  expect 0 "$RECRUIT"  # no command: the help (cli_version checks its text)
   expect 0 "$RECRUIT" --help
   ;;
 filter_plant_mismatch)  # filter --plant: a model identified on another plant is refused (3)
