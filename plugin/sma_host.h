@@ -49,6 +49,9 @@ class SmaHost {
     return Act(b).gear * d->ten_length[Act(b).tendon];
   }
   double unit_ref_length(int b) const { return Act(b).ref_length; }
+  // The load-time warnings about bundle b's instance (design limits, fit to the tendon), as
+  // loading printed them once per model.
+  std::vector<std::string> LoadWarnings(int b) const { return Inst(b).LoadWarnings(m_); }
 
   // Every unit of every bundle off, cold, at the current tendon lengths; bundle b's stream
   // seeded with Rng::DeriveSeed(seed, b). Keeps qpos, qvel and time; ends with mj_forward.

@@ -141,18 +141,24 @@ Result<std::unique_ptr<SmaInstance>> SmaInstance::Create(const mjModel* m, int i
   if (in_fit_check) return std::unique_ptr<SmaInstance>();
   auto p = Build(m, instance, true);
   if (p.ok() && FirstCheck(m, instance)) {
-    // Design check (issue 26 item 3): one warning per bundle past a long-life limit.
-    for (const SmaActuator& a : (*p)->actuators()) {
-      const std::string w = DesignWarning(a.model.config());
-      if (!w.empty()) mju_warning("recruit.sma %s", w.c_str());
-    }
-    const std::vector<TendonFit> fits = (*p)->Fit(m);
-    for (int k = 0; k < static_cast<int>(fits.size()); ++k) {
-      const std::string w = (*p)->FitWarning(m, k, fits[k]);
-      if (!w.empty()) mju_warning("%s", w.c_str());
-    }
+    for (const std::string& w : (*p)->LoadWarnings(m)) mju_warning("%s", w.c_str());
   }
   return p;
+}
+
+std::vector<std::string> SmaInstance::LoadWarnings(const mjModel* m) const {
+  std::vector<std::string> out;
+  // The design against the wire's long-life limits: one warning per bundle past one.
+  for (const SmaActuator& a : actuators_) {
+    const std::string w = DesignWarning(a.model.config());
+    if (!w.empty()) out.push_back("recruit.sma " + w);
+  }
+  const std::vector<TendonFit> fits = Fit(m);
+  for (int k = 0; k < static_cast<int>(fits.size()); ++k) {
+    const std::string w = FitWarning(m, k, fits[k]);
+    if (!w.empty()) out.push_back(w);
+  }
+  return out;
 }
 
 std::vector<TendonFit> SmaInstance::Fit(const mjModel* m) const {

@@ -92,6 +92,9 @@ class SmaInstance {
   // The fit of each actuator's bundle to its tendon (in actuator order). Builds a scratch mjData
   // (mj_makeData runs every plugin's init: a thread_local flag keeps this from recursing).
   std::vector<TendonFit> Fit(const mjModel* m) const;
+  // What loading the model warns of (once per distinct model, through mju_warning): each
+  // bundle's design past its wire's long-life limits, and each misfit to its tendon.
+  std::vector<std::string> LoadWarnings(const mjModel* m) const;
   // The warning text for actuator k, or "" when it fits.
   std::string FitWarning(const mjModel* m, int k, const TendonFit& fit) const;
 

@@ -9,6 +9,7 @@
 #include <limits>
 #include <memory>
 
+#include "common/json_file.h"
 #include "common/mujoco_ptr.h"
 #include "common/rng.h"
 #include "sim/force_sensor.h"
@@ -175,9 +176,41 @@ Result<std::string> BundleModelFile(const Task& task, const ControllerSettings& 
   return found;
 }
 
+// What loading the plant's model warned of for its bundles, each text once.
+std::vector<std::string> LoadWarnings(const Plant& plant) {
+  std::vector<std::string> out;
+  for (int i = 0; i < plant.num_bundles(); ++i) {
+    for (std::string& w : plant.host().LoadWarnings(plant.bundle_index(i))) {
+      if (std::find(out.begin(), out.end(), w) == out.end()) out.push_back(std::move(w));
+    }
+  }
+  return out;
+}
+
+// A warning when the identified model in `file` explains less than kMinHoldoutR2 of the force it
+// was checked on (held-out data at the identification pose): the estimate and the self-tuned
+// loop's design rest on it.
+constexpr double kMinHoldoutR2 = 0.9;
+void IdentificationWarning(const std::string& file, const std::string& bundle,
+                           std::vector<std::string>& warnings) {
+  auto j = LoadJsonFile(file);
+  if (!j.ok() || !j->contains("identification")) return;
+  const nlohmann::json& id = (*j)["identification"];
+  if (!id.contains("holdout") || !id["holdout"].contains("r2")) return;
+  const double r2 = id["holdout"]["r2"].get<double>();
+  if (r2 >= kMinHoldoutR2) return;
+  char buf[300];
+  std::snprintf(buf, sizeof buf,
+                "%s: its identified model explains R^2 = %.2f of held-out force (below %.2f): the "
+                "estimate and the loop's design rest on it (%s)",
+                bundle.c_str(), r2, kMinHoldoutR2, file.c_str());
+  if (std::find(warnings.begin(), warnings.end(), buf) == warnings.end()) warnings.push_back(buf);
+}
+
 Result<std::vector<Channel> > MakeChannels(const Task& task, const ControllerSettings& settings,
                                            const Plant& plant, const RunOptions& options,
-                                           const std::string& where, double& identify_s) {
+                                           const std::string& where, double& identify_s,
+                                           std::vector<std::string>& warnings) {
   auto spec = control::EstimatorSpec::Parse(settings.estimator, "extended", settings.filter_model,
                                             20, settings.force_noise_std);
   if (!spec.ok()) return Error{where + ".controller.estimator: " + spec.error()};
@@ -201,6 +234,7 @@ Result<std::vector<Channel> > MakeChannels(const Task& task, const ControllerSet
       auto file = BundleModelFile(task, settings, plant, i, options, bundle_spec, identify_s);
       if (!file) return Error{where + ".controller: " + file.error()};
       bundle_spec.model_file = *file;
+      IdentificationWarning(*file, host.bundle_name(b), warnings);
     }
     auto c = control::RecruitmentController::Create(p, bundle_spec);
     if (!c.ok()) return Error{where + ".controller: " + c.error()};
@@ -219,7 +253,8 @@ Result<std::vector<Channel> > MakeChannels(const Task& task, const ControllerSet
 // the chain identified for it: the Kalman estimator's own model, else the identified one.
 Result<std::vector<control::ActuatorResponse> > ActuatorResponses(
     const Task& task, const ControllerSettings& settings, const Plant& plant,
-    const std::vector<Channel>& channels, const RunOptions& options, double& identify_s) {
+    const std::vector<Channel>& channels, const RunOptions& options, double& identify_s,
+    std::vector<std::string>& warnings) {
   std::vector<control::ActuatorResponse> out;
   for (int i = 0; i < plant.num_bundles(); ++i) {
     const auto* kalman =
@@ -231,7 +266,17 @@ Result<std::vector<control::ActuatorResponse> > ActuatorResponses(
       control::EstimatorSpec spec;
       spec.model_file = settings.filter_model;
       auto file = BundleModelFile(task, settings, plant, i, options, spec, identify_s);
-      if (!file) return Error{file.error()};
+      if (!file && options.identify_missing_models) return Error{file.error()};
+      if (!file) {
+        // No identified model and none to be made: the design rests on the unit's own lag.
+        const double tau = plant.host().bundle(plant.bundle_index(i)).unit().time_constant();
+        out.push_back(control::FirstOrderActuatorResponse(settings.dT, settings.lambda, tau));
+        warnings.push_back(plant.bundle_name(i) +
+                           ": no identified model for this dT; the loop is designed on the "
+                           "unit's thermal lag");
+        continue;
+      }
+      IdentificationWarning(*file, plant.bundle_name(i), warnings);
       auto loaded = FilterModel::FromJson(*file);
       if (!loaded) return Error{loaded.error()};
       model = std::move(loaded).value();
@@ -250,6 +295,8 @@ Result<std::vector<control::ActuatorResponse> > ActuatorResponses(
       // approach through the unit's own thermal lag.
       const double tau = plant.host().bundle(plant.bundle_index(i)).unit().time_constant();
       out.push_back(control::FirstOrderActuatorResponse(settings.dT, settings.lambda, tau));
+      warnings.push_back(plant.bundle_name(i) + ": " + r.error() +
+                         "; the loop is designed on the unit's thermal lag instead");
     }
   }
   return out;
@@ -501,9 +548,11 @@ Result<std::vector<JointDesignRecord> > DesignTaskLoops(const Task& task,
   Plant& plant = **plant_or;
   plant.Reset(options.seed);
   double identify_s = 0;
-  auto channels = MakeChannels(task, settings, plant, options, where, identify_s);
+  std::vector<std::string> warnings;
+  auto channels = MakeChannels(task, settings, plant, options, where, identify_s, warnings);
   if (!channels.ok()) return Error{channels.error()};
-  auto responses = ActuatorResponses(task, settings, plant, *channels, options, identify_s);
+  auto responses =
+      ActuatorResponses(task, settings, plant, *channels, options, identify_s, warnings);
   if (!responses) return Error{where + ".outer_loop: " + responses.error()};
   auto loops = JointLoops::Create(task, plant, std::move(responses).value(), settings.dT);
   if (!loops) return Error{where + ".outer_loop: " + loops.error()};
@@ -549,7 +598,10 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
   Plant& plant = **plant_or;
   plant.Reset(options.seed);
   double identify_s = 0;  // time spent identifying filter models, left out of wall_seconds
-  auto channels_or = MakeChannels(task, settings, plant, options, where, identify_s);
+  // Every warning of the run, in its summary: what loading the model warned of (design limits,
+  // fit), the identified models' quality, then the limits the run exceeded.
+  std::vector<std::string> warnings = LoadWarnings(plant);
+  auto channels_or = MakeChannels(task, settings, plant, options, where, identify_s, warnings);
   if (!channels_or.ok()) return Error{channels_or.error()};
   std::vector<Channel>& channels = *channels_or;
   const int nb = plant.num_bundles();
@@ -557,7 +609,8 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
   if (task.outer) angle_loop.gains = *task.outer;
   std::optional<JointLoops> joint_loops;
   if (task.auto_loop) {
-    auto responses = ActuatorResponses(task, settings, plant, channels, options, identify_s);
+    auto responses =
+        ActuatorResponses(task, settings, plant, channels, options, identify_s, warnings);
     if (!responses) return Error{where + ".outer_loop: " + responses.error()};
     auto loops = JointLoops::Create(task, plant, std::move(responses).value(), settings.dT);
     if (!loops) return Error{where + ".outer_loop: " + loops.error()};
@@ -649,10 +702,14 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
   s.physics_steps = num_steps;
   s.control_instants = control_instants;
   s.unit = sample.reference_unit;
+  s.warnings = std::move(warnings);
+  const size_t load_warnings = s.warnings.size();  // already printed when the model loaded
   Summarize(task, plant, sig, channels, s);
   if (joint_loops) SummarizeJoints(task, plant, sig, more_joints, *joint_loops, s);
   s.identification_seconds = identify_s;
-  for (const std::string& w : s.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
+  for (size_t k = load_warnings; k < s.warnings.size(); ++k) {
+    std::fprintf(stderr, "warning: %s\n", s.warnings[k].c_str());
+  }
   s.wall_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count() -
       identify_s;

@@ -1,0 +1,211 @@
+// The self-tuned outer loop's plant side and its runs: the static torque against the limb's
+// gravity summed by hand, the moment arms against finite differences of the tendons' lengths,
+// the one-joint form with "outer_loop": "auto", the several-joint form on a two-joint arm, and
+// the load-time warnings in the run's summary.
+#include <gtest/gtest.h>
+#include <mujoco/mujoco.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+
+#include "sim/plant.h"
+#include "sim/run_task.h"
+#include "tests/plugin/mujoco_util.h"
+
+namespace recruit::sim {
+namespace {
+
+namespace fs = std::filesystem;
+const std::string kRoot = RECRUIT_SOURCE_DIR;
+
+Result<Task> TaskFromText(const std::string& text, const std::string& dir) {
+  return Task::FromJsonText(text, dir + "/task.json");
+}
+
+std::string ArmTask(const std::string& loop) {
+  return R"({"name": "t", "model": ")" + kRoot + R"(/models/elbow_arm.xml", "tracked": "angle",
+    "agonist": "flexor", "antagonist": "extensor", "joint": "elbow", "duration": 30,
+    "reference": {"type": "steps", "times": [5], "values": [40], "unit": "deg"},
+    "controller": {"estimator": "output", "dT": 1.0, "lambda": 0.2},
+    "outer_loop": )" +
+         loop + "}";
+}
+
+TEST(JointLoop, OneJointFormWithAutoServesItsJointWithAgonistAndAntagonist) {
+  auto t = TaskFromText(ArmTask("\"auto\""), kRoot + "/models/tasks");
+  ASSERT_TRUE(t.ok()) << t.error();
+  EXPECT_TRUE(t->auto_loop);
+  ASSERT_EQ(t->joints.size(), 1u);
+  EXPECT_EQ(t->joints[0].joint, "elbow");
+  EXPECT_DOUBLE_EQ(t->joints[0].reference(10), 40 * M_PI / 180);
+  EXPECT_EQ(t->bundles, (std::vector<std::string>{"flexor", "extensor"}));
+  // Hand-set gains keep the old loop.
+  auto old = TaskFromText(ArmTask(R"({"kp": 8, "ki": 0.3})"), kRoot + "/models/tasks");
+  ASSERT_TRUE(old.ok()) << old.error();
+  EXPECT_FALSE(old->auto_loop);
+  EXPECT_TRUE(old->joints.empty());
+}
+
+TEST(JointLoop, JointsFormErrorsNameTheField) {
+  const std::string dir = kRoot + "/models/tasks";
+  const std::string head = R"({"name": "t", "model": "../elbow_arm.xml", "tracked": "angle",
+    "duration": 10, )";
+  struct Case {
+    std::string body, want;
+  } cases[] = {
+      {R"("joints": [])", "task.json.joints: must be an array of 1 to 64"},
+      {R"("joints": [{"joint": "elbow"}])", "task.json.joints[0]: missing field 'reference'"},
+      {R"("joints": [{"joint": "elbow", "reference": {"type": "constant", "value": 1}, "x": 1}])",
+       "task.json.joints[0]: unknown field 'x'"},
+      {R"("joints": [{"joint": "elbow", "reference": {"type": "constant", "value": 1}},
+                     {"joint": "elbow", "reference": {"type": "constant", "value": 2}}])",
+       "task.json.joints[1].joint: 'elbow' is listed twice"},
+      {R"("joints": [{"joint": "elbow", "reference": {"type": "constant", "value": 1}}],
+          "agonist": "flexor")",
+       "task.json.agonist: not with 'joints'"},
+      {R"("joints": [{"joint": "elbow", "reference": {"type": "constant", "value": 1}}],
+          "bundles": ["flexor", "flexor"])",
+       "task.json.bundles[1]: 'flexor' is listed twice"},
+      {R"("joints": [{"joint": "elbow", "reference": {"type": "constant", "value": 1}}],
+          "outer_loop": {"kp": 1})",
+       "task.json.outer_loop: a task with 'joints' designs its own loop"},
+      {R"("joints": [{"joint": "elbow", "reference": {"type": "constant", "value": 1}}],
+          "co_contraction": 0.9)",
+       "task.json.co_contraction: 0.9 is out of range"},
+  };
+  for (const Case& c : cases) {
+    auto t = TaskFromText(head + c.body + "}", dir);
+    ASSERT_FALSE(t.ok()) << c.body;
+    EXPECT_NE(t.error().find(c.want), std::string::npos) << t.error();
+  }
+  auto bad_joint = TaskFromText(
+      head + R"("joints": [{"joint": "knee", "reference": {"type": "constant", "value": 1}}]})",
+      dir);
+  ASSERT_TRUE(bad_joint.ok());
+  auto plant = Plant::Create(*bad_joint, false);
+  ASSERT_FALSE(plant.ok());
+  EXPECT_NE(plant.error().find("joints[0].joint: no joint 'knee'"), std::string::npos)
+      << plant.error();
+}
+
+// The static torque is what holds the limb still: with the driven joint at q, MuJoCo's
+// inverse dynamics against the gravity torque of every body below the elbow summed by hand.
+TEST(JointLoop, StaticTorqueIsTheGravityTorqueOfTheBodiesTheJointCarries) {
+  auto t = TaskFromText(ArmTask("\"auto\""), kRoot + "/models/tasks");
+  ASSERT_TRUE(t.ok());
+  auto p = Plant::Create(*t, false);
+  ASSERT_TRUE(p.ok()) << p.error();
+  Plant& plant = **p;
+  plant.Reset(1);
+  const mjModel* m = plant.model();
+  DataPtr d(mj_makeData(m));
+  const int joint = mj_name2id(m, mjOBJ_JOINT, "elbow");
+  for (double deg : {10.0, 40.0, 75.0}) {
+    const double q = deg * M_PI / 180;
+    const double tau = plant.StaticTorque(Eigen::VectorXd::Constant(1, q))[0];
+    d->qpos[m->jnt_qposadr[joint]] = q;
+    mj_kinematics(m, d.get());
+    // Torque about the joint axis of gravity on each body of the forearm's subtree.
+    const double* axis = d->xaxis + 3 * joint;
+    const double* anchor = d->xanchor + 3 * joint;
+    double want = 0;
+    for (int b = 1; b < m->nbody; ++b) {
+      int up = b;
+      while (up > 0 && up != m->jnt_bodyid[joint]) up = m->body_parentid[up];
+      if (up != m->jnt_bodyid[joint]) continue;
+      const double r[3] = {d->xipos[3 * b] - anchor[0], d->xipos[3 * b + 1] - anchor[1],
+                           d->xipos[3 * b + 2] - anchor[2]};
+      const double f[3] = {0, 0, m->body_mass[b] * m->opt.gravity[2]};
+      const double c[3] = {r[1] * f[2] - r[2] * f[1], r[2] * f[0] - r[0] * f[2],
+                           r[0] * f[1] - r[1] * f[0]};
+      want -= c[0] * axis[0] + c[1] * axis[1] + c[2] * axis[2];  // the torque that holds it
+    }
+    // The joint's spring (none here) and nothing else.
+    EXPECT_NEAR(tau, want, 1e-9 * std::abs(want) + 1e-12) << deg;
+    EXPECT_GT(tau, 0);  // gravity extends the elbow: holding it takes flexion
+  }
+}
+
+// Moment arms: minus the derivative of each bundle's length coordinate (gear x tendon length)
+// with respect to the joint, by central differences.
+TEST(JointLoop, MomentArmsAreMinusTheDerivativeOfEachBundlesLength) {
+  auto t = TaskFromText(ArmTask("\"auto\""), kRoot + "/models/tasks");
+  ASSERT_TRUE(t.ok());
+  auto p = Plant::Create(*t, false);
+  ASSERT_TRUE(p.ok());
+  Plant& plant = **p;
+  plant.Reset(1);
+  const Eigen::MatrixXd arms = plant.MomentArms();
+  const mjModel* m = plant.model();
+  DataPtr d(mj_makeData(m));
+  mju_copy(d->qpos, plant.data()->qpos, m->nq);
+  const int qadr = m->jnt_qposadr[mj_name2id(m, mjOBJ_JOINT, "elbow")];
+  const double h = 1e-6, q0 = d->qpos[qadr];
+  for (int i = 0; i < plant.num_bundles(); ++i) {
+    const int ten = plant.host().tendon_id(plant.bundle_index(i));
+    d->qpos[qadr] = q0 + h;
+    mj_forward(m, d.get());
+    const double up = d->ten_length[ten];
+    d->qpos[qadr] = q0 - h;
+    mj_forward(m, d.get());
+    const double down = d->ten_length[ten];
+    EXPECT_NEAR(arms(0, i), -(up - down) / (2 * h), 1e-6) << plant.bundle_name(i);
+  }
+  EXPECT_GT(arms(0, 0), 0);  // the flexor flexes
+  EXPECT_LT(arms(0, 1), 0);
+}
+
+// A run of the self-tuned loop without identified models (the output estimator, no
+// identification): it reaches toward the reference and its summary has the loop's designs.
+TEST(JointLoop, OneJointRunTracksAndReportsItsDesigns) {
+  auto t = TaskFromText(ArmTask("\"auto\""), kRoot + "/models/tasks");
+  ASSERT_TRUE(t.ok());
+  RunOptions o;
+  o.seed = 7;
+  o.quiet = true;
+  o.identify_missing_models = false;
+  o.dT = 0.75;  // no model is shipped for it: the loop is designed on the units' lag
+  auto r = RunTask(*t, o);
+  ASSERT_TRUE(r.ok()) << r.error();
+  ASSERT_EQ(r->steps.size(), 1u);
+  EXPECT_LT(std::abs(r->steps[0].overshoot), 0.5);
+  ASSERT_EQ(r->joints.size(), 1u);
+  EXPECT_FALSE(r->loop_designs.empty());
+  EXPECT_GT(r->loop_designs[0]["kp"].get<double>(), 0);
+  bool said = false;
+  for (const std::string& w : r->warnings) said |= w.find("thermal lag") != std::string::npos;
+  EXPECT_TRUE(said);
+}
+
+// A bundle designed past the wire's long-life temperature: the warning loading printed is in
+// the run's summary too.
+TEST(JointLoop, TheSummaryCarriesWhatLoadingTheModelWarnedOf) {
+  const fs::path dir = fs::temp_directory_path() / "recruit_summary_warnings";
+  fs::create_directories(dir);
+  std::ifstream in(kRoot + "/models/isometric_bench.xml");
+  std::string xml((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  // Insert a hotter current into the bench's instance config.
+  xml = std::regex_replace(xml, std::regex("<config key=\"units\""),
+                           "<config key=\"current\" value=\"0.22\"/><config key=\"units\"",
+                           std::regex_constants::format_first_only);
+  { std::ofstream(dir / "bench.xml") << xml; }
+  const std::string task = R"({"name": "w", "model": "bench.xml", "tracked": "force",
+    "agonist": "bundle", "duration": 2, "reference": {"type": "constant", "value": 5},
+    "controller": {"estimator": "output", "dT": 0.5}})";
+  auto t = Task::FromJsonText(task, (dir / "task.json").string());
+  ASSERT_TRUE(t.ok()) << t.error();
+  RunOptions o;
+  o.quiet = true;
+  sma::testing::WarningCapture capture;  // MuJoCo prints it once; keep it out of MUJOCO_LOG.TXT
+  auto r = RunTask(*t, o);
+  ASSERT_TRUE(r.ok()) << r.error();
+  bool found = false;
+  for (const std::string& w : r->warnings) found |= w.find("120 C") != std::string::npos;
+  EXPECT_TRUE(found) << ::testing::PrintToString(r->warnings);
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace recruit::sim
