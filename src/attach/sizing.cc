@@ -102,26 +102,50 @@ Result<BundleDesign> SizeBundle(const SizingInput& in, const SizingLimits& limit
   }
   const double l_mid = 0.5 * (in.length_min + in.length_max);
   // Diameter: the thinnest stock wire whose bundle needs at most 2 wires per segment within
-  // max_units units (fast cooling, and enough units for the controller's resolution).
+  // max_units units (fast cooling, and enough units for the controller's resolution), unless
+  // that wire cools slower than max_time_constant: then the thickest wire that does not, with up
+  // to max_parallel wires per segment and max_units_fast units (more wires, the bandwidth kept).
   const std::vector<double>& stock = StockDiameters();
+  bool chosen = false, fast_found = false;
+  sma::UnitParams fast;  // the thickest fast-enough design so far
+  int fast_units = 0;
   for (std::size_t i = 0; i < stock.size(); ++i) {
     auto unit = DesignUnit(stock[i], length, series, limits);
     if (!unit.ok()) {
-      if (i + 1 < stock.size()) continue;
+      if (i + 1 < stock.size() || fast_found) continue;
       return Error{where + unit.error()};
     }
     const double s_mid = unit->params().prestretch - out.gear * (in.length_max - l_mid);
     const double per_wire = out.gear * unit->Tension(0.0, s_mid);
     const int wires = static_cast<int>(std::ceil(in.peak_force / per_wire - 1e-9));
     const int parallel = (wires + limits.max_units - 1) / limits.max_units;
-    if (parallel > 2 && i + 1 < stock.size()) continue;
     sma::UnitParams p = unit->params();
     p.parallel = parallel;
-    out.units = (wires + parallel - 1) / parallel;
     p.prestretch = series * eps_L * length - out.gear * (in.length_max - in.ref_length);
-    out.unit = p;
-    break;
+    const int units = (wires + parallel - 1) / parallel;
+    const bool fast_enough = unit->time_constant() <= limits.max_time_constant;
+    if (parallel <= 2 && (fast_enough || !fast_found)) {
+      out.unit = p, out.units = units, chosen = true;
+      break;
+    }
+    const int parallel_fast = (wires + limits.max_units_fast - 1) / limits.max_units_fast;
+    if (parallel_fast <= limits.max_parallel && fast_enough) {
+      fast = p;
+      fast.parallel = parallel_fast;
+      fast_units = (wires + parallel_fast - 1) / parallel_fast;
+      fast_found = true;
+    }
+    if (parallel <= 2 || i + 1 == stock.size()) {
+      if (fast_found) {
+        out.unit = fast, out.units = fast_units;
+      } else {
+        out.unit = p, out.units = units;
+      }
+      chosen = true;
+      break;
+    }
   }
+  if (!chosen) return Error{where + "no stock wire meets the force"};
   auto u = sma::UnitModel::Create(out.unit);
   if (!u.ok()) return Error{where + u.error()};
   const sma::UnitLimits datasheet = sma::UnitLimits::ForWire(out.unit.wire_diameter);

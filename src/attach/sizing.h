@@ -23,7 +23,11 @@ struct SizingLimits {
   double steady_temperature = 115;     // C: a held-on wire's steady temperature (<= 120)
   int max_units = 100;                 // units per bundle (the controller's resolution)
   int max_parallel = 6;                // wires per segment
-  double min_segment_length = 0.03;    // m
+  // s: the slowest unit thermal time constant chosen when a thinner wire can meet the force with
+  // at most max_parallel wires per segment (0.15 mm wire: 2.0 s; the bundle's bandwidth).
+  double max_time_constant = 2.0;
+  int max_units_fast = 300;          // units a bundle of such thinner wires may have
+  double min_segment_length = 0.03;  // m
 };
 
 // Stock Flexinol diameters (m), thinnest first.
