@@ -64,9 +64,14 @@ Result<nlohmann::json> StarterTask(const AttachReport& report, const std::vector
       const double q = j.usable_lo + kStepFractions[k] * (j.usable_hi - j.usable_lo);
       values.push_back(Round1(q * 180 / M_PI));
     }
+    const double middle = Round1(0.5 * (j.usable_lo + j.usable_hi) * 180 / M_PI);
     list.push_back({{"joint", j.joint},
                     {"reference",
-                     {{"type", "steps"}, {"times", times}, {"values", values}, {"unit", "deg"}}}});
+                     {{"type", "steps"},
+                      {"initial", middle},
+                      {"times", times},
+                      {"values", values},
+                      {"unit", "deg"}}}});
   }
   task["joints"] = list;
   nlohmann::json bundles = nlohmann::json::array();

@@ -13,7 +13,10 @@
 namespace recruit::attach {
 
 inline constexpr double kStepHold = 20;  // s per step
-inline constexpr double kStepStart = 5;  // s before the first step
+// s before the first step: the limb goes from its rest pose to the middle of the usable range
+// (the references' initial value), so that the first scored step starts settled and is as
+// large as the others.
+inline constexpr double kStepStart = 20;
 
 // The task JSON (docs/howto-own-model.md); `task_path` is where it will be written (the model
 // path in it is relative to that folder). Error when a locked joint is not one the bundles cross
