@@ -14,7 +14,7 @@ $R attach models/arm2j_muscle.xml --muscles all -o "$OUT/arm2j.xml" --task "$OUT
 $R attach "$M/elbow/myoelbow_1dof6muscles.xml" --muscles all -o "$OUT/myoelbow.xml" \
   --task "$OUT/myoelbow_task.json" >"$OUT/myoelbow_attach.txt"
 $R attach "$M/finger/myofinger_v0.xml" --muscles all --lock IFadb,IFpip,IFdip -o "$OUT/finger.xml" \
-  --task "$OUT/finger_task.json" >"$OUT/finger_attach.txt"
+  --force 40 --task "$OUT/finger_task.json" >"$OUT/finger_attach.txt"
 python3 scripts/dev/eval_tasks.py --seeds "$SEEDS" "$OUT/arm2j_task.json" "$OUT/myoelbow_task.json" \
   "$OUT/finger_task.json"
 python3 scripts/dev/eval_tasks.py --seeds "$SEEDS" --override-auto models/tasks/arm_reach_hold.json \

@@ -22,7 +22,7 @@ struct SizingLimits {
   double design_stress = 0.8 * 172e6;  // Pa: a hot wire's stress at the tendon's longest
   double steady_temperature = 115;     // C: a held-on wire's steady temperature (<= 120)
   int max_units = 100;                 // units per bundle (the controller's resolution)
-  int max_parallel = 6;                // wires per segment
+  int max_parallel = 8;                // wires per segment
   // s: the slowest unit thermal time constant chosen when a thinner wire can meet the force with
   // at most max_parallel wires per segment (0.15 mm wire: 2.0 s; the bundle's bandwidth).
   double max_time_constant = 2.0;
