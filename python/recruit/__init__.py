@@ -18,6 +18,7 @@ Contents:
                        trace (a column dict of NumPy arrays)
     sweep              a grid of runs on all cores -> column dict, one row per run
     aggregate          a sweep's runs per grid cell -> column dict (`recruit sweep`'s table)
+    attach             a model's muscles become sized SMA bundles (`recruit attach`) -> report
 
 Errors in arguments or files raise ValueError carrying the C++ message.
 """
@@ -75,6 +76,7 @@ ExactFilter = _recruit.ExactFilter
 ParticleFilter = _recruit.ParticleFilter
 Bundles = _recruit.Bundles
 Controller = _recruit.Controller
+attach = _recruit.attach
 
 FilterModel.__doc__ = """What a population filter knows about the units and the sensor.
 
@@ -300,4 +302,4 @@ def aggregate(runs: Mapping[str, Any], max_overshoot: float = 0.10,
 
 __all__ = ["FilterModel", "KalmanFilter", "ExactFilter", "ParticleFilter", "Bundles",
            "Controller", "expectation_law", "filter_log", "simulate", "sweep", "aggregate",
-           "PLUGIN_LIBRARY", "MUJOCO_BUILD_VERSION", "MUJOCO_VERSION"]
+           "attach", "PLUGIN_LIBRARY", "MUJOCO_BUILD_VERSION", "MUJOCO_VERSION"]

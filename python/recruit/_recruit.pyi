@@ -1,4 +1,5 @@
 # Type stubs of the extension module (python/src/*.cc); documentation in __init__.py.
+import os
 from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
@@ -184,3 +185,11 @@ def sweep_json(task_path: str, dT: Sequence[float], lam: Sequence[float],
                filter_model: Optional[str], threads: int, out_dir: str) -> str: ...
 def aggregate(runs: Dict[str, Any], max_overshoot: float = ...,
               min_settled: float = ...) -> Dict[str, Any]: ...
+
+# bind_attach.cc
+def attach(model: Union[str, "os.PathLike[str]"], muscles: Union[str, Sequence[str]],
+           output: Optional[Union[str, "os.PathLike[str]"]] = ...,
+           task: Optional[Union[str, "os.PathLike[str]"]] = ...,
+           report: Optional[Union[str, "os.PathLike[str]"]] = ..., size_only: bool = ...,
+           force: Optional[float] = ..., lengthrange_from_joints: bool = ...,
+           lock: Optional[Union[str, Sequence[str]]] = ...) -> Dict[str, Any]: ...

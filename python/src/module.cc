@@ -10,4 +10,5 @@ PYBIND11_MODULE(_recruit, mod) {
   recruit::py_bind::BindFilter(mod);
   recruit::py_bind::BindControl(mod);
   recruit::py_bind::BindSim(mod);
+  recruit::py_bind::BindAttach(mod);
 }

@@ -3,13 +3,16 @@
 // forms, path jumps against a dense sweep, the gear transmission against its closed form.
 #include "attach/attach.h"
 
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <mujoco/mujoco.h>
 
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <string>
 
 #include "attach/sizing.h"
@@ -17,6 +20,7 @@
 #include "plugin/sma_host.h"
 #include "plugin/sma_plugin.h"
 #include "plugin/tendon_range.h"
+#include "sim/task.h"
 
 namespace recruit::attach {
 namespace {
@@ -296,6 +300,124 @@ TEST(Gear, NonPositiveGearIsRefused) {
   auto m = LoadModelFromString(xml);
   ASSERT_FALSE(m.ok());
   EXPECT_NE(m.error().find("gear=-2 is invalid: must be > 0"), std::string::npos) << m.error();
+}
+
+// The starter task of an attached model, read back with the task loader (src/sim/task.cc).
+struct AttachedWithTask {
+  Result<AttachReport> report = Error{"not run"};
+  std::string task;
+};
+
+AttachedWithTask AttachArmWithTask(const std::string& name, const std::vector<std::string>& lock) {
+  const std::string dir = TempDir(name);
+  AttachOptions o;
+  o.model = kSrc + "/models/arm2j_muscle.xml";
+  o.muscles = {"all"};
+  o.output = dir + "/arm2j_sma.xml";
+  o.task = dir + "/task.json";
+  o.lock = lock;
+  return {Attach(o), o.task};
+}
+
+std::vector<std::string> DrivenJoints(const sim::Task& t) {
+  std::vector<std::string> out;
+  for (const sim::DrivenJoint& j : t.joints) out.push_back(j.joint);
+  return out;
+}
+
+TEST(StarterTask, LockedJointIsNotDriven) {
+  using ::testing::ElementsAre;
+  auto free = AttachArmWithTask("task_free", {});
+  ASSERT_TRUE(free.report.ok()) << free.report.error();
+  auto t = sim::Task::FromFile(free.task);
+  ASSERT_TRUE(t.ok()) << t.error();
+  EXPECT_THAT(DrivenJoints(*t), ElementsAre("shoulder", "elbow"));
+
+  for (const std::string locked : {"elbow", "shoulder"}) {
+    auto a = AttachArmWithTask("task_lock_" + locked, {locked});
+    ASSERT_TRUE(a.report.ok()) << a.report.error();
+    auto tl = sim::Task::FromFile(a.task);
+    ASSERT_TRUE(tl.ok()) << tl.error();
+    EXPECT_THAT(DrivenJoints(*tl), ElementsAre(locked == "elbow" ? "shoulder" : "elbow"));
+    // Locking a joint keeps every bundle: the lock is about the task, not the model.
+    EXPECT_EQ(tl->bundles.size(), 6u);
+  }
+  // A joint no replaced tendon crosses, and locking everything, are refused; nothing written.
+  const std::string dir = TempDir("task_lock_bad");
+  AttachOptions o;
+  o.model = kSrc + "/models/arm2j_muscle.xml";
+  o.muscles = {"all"};
+  o.output = dir + "/out.xml";
+  o.task = dir + "/task.json";
+  o.lock = {"wrist"};
+  auto r = Attach(o);
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.error().find("--lock wrist"), std::string::npos) << r.error();
+  o.lock = {"shoulder", "elbow"};
+  r = Attach(o);
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.error().find("drives no joint"), std::string::npos) << r.error();
+  EXPECT_TRUE(fs::is_empty(dir));
+}
+
+TEST(StarterTask, StepsLieInsideTheUsableRangesAndTheTaskNamesTheNewBundles) {
+  auto a = AttachArmWithTask("task_content", {});
+  ASSERT_TRUE(a.report.ok()) << a.report.error();
+  const AttachReport& r = *a.report;
+  auto t = sim::Task::FromFile(a.task);
+  ASSERT_TRUE(t.ok()) << t.error();
+  EXPECT_EQ(t->tracked, sim::Tracked::kAngle);
+  EXPECT_TRUE(t->auto_loop);
+  EXPECT_EQ(fs::canonical(t->model_path), fs::canonical(r.output));
+  std::vector<std::string> names;
+  for (const BundleReport& b : r.bundles) names.push_back(b.name);
+  EXPECT_EQ(t->bundles, names);
+  ModelPtr m = Load(r.output);
+  ASSERT_TRUE(m);
+  for (const std::string& n : t->bundles) {
+    const int id = mj_name2id(m.get(), mjOBJ_ACTUATOR, n.c_str());
+    ASSERT_GE(id, 0) << n;
+    EXPECT_GE(m->actuator_plugin[id], 0) << n;
+  }
+
+  // The raw file: times strictly increasing, one value per time, in degrees.
+  std::ifstream in(a.task);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  ASSERT_EQ(j["joints"].size(), t->joints.size());
+  for (size_t k = 0; k < t->joints.size(); ++k) {
+    const sim::DrivenJoint& dj = t->joints[k];
+    const nlohmann::json& ref = j["joints"][k]["reference"];
+    ASSERT_EQ(j["joints"][k]["joint"], dj.joint);
+    const std::vector<double> times = ref["times"], values = ref["values"];
+    ASSERT_EQ(ref["unit"], "deg");
+    ASSERT_EQ(times.size(), values.size());
+    ASSERT_GE(times.size(), 2u);
+    // The usable range: the narrowest over every bundle that crosses the joint (report), and
+    // inside the joint's own range in the written model.
+    double lo = -INFINITY, hi = INFINITY;
+    for (const BundleReport& b : r.bundles) {
+      for (const JointUse& u : b.joints) {
+        if (u.joint != dj.joint) continue;
+        lo = std::max(lo, u.usable_lo);
+        hi = std::min(hi, u.usable_hi);
+      }
+    }
+    const int jid = mj_name2id(m.get(), mjOBJ_JOINT, dj.joint.c_str());
+    ASSERT_GE(jid, 0);
+    ASSERT_TRUE(std::isfinite(lo) && std::isfinite(hi)) << dj.joint;
+    EXPECT_GE(lo, m->jnt_range[2 * jid] - 1e-5);
+    EXPECT_LE(hi, m->jnt_range[2 * jid + 1] + 1e-5);
+    for (size_t i = 0; i < times.size(); ++i) {
+      if (i > 0) {
+        EXPECT_GT(times[i], times[i - 1]) << dj.joint;
+      }
+      EXPECT_LT(times[i], t->duration);
+      const double q = dj.reference(times[i]);  // rad, as the loader converted it
+      EXPECT_NEAR(q, values[i] * M_PI / 180, 1e-12) << dj.joint << " step " << i;
+      EXPECT_GT(q, lo) << dj.joint << " step " << i;
+      EXPECT_LT(q, hi) << dj.joint << " step " << i;
+    }
+  }
 }
 
 // MyoSuite's models through the installed myo-sim package (a test dependency).

@@ -1,0 +1,110 @@
+// recruit.attach: `recruit attach` from Python (src/attach/attach.h). Returns the report the
+// CLI's --report writes, as a dict; errors raise with the CLI's message: OSError when a file
+// cannot be read or written (exit code 4 in the CLI), ValueError otherwise.
+#include <Python.h>
+#include <pybind11/stl.h>
+
+#include <cmath>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "attach/attach.h"
+#include "attach/report.h"
+#include "bindings.h"
+#include "common/exit_codes.h"
+#include "convert.h"
+
+namespace recruit::py_bind {
+namespace {
+
+[[noreturn]] void Raise(const std::string& message) {
+  if (exit_code::FromMessage(message) == exit_code::kIo) {
+    PyErr_SetString(PyExc_OSError, message.c_str());
+    throw py::error_already_set();
+  }
+  Fail(message);
+}
+
+// A path (str or os.PathLike); None -> "".
+std::string PathArg(const py::object& o) {
+  if (o.is_none()) return "";
+  return py::module_::import("os").attr("fspath")(o).cast<std::string>();
+}
+
+// A comma-separated string (as the CLI option) or a sequence of names; None -> {}.
+std::vector<std::string> NameList(const py::object& o, const std::string& what) {
+  std::vector<std::string> out;
+  if (o.is_none()) return out;
+  if (py::isinstance<py::str>(o)) {
+    std::stringstream in(o.cast<std::string>());
+    for (std::string item; std::getline(in, item, ',');) {
+      if (!item.empty()) out.push_back(item);
+    }
+    return out;
+  }
+  try {
+    out = o.cast<std::vector<std::string>>();
+  } catch (const py::cast_error&) {
+    Fail(what + ": must be a string (comma-separated names) or a sequence of strings");
+  }
+  return out;
+}
+
+py::object Attach(const py::object& model, const py::object& muscles, const py::object& output,
+                  const py::object& task, const py::object& report, bool size_only,
+                  const py::object& force, bool lengthrange_from_joints, const py::object& lock) {
+  attach::AttachOptions o;
+  o.model = PathArg(model);
+  o.muscles = NameList(muscles, "muscles");
+  o.output = PathArg(output);
+  o.task = PathArg(task);
+  o.report = PathArg(report);
+  o.size_only = size_only;
+  if (!force.is_none()) {
+    try {
+      o.force = force.cast<double>();
+    } catch (const py::cast_error&) {
+      Fail("force: must be a number (N) or None");
+    }
+    // The CLI's --force check (src/cli/attach_command.cc).
+    if (!std::isfinite(o.force) || o.force <= 0 || o.force > 1e7) {
+      Fail("force: value '" + py::str(force).cast<std::string>() +
+           "' not allowed: must be a force in N (0 < force <= 1e7)");
+    }
+  }
+  o.lengthrange_from_joints = lengthrange_from_joints;
+  o.lock = NameList(lock, "lock");
+  std::optional<Result<attach::AttachReport>> r;
+  {
+    py::gil_scoped_release release;
+    r.emplace(attach::Attach(o));
+  }
+  if (!r->ok()) Raise(r->error());
+  return py::module_::import("json").attr("loads")(attach::ReportJson(**r).dump());
+}
+
+}  // namespace
+
+void BindAttach(py::module_& mod) {
+  mod.def("attach", &Attach, py::arg("model"), py::arg("muscles"), py::arg("output") = py::none(),
+          py::arg("task") = py::none(), py::arg("report") = py::none(),
+          py::arg("size_only") = false, py::arg("force") = py::none(),
+          py::arg("lengthrange_from_joints") = false, py::arg("lock") = py::none(),
+          R"doc(Turns a MuJoCo model's muscles into sized recruit.sma bundles, as `recruit attach`.
+
+model: the input MJCF. muscles: actuator names (a list, or one comma-separated string) or
+"all" (every muscle on a tendon). output: the model to write (required unless size_only).
+task: also write a starter task (JSON). report: also write the report (JSON). size_only: design
+only, write nothing but the report. force: peak force of every bundle (N) instead of each
+muscle's F0. lengthrange_from_joints: set the lengthrange of other muscles whose MuJoCo
+computation fails from the joint ranges. lock: joints the starter task does not drive.
+
+Returns the report as a dict (what `--report` writes: model, output, task, changes, warnings,
+lengthranges_from_joints, bundles). Raises ValueError for bad input and OSError when a file
+cannot be read or written, with the CLI's message; nothing is written on error.
+docs/howto-own-model.md has the guide. The GIL is released meanwhile.)doc");
+}
+
+}  // namespace recruit::py_bind
