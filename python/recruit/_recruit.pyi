@@ -184,3 +184,7 @@ def sweep_json(task_path: str, dT: Sequence[float], lam: Sequence[float],
                filter_model: Optional[str], threads: int, out_dir: str) -> str: ...
 def aggregate(runs: Dict[str, Any], max_overshoot: float = ...,
               min_settled: float = ...) -> Dict[str, Any]: ...
+# sim::kMetricFields: per metric {"name", "unit", "integer", "may_be_nan"}.
+METRIC_FIELDS: Tuple[Dict[str, Any], ...]
+# sim::CellColumns(): the columns of table.csv and of aggregate(...).
+CELL_COLUMNS: Tuple[str, ...]
