@@ -100,7 +100,7 @@ Status CheckActuator(const mjModel* m, int a, const std::string& where) {
   return Status::Ok();
 }
 
-// --- Fit check (issue 9 item 8) ---
+// --- Fit check ---
 
 // True while this thread builds a scratch mjData for a fit check: mj_makeData runs every
 // plugin instance's init, which must not start another check.
@@ -141,7 +141,7 @@ Result<std::unique_ptr<SmaInstance>> SmaInstance::Create(const mjModel* m, int i
   if (in_fit_check) return std::unique_ptr<SmaInstance>();
   auto p = Build(m, instance, true);
   if (p.ok() && FirstCheck(m, instance)) {
-    // Design check (issue 26 item 3): one warning per bundle past a long-life limit.
+    // Design check: one warning per bundle past a long-life limit (plugin/design_limits.h).
     for (const SmaActuator& a : (*p)->actuators()) {
       const std::string w = DesignWarning(a.model.config());
       if (!w.empty()) mju_warning("recruit.sma %s", w.c_str());
