@@ -73,7 +73,9 @@ TEST(RunMetricsTable, EachFieldOnceWithOnePointerAndAUnit) {
     EXPECT_TRUE(names.insert(f.name).second) << f.name;
     EXPECT_NE(f.real == nullptr, f.count == nullptr) << f.name;
     EXPECT_GT(std::string(f.unit).size(), 0u) << f.name;
-    if (f.cell_mean) EXPECT_TRUE(columns.insert(f.cell_mean).second) << f.cell_mean;
+    if (f.cell_mean) {
+      EXPECT_TRUE(columns.insert(f.cell_mean).second) << f.cell_mean;
+    }
   }
   // Distinct members: with every value distinct, no two entries read the same one.
   const RunMetrics m = Distinct();
