@@ -46,7 +46,7 @@ class SmaBundle {
   void Advance(double* s, double stretch, double dt) const;
 
   // Total tension of the bundle (N, >= 0) at unit extension `stretch`: pure, reads s only
-  // (the "compute" step of a MuJoCo 3.x actuator plugin).
+  // (the "compute" step of a MuJoCo actuator plugin).
   double Tension(const double* s, double stretch) const;
   // Rate of the actuator's MuJoCo-integrated state: none, all state advances in Advance.
   double ActDot(const double* s) const { return 0; }

@@ -100,7 +100,7 @@ Status CheckActuator(const mjModel* m, int a, const std::string& where) {
   return Status::Ok();
 }
 
-// --- Fit check (issue 9 item 8) ---
+// --- Fit check ---
 
 // True while this thread builds a scratch mjData for a fit check: mj_makeData runs every
 // plugin instance's init, which must not start another check.

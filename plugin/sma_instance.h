@@ -42,7 +42,7 @@ struct SmaActuator {
   double gear = 1;  // transmission: units stretch gear x the tendon's change, pull it gear x
 };
 
-// How a bundle fits its tendon over the joint limits (issue 9 item 8): the tendon's length
+// How a bundle fits its tendon over the joint limits: the tendon's length
 // range when the limited hinge and slide joints that move it are sampled over their ranges
 // (other joints at qpos0), against the units' stroke and forces.
 struct TendonFit {

@@ -31,8 +31,8 @@ struct UnitParams {
   // 0.18 A. Steady on-temperature about 116 C (Af = 78 C), settled isometric force 0.447 N
   // per unit (26.8 N for 60: the paper's Fig. 4) at 57 MPa wire stress (Dynalloy rates 172 MPa
   // for long life), current 90 % of Dynalloy's 200 mA "1 s contraction" value for 0.1 mm,
-  // thermal time constant 0.98 s against Dynalloy's 1.1 s cooling time. The previous default
-  // (0.1 mm wire coiled to 0.33 mm, 0.235 A) ran at 171 C and about 1 GPa equivalent stress.
+  // thermal time constant 0.98 s against Dynalloy's 1.1 s cooling time. A 0.1 mm wire coiled to
+  // 0.33 mm that gives Fig. 4 at 0.235 A runs at 171 C and ~1 GPa (docs/sma-units.md).
   ForceLaw law = ForceLaw::kWire;
   double wire_diameter = 0.1e-3;   // m
   double wire_length = 0.1;        // m, wire law only (a spring's wire is pi * D * turns long)

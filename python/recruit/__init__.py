@@ -233,9 +233,10 @@ def simulate(task_path: PathLike, *, estimator: Optional[str] = None,
     return summary
 
 
-_METRICS = ("tracking_rmse", "iae", "overshoot", "max_overshoot", "settling_time",
-            "settled_fraction", "oscillation", "switching_rate", "estimator_rmse", "mean_nees",
-            "estimator_within3", "num_steps")
+# The run metrics (C++ sim::kMetricFields): the keys of a summary's "metrics" and the metric
+# columns of sweep(...), in the order of the sweep table's columns.
+METRICS: Tuple[str, ...] = tuple(f["name"] for f in _recruit.METRIC_FIELDS)
+_INTEGER_METRICS = frozenset(f["name"] for f in _recruit.METRIC_FIELDS if f["integer"])
 
 
 def _as_list(x, kind):
@@ -253,9 +254,8 @@ def sweep(task_path: PathLike, *, dT: Union[float, Sequence[float]],
     Rng::DeriveSeed(base_seed, s), as the CLI: the same arguments give the same results.
     Returns a column dict, one row per run in grid order (dT outermost, then lam, estimator,
     seed index): dT, lambda, estimator, seed_index, seed, duration, wall_seconds, physics_steps
-    and the metrics (tracking_rmse, iae, overshoot, max_overshoot, settling_time,
-    settled_fraction, oscillation, switching_rate, estimator_rmse, mean_nees (NaN without a
-    variance), estimator_within3, num_steps). pandas.DataFrame(...) takes it directly;
+    and one column per name in METRICS (tracking_rmse, overshoot, ...; mean_nees is NaN without
+    a variance, num_steps is an integer). pandas.DataFrame(...) takes it directly;
     aggregate(...) gives the per-cell table. Not resumable: every call runs every point.
     """
     with _tempfile.TemporaryDirectory(prefix="recruit-sweep-") as out:
@@ -280,9 +280,9 @@ def sweep(task_path: PathLike, *, dT: Union[float, Sequence[float]],
         "wall_seconds": col("wall_seconds"),
         "physics_steps": col("physics_steps", _np.int64),
     }
-    for k in _METRICS:
+    for k in METRICS:
         # JSON has no NaN: a missing value (mean_nees of an estimator without variance) is null.
-        out[k] = col(k, _np.int64 if k == "num_steps" else float,
+        out[k] = col(k, _np.int64 if k in _INTEGER_METRICS else float,
                      lambda r, k=k: _np.nan if r["metrics"][k] is None else r["metrics"][k])
     return out
 
@@ -291,15 +291,15 @@ def aggregate(runs: Mapping[str, Any], max_overshoot: float = 0.10,
               min_settled: float = 0.90) -> Dict[str, Any]:
     """The runs of sweep(...) (or any subset of its rows) per grid cell (dT, lambda, estimator).
 
-    Returns a column dict with the columns of `recruit sweep`'s table.csv: dT, lambda,
-    estimator, seeds, overshoot_mean, overshoot_sd, settling_time_mean, settled_fraction,
-    tracking_rmse_mean, iae_mean, oscillation_mean, switching_rate_mean, estimator_rmse_mean,
-    mean_nees_mean, estimator_within3_mean, meets_criterion, margin. A cell meets the criterion
-    when its mean overshoot <= max_overshoot and its settled fraction >= min_settled.
+    Returns a column dict with the columns of `recruit sweep`'s table.csv, in its order: dT,
+    lambda, estimator, seeds, the seeds' mean of each metric the table shows (overshoot_mean,
+    overshoot_sd, settling_time_mean, settled_fraction, tracking_rmse_mean, ...),
+    meets_criterion, margin. A cell meets the criterion when its mean overshoot <= max_overshoot
+    and its settled fraction >= min_settled.
     """
     return _recruit.aggregate(dict(runs), float(max_overshoot), float(min_settled))
 
 
 __all__ = ["FilterModel", "KalmanFilter", "ExactFilter", "ParticleFilter", "Bundles",
            "Controller", "expectation_law", "filter_log", "simulate", "sweep", "aggregate",
-           "attach", "PLUGIN_LIBRARY", "MUJOCO_BUILD_VERSION", "MUJOCO_VERSION"]
+           "attach", "METRICS", "PLUGIN_LIBRARY", "MUJOCO_BUILD_VERSION", "MUJOCO_VERSION"]

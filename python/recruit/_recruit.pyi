@@ -193,3 +193,8 @@ def attach(model: Union[str, "os.PathLike[str]"], muscles: Union[str, Sequence[s
            report: Optional[Union[str, "os.PathLike[str]"]] = ..., size_only: bool = ...,
            force: Optional[float] = ..., lengthrange_from_joints: bool = ...,
            lock: Optional[Union[str, Sequence[str]]] = ...) -> Dict[str, Any]: ...
+
+# sim::kMetricFields: per metric {"name", "unit", "integer", "may_be_nan"}.
+METRIC_FIELDS: Tuple[Dict[str, Any], ...]
+# sim::CellColumns(): the columns of table.csv and of aggregate(...).
+CELL_COLUMNS: Tuple[str, ...]

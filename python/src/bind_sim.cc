@@ -151,95 +151,79 @@ std::string Sweep(const std::string& task_path, const std::vector<double>& dTs,
   return runs.dump();
 }
 
-// Cells of a run column dict (sweep's): per (dT, lambda, estimator), as table.csv.
+// Cells of a run column dict (sweep's): per (dT, lambda, estimator), as table.csv. The metric
+// columns come from sim::kMetricFields: those the cells aggregate are read, the cells' written.
 py::dict AggregateColumns(const py::dict& runs, double max_overshoot, double min_settled) {
-  auto column = [&runs](const char* name) {
-    if (!runs.contains(name)) Fail(std::string("aggregate: runs has no column '") + name + "'");
-    return ToVector(runs[name], name);
-  };
   if (!runs.contains("estimator")) Fail("aggregate: runs has no column 'estimator'");
   const auto est = runs["estimator"].cast<std::vector<std::string>>();
-  const Eigen::VectorXd dT = column("dT"), lambda = column("lambda"),
-                        tracking_rmse = column("tracking_rmse"), iae = column("iae"),
-                        overshoot = column("overshoot"), settling = column("settling_time"),
-                        settled = column("settled_fraction"), osc = column("oscillation"),
-                        sw = column("switching_rate"), er = column("estimator_rmse"),
-                        nees = column("mean_nees"), w3 = column("estimator_within3");
   const Eigen::Index n = static_cast<Eigen::Index>(est.size());
-  for (const Eigen::VectorXd* v : {&dT, &lambda, &tracking_rmse, &iae, &overshoot, &settling,
-                                   &settled, &osc, &sw, &er, &nees, &w3}) {
-    if (v->size() != n) Fail("aggregate: the columns of runs differ in length");
-  }
+  auto column = [&runs, n](const char* name) {
+    if (!runs.contains(name)) Fail(std::string("aggregate: runs has no column '") + name + "'");
+    Eigen::VectorXd v = ToVector(runs[name], name);
+    if (v.size() != n) Fail("aggregate: the columns of runs differ in length");
+    return v;
+  };
+  const Eigen::VectorXd dT = column("dT"), lambda = column("lambda");
   std::vector<sim::RunSummary> rs(n);
   for (Eigen::Index i = 0; i < n; ++i) {
-    sim::RunSummary& r = rs[i];
-    r.dT = dT(i);
-    r.lambda = lambda(i);
-    r.estimator = est[i];
-    r.metrics.tracking_rmse = tracking_rmse(i);
-    r.metrics.iae = iae(i);
-    r.metrics.overshoot = overshoot(i);
-    r.metrics.settling_time = settling(i);
-    r.metrics.settled_fraction = settled(i);
-    r.metrics.oscillation = osc(i);
-    r.metrics.switching_rate = sw(i);
-    r.metrics.estimator_rmse = er(i);
-    r.metrics.mean_nees = nees(i);
-    r.metrics.estimator_within3 = w3(i);
+    rs[i].dT = dT(i);
+    rs[i].lambda = lambda(i);
+    rs[i].estimator = est[i];
+  }
+  for (const sim::MetricField& f : sim::kMetricFields) {
+    if (!f.cell_mean) continue;
+    const Eigen::VectorXd v = column(f.name);
+    for (Eigen::Index i = 0; i < n; ++i) sim::SetMetric(rs[i].metrics, f, v(i));
   }
   sim::TrackingCriterion criterion;
   criterion.max_overshoot = max_overshoot;
   criterion.min_settled = min_settled;
   const std::vector<sim::CellStats> cells = sim::Aggregate(rs, criterion);
-  // Column names as table.csv (sim/sweep.cc WriteSweepReport).
+  // Column names and order as table.csv (sim::CellColumns).
+  const std::vector<std::string> names = sim::CellMetricColumns();
   std::vector<std::string> estimators;
   std::vector<bool> meets;
   std::vector<int> nseeds;
-  std::vector<std::vector<double>> v(14);
+  std::vector<double> dTs, lambdas, margins;
+  std::vector<std::vector<double>> metrics(names.size());
   for (const auto& c : cells) {
+    dTs.push_back(c.dT);
+    lambdas.push_back(c.lambda);
     estimators.push_back(c.estimator);
-    meets.push_back(c.meets);
     nseeds.push_back(c.seeds);
-    const double row[14] = {c.dT,
-                            c.lambda,
-                            c.overshoot_mean,
-                            c.overshoot_sd,
-                            c.settling_mean,
-                            c.settled_fraction,
-                            c.rmse_mean,
-                            c.iae_mean,
-                            c.oscillation_mean,
-                            c.switching_mean,
-                            c.estimator_rmse_mean,
-                            c.nees_mean,
-                            c.within3_mean,
-                            c.margin};
-    for (int k = 0; k < 14; ++k) v[k].push_back(row[k]);
+    const std::vector<double> row = sim::CellMetricValues(c);
+    for (size_t k = 0; k < names.size(); ++k) metrics[k].push_back(row[k]);
+    meets.push_back(c.meets);
+    margins.push_back(c.margin);
   }
   auto arr = [](const std::vector<double>& x) {
     return FromVector(Eigen::Map<const Eigen::VectorXd>(x.data(), x.size()));
   };
   py::dict out;
-  out["dT"] = arr(v[0]);
-  out["lambda"] = arr(v[1]);
+  out["dT"] = arr(dTs);
+  out["lambda"] = arr(lambdas);
   out["estimator"] = estimators;
   out["seeds"] = py::array_t<int>(nseeds.size(), nseeds.data());
-  out["overshoot_mean"] = arr(v[2]);
-  out["overshoot_sd"] = arr(v[3]);
-  out["settling_time_mean"] = arr(v[4]);
-  out["settled_fraction"] = arr(v[5]);
-  out["tracking_rmse_mean"] = arr(v[6]);
-  out["iae_mean"] = arr(v[7]);
-  out["oscillation_mean"] = arr(v[8]);
-  out["switching_rate_mean"] = arr(v[9]);
-  out["estimator_rmse_mean"] = arr(v[10]);
-  out["mean_nees_mean"] = arr(v[11]);
-  out["estimator_within3_mean"] = arr(v[12]);
+  for (size_t k = 0; k < names.size(); ++k) out[py::str(names[k])] = arr(metrics[k]);
   py::array_t<bool> m(meets.size());
   for (size_t i = 0; i < meets.size(); ++i) m.mutable_data()[i] = meets[i];
   out["meets_criterion"] = m;
-  out["margin"] = arr(v[13]);
+  out["margin"] = arr(margins);
   return out;
+}
+
+// sim::kMetricFields as a tuple of dicts: name, unit, integer (a count), may_be_nan.
+py::tuple MetricFields() {
+  py::list out;
+  for (const sim::MetricField& f : sim::kMetricFields) {
+    py::dict d;
+    d["name"] = f.name;
+    d["unit"] = f.unit;
+    d["integer"] = f.count != nullptr;
+    d["may_be_nan"] = f.may_be_nan;
+    out.append(d);
+  }
+  return py::tuple(out);
 }
 
 }  // namespace
@@ -257,6 +241,9 @@ void BindSim(py::module_& mod) {
   mod.def("aggregate", &AggregateColumns, py::arg("runs"), py::arg("max_overshoot") = 0.10,
           py::arg("min_settled") = 0.90,
           "A sweep's run columns -> cell columns (as `recruit sweep`'s table.csv).");
+  mod.attr("METRIC_FIELDS") = MetricFields();
+  const std::vector<std::string> columns = sim::CellColumns();
+  mod.attr("CELL_COLUMNS") = py::tuple(py::cast(columns));
 }
 
 }  // namespace recruit::py_bind

@@ -1,4 +1,4 @@
-// Loading MJCF from a file or from a string (MuJoCo 3's VFS: mj_addBufferVFS), with MuJoCo's own
+// Loading MJCF from a file or from a string (MuJoCo's VFS: mj_addBufferVFS), with MuJoCo's own
 // compiler error in the message.
 #pragma once
 

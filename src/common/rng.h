@@ -1,6 +1,7 @@
 // Rng: the project's only source of randomness. xoshiro256** (Blackman and Vigna, 2018), seeded
-// by SplitMix64. Its whole state is four 64-bit words, so it can live inside mjData.userdata and
-// be forked exactly by mj_copyData. It satisfies UniformRandomBitGenerator, so <random>
+// by SplitMix64. Its whole state is four 64-bit words, so it can live inside mjData.plugin_state
+// (the plugin stores them as eight exact 32-bit halves, plugin/bundle.cc) and be forked exactly by
+// mj_copyData. It satisfies UniformRandomBitGenerator, so <random>
 // distributions take it. Callers create it with an explicit seed and pass it in.
 #pragma once
 

@@ -196,7 +196,7 @@ class PopulationKalmanFilterT {
   OutVec innov_;
   Eigen::Matrix<double, R, M> Kt_;
   Eigen::LLT<OutMat> llt_;  // r > 1 only; computed once at Create so that no member is
-                            // left uninitialised (moving it was undefined behaviour)
+                            // left uninitialised (moving an uninitialised LLT is undefined)
   // PredictBroadcast: the model's broadcast transition and the sparse A it fills.
   bool has_broadcast_ = false;
   BroadcastTransitionModel broadcast_;

@@ -76,19 +76,7 @@ nlohmann::json RunSummary::ToJson() const {
   j["control_instants"] = control_instants;
   j["wall_seconds"] = wall_seconds;
   j["identification_seconds"] = identification_seconds;
-  const RunMetrics& m = metrics;
-  j["metrics"] = {{"tracking_rmse", m.tracking_rmse},
-                  {"iae", m.iae},
-                  {"overshoot", m.overshoot},
-                  {"max_overshoot", m.max_overshoot},
-                  {"settling_time", m.settling_time},
-                  {"settled_fraction", m.settled_fraction},
-                  {"oscillation", m.oscillation},
-                  {"switching_rate", m.switching_rate},
-                  {"estimator_rmse", m.estimator_rmse},
-                  {"mean_nees", m.mean_nees},
-                  {"estimator_within3", m.estimator_within3},
-                  {"num_steps", m.num_steps}};
+  j["metrics"] = MetricsToJson(metrics);
   nlohmann::json steps_json = nlohmann::json::array();
   for (size_t k = 0; k < steps.size(); ++k) {
     const StepResponse& s = steps[k];

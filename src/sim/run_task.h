@@ -12,6 +12,7 @@
 #include "common/result.h"
 #include "common/step_observer.h"
 #include "sim/metrics.h"
+#include "sim/run_metrics.h"
 #include "sim/task.h"
 
 namespace recruit::sim {
@@ -30,21 +31,6 @@ struct RunOptions {
   // and dT (identification/model_cache.h); false = an error naming the command that makes one.
   bool identify_missing_models = true;
   bool quiet = false;  // no notes on stderr (e.g. that a model is being identified)
-};
-
-struct RunMetrics {
-  double tracking_rmse = 0;      // N or rad
-  double iae = 0;                // N s or rad s
-  double overshoot = 0;          // mean over steps, fraction of the step size
-  double max_overshoot = 0;      // largest over steps
-  double settling_time = 0;      // mean over steps, s (an unsettled step counts its whole hold)
-  double settled_fraction = 0;   // steps that settled within their hold
-  double oscillation = 0;        // excess total variation, see metrics.h
-  double switching_rate = 0;     // unit transitions per unit per second (all bundles)
-  double estimator_rmse = 0;     // units, at control instants (agonist)
-  double mean_nees = 0;          // on-count NEES at control instants (agonist); NaN: no variance
-  double estimator_within3 = 0;  // fraction of control instants with |n^ - n| <= 3
-  int num_steps = 0;
 };
 
 // One bundle's scores: its estimate against the ground-truth count at the control instants, and

@@ -132,21 +132,7 @@ Result<RunSummary> RunSummaryFromJson(const json& j) {
     s.physics_steps = j.at("physics_steps").get<long>();
     s.control_instants = j.at("control_instants").get<long>();
     s.wall_seconds = j.at("wall_seconds").get<double>();
-    const json& m = j.at("metrics");
-    RunMetrics& r = s.metrics;
-    r.tracking_rmse = m.at("tracking_rmse");
-    r.iae = m.at("iae");
-    r.overshoot = m.at("overshoot");
-    r.max_overshoot = m.at("max_overshoot");
-    r.settling_time = m.at("settling_time");
-    r.settled_fraction = m.at("settled_fraction");
-    r.oscillation = m.at("oscillation");
-    r.switching_rate = m.at("switching_rate");
-    r.estimator_rmse = m.at("estimator_rmse");
-    // NaN (no variance: output only) is stored as null.
-    r.mean_nees = m.at("mean_nees").is_null() ? std::nan("") : m.at("mean_nees").get<double>();
-    r.estimator_within3 = m.at("estimator_within3");
-    r.num_steps = m.at("num_steps");
+    s.metrics = MetricsFromJson(j.at("metrics"));
     for (const json& st : j.at("steps")) {
       StepResponse sr;
       sr.step = {st.at("time"), st.at("from"), st.at("to"), st.at("end")};
@@ -273,6 +259,11 @@ double Sd(const std::vector<double>& v) {
   return std::sqrt(s / (v.size() - 1));
 }
 
+// >= 0 iff the criterion is met: min(overshoot limit - overshoot, settled - required settled).
+double Margin(const TrackingCriterion& criterion, double overshoot, double settled_fraction) {
+  return std::min(criterion.max_overshoot - overshoot, settled_fraction - criterion.min_settled);
+}
+
 }  // namespace
 
 std::vector<CellStats> Aggregate(const std::vector<RunSummary>& runs,
@@ -304,40 +295,46 @@ std::vector<CellStats> Aggregate(const std::vector<SweepRun>& grid,
     std::tie(c.plant, c.dT, c.lambda, c.estimator) = key;
     c.plant_values = first[key]->plant_values;
     c.seeds = static_cast<int>(g.size());
-    std::vector<double> os, st, sf, rmse, iae, osc, sw, er, nees, w3, margins;
+    std::vector<double> margins;
     for (const RunSummary* r : g) {
-      os.push_back(r->metrics.overshoot);
-      st.push_back(r->metrics.settling_time);
-      sf.push_back(r->metrics.settled_fraction);
-      rmse.push_back(r->metrics.tracking_rmse);
-      iae.push_back(r->metrics.iae);
-      osc.push_back(r->metrics.oscillation);
-      sw.push_back(r->metrics.switching_rate);
-      er.push_back(r->metrics.estimator_rmse);
-      if (std::isfinite(r->metrics.mean_nees)) nees.push_back(r->metrics.mean_nees);
-      w3.push_back(r->metrics.estimator_within3);
-      margins.push_back(std::min(criterion.max_overshoot - r->metrics.overshoot,
-                                 r->metrics.settled_fraction - criterion.min_settled));
+      margins.push_back(Margin(criterion, r->metrics.overshoot, r->metrics.settled_fraction));
       if (margins.back() >= 0) ++c.seeds_meeting;
     }
-    c.overshoot_mean = Mean(os);
-    c.overshoot_sd = Sd(os);
-    c.settling_mean = Mean(st);
-    c.settled_fraction = Mean(sf);
-    c.rmse_mean = Mean(rmse);
-    c.iae_mean = Mean(iae);
-    c.oscillation_mean = Mean(osc);
-    c.switching_mean = Mean(sw);
-    c.estimator_rmse_mean = Mean(er);
-    c.nees_mean = nees.empty() ? std::nan("") : Mean(nees);
-    c.within3_mean = Mean(w3);
-    c.margin = std::min(criterion.max_overshoot - c.overshoot_mean,
-                        c.settled_fraction - criterion.min_settled);
+    for (size_t k = 0; k < kMetricCount; ++k) {
+      const MetricField& f = kMetricFields[k];
+      std::vector<double> v;
+      for (const RunSummary* r : g) {
+        const double x = MetricValue(r->metrics, f);
+        if (!f.may_be_nan || std::isfinite(x)) v.push_back(x);
+      }
+      c.mean[k] = f.may_be_nan && v.empty() ? std::nan("") : Mean(v);
+      c.sd[k] = Sd(v);
+    }
+    c.margin =
+        Margin(criterion, c.Mean(&RunMetrics::overshoot), c.Mean(&RunMetrics::settled_fraction));
     c.meets = c.margin >= 0;
     c.margin_se = Sd(margins) / std::sqrt(static_cast<double>(margins.size()));
     cells.push_back(c);
   }
   return cells;
+}
+
+std::vector<std::string> CellColumns() {
+  std::vector<std::string> out{"dT", "lambda", "estimator", "seeds"};
+  for (std::string& name : CellMetricColumns()) out.push_back(std::move(name));
+  out.push_back("meets_criterion");
+  out.push_back("margin");
+  return out;
+}
+
+std::vector<double> CellMetricValues(const CellStats& c) {
+  std::vector<double> out;
+  for (size_t k = 0; k < kMetricCount; ++k) {
+    if (!kMetricFields[k].cell_mean) continue;
+    out.push_back(c.mean[k]);
+    if (kMetricFields[k].cell_sd) out.push_back(c.sd[k]);
+  }
+  return out;
 }
 
 Status WriteSweepReport(const std::vector<CellStats>& cells, const TrackingCriterion& criterion,
@@ -365,11 +362,9 @@ Status WriteSweepReport(const std::vector<CellStats>& cells, const TrackingCrite
     }
     return out;
   };
-  std::string csv =
-      plant_head +
-      "dT,lambda,estimator,seeds,overshoot_mean,overshoot_sd,settling_time_mean,"
-      "settled_fraction,tracking_rmse_mean,iae_mean,oscillation_mean,switching_rate_mean,"
-      "estimator_rmse_mean,mean_nees_mean,estimator_within3_mean,meets_criterion,margin\n";
+  std::string csv = plant_head;
+  for (const std::string& name : CellColumns()) csv += name + ",";
+  csv.back() = '\n';
   std::string md = fmt::format(
       "# Sweep: {}\n\nCriterion: mean step overshoot <= {:.0f} % and at least {:.0f} % of "
       "steps settled within the 10 % band, over all seeds of a cell. Margin = min(overshoot "
@@ -380,23 +375,21 @@ Status WriteSweepReport(const std::vector<CellStats>& cells, const TrackingCrite
       title, 100 * criterion.max_overshoot, 100 * criterion.min_settled, plant_md_head,
       plant_md_rule);
   for (const auto& c : cells) {
-    csv +=
-        plant_cols(c, false) +
-        fmt::format(
-            "{:g},{:g},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},"
-            "{:.6g},{:.6g},{:.6g},{},{:.6g}\n",
-            c.dT, c.lambda, c.estimator, c.seeds, c.overshoot_mean, c.overshoot_sd, c.settling_mean,
-            c.settled_fraction, c.rmse_mean, c.iae_mean, c.oscillation_mean, c.switching_mean,
-            c.estimator_rmse_mean, c.nees_mean, c.within3_mean, c.meets ? 1 : 0, c.margin);
+    csv += plant_cols(c, false) +
+           fmt::format("{:g},{:g},{},{},", c.dT, c.lambda, c.estimator, c.seeds);
+    for (double x : CellMetricValues(c)) csv += fmt::format("{:.6g},", x);
+    csv += fmt::format("{},{:.6g}\n", c.meets ? 1 : 0, c.margin);
     md += (c.plant_values.empty() ? "" : plant_cols(c, true)) +
           fmt::format(
               "| {:g} | {:g} | {} | {} | {:.1f} ± {:.1f} | {:.2f} | {:.0f} | {:.3g} | {:.3f} | "
               "{:.4f} "
               "| {:.2f} | {:.2f} | {:.0f} | {} | {:+.3f} |\n",
-              c.dT, c.lambda, c.estimator, c.seeds, 100 * c.overshoot_mean, 100 * c.overshoot_sd,
-              c.settling_mean, 100 * c.settled_fraction, c.rmse_mean, c.oscillation_mean,
-              c.switching_mean, c.estimator_rmse_mean, c.nees_mean, 100 * c.within3_mean,
-              c.meets ? "yes" : "no", c.margin);
+              c.dT, c.lambda, c.estimator, c.seeds, 100 * c.Mean(&RunMetrics::overshoot),
+              100 * c.Sd(&RunMetrics::overshoot), c.Mean(&RunMetrics::settling_time),
+              100 * c.Mean(&RunMetrics::settled_fraction), c.Mean(&RunMetrics::tracking_rmse),
+              c.Mean(&RunMetrics::oscillation), c.Mean(&RunMetrics::switching_rate),
+              c.Mean(&RunMetrics::estimator_rmse), c.Mean(&RunMetrics::mean_nees),
+              100 * c.Mean(&RunMetrics::estimator_within3), c.meets ? "yes" : "no", c.margin);
   }
 
   // Shortest sampling period meeting the criterion, per plant point, estimator and lambda.
@@ -453,8 +446,8 @@ Status WriteSweepReport(const std::vector<CellStats>& cells, const TrackingCrite
     dat += "# estimator " + e + "\n# dT lambda overshoot_percent meets\n";
     for (const auto& c : cells) {
       if (c.estimator == e) {
-        dat += fmt::format("{:g} {:g} {:.4f} {}\n", c.dT, c.lambda, 100 * c.overshoot_mean,
-                           c.meets ? 1 : 0);
+        dat += fmt::format("{:g} {:g} {:.4f} {}\n", c.dT, c.lambda,
+                           100 * c.Mean(&RunMetrics::overshoot), c.meets ? 1 : 0);
       }
     }
     dat += "\n\n";

@@ -7,6 +7,7 @@
 // same.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -14,6 +15,7 @@
 #include <vector>
 
 #include "common/result.h"
+#include "sim/run_metrics.h"
 #include "sim/run_task.h"
 
 namespace recruit::sim {
@@ -95,13 +97,11 @@ struct CellStats {
   double dT = 0, lambda = 0;
   std::string estimator;
   int seeds = 0;
-  double overshoot_mean = 0, overshoot_sd = 0;
-  double settling_mean = 0;
-  double settled_fraction = 0;
-  double rmse_mean = 0, iae_mean = 0;
-  double oscillation_mean = 0;
-  double switching_mean = 0;
-  double estimator_rmse_mean = 0, nees_mean = 0, within3_mean = 0;
+  // Per field of kMetricFields (sim/run_metrics.h), over seeds: the mean (of the finite values
+  // for a field that may be NaN; NaN if none is) and the sample standard deviation.
+  std::array<double, kMetricCount> mean{}, sd{};
+  double Mean(double RunMetrics::*field) const { return mean.at(MetricIndex(field)); }
+  double Sd(double RunMetrics::*field) const { return sd.at(MetricIndex(field)); }
   bool meets = false;
   double margin = 0;  // min(max_overshoot - overshoot, settled - min_settled); >= 0 iff meets
   // Over seeds: each seed's own margin (same formula on its run alone), how many meet, and the
@@ -117,6 +117,12 @@ std::vector<CellStats> Aggregate(const std::vector<RunSummary>& runs,
 std::vector<CellStats> Aggregate(const std::vector<SweepRun>& grid,
                                  const std::vector<RunSummary>& runs,
                                  const TrackingCriterion& criterion);
+
+// The columns of table.csv and of the Python aggregate, plant axes left out: dT, lambda,
+// estimator, seeds, the metric columns (CellMetricColumns()), meets_criterion, margin.
+std::vector<std::string> CellColumns();
+// A cell's values of the metric columns, in their order.
+std::vector<double> CellMetricValues(const CellStats& c);
 
 // Writes table.csv, table.md (with a column per plant axis when there are plant points),
 // and, without plant axes, stability.dat (the map's data: `recruit sweep` draws stability.png from
