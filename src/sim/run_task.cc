@@ -14,7 +14,6 @@
 #include "common/rng.h"
 #include "sim/force_sensor.h"
 
-#if RECRUIT_CONTROL_AVAILABLE && RECRUIT_SMA_AVAILABLE
 #include "control/kalman_estimator.h"
 #include "control/recruitment_controller.h"
 #include "estimation/filter_model.h"
@@ -24,8 +23,6 @@
 #include "sim/joint_loop.h"
 #include "sim/metrics_stream.h"
 #include "sim/plant.h"
-#define RECRUIT_SIM_CLOSED_LOOP 1
-#endif
 
 namespace recruit::sim {
 namespace {
@@ -120,12 +117,6 @@ nlohmann::json RunSummary::ToJson() const {
   return j;
 }
 
-#if !RECRUIT_SIM_CLOSED_LOOP
-Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
-                           const std::vector<StepObserver*>& observers) {
-  return Error{"RunTask: built without the SMA plugin and the controller"};
-}
-#else
 namespace {
 
 // One bundle's controller side: its load cell and its recruitment controller (which owns the
@@ -703,6 +694,5 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
       identify_s;
   return s;
 }
-#endif
 
 }  // namespace recruit::sim
