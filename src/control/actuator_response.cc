@@ -18,6 +18,20 @@ void Advance(const BroadcastTransitionModel& chain, double target_on, double lam
   x = chain.Matrix(b.p_on, b.p_off) * x;
 }
 
+// Advances x under the law towards `target` until its force h'x changes by less than
+// `tolerance` in a period (or `max_periods` have passed).
+void Settle(const BroadcastTransitionModel& chain, double target, double lambda,
+            const Eigen::Ref<const Eigen::VectorXd>& h, double tolerance, int max_periods,
+            Eigen::VectorXd& x) {
+  double before = 0;
+  for (int k = 0; k < max_periods; ++k) {
+    Advance(chain, target, lambda, x);
+    const double y = h.dot(x);
+    if (k > 10 && std::abs(y - before) < tolerance) return;
+    before = y;
+  }
+}
+
 }  // namespace
 
 double ActuatorResponse::At(double t) const {
@@ -59,26 +73,14 @@ Result<ActuatorResponse> PredictActuatorResponse(const BroadcastTransitionModel&
   Eigen::VectorXd x = Eigen::VectorXd::Zero(m);
   x[0] = 1;
   // Settle at `from` (the law's count target is the force target over one settled unit's).
-  double before = 0;
-  for (int k = 0; k < 20 * max_samples; ++k) {
-    Advance(chain, from, lambda, x);
-    const double y = h.dot(x);
-    if (k > 10 && std::abs(y - before) < 1e-12 * unit_force) break;
-    before = y;
-  }
+  Settle(chain, from, lambda, h, 1e-12 * unit_force, 20 * max_samples, x);
   const double y0 = h.dot(x);
   ActuatorResponse r;
   r.dT = chain.dt;
   r.s.push_back(0);
   // The force the step ends at, from the same chain settled at `to` (not assumed linear).
   Eigen::VectorXd settled = x;
-  double prev = 0;
-  for (int k = 0; k < 20 * max_samples; ++k) {
-    Advance(chain, to, lambda, settled);
-    const double y = h.dot(settled);
-    if (k > 10 && std::abs(y - prev) < 1e-12 * unit_force) break;
-    prev = y;
-  }
+  Settle(chain, to, lambda, h, 1e-12 * unit_force, 20 * max_samples, settled);
   const double y1 = h.dot(settled);
   if (std::abs(y1 - y0) < 1e-9 * unit_force) {
     return Error{"actuator response: the chain's force does not follow its on-count"};
