@@ -160,7 +160,7 @@ double CurveRow(const Image& img, const mjvFigure& f, int x, const std::array<fl
 double Plateau(double t, double len, double unit, double offset) {
   static const int pattern[] = {0, 3, 3, 1, 6, 2, 9, 4, 0, 7, 5, 8};
   const int k = static_cast<int>(std::floor(t / len));
-  return offset + unit * pattern[k % 12];
+  return offset + unit * pattern[((k % 12) + 12) % 12];  // t < 0 (before the window) too
 }
 
 struct Case {
