@@ -102,6 +102,7 @@ py::tuple Simulate(const std::string& task_path, const py::object& estimator,
   opt.force_noise_std = Opt<double>(force_noise_std);
   opt.duration = Opt<double>(duration);
   opt.seed = seed;
+  opt.identify_missing_models = true;  // as `recruit simulate` does
   TraceRecorder trace(trace_every);
   std::vector<StepObserver*> observers;
   if (trace_every > 0) observers.push_back(&trace);
@@ -124,6 +125,7 @@ std::string Sweep(const std::string& task_path, const std::vector<double>& dTs,
   if (threads < 0) Fail("threads: must be >= 0 (0: all cores)");
   const sim::Task task = Take(sim::Task::FromFile(task_path));
   sim::SweepSpec spec;
+  spec.identify_missing_models = true;  // as `recruit sweep` does
   spec.dTs = dTs;
   spec.lambdas = lambdas;
   spec.estimators = estimators;

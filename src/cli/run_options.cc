@@ -5,6 +5,8 @@
 namespace recruit::cli {
 
 void AddRunOptions(CLI::App* cmd, sim::RunOptions* options) {
+  // The commands identify a missing filter model (and cache it), as docs/identification.md says.
+  options->identify_missing_models = true;
   cmd->add_option_function<std::string>(
          "--estimator", [options](const std::string& v) { options->estimator = v; },
          "How the controller counts units that are on: output (force / settled unit force, the "

@@ -10,6 +10,7 @@ namespace recruit::cli {
 
 // Adds --estimator, --filter-model, --dT, --lambda, --seed, --duration and --progress to `cmd`,
 // writing into `options` (unset options keep the task file's values).
+// Also turns on identify_missing_models: the commands identify a missing filter model.
 void AddRunOptions(CLI::App* cmd, sim::RunOptions* options);
 
 }  // namespace recruit::cli

@@ -147,6 +147,7 @@ Result<Prepared> Prepare(const SweepArgs& a, int* code) {
   spec.lambdas = pick("lambda", a.lambdas, p.file.lambdas);
   spec.estimators = pick("estimator", a.estimators, p.file.estimators);
   spec.seeds = a.given.count("seeds") || !p.file.seeds ? a.seeds : *p.file.seeds;
+  spec.identify_missing_models = true;  // as simulate does: a missing model is identified, cached
   spec.base_seed =
       a.given.count("base-seed") || !p.file.base_seed ? a.base_seed : *p.file.base_seed;
   if (a.duration > 0) {

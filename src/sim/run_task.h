@@ -27,9 +27,11 @@ struct RunOptions {
   std::optional<double> duration;         // s
   std::uint64_t seed = 1;
   bool progress = false;  // progress on stderr
-  // kalman-augmented without a model file: identify (and cache) a missing model for the bundle
-  // and dT (identification/model_cache.h); false = an error naming the command that makes one.
-  bool identify_missing_models = true;
+  // kalman-augmented without a model file, and the self-tuned loop's design: identify (and
+  // cache, identification/model_cache.h) a model missing from the search path for the bundle and
+  // dT. Off (an error naming the command that makes one) unless the caller turns it on: the
+  // `recruit` commands and the Python package do; a library user decides.
+  bool identify_missing_models = false;
   bool quiet = false;  // no notes on stderr (e.g. that a model is being identified)
 };
 

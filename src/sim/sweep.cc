@@ -42,6 +42,7 @@ RunOptions RunOptionsFor(const SweepRun& run, const SweepSpec& spec) {
   o.seed = run.seed;
   o.duration = spec.duration;
   o.filter_model = spec.filter_model;
+  o.identify_missing_models = spec.identify_missing_models;
   return o;
 }
 

@@ -34,7 +34,8 @@ struct SweepSpec {
   std::uint64_t base_seed = 1;
   std::optional<double> duration;  // override of the task's
   std::optional<std::string> filter_model;
-  std::vector<PlantPoint> plant;  // outermost loop of the grid; empty = one point, no axes
+  std::vector<PlantPoint> plant;         // outermost loop of the grid; empty = one point, no axes
+  bool identify_missing_models = false;  // RunOptions::identify_missing_models of every run
 };
 
 struct SweepRun {
