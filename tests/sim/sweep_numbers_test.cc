@@ -7,7 +7,6 @@
 #include <cctype>
 #include <cmath>
 #include <cstdlib>
-#include <cstring>
 #include <filesystem>
 #include <sstream>
 #include <string>
@@ -47,10 +46,11 @@ double Parse(const std::string& text) {
   return x;
 }
 
-// Bitwise equal, NaN equal to NaN.
+// Equal as doubles, NaN equal to NaN.
 bool Same(double a, double b) { return (std::isnan(a) && std::isnan(b)) || a == b; }
 
-// Values whose %.6g or %.17g text does not read back as themselves, or reads "0.28999999999999998".
+// A cell of numbers whose %.6g text does not read back (and 0.29, %.17g "0.28999999999999998"),
+// a subnormal and a NaN mean.
 CellStats Cell(double dT, double lambda, std::vector<std::pair<std::string, double>> plant) {
   CellStats c;
   c.plant_values = std::move(plant);
