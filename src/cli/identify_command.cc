@@ -1,6 +1,8 @@
 // recruit identify: fit the augmented transient model of an SMA unit (docs/identification.md)
 // from the bench (switching the units through the plugin) or from a recorded switching log, and
 // save it as a filter model file.
+#include <fmt/format.h>
+
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -39,10 +41,14 @@ struct IdentifyArgs {
   std::string save_log;
 };
 
-// The fitted chain, one line per state.
-void PrintChain(const recruit::control::TransientChain& c) {
-  std::printf("%-8s %-4s %10s %10s\n", "state", "on", "H (N)", "advance");
-  const auto names = c.StateNames();
+// The model as written, one line per state: its name and H from the model file's JSON (H as the
+// shortest text that reads back as the written double, so the table is the file's H exactly:
+// clamped to >= 0 and, from the bench, carried onto the force law), on/off and the advance
+// probability from the fitted chain.
+void PrintModel(const recruit::control::TransientChain& c, const nlohmann::json& model) {
+  const nlohmann::json& names = model.at("states");
+  const nlohmann::json& H = model.at("H").at(0);
+  std::printf("%-8s %-4s %24s %10s\n", "state", "on", "H (N)", "advance");
   const auto on = c.IsOn();
   for (int s = 0; s < c.num_states(); ++s) {
     char adv[32] = "-";
@@ -51,7 +57,9 @@ void PrintChain(const recruit::control::TransientChain& c) {
     } else if (s >= c.cool(1)) {
       std::snprintf(adv, sizeof adv, "%.3f", c.cool_advance[s - c.cool(1)]);
     }
-    std::printf("%-8s %-4s %10.4f %10s\n", names[s].c_str(), on[s] ? "on" : "off", c.force[s], adv);
+    const std::string h = fmt::format("{}", H.at(s).get<double>());
+    std::printf("%-8s %-4s %24s %10s\n", names.at(s).get<std::string>().c_str(),
+                on[s] ? "on" : "off", h.c_str(), adv);
   }
 }
 
@@ -94,7 +102,7 @@ Result<nlohmann::json> IdentifyFromLog(const IdentifyArgs& a, const std::string&
                          {"R_N2", fit->force_noise_var}};
   std::printf("identified %d-state model, N = %d, dT = %g s, from %s\n", c.num_states(),
               log->num_units, log->dT, a.log_in.c_str());
-  PrintChain(c);
+  PrintModel(c, j);
   PrintFit(*fit);
   return j;
 }
@@ -126,7 +134,7 @@ Result<nlohmann::json> IdentifyFromBench(const IdentifyArgs& a, const std::strin
               ident["plant"].value("actuator", std::string()).c_str(),
               ident["pose"].get<std::string>().empty() ? "its fixed pose"
                                                        : ident["pose"].get<std::string>().c_str());
-  PrintChain(id->fit.chain);
+  PrintModel(id->fit.chain, id->model);
   std::printf("settled unit force (plugin, at ref_length): %.4f N\n",
               ident["settled_unit_force_N"].get<double>());
   PrintFit(id->fit);

@@ -338,6 +338,10 @@ std::vector<double> CellMetricValues(const CellStats& c) {
   return out;
 }
 
+// Numbers: every value of table.csv, and the grid coordinates (plant values, dT, lambda) in
+// table.md, are written as "{}" writes them: the shortest text that reads back as the same double
+// (0.29, not 0.28999999999999998). table.md rounds its measured statistics for reading; table.csv
+// holds them exactly.
 Status WriteSweepReport(const std::vector<CellStats>& cells, const TrackingCriterion& criterion,
                         const std::string& out_dir, const std::string& title) {
   const fs::path dir(out_dir);
@@ -359,7 +363,7 @@ Status WriteSweepReport(const std::vector<CellStats>& cells, const TrackingCrite
     if (c.plant_values.empty()) return std::string();
     std::string out = md ? fmt::format("| {} ", c.plant) : fmt::format("{},", c.plant);
     for (const auto& [name, v] : c.plant_values) {
-      out += md ? fmt::format("| {:.6g} ", v) : fmt::format("{:.17g},", v);
+      out += md ? fmt::format("| {} ", v) : fmt::format("{},", v);
     }
     return out;
   };
@@ -376,13 +380,12 @@ Status WriteSweepReport(const std::vector<CellStats>& cells, const TrackingCrite
       title, 100 * criterion.max_overshoot, 100 * criterion.min_settled, plant_md_head,
       plant_md_rule);
   for (const auto& c : cells) {
-    csv += plant_cols(c, false) +
-           fmt::format("{:g},{:g},{},{},", c.dT, c.lambda, c.estimator, c.seeds);
-    for (double x : CellMetricValues(c)) csv += fmt::format("{:.6g},", x);
-    csv += fmt::format("{},{:.6g}\n", c.meets ? 1 : 0, c.margin);
+    csv += plant_cols(c, false) + fmt::format("{},{},{},{},", c.dT, c.lambda, c.estimator, c.seeds);
+    for (double x : CellMetricValues(c)) csv += fmt::format("{},", x);
+    csv += fmt::format("{},{}\n", c.meets ? 1 : 0, c.margin);
     md += (c.plant_values.empty() ? "" : plant_cols(c, true)) +
           fmt::format(
-              "| {:g} | {:g} | {} | {} | {:.1f} ± {:.1f} | {:.2f} | {:.0f} | {:.3g} | {:.3f} | "
+              "| {} | {} | {} | {} | {:.1f} ± {:.1f} | {:.2f} | {:.0f} | {:.3g} | {:.3f} | "
               "{:.4f} "
               "| {:.2f} | {:.2f} | {:.0f} | {} | {:+.3f} |\n",
               c.dT, c.lambda, c.estimator, c.seeds, 100 * c.Mean(&RunMetrics::overshoot),
@@ -417,12 +420,12 @@ Status WriteSweepReport(const std::vector<CellStats>& cells, const TrackingCrite
       if (col[i]->meets) best = i;
     }
     if (best < 0) {
-      shortest += lead + fmt::format("| {} | {:g} | none of the dT tried | - | - |\n", est, lambda);
+      shortest += lead + fmt::format("| {} | {} | none of the dT tried | - | - |\n", est, lambda);
     } else {
       const std::string next =
-          best > 0 ? fmt::format("{:g} (margin {:+.3f})", col[best - 1]->dT, col[best - 1]->margin)
+          best > 0 ? fmt::format("{} (margin {:+.3f})", col[best - 1]->dT, col[best - 1]->margin)
                    : std::string("none shorter tried");
-      shortest += lead + fmt::format("| {} | {:g} | {:g} | {:+.3f} | {} |\n", est, lambda,
+      shortest += lead + fmt::format("| {} | {} | {} | {:+.3f} | {} |\n", est, lambda,
                                      col[best]->dT, col[best]->margin, next);
     }
   }
@@ -447,7 +450,7 @@ Status WriteSweepReport(const std::vector<CellStats>& cells, const TrackingCrite
     dat += "# estimator " + e + "\n# dT lambda overshoot_percent meets\n";
     for (const auto& c : cells) {
       if (c.estimator == e) {
-        dat += fmt::format("{:g} {:g} {:.4f} {}\n", c.dT, c.lambda,
+        dat += fmt::format("{} {} {:.4f} {}\n", c.dT, c.lambda,
                            100 * c.Mean(&RunMetrics::overshoot), c.meets ? 1 : 0);
       }
     }

@@ -249,7 +249,8 @@ std::string Fmt(double x, const char* spec) {
 }  // namespace
 
 std::string ReportMarkdown(const ReportInput& in, const std::vector<Recommendation>& recs,
-                           const std::vector<Sensitivity>& sens, bool with_figures) {
+                           const std::vector<Sensitivity>& sens, bool with_figures,
+                           bool with_stability_map) {
   const double c = DelayLoopGainForOvershoot(in.criterion.max_overshoot);
   const bool bound = !in.latency.empty();
   std::string md = fmt::format(
@@ -282,15 +283,15 @@ std::string ReportMarkdown(const ReportInput& in, const std::vector<Recommendati
         "|---|---|---|---|---|---|---|" + (bound ? "---|---|" : "") + "\n";
   for (const auto& r : recs) {
     std::string row = fmt::format("| {} ", r.plant);
-    for (const auto& [name, v] : r.plant_values) row += fmt::format("| {:.6g} ", v);
+    for (const auto& [name, v] : r.plant_values) row += fmt::format("| {} ", v);
     if (r.found) {
-      row += fmt::format("| {} | {:g} | {:g} | {:+.3f} ± {:.3f} | {} | {}/{} | {}{} |", r.estimator,
+      row += fmt::format("| {} | {} | {} | {:+.3f} ± {:.3f} | {} | {}/{} | {}{} |", r.estimator,
                          r.lambda, r.dT, r.margin, r.margin_se, Fmt(100 * r.confidence, "{:.0f} %"),
                          r.seeds_meeting, r.seeds, r.censored ? "<= " : "",
                          Fmt(r.critical_dT, "{:.3g}"));
     } else {
-      row += fmt::format("| {} | {:g} | none of the dT tried | - | - | - | - |", r.estimator,
-                         r.lambda);
+      row +=
+          fmt::format("| {} | {} | none of the dT tried | - | - | - | - |", r.estimator, r.lambda);
     }
     if (bound) {
       const double tau =
@@ -311,18 +312,29 @@ std::string ReportMarkdown(const ReportInput& in, const std::vector<Recommendati
         "|---|---|---|---|---|---|\n";
     for (const auto& s : sens) {
       if (s.fitted) {
-        md += fmt::format("| {} | {:g} | {} | {:+.3f} {} | x{:.3g} | {} |\n", s.estimator, s.lambda,
+        md += fmt::format("| {} | {} | {} | {:+.3f} {} | x{:.3g} | {} |\n", s.estimator, s.lambda,
                           s.axis, s.slope, s.log_axis ? "(d ln dT*/d ln x)" : "(1/unit)", s.effect,
                           s.points);
       } else {
-        md += fmt::format("| {} | {:g} | {} | not fitted | - | {} |\n", s.estimator, s.lambda,
-                          s.axis, s.points);
+        md += fmt::format("| {} | {} | {} | not fitted | - | {} |\n", s.estimator, s.lambda, s.axis,
+                          s.points);
       }
     }
   }
   if (with_figures) {
     md += "\n## Figures\n\n![criterion margin against dT](margin.png)\n";
     if (!axes.empty()) md += "\n![critical dT against each plant axis](critical_dt.png)\n";
+    if (with_stability_map) {
+      md +=
+          "\n![stability map: mean step overshoot per dT and lambda, ring = meets the "
+          "criterion](stability.png)\n\n"
+          "Stability map: one panel per estimator, a cell per dT tried (across, in increasing "
+          "order, equally spaced) and lambda (up), coloured by the cell's mean step overshoot over "
+          "its seeds (green 0 %, yellow 10 %, red 50 % or more; the number in the cell, in %), "
+          "with a black ring where the cell meets the criterion. In each lambda row the leftmost "
+          "ringed cell is the recommended dT; a cell with no ring whose overshoot is within the "
+          "limit fails the settling part of the criterion.\n";
+    }
     md += "\nSVG versions: margin.svg" + std::string(axes.empty() ? "" : ", critical_dt.svg") +
           ". Full per-cell table: table.md, table.csv.\n";
   }
@@ -350,7 +362,18 @@ Status WriteReport(const ReportInput& in, const std::string& out_dir,
       if (fmt_ == plot::Format::kPng) pngs[file] = *bytes;
     }
   }
-  const std::string md = ReportMarkdown(in, recs, sens, true);
+  // The dT x lambda map `recruit sweep` draws before the report (sweeps without plant axes).
+  bool with_map = false;
+  if (in.cells.empty() || in.cells.front().plant_values.empty()) {
+    std::error_code ec;
+    if (fs::exists(dir / "stability.png", ec)) {
+      auto bytes = ReadFile((dir / "stability.png").string());
+      if (!bytes.ok()) return Error{"report figure stability: " + bytes.error()};
+      pngs["stability.png"] = std::move(bytes).value();
+      with_map = true;
+    }
+  }
+  const std::string md = ReportMarkdown(in, recs, sens, true, with_map);
   if (Status s = WriteFileAtomically((dir / "report.md").string(), md); !s.ok()) return s;
   return WriteFileAtomically((dir / "report.html").string(),
                              MarkdownToHtml(md, pngs, "Sampling-period report: " + in.title));

@@ -29,16 +29,20 @@ struct ReportInput {
   std::vector<double> latency;
 };
 
-// The Markdown text (figure links relative to the report); figures are listed only if made.
+// The Markdown text (figure links relative to the report); figures are listed only if made,
+// stability.png (with how to read it) only if `with_stability_map`.
 std::string ReportMarkdown(const ReportInput& in, const std::vector<Recommendation>& recs,
-                           const std::vector<Sensitivity>& sens, bool with_figures);
+                           const std::vector<Sensitivity>& sens, bool with_figures,
+                           bool with_stability_map = false);
 
 // Draws a figure as PNG or SVG bytes: plot::RenderFigure, which `recruit` reaches through its
 // plot module (cli/command_modules.h) so that only the commands that draw load cairo.
 using FigureRenderer =
     std::function<Result<std::string>(const plot::Figure&, int width, int height, plot::Format)>;
 
-// Writes report.md, report.html and the figures into `out_dir`.
+// Writes report.md, report.html and the figures into `out_dir`. A sweep without plant axes whose
+// `out_dir` holds stability.png (StabilityMapOptions; `recruit sweep` draws it first) gets it
+// linked in report.md and embedded in report.html.
 Status WriteReport(const ReportInput& in, const std::string& out_dir, const FigureRenderer& render);
 
 // What `recruit sweep` asks `recruit plot --stability-map` for: <out_dir>/stability.png from the
