@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <functional>
+#include <map>
 #include <mutex>
 #include <set>
 #include <string>
@@ -126,11 +127,15 @@ bool IsSmaInstance(const mjModel* m, int instance) {
 
 // True the first time (m, instance) is seen with this content: init runs for every mjData, the
 // check needs thousands of kinematics passes, so it runs once per distinct compiled model.
+static std::size_t ModelContentHash(const mjModel* m) {
+  return std::hash<std::string_view>()(
+      std::string_view(static_cast<const char*>(m->buffer), static_cast<std::size_t>(m->nbuffer)));
+}
+
 static bool FirstCheck(const mjModel* m, int instance) {
   static std::mutex mu;
   static std::set<std::pair<std::size_t, int>> seen;
-  const std::size_t h = std::hash<std::string_view>()(
-      std::string_view(static_cast<const char*>(m->buffer), static_cast<std::size_t>(m->nbuffer)));
+  const std::size_t h = ModelContentHash(m);
   std::lock_guard<std::mutex> lock(mu);
   return seen.insert({h, instance}).second;
 }
@@ -147,6 +152,22 @@ Result<std::unique_ptr<SmaInstance>> SmaInstance::Create(const mjModel* m, int i
 }
 
 std::vector<std::string> SmaInstance::LoadWarnings(const mjModel* m) const {
+  // Kept per distinct model and instance: the fit check samples the joints thousands of times,
+  // and every run of a model asks again for what its first load printed.
+  static std::mutex mu;
+  static std::map<std::pair<std::size_t, int>, std::vector<std::string>> kept;
+  const auto key = std::make_pair(ModelContentHash(m), instance_);
+  {
+    std::lock_guard<std::mutex> lock(mu);
+    if (auto it = kept.find(key); it != kept.end()) return it->second;
+  }
+  std::vector<std::string> out = ComputeLoadWarnings(m);
+  std::lock_guard<std::mutex> lock(mu);
+  kept.emplace(key, out);
+  return out;
+}
+
+std::vector<std::string> SmaInstance::ComputeLoadWarnings(const mjModel* m) const {
   std::vector<std::string> out;
   // The design against the wire's long-life limits: one warning per bundle past one.
   for (const SmaActuator& a : actuators_) {

@@ -94,6 +94,7 @@ class SmaInstance {
   std::vector<TendonFit> Fit(const mjModel* m) const;
   // What loading the model warns of (once per distinct model, through mju_warning): each
   // bundle's design past its wire's long-life limits, and each misfit to its tendon.
+  // Computed once per distinct model (its content) and instance.
   std::vector<std::string> LoadWarnings(const mjModel* m) const;
   // The warning text for actuator k, or "" when it fits.
   std::string FitWarning(const mjModel* m, int k, const TendonFit& fit) const;
@@ -127,6 +128,7 @@ class SmaInstance {
   }
 
  private:
+  std::vector<std::string> ComputeLoadWarnings(const mjModel* m) const;
   SmaInstance() = default;
   // check_actuators = false skips the checks of the actuators' transmission and dynamics.
   static Result<std::unique_ptr<SmaInstance>> Build(const mjModel* m, int instance,

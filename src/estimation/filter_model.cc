@@ -225,6 +225,12 @@ Result<FilterModel> FilterModel::FromJsonValue(const nlohmann::json& j, const st
     }
   }
   if (Status s = f.Validate(where); !s.ok()) return Error{s.error()};
+  const nlohmann::json* r2 = &j;
+  for (const char* key : {"identification", "holdout", "r2"}) {
+    r2 = r2->is_object() && r2->contains(key) ? &(*r2)[key] : nullptr;
+    if (r2 == nullptr) break;
+  }
+  if (r2 != nullptr && r2->is_number()) f.holdout_r2 = r2->get<double>();
   return f;
 }
 

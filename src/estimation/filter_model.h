@@ -5,6 +5,7 @@
 
 #include <Eigen/Dense>
 #include <cstdint>
+#include <limits>
 #include <nlohmann/json_fwd.hpp>
 #include <string>
 #include <vector>
@@ -33,6 +34,9 @@ struct FilterModel {
   Eigen::MatrixXd A;                   // kConstant: m x m column-stochastic
   Eigen::VectorXd x0;                  // initial estimate, sums to N (default: all in state 0)
   Eigen::MatrixXd P0;                  // initial covariance (default 0: x0 known exactly)
+  // Read only: the R^2 of the force held out of the identification (identification.holdout.r2)
+  // when the file records one; NaN otherwise.
+  double holdout_r2 = std::numeric_limits<double>::quiet_NaN();
 
   int num_states() const { return static_cast<int>(state_names.size()); }
   int num_outputs() const { return static_cast<int>(H.rows()); }

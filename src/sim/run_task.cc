@@ -9,17 +9,15 @@
 #include <limits>
 #include <memory>
 
-#include "common/json_file.h"
 #include "common/mujoco_ptr.h"
 #include "common/rng.h"
-#include "sim/force_sensor.h"
-
 #include "control/kalman_estimator.h"
 #include "control/recruitment_controller.h"
 #include "estimation/filter_model.h"
 #include "identification/model_cache.h"
 #include "identification/plant_record.h"
 #include "plugin/sma_host.h"
+#include "sim/force_sensor.h"
 #include "sim/joint_loop.h"
 #include "sim/metrics_stream.h"
 #include "sim/plant.h"
@@ -166,23 +164,18 @@ std::vector<std::string> LoadWarnings(const Plant& plant) {
   return out;
 }
 
-// A warning when the identified model in `file` explains less than kMinHoldoutR2 of the force it
-// was checked on (held-out data at the identification pose): the estimate and the self-tuned
-// loop's design rest on it.
+// A warning when an identified model explains less than kMinHoldoutR2 of the force it was
+// checked on (held-out data at the identification pose): the estimate and the self-tuned loop's
+// design rest on it.
 constexpr double kMinHoldoutR2 = 0.9;
-void IdentificationWarning(const std::string& file, const std::string& bundle,
+void IdentificationWarning(const FilterModel& model, const std::string& bundle,
                            std::vector<std::string>& warnings) {
-  auto j = LoadJsonFile(file);
-  if (!j.ok() || !j->contains("identification")) return;
-  const nlohmann::json& id = (*j)["identification"];
-  if (!id.contains("holdout") || !id["holdout"].contains("r2")) return;
-  const double r2 = id["holdout"]["r2"].get<double>();
-  if (r2 >= kMinHoldoutR2) return;
+  if (!(model.holdout_r2 < kMinHoldoutR2)) return;  // NaN: not recorded
   char buf[300];
   std::snprintf(buf, sizeof buf,
                 "%s: its identified model explains R^2 = %.2f of held-out force (below %.2f): the "
-                "estimate and the loop's design rest on it (%s)",
-                bundle.c_str(), r2, kMinHoldoutR2, file.c_str());
+                "estimate and the loop's design rest on it",
+                bundle.c_str(), model.holdout_r2, kMinHoldoutR2);
   if (std::find(warnings.begin(), warnings.end(), buf) == warnings.end()) warnings.push_back(buf);
 }
 
@@ -213,10 +206,12 @@ Result<std::vector<Channel> > MakeChannels(const Task& task, const ControllerSet
       auto file = BundleModelFile(task, settings, plant, i, options, bundle_spec, identify_s);
       if (!file) return Error{where + ".controller: " + file.error()};
       bundle_spec.model_file = *file;
-      IdentificationWarning(*file, host.bundle_name(b), warnings);
     }
     auto c = control::RecruitmentController::Create(p, bundle_spec);
     if (!c.ok()) return Error{where + ".controller: " + c.error()};
+    if (const auto* k = dynamic_cast<const control::KalmanOnCountEstimator*>(&c->estimator())) {
+      IdentificationWarning(k->model(), host.bundle_name(b), warnings);
+    }
     // Each load cell has its own noise stream derived from the run seed (the plugin's unit
     // streams use the seed itself).
     auto sensor =
@@ -255,10 +250,10 @@ Result<std::vector<control::ActuatorResponse> > ActuatorResponses(
                            "unit's thermal lag");
         continue;
       }
-      IdentificationWarning(*file, plant.bundle_name(i), warnings);
       auto loaded = FilterModel::FromJson(*file);
       if (!loaded) return Error{loaded.error()};
       model = std::move(loaded).value();
+      IdentificationWarning(model, plant.bundle_name(i), warnings);
     }
     if (model.transition != TransitionSource::kBroadcast || model.H.rows() < 1) {
       return Error{"bundle '" + plant.bundle_name(i) +
