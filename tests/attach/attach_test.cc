@@ -20,6 +20,8 @@
 #include "plugin/sma_host.h"
 #include "plugin/sma_plugin.h"
 #include "plugin/tendon_range.h"
+#include "sim/csv_writer.h"
+#include "sim/run_task.h"
 #include "sim/task.h"
 
 namespace recruit::attach {
@@ -463,6 +465,66 @@ TEST(Attach, MyoSuiteElbowAndFingerLoadFromTheirNewFolder) {
       EXPECT_EQ(r->bundles.size(), 6u);
     }
   }
+}
+
+}  // namespace
+}  // namespace recruit::attach
+
+namespace recruit::attach {
+namespace {
+
+// The starter task of an attached two-joint arm runs through the several-joint loop: both
+// joints scored, each step named by its joint, the CSV with the second joint's columns.
+TEST(StarterTask, RunsThroughTheSeveralJointLoop) {
+  const fs::path dir = fs::temp_directory_path() / "recruit_attach_run";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  AttachOptions o;
+  o.model = kSrc + "/models/arm2j_muscle.xml";
+  o.muscles = {"all"};
+  o.output = (dir / "arm2j.xml").string();
+  o.task = (dir / "task.json").string();
+  sma::RegisterSmaPlugin();
+  struct Quiet {  // the fit check's warnings, if any, stay out of MUJOCO_LOG.TXT
+    void (*old)(const char*) = mju_user_warning;
+    Quiet() {
+      mju_user_warning = [](const char*) {};
+    }
+    ~Quiet() { mju_user_warning = old; }
+  } quiet;
+  auto r = Attach(o);
+  ASSERT_TRUE(r.ok()) << r.error();
+  auto task = sim::Task::FromFile(o.task);
+  ASSERT_TRUE(task.ok()) << task.error();
+  ASSERT_EQ(task->joints.size(), 2u);
+  sim::RunOptions run;
+  run.estimator = "output";  // no identified model needed
+  run.duration = 30;         // the first step of each joint, at 20 s
+  run.quiet = true;
+  const std::string csv = (dir / "steps.csv").string();
+  sim::CsvStepWriter writer(csv, 100);
+  auto s = sim::RunTask(*task, run, {&writer});
+  ASSERT_TRUE(s.ok()) << s.error();
+  ASSERT_TRUE(writer.Commit().ok());
+  ASSERT_EQ(s->joints.size(), 2u);
+  EXPECT_EQ(s->joints[0].joint, "shoulder");
+  EXPECT_EQ(s->joints[1].joint, "elbow");
+  ASSERT_EQ(s->steps.size(), 2u);  // one step of each joint at 20 s
+  ASSERT_EQ(s->step_joints.size(), 2u);
+  EXPECT_EQ(s->step_joints[0], "shoulder");
+  EXPECT_EQ(s->step_joints[1], "elbow");
+  EXPECT_EQ(s->metrics.num_steps, 2);
+  EXPECT_NEAR(s->metrics.tracking_rmse,
+              std::sqrt(0.5 * (std::pow(s->joints[0].tracking_rmse, 2) +
+                               std::pow(s->joints[1].tracking_rmse, 2))),
+              1e-12);
+  EXPECT_FALSE(s->loop_designs.empty());
+  std::ifstream in(csv);
+  std::string header;
+  std::getline(in, header);
+  EXPECT_EQ(header.rfind("time,reference,measured,angle,elbow.reference,elbow.angle,", 0), 0u)
+      << header;
+  fs::remove_all(dir);
 }
 
 }  // namespace
