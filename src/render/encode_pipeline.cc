@@ -6,9 +6,7 @@ namespace recruit::render {
 
 EncodePipeline::EncodePipeline(int width, int height, std::unique_ptr<Mp4Writer> mp4,
                                std::unique_ptr<GifWriter> gif, int gif_stride, int queue_frames)
-    : width_(width),
-      height_(height),
-      mp4_(std::move(mp4)),
+    : mp4_(std::move(mp4)),
       gif_(std::move(gif)),
       gif_stride_(gif_stride < 1 ? 1 : gif_stride),
       async_(queue_frames > 0) {

@@ -47,7 +47,6 @@ class EncodePipeline {
   void Run();
   Status Write(const Frame& frame);
 
-  const int width_, height_;
   std::unique_ptr<Mp4Writer> mp4_;
   std::unique_ptr<GifWriter> gif_;
   const int gif_stride_;

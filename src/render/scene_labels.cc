@@ -10,7 +10,8 @@ namespace recruit::render {
 
 int TextWidth(const std::string& s, const mjrContext* con) {
   int w = 0;
-  for (unsigned char c : s) w += c < 127 ? con->charWidth[c] : con->charWidth['?'];
+  for (unsigned char c : s)
+    w += c < 127 ? con->charWidth[c] : con->charWidth[static_cast<unsigned char>('?')];
   return w;
 }
 

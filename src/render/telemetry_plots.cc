@@ -128,7 +128,8 @@ TextMetrics TextMetrics::FromContext(const mjrContext* con) {
   t.char_height = con->charHeight;
   t.width = [con](const std::string& s) {
     int w = 0;
-    for (unsigned char c : s) w += c < 127 ? con->charWidth[c] : con->charWidth['?'];
+    for (unsigned char c : s)
+      w += c < 127 ? con->charWidth[c] : con->charWidth[static_cast<unsigned char>('?')];
     return w;
   };
   return t;

@@ -211,7 +211,8 @@ void CheckPanel(
   for (size_t i = 0; i < ticks.size(); ++i) {
     EXPECT_NEAR(runs[i].centre, grid[i], con.charHeight / 4.0) << labels[i];
     const int width = right - runs[i].left;
-    EXPECT_NEAR(width, text.width(labels[i]), con.charWidth['0'] * 0.6) << labels[i];
+    EXPECT_NEAR(width, text.width(labels[i]), con.charWidth[static_cast<unsigned char>('0')] * 0.6)
+        << labels[i];
     EXPECT_DOUBLE_EQ(std::strtod(labels[i].c_str(), nullptr), ticks[i]);
   }
   // Each curve, read at plateau columns through the grid rows and the tick values, gives the
