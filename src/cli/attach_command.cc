@@ -90,6 +90,11 @@ void AddAttachCommand(CLI::App& app, int& exit_code) {
                 "set the lengthrange of other muscles whose MuJoCo computation fails from the "
                 "joint ranges");
   sub->add_option("--lock", args->lock, "joints the starter task does not drive (comma-separated)");
+  sub->add_option("--max-time-constant", args->options.limits.max_time_constant,
+                  "slowest unit thermal time constant (s) sizing prefers a thinner wire for, with "
+                  "more wires: bandwidth against heating power")
+      ->check(NumberIn(0, true, 1e3, "seconds"))
+      ->capture_default_str();
   sub->callback([args, &exit_code] { exit_code = RunAttach(*args); });
 }
 

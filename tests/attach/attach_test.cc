@@ -218,6 +218,27 @@ TEST(TendonRange, FindsThePathJumpAndSizesOnTheUsableSide) {
 }
 
 // Sizing: closed forms of the straight wire in series with its coupling spring.
+// A large force: the thinnest wire with at most 2 per segment is slow; the bandwidth rule takes
+// a thinner wire with more of them (faster, hotter bill), and a looser rule keeps the thick one.
+TEST(Sizing, TheBandwidthRuleTradesHeatingPowerForTheTimeConstant) {
+  SizingInput in{"b", 900, 0.04, 0.1, 0.14, 0.12};
+  auto fast = SizeBundle(in);
+  ASSERT_TRUE(fast.ok()) << fast.error();
+  SizingLimits loose;
+  loose.max_time_constant = 100;
+  auto slow = SizeBundle(in, loose);
+  ASSERT_TRUE(slow.ok()) << slow.error();
+  EXPECT_LE(fast->time_constant, 2.0);
+  EXPECT_GT(slow->time_constant, 2.0);
+  EXPECT_LT(fast->unit.wire_diameter, slow->unit.wire_diameter);
+  EXPECT_LE(slow->unit.parallel, 2);
+  EXPECT_LE(fast->unit.parallel, loose.max_parallel);
+  EXPECT_GT(fast->power, slow->power);
+  // Both meet the force.
+  EXPECT_GE(fast->force_mid, 900);
+  EXPECT_GE(slow->force_mid, 900);
+}
+
 TEST(Sizing, MatchesForceWithinLimitsAndCoversTheStroke) {
   for (double force : {5.0, 40.0, 600.0}) {
     for (double excursion : {0.01, 0.03, 0.08}) {
