@@ -56,7 +56,6 @@ Result<JointLoops> JointLoops::Create(const Task& task, const Plant& plant,
   loops.target_.hold = std::max(hold, 4 * dT);
   loops.gains_.resize(plant.num_joints());
   loops.integral_.assign(plant.num_joints(), 0.0);
-  loops.tensions_.assign(plant.num_bundles(), 0.0);
   // Slower bundles are priced by how much slower they are than the fastest: the fast ones take
   // a joint's demand where they can, the slow ones what only they can give.
   double fastest = std::numeric_limits<double>::infinity();

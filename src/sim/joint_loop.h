@@ -53,7 +53,6 @@ class JointLoops {
   control::LoopTarget target_;
   std::vector<std::map<double, control::LoopGains>> gains_;  // per joint, by reference value
   std::vector<double> integral_;                             // rad s, per joint
-  std::vector<double> tensions_;                             // N, the last allocation
   Eigen::VectorXd price_;  // per bundle: its time to 63 % over the fastest bundle's
   std::vector<JointDesignRecord> designs_;
 };

@@ -23,6 +23,7 @@
 #include "sim/csv_writer.h"
 #include "sim/run_task.h"
 #include "sim/task.h"
+#include "tests/plugin/mujoco_util.h"
 
 namespace recruit::attach {
 namespace {
@@ -279,15 +280,7 @@ TEST(Gear, IsATransmissionWithTheClosedForm) {
   <actuator><plugin name="p" instance="u" tendon="t" gear="0.5" ctrlrange="-1 1"/></actuator>
 </mujoco>)";
   sma::RegisterSmaPlugin();
-  // The fit check warns about this toy bench (its stroke is short): the warning would go to
-  // MUJOCO_LOG.TXT in the folder the test runs in.
-  struct Quiet {
-    void (*old)(const char*) = mju_user_warning;
-    Quiet() {
-      mju_user_warning = [](const char*) {};
-    }
-    ~Quiet() { mju_user_warning = old; }
-  } quiet;
+  sma::testing::WarningCapture quiet;  // the fit check may warn: not into MUJOCO_LOG.TXT
   auto m = LoadModelFromString(xml);
   ASSERT_TRUE(m.ok()) << m.error();
   DataPtr d(mj_makeData(m->get()));
@@ -506,13 +499,7 @@ TEST(StarterTask, RunsThroughTheSeveralJointLoop) {
   o.output = (dir / "arm2j.xml").string();
   o.task = (dir / "task.json").string();
   sma::RegisterSmaPlugin();
-  struct Quiet {  // the fit check's warnings, if any, stay out of MUJOCO_LOG.TXT
-    void (*old)(const char*) = mju_user_warning;
-    Quiet() {
-      mju_user_warning = [](const char*) {};
-    }
-    ~Quiet() { mju_user_warning = old; }
-  } quiet;
+  sma::testing::WarningCapture quiet;  // the fit check may warn: not into MUJOCO_LOG.TXT
   auto r = Attach(o);
   ASSERT_TRUE(r.ok()) << r.error();
   auto task = sim::Task::FromFile(o.task);
