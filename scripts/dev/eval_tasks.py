@@ -53,7 +53,8 @@ def main():
                 print(f"{os.path.basename(task)} dT {dT}: settled {settled}/{steps} "
                       f"({100*settled/max(steps,1):.0f} %), worst overshoot {100*worst_os:.1f} %")
                 for b in nees:
-                    print(f"   {b}: NEES {min(nees[b]):.2f}..{max(nees[b]):.2f}, within3 min {min(within[b]):.3f}")
+                    v=[x for x in nees[b] if x is not None]; w=[x for x in within[b] if x is not None]
+                    if v: print(f"   {b}: NEES {min(v):.2f}..{max(v):.2f}, within3 min {min(w):.3f}")
                 if warns: print("   warnings:", sorted(warns)[:5])
                 print("   per seed (settled, max os):", " ".join(f"{s}:{f:.2f}/{o:.2f}" for s, f, o in rows))
 

@@ -22,14 +22,16 @@ struct TuneLoopArgs {
 void PrintDesign(const sim::JointDesignRecord& r, bool response) {
   const control::LoopDesign& d = r.design;
   std::printf(
-      "%-14s %8.2f  I %.3g kg m2, b %.3g N m s/rad, k %.3g N m/rad, bundles' t63 %.2f s\n"
+      "%-14s %8.2f  I %.3g kg m2, b %.3g N m s/rad, k %.3g N m/rad (bundles' %.3g), bundles' t63 "
+      "%.2f s\n"
       "%-14s %8s  kp %.4g N m/rad, ki %.4g N m/(rad s), kd %.4g N m s/rad\n"
       "%-14s %8s  predicted: overshoot %.1f %%, settles in %.1f s%s; 1.5x slower bundles and "
       "1.5x gain: overshoot %.1f %%, %s%s\n",
       r.joint.c_str(), r.reference * 180 / M_PI, r.dynamics.inertia, r.dynamics.damping,
-      r.dynamics.stiffness, r.actuator_t63, "", "", d.gains.kp, d.gains.ki, d.gains.kd, "", "",
-      100 * d.nominal.overshoot, d.nominal.settling_time, d.nominal.settled ? "" : " (not settled)",
-      100 * d.robust.overshoot, d.robust.settled ? "settles" : "does not settle",
+      r.dynamics.stiffness, r.bundle_stiffness, r.actuator_t63, "", "", d.gains.kp, d.gains.ki,
+      d.gains.kd, "", "", 100 * d.nominal.overshoot, d.nominal.settling_time,
+      d.nominal.settled ? "" : " (not settled)", 100 * d.robust.overshoot,
+      d.robust.settled ? "settles" : "does not settle",
       d.meets ? "" : "  [no design on the grid meets the target]");
   if (!response) return;
   std::printf("%-14s %8s  step response (fraction of the step) at t = 0, dT, ...:", "", "");

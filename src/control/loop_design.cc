@@ -104,8 +104,8 @@ Result<LoopDesign> DesignJointLoop(const JointDynamics& joint, const ActuatorRes
   }
   // Scales: the actuator's time to 63 % and a stiffness the loop must at least match.
   const double t63 = std::max(act.TimeTo(0.63), dT);
-  const double k_ref =
-      std::max({std::abs(joint.stiffness), joint.damping / t63, joint.inertia / (t63 * t63)});
+  const double k_ref = std::max({std::abs(joint.stiffness), joint.damping / t63,
+                                 joint.inertia / (t63 * t63), target.torque_error});
   LoopDesign best;
   double best_penalty = std::numeric_limits<double>::infinity();
   for (double a : {0.0, 0.125, 0.25, 0.5, 1.0, 2.0, 4.0, 8.0}) {
@@ -115,7 +115,8 @@ Result<LoopDesign> DesignJointLoop(const JointDynamics& joint, const ActuatorRes
         d.gains = {a * k_ref, b * k_ref / t63, c * k_ref * t63};
         d.nominal = PredictStep(joint, act, dT, d.gains, target);
         d.robust = PredictStep(joint, act, dT, d.gains, target, 1.5, 1.5);
-        d.offset = PredictStep(joint, act, dT, d.gains, target, 1, 1, kFeedforwardError * k_ref);
+        d.offset = PredictStep(joint, act, dT, d.gains, target, 1, 1,
+                               kFeedforwardError * k_ref + target.torque_error);
         d.meets = d.nominal.settled && d.nominal.overshoot <= target.overshoot &&
                   d.robust.settled && d.robust.overshoot <= 0.25 && d.offset.settled &&
                   d.offset.overshoot <= 0.25;

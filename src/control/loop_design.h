@@ -10,7 +10,8 @@
 // on a grid by simulating that model: the fastest settling into the band with the stated
 // overshoot, that also keeps settling (overshoot <= 25 %) with the actuator 1.5x slower and the
 // loop gain 1.5x higher, and when the static torque of the new pose is off by half the
-// step's (an error only the integral removes: the bundles' force model, the estimate's bias).
+// step's plus LoopTarget::torque_error (an error only the integral removes: the bundles' force
+// model, the estimate's bias).
 #pragma once
 
 #include <string>
@@ -39,6 +40,9 @@ struct LoopTarget {
   double overshoot = 0.05;  // fraction of the step
   double band = 0.10;       // settling band, fraction of the step
   double hold = 20;         // s, time a step has to settle
+  // N m per unit of the step: an error of the feedforward that only the integral removes (the
+  // bundles' force falling short of their references), on top of half the joint's stiffness.
+  double torque_error = 0;
 };
 
 struct PredictedStep {

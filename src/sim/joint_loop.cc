@@ -10,7 +10,19 @@ namespace recruit::sim {
 namespace {
 
 constexpr double kStiffnessStep = 1e-3;  // rad, for d tau_static / dq
-constexpr double kLimitMargin = 0.03;    // of a joint's range: the loop's reference stays inside
+constexpr double kLengthStep = 1e-4;     // m, for a unit force map's slope
+// How far the bundles' tension may fall short of its reference at a hold, as a fraction: the
+// unit force map's error and the estimate's bias (MyoSuite's elbow, attached with --force 150:
+// 6-25 % at the holds of seed 401).
+constexpr double kForceError = 0.15;
+constexpr double kLeastStep = 0.05;  // rad: the least step a design assumes
+// A joint's stiffness at constant counts is kept at least this fraction of the sum of the
+// magnitudes it is made of (the limb's and each bundle's): with less, the errors of the model
+// (force map, moment arms) can make a pose the bundles hold unstable. 0.5 settled 7/16, 6/8
+// and 3/8 steps of the development cases at dT 1 (two-joint arm, MyoSuite elbow and finger,
+// seeds 401-402) against 4/16, 4/8 and 2/8 without; 0.25 gave 7/16, 4/8, 3/8.
+constexpr double kStiffnessMargin = 0.5;
+constexpr double kLimitMargin = 0.03;  // of a joint's range: the loop's reference stays inside
 
 }  // namespace
 
@@ -38,13 +50,16 @@ Eigen::VectorXd JointLoops::LoopReference(const Plant& plant, double t) const {
 }
 
 Result<JointLoops> JointLoops::Create(const Task& task, const Plant& plant,
-                                      std::vector<control::ActuatorResponse> responses, double dT) {
-  if (static_cast<int>(responses.size()) != plant.num_bundles()) {
-    return Error{"joint loops: one actuator response per bundle is needed"};
+                                      std::vector<control::ActuatorResponse> responses,
+                                      std::vector<UnitForce> on_unit_force, double dT) {
+  if (static_cast<int>(responses.size()) != plant.num_bundles() ||
+      static_cast<int>(on_unit_force.size()) != plant.num_bundles()) {
+    return Error{"joint loops: one actuator response and unit force map per bundle is needed"};
   }
   JointLoops loops;
   loops.task_ = &task;
   loops.responses_ = std::move(responses);
+  loops.on_unit_force_ = std::move(on_unit_force);
   loops.dT_ = dT;
   loops.target_.band = task.settle_band;
   // The hold a step has to settle in: the shortest of the task's steps, at most 60 s (a longer
@@ -54,7 +69,8 @@ Result<JointLoops> JointLoops::Create(const Task& task, const Plant& plant,
     hold = std::min(hold, ShortestHold(d.reference, task.duration));
   }
   loops.target_.hold = std::max(hold, 4 * dT);
-  loops.gains_.resize(plant.num_joints());
+  loops.last_target_.assign(plant.num_joints(), std::nan(""));
+  loops.settings_.resize(plant.num_joints());
   loops.integral_.assign(plant.num_joints(), 0.0);
   // Slower bundles are priced by how much slower they are than the fastest: the fast ones take
   // a joint's demand where they can, the slow ones what only they can give.
@@ -69,16 +85,79 @@ Result<JointLoops> JointLoops::Create(const Task& task, const Plant& plant,
   return loops;
 }
 
-Result<JointDesignRecord> JointLoops::Design(const Plant& plant, int j,
-                                             const Eigen::VectorXd& r) const {
-  JointDesignRecord rec;
-  rec.joint = plant.joint_name(j);
-  rec.reference = r[j];
+JointLoops::Holding JointLoops::HoldingAt(const Plant& plant, int j,
+                                          const Eigen::VectorXd& r) const {
+  const int nb = plant.num_bundles();
+  const Eigen::MatrixXd arms = plant.MomentArmsAt(r);
+  const Eigen::VectorXd lengths = plant.UnitLengthsAt(r);
   Eigen::VectorXd up = r, down = r;
   up[j] += kStiffnessStep;
   down[j] -= kStiffnessStep;
-  rec.dynamics.stiffness =
+  const Eigen::VectorXd arm_slope =
+      (plant.MomentArmsAt(up).row(j) - plant.MomentArmsAt(down).row(j)).transpose() /
+      (2 * kStiffnessStep);
+  // The tensions that hold the reference: its static torque shared as Step shares it.
+  control::AllocationProblem p;
+  p.arms = arms;
+  p.torque = plant.StaticTorque(r);
+  p.cap.resize(nb);
+  p.floor.resize(nb);
+  p.price = price_;
+  Eigen::VectorXd slope(nb);  // d ln(unit force) / dL, 1/m
+  for (int i = 0; i < nb; ++i) {
+    const double f = on_unit_force_[i](lengths[i]);
+    p.cap[i] = std::max(plant.num_units(i) * f, 1e-9);
+    p.floor[i] = task_->co_contraction * p.cap[i];
+    slope[i] = f > 0 ? (on_unit_force_[i](lengths[i] + kLengthStep) -
+                        on_unit_force_[i](lengths[i] - kLengthStep)) /
+                           (2 * kLengthStep * f)
+                     : 0.0;
+  }
+  // Torque tau_j = sum_i A_ji T_i with T_i = n_i f_i(L_i) and dL_i/dq_j = -A_ji (a bundle shortens
+  // as it pulls): at constant counts -dtau_j/dq_j = sum_i T_i (A_ji^2 f_i'/f_i - dA_ji/dq_j).
+  Holding h;
+  h.coef.resize(nb);
+  for (int i = 0; i < nb; ++i) h.coef[i] = arms(j, i) * arms(j, i) * slope[i] - arm_slope[i];
+  h.limb_stiffness =
       (plant.StaticTorque(up)[j] - plant.StaticTorque(down)[j]) / (2 * kStiffnessStep);
+  std::vector<const Holding*> rows(plant.num_joints(), nullptr);
+  rows[j] = &h;
+  const Eigen::VectorXd tensions = Allocate(p, rows);
+  h.stiffness = h.coef.dot(tensions);
+  for (int i = 0; i < nb; ++i) h.torque += std::abs(arms(j, i) * tensions[i]);
+  return h;
+}
+
+Eigen::VectorXd JointLoops::Allocate(const control::AllocationProblem& p,
+                                     const std::vector<const Holding*>& holding) const {
+  Eigen::VectorXd t = control::AllocateTensions(p);
+  control::AllocationProblem q = p;
+  int added = 0;
+  for (size_t j = 0; j < holding.size(); ++j) {
+    const Holding* h = holding[j];
+    if (h == nullptr) continue;
+    const double least =
+        kStiffnessMargin * (std::abs(h->limb_stiffness) + h->coef.cwiseAbs().dot(t));
+    if (h->limb_stiffness + h->coef.dot(t) >= least) continue;
+    q.arms.conservativeResize(q.arms.rows() + 1, Eigen::NoChange);
+    q.torque.conservativeResize(q.torque.size() + 1);
+    q.arms.row(q.arms.rows() - 1) = h->coef.transpose();
+    q.torque[q.torque.size() - 1] = least - h->limb_stiffness;
+    ++added;
+  }
+  return added ? control::AllocateTensions(q) : t;
+}
+
+Result<JointDesignRecord> JointLoops::Design(const Plant& plant, int j, const Eigen::VectorXd& r,
+                                             double step) const {
+  JointDesignRecord rec;
+  rec.joint = plant.joint_name(j);
+  rec.reference = r[j];
+  rec.holding = HoldingAt(plant, j, r);
+  rec.bundle_stiffness = rec.holding.stiffness;
+  rec.step = std::max(std::abs(step), kLeastStep);
+  rec.torque_error = kForceError * rec.holding.torque;
+  rec.dynamics.stiffness = rec.holding.limb_stiffness + rec.bundle_stiffness;
   rec.dynamics.inertia = plant.JointInertia(j, r);
   rec.dynamics.damping = plant.JointDamping(j);
   // The response of the joint's torque: the allocation gives a demand to the fastest bundles
@@ -96,7 +175,9 @@ Result<JointDesignRecord> JointLoops::Design(const Plant& plant, int j,
   }
   if (act == nullptr) return Error{"joint '" + rec.joint + "': no bundle of the task crosses it"};
   rec.actuator_t63 = act->TimeTo(0.63);
-  auto d = control::DesignJointLoop(rec.dynamics, *act, dT_, target_);
+  control::LoopTarget target = target_;
+  target.torque_error = rec.torque_error / rec.step;
+  auto d = control::DesignJointLoop(rec.dynamics, *act, dT_, target);
   if (!d.ok()) return Error{"joint '" + rec.joint + "': " + d.error()};
   rec.design = std::move(d).value();
   return rec;
@@ -108,22 +189,32 @@ void JointLoops::Step(double t, const Plant& plant, const std::vector<double>& c
   const Eigen::VectorXd r = LoopReference(plant, t);
   // Gains for this pose: designed once per reference value (a step's target).
   std::vector<control::LoopGains> gains(nj);
+  std::vector<const Holding*> holding(nj, nullptr);
   for (int j = 0; j < nj; ++j) {
-    auto it = gains_[j].find(r[j]);
-    if (it == gains_[j].end()) {
-      auto rec = Design(plant, j, r);
-      control::LoopGains g;  // no bundle crosses the joint: feedforward only
+    // The step a new reference value makes: from the last one, or from the limb at the start.
+    const double from = std::isnan(last_target_[j]) ? plant.JointAngle(j) : last_target_[j];
+    last_target_[j] = r[j];
+    auto it = settings_[j].find(r[j]);
+    if (it == settings_[j].end()) {
+      auto rec = Design(plant, j, r, r[j] - from);
+      Setting set;  // no bundle crosses the joint: feedforward only
       if (rec.ok()) {
-        g = rec->design.gains;
+        set = {rec->design.gains, rec->holding};
         designs_.push_back(std::move(rec).value());
       }
-      it = gains_[j].emplace(r[j], g).first;
+      it = settings_[j].emplace(r[j], set).first;
     }
-    gains[j] = it->second;
+    gains[j] = it->second.gains;
+    if (it->second.holding.coef.size() == nb) holding[j] = &it->second.holding;
   }
   const Eigen::VectorXd feedforward = plant.StaticTorque(r);
+  // The bundles are set for the reference pose: arms and unit forces there. Each bundle's
+  // on-count is its tension there over its unit force there, and the force reference handed to
+  // its controller is that count at the present length, so the count does not follow the limb
+  // as it moves and the bundles' own force-length stiffness keeps acting.
+  const Eigen::VectorXd ref_lengths = plant.UnitLengthsAt(r);
   control::AllocationProblem p;
-  p.arms = plant.MomentArms();
+  p.arms = plant.MomentArmsAt(r);
   p.torque.resize(nj);
   Eigen::VectorXd trial(nj);
   for (int j = 0; j < nj; ++j) {
@@ -135,21 +226,16 @@ void JointLoops::Step(double t, const Plant& plant, const std::vector<double>& c
   p.cap.resize(nb);
   p.floor.resize(nb);
   p.price = price_;
-  for (int i = 0; i < nb; ++i) {
-    p.cap[i] = std::max(capacity[i], 1e-9);
-    p.floor[i] = task_->co_contraction * p.cap[i];
-  }
-  Eigen::VectorXd tensions = control::AllocateTensions(p);
-  // Whole units: each bundle's controller holds whole on-counts, so the demand is met by the
-  // combination of counts that comes nearest it (control::RoundToUnits).
   Eigen::VectorXd unit_force(nb);
   Eigen::VectorXi units(nb);
   for (int i = 0; i < nb; ++i) {
     units[i] = plant.num_units(i);
-    unit_force[i] = capacity[i] / units[i];
+    unit_force[i] = on_unit_force_[i](ref_lengths[i]);
+    p.cap[i] = std::max(units[i] * unit_force[i], 1e-9);
+    p.floor[i] = task_->co_contraction * p.cap[i];
   }
-  tensions = control::RoundToUnits(p, tensions, unit_force, units);
-  const Eigen::VectorXd achieved = p.arms * tensions;
+  const Eigen::VectorXd continuous = Allocate(p, holding);
+  const Eigen::VectorXd achieved = p.arms * continuous;
   for (int j = 0; j < nj; ++j) {
     // Anti-windup: the integral grows only while the bundles can still deliver what it asks.
     const double e = r[j] - plant.JointAngle(j);
@@ -158,7 +244,12 @@ void JointLoops::Step(double t, const Plant& plant, const std::vector<double>& c
     const bool saturated = std::abs(short_by) > 1e-3 * span && short_by * e > 0;
     if (!saturated) integral_[j] = trial[j];
   }
-  for (int i = 0; i < nb; ++i) force_ref[i] = tensions[i];
+  // Whole units: each bundle's controller holds whole on-counts, so the demand is met by the
+  // combination of counts that comes nearest it (control::RoundToUnits).
+  const Eigen::VectorXd tensions = control::RoundToUnits(p, continuous, unit_force, units);
+  for (int i = 0; i < nb; ++i) {
+    force_ref[i] = unit_force[i] > 0 ? tensions[i] / unit_force[i] * capacity[i] / units[i] : 0.0;
+  }
 }
 
 }  // namespace recruit::sim

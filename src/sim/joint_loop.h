@@ -1,11 +1,16 @@
 // JointLoops: the self-tuned outer loop of an angle task ("outer_loop": "auto"). At each control
 // instant every driven joint's torque demand is the static torque of its reference pose
 // (Plant::StaticTorque) plus a PID on its angle error, with gains designed on the model
-// (control/loop_design.h) for the pose of each new reference value; the demands are then shared
-// among the bundles by their moment arms and capacities (control/torque_allocation.h), which
-// gives each bundle's force reference. docs/controller.md, "The self-tuned outer loop".
+// (control/loop_design.h) for the pose of each new reference value. The demands are shared
+// among the bundles by their moment arms and capacities at the reference pose
+// (control/torque_allocation.h), with co-contraction where a joint would otherwise be held with
+// too little stiffness, and each bundle's share becomes an on-count at the reference pose: the
+// force reference its controller gets is that count's force at the present length, so the
+// count does not chase the limb as it moves and the bundles' own stiffness keeps acting.
+// docs/controller.md, "The self-tuned outer loop".
 #pragma once
 
+#include <functional>
 #include <map>
 #include <string>
 #include <vector>
@@ -13,26 +18,47 @@
 #include "common/result.h"
 #include "control/actuator_response.h"
 #include "control/loop_design.h"
+#include "control/torque_allocation.h"
 #include "sim/plant.h"
 #include "sim/task.h"
 
 namespace recruit::sim {
 
+// How the bundles hold a joint at a pose, with the tensions the allocation gives there.
+struct JointHolding {
+  double stiffness = 0;  // N m/rad: the bundles' at constant on-counts
+  double torque = 0;     // N m: the sum of the bundles' torques' magnitudes
+  // Per bundle, N m/rad per newton: its stiffness on the joint per unit of its tension.
+  Eigen::VectorXd coef;
+  double limb_stiffness = 0;  // N m/rad: d tau_static / dq, the limb's own
+};
+
 // One design of one joint's loop: at which reference, on what model, with what prediction.
 struct JointDesignRecord {
   std::string joint;
-  double reference = 0;  // rad
-  control::JointDynamics dynamics;
+  double reference = 0;             // rad
+  control::JointDynamics dynamics;  // stiffness: the limb's and the bundles' (below), summed
+  // The bundles' share of the stiffness at constant on-counts, holding the reference with the
+  // tensions the allocation gives there: their force-length slope (stabilising) and the change of
+  // their moment arms with the angle (either sign). N m/rad.
+  double bundle_stiffness = 0;
+  JointHolding holding;
+  double step = 0;          // rad, the step designed for
+  double torque_error = 0;  // N m, the feedforward error the integral must remove
   double actuator_t63 = 0;  // s, the design's bundle response: its time to 63 % of a step
   control::LoopDesign design;
 };
 
 class JointLoops {
  public:
-  // `responses`: each bundle's tension step response (control/actuator_response.h), in the
-  // plant's bundle order. `dT` the sampling period.
+  // Tension (N) of one unit that is on, at bundle length coordinate L (Plant::UnitLength).
+  using UnitForce = std::function<double(double L)>;
+  // `responses`: each bundle's tension step response (control/actuator_response.h), and
+  // `on_unit_force` each bundle's unit force map, in the plant's bundle order. `dT` the sampling
+  // period.
   static Result<JointLoops> Create(const Task& task, const Plant& plant,
-                                   std::vector<control::ActuatorResponse> responses, double dT);
+                                   std::vector<control::ActuatorResponse> responses,
+                                   std::vector<UnitForce> on_unit_force, double dT);
 
   // The force reference (N) of every bundle at a control instant; `capacity` is each bundle's
   // tension with every unit on at its present length.
@@ -43,17 +69,34 @@ class JointLoops {
   const std::vector<JointDesignRecord>& designs() const { return designs_; }
   // The driven joints' references at t, kept 3 % of each limited joint's range inside it.
   Eigen::VectorXd LoopReference(const Plant& plant, double t) const;
-  // Designs the loop of joint j for the reference value r (the other joints at theirs).
-  Result<JointDesignRecord> Design(const Plant& plant, int j, const Eigen::VectorXd& r) const;
+  // Designs the loop of joint j for a step of size `step` (rad) to the reference value r (the
+  // other joints at theirs).
+  Result<JointDesignRecord> Design(const Plant& plant, int j, const Eigen::VectorXd& r,
+                                   double step) const;
+  // How the bundles hold joint j at pose r (JointHolding).
+  using Holding = JointHolding;
+  Holding HoldingAt(const Plant& plant, int j, const Eigen::VectorXd& r) const;
 
  private:
   const Task* task_ = nullptr;
   std::vector<control::ActuatorResponse> responses_;
+  std::vector<UnitForce> on_unit_force_;
   double dT_ = 0;
   control::LoopTarget target_;
-  std::vector<std::map<double, control::LoopGains>> gains_;  // per joint, by reference value
-  std::vector<double> integral_;                             // rad s, per joint
-  Eigen::VectorXd price_;  // per bundle: its time to 63 % over the fastest bundle's
+  // Per joint, by reference value: the loop's gains and how the bundles hold the pose.
+  struct Setting {
+    control::LoopGains gains;
+    Holding holding;
+  };
+  std::vector<std::map<double, Setting>> settings_;
+  // The allocation with each joint's stiffness at least `least_stiffness` where the bundles can
+  // give it: one more row per joint that falls short.
+  Eigen::VectorXd Allocate(const control::AllocationProblem& p,
+                           const std::vector<const Holding*>& holding) const;
+
+  std::vector<double> integral_;     // rad s, per joint
+  std::vector<double> last_target_;  // rad, per joint: NaN before the first instant
+  Eigen::VectorXd price_;            // per bundle: its time to 63 % over the fastest bundle's
   std::vector<JointDesignRecord> designs_;
 };
 

@@ -343,9 +343,35 @@ Status Plant::FindJoints(const Task& task, const std::string& where) {
   return Status::Ok();
 }
 
-Eigen::MatrixXd Plant::MomentArms() const {
+Eigen::MatrixXd Plant::MomentArms() const { return MomentArmsOf(data_.get()); }
+
+void Plant::PoseTransmission(const Eigen::VectorXd& q) const {
+  // The stages the tendons and actuator moments need, not collision or the mass matrix.
   const mjModel* m = model_.get();
-  const mjData* d = data_.get();
+  mjData* s = scratch_.get();
+  PoseScratch(q);
+  mj_kinematics(m, s);
+  mj_comPos(m, s);
+  mj_tendon(m, s);
+  mj_transmission(m, s);
+}
+
+Eigen::MatrixXd Plant::MomentArmsAt(const Eigen::VectorXd& q) const {
+  PoseTransmission(q);
+  return MomentArmsOf(scratch_.get());
+}
+
+Eigen::VectorXd Plant::UnitLengthsAt(const Eigen::VectorXd& q) const {
+  PoseTransmission(q);
+  Eigen::VectorXd lengths(num_bundles());
+  for (int i = 0; i < num_bundles(); ++i) {
+    lengths[i] = host_->UnitLength(scratch_.get(), bundles_[i]);
+  }
+  return lengths;
+}
+
+Eigen::MatrixXd Plant::MomentArmsOf(const mjData* d) const {
+  const mjModel* m = model_.get();
   Eigen::MatrixXd arms = Eigen::MatrixXd::Zero(num_joints(), num_bundles());
   for (int i = 0; i < num_bundles(); ++i) {
     const int out = m->actuator_outadr[host_->actuator_id(bundles_[i])];

@@ -79,6 +79,10 @@ class Plant {
   // joints x bundles: the torque (N m) on driven joint j per newton of bundle i's tension at
   // the pose of the last step (MuJoCo's actuator moment; a bundle pulls, so minus the moment).
   Eigen::MatrixXd MomentArms() const;
+  // The same with the driven joints at `q` (the others where they are now), and each bundle's
+  // length coordinate (UnitLength) there: what the loop design linearises about.
+  Eigen::MatrixXd MomentArmsAt(const Eigen::VectorXd& q) const;
+  Eigen::VectorXd UnitLengthsAt(const Eigen::VectorXd& q) const;
   // The torque each driven joint needs to hold the limb still with the driven joints at `q`
   // (the others where they are now): gravity, payloads and springs, from MuJoCo's inverse
   // dynamics with zero velocity and acceleration and no constraint rows.
@@ -103,6 +107,8 @@ class Plant {
 
  private:
   Plant() = default;
+  Eigen::MatrixXd MomentArmsOf(const mjData* d) const;
+  void PoseTransmission(const Eigen::VectorXd& q) const;  // scratch: tendons, moments at q
   Status FindBundles(const Task& task, const std::string& where);
   Status FindJoints(const Task& task, const std::string& where);
   void ApplyPayloads();

@@ -276,6 +276,15 @@ Result<std::vector<control::ActuatorResponse> > ActuatorResponses(
   return out;
 }
 
+// Each bundle's unit force map (its controller's), for the loop design.
+std::vector<JointLoops::UnitForce> UnitForces(const std::vector<Channel>& channels) {
+  std::vector<JointLoops::UnitForce> out;
+  for (const Channel& c : channels) {
+    out.push_back([&c](double L) { return c.controller.OnUnitForce(L); });
+  }
+  return out;
+}
+
 // The force reference of each bundle at a control instant: the task's force reference for a
 // force task; for an angle task the outer loop's net force, split into agonist and antagonist
 // on top of their tone.
@@ -428,6 +437,7 @@ nlohmann::json DesignJson(const JointDesignRecord& r) {
           {"inertia", r.dynamics.inertia},
           {"damping", r.dynamics.damping},
           {"stiffness", r.dynamics.stiffness},
+          {"bundle_stiffness", r.bundle_stiffness},
           {"actuator_t63", r.actuator_t63},
           {"kp", d.gains.kp},
           {"ki", d.gains.ki},
@@ -460,7 +470,20 @@ void SummarizeJoints(const Task& task, const Plant& plant, const SignalMetrics& 
     }
   }
   s.loop_designs = nlohmann::json::array();
-  for (const JointDesignRecord& r : loops.designs()) s.loop_designs.push_back(DesignJson(r));
+  for (const JointDesignRecord& r : loops.designs()) {
+    s.loop_designs.push_back(DesignJson(r));
+    // A pose the bundles hold unstably at constant counts drifts faster than they can follow.
+    if (r.dynamics.stiffness <= 0) {
+      char buf[320];
+      std::snprintf(buf, sizeof buf,
+                    "joint '%s' at %.4g deg: the bundles cannot hold this pose at constant "
+                    "on-counts (stiffness %.3g N m/rad, the bundles' %.3g): the loop may not "
+                    "settle there",
+                    r.joint.c_str(), r.reference * 180 / M_PI, r.dynamics.stiffness,
+                    r.bundle_stiffness);
+      s.warnings.push_back(buf);
+    }
+  }
   if (plant.num_joints() < 2) return;  // the one joint's metrics are already the run's
   RunMetrics& mt = s.metrics;
   mt.tracking_rmse = std::sqrt(sq / plant.num_joints());
@@ -528,7 +551,8 @@ Result<std::vector<JointDesignRecord> > DesignTaskLoops(const Task& task,
   auto responses =
       ActuatorResponses(task, settings, plant, *channels, options, identify_s, warnings);
   if (!responses) return Error{where + ".outer_loop: " + responses.error()};
-  auto loops = JointLoops::Create(task, plant, std::move(responses).value(), settings.dT);
+  auto loops = JointLoops::Create(task, plant, std::move(responses).value(), UnitForces(*channels),
+                                  settings.dT);
   if (!loops) return Error{where + ".outer_loop: " + loops.error()};
   const double duration = options.duration ? *options.duration : task.duration;
   std::vector<JointDesignRecord> out;
@@ -538,11 +562,14 @@ Result<std::vector<JointDesignRecord> > DesignTaskLoops(const Task& task,
       times.push_back(st.time);
     }
     std::vector<double> done;
+    double from = plant.JointAngle(j);  // the limb at rest where the run starts
     for (double t : times) {
       const Eigen::VectorXd r = loops->LoopReference(plant, t + 1e-9);
+      const double step = r[j] - from;
+      from = r[j];
       if (std::find(done.begin(), done.end(), r[j]) != done.end()) continue;
       done.push_back(r[j]);
-      auto rec = loops->Design(plant, j, r);
+      auto rec = loops->Design(plant, j, r, step);
       if (!rec) return Error{where + ": " + rec.error()};
       out.push_back(std::move(rec).value());
     }
@@ -586,7 +613,8 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
     auto responses =
         ActuatorResponses(task, settings, plant, channels, options, identify_s, warnings);
     if (!responses) return Error{where + ".outer_loop: " + responses.error()};
-    auto loops = JointLoops::Create(task, plant, std::move(responses).value(), settings.dT);
+    auto loops = JointLoops::Create(task, plant, std::move(responses).value(), UnitForces(channels),
+                                    settings.dT);
     if (!loops) return Error{where + ".outer_loop: " + loops.error()};
     joint_loops = std::move(loops).value();
   }

@@ -163,20 +163,36 @@ TEST(JointLoop, OneJointRunTracksAndReportsItsDesigns) {
   auto t = TaskFromText(ArmTask("\"auto\""), kRoot + "/models/tasks");
   ASSERT_TRUE(t.ok());
   RunOptions o;
-  o.seed = 7;
   o.quiet = true;
   o.identify_missing_models = false;
   o.dT = 0.75;  // no model is shipped for it: the loop is designed on the units' lag
-  auto r = RunTask(*t, o);
-  ASSERT_TRUE(r.ok()) << r.error();
-  ASSERT_EQ(r->steps.size(), 1u);
-  EXPECT_LT(std::abs(r->steps[0].overshoot), 0.5);
-  ASSERT_EQ(r->joints.size(), 1u);
-  EXPECT_FALSE(r->loop_designs.empty());
-  EXPECT_GT(r->loop_designs[0]["kp"].get<double>(), 0);
-  bool said = false;
-  for (const std::string& w : r->warnings) said |= w.find("thermal lag") != std::string::npos;
-  EXPECT_TRUE(said);
+  // Nor one a user's cache may hold: an empty cache for this test.
+  const fs::path cache = fs::temp_directory_path() / "recruit_joint_loop_empty_cache";
+  fs::remove_all(cache);
+  fs::create_directories(cache);
+  ::setenv("RECRUIT_MODEL_CACHE", cache.c_str(), 1);
+  // Designed on the lag alone the loop is rougher than on an identified chain, but it tracks:
+  // over six seeds the 40 deg step settles in at least five, with mean overshoot below 50 %.
+  double overshoot = 0;
+  int settled = 0;
+  for (std::uint64_t seed = 1; seed <= 6; ++seed) {
+    o.seed = seed;
+    auto r = RunTask(*t, o);
+    ASSERT_TRUE(r.ok()) << r.error();
+    ASSERT_EQ(r->steps.size(), 1u);
+    overshoot += r->steps[0].overshoot / 6;
+    settled += r->steps[0].settled;
+    ASSERT_EQ(r->joints.size(), 1u);
+    ASSERT_FALSE(r->loop_designs.empty());
+    EXPECT_GT(r->loop_designs[0]["kp"].get<double>(), 0);
+    bool said = false;
+    for (const std::string& w : r->warnings) said |= w.find("thermal lag") != std::string::npos;
+    EXPECT_TRUE(said);
+  }
+  ::unsetenv("RECRUIT_MODEL_CACHE");
+  fs::remove_all(cache);
+  EXPECT_LT(overshoot, 0.5);
+  EXPECT_GE(settled, 5);
 }
 
 // A bundle designed past the wire's long-life temperature: the warning loading printed is in
