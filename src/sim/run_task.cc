@@ -179,10 +179,10 @@ void IdentificationWarning(const FilterModel& model, const std::string& bundle,
   if (std::find(warnings.begin(), warnings.end(), buf) == warnings.end()) warnings.push_back(buf);
 }
 
-Result<std::vector<Channel> > MakeChannels(const Task& task, const ControllerSettings& settings,
-                                           const Plant& plant, const RunOptions& options,
-                                           const std::string& where, double& identify_s,
-                                           std::vector<std::string>& warnings) {
+Result<std::vector<Channel>> MakeChannels(const Task& task, const ControllerSettings& settings,
+                                          const Plant& plant, const RunOptions& options,
+                                          const std::string& where, double& identify_s,
+                                          std::vector<std::string>& warnings) {
   auto spec = control::EstimatorSpec::Parse(settings.estimator, "extended", settings.filter_model,
                                             20, settings.force_noise_std);
   if (!spec.ok()) return Error{where + ".controller.estimator: " + spec.error()};
@@ -225,7 +225,7 @@ Result<std::vector<Channel> > MakeChannels(const Task& task, const ControllerSet
 
 // Each bundle's tension step response under the law (control/actuator_response.h), predicted on
 // the chain identified for it: the Kalman estimator's own model, else the identified one.
-Result<std::vector<control::ActuatorResponse> > ActuatorResponses(
+Result<std::vector<control::ActuatorResponse>> ActuatorResponses(
     const Task& task, const ControllerSettings& settings, const Plant& plant,
     const std::vector<Channel>& channels, const RunOptions& options, double& identify_s,
     std::vector<std::string>& warnings) {
@@ -306,22 +306,61 @@ void ForceReferences(const Task& task, AngleLoop& loop, JointLoops* joints, cons
   }
 }
 
-// One control instant of bundle i: the load cell samples the tendon force, the encoder gives the
-// tendon length, the controller estimates and broadcasts.
-Status ControlBundle(Channel& ch, Plant& plant, int i, double force_ref, BundleTelemetry& bt) {
-  // The a-posteriori estimate is of the state at this instant, before its broadcast.
-  const int on_before = plant.OnCount(i);
-  const double sensed = ch.sensor.SampleAndHold(plant.Force(i));
-  const control::Broadcast bc = ch.controller.Step(force_ref, sensed, plant.UnitLength(i));
-  if (Status st = plant.Broadcast(i, bc.p_on, bc.p_off); !st.ok()) return st;
-  const double var = ch.controller.estimated_on_variance();
-  bt.estimated_on = ch.controller.estimated_on();
-  bt.estimated_on_std =
-      std::isfinite(var) ? std::sqrt(std::max(var, 0.0)) : std::numeric_limits<double>::quiet_NaN();
-  bt.p_on = bc.p_on;
-  bt.p_off = bc.p_off;
-  bt.force_reference = force_ref;
-  ch.score.Add(bt.estimated_on, on_before, var);
+// One control instant: each load cell samples its tendon's force and each encoder the tendon's
+// length; the outer loop sets the force references and each bundle's controller estimates and
+// broadcasts (or `hook` decides in their place, or records what they decided).
+Status ControlInstantStep(const Task& task, AngleLoop& loop, JointLoops* joints, Plant& plant,
+                          std::vector<Channel>& channels, double t, double dT,
+                          ControlInstantHook* hook, ControlInstant& ci,
+                          std::vector<double>& force_ref, TelemetrySample& sample) {
+  const int nb = plant.num_bundles();
+  ci.time = t;
+  ci.reference = task.reference(t);
+  ci.angle = plant.angle();
+  ci.angular_velocity = plant.angular_velocity();
+  ci.sensed_force.resize(nb);
+  ci.tendon_length.resize(nb);
+  ci.force_reference.resize(nb);
+  ci.broadcast.resize(nb);
+  ci.estimated_on.resize(nb);
+  ci.estimated_on_variance.resize(nb);
+  std::vector<int> on_before(nb);  // the a-posteriori estimate is of the state before broadcasting
+  for (int i = 0; i < nb; ++i) {
+    on_before[i] = plant.OnCount(i);
+    ci.sensed_force[i] = channels[i].sensor.SampleAndHold(plant.Force(i));
+    ci.tendon_length[i] = plant.UnitLength(i);
+  }
+  if (hook != nullptr && hook->Replaces()) {
+    if (joints != nullptr)
+      return Error{"a replacing control hook cannot drive \"outer_loop\": \"auto\""};
+    if (Status st = hook->OnInstant(ci); !st.ok()) return st;
+    force_ref = ci.force_reference;
+  } else {
+    ForceReferences(task, loop, joints, plant, channels, t, dT, force_ref);
+    for (int i = 0; i < nb; ++i) {
+      control::RecruitmentController& c = channels[i].controller;
+      ci.force_reference[i] = force_ref[i];
+      ci.broadcast[i] = c.Step(force_ref[i], ci.sensed_force[i], ci.tendon_length[i]);
+      ci.estimated_on[i] = c.estimated_on();
+      ci.estimated_on_variance[i] = c.estimated_on_variance();
+    }
+    if (hook != nullptr) {
+      if (Status st = hook->OnInstant(ci); !st.ok()) return st;
+    }
+  }
+  for (int i = 0; i < nb; ++i) {
+    const control::Broadcast& bc = ci.broadcast[i];
+    if (Status st = plant.Broadcast(i, bc.p_on, bc.p_off); !st.ok()) return st;
+    const double var = ci.estimated_on_variance[i];
+    BundleTelemetry& bt = sample.bundles[i];
+    bt.estimated_on = ci.estimated_on[i];
+    bt.estimated_on_std = std::isfinite(var) ? std::sqrt(std::max(var, 0.0))
+                                             : std::numeric_limits<double>::quiet_NaN();
+    bt.p_on = bc.p_on;
+    bt.p_off = bc.p_off;
+    bt.force_reference = force_ref[i];
+    channels[i].score.Add(bt.estimated_on, on_before[i], var);
+  }
   return Status::Ok();
 }
 
@@ -510,8 +549,8 @@ class Progress {
 
 }  // namespace
 
-Result<std::vector<JointDesignRecord> > DesignTaskLoops(const Task& task,
-                                                        const RunOptions& options) {
+Result<std::vector<JointDesignRecord>> DesignTaskLoops(const Task& task,
+                                                       const RunOptions& options) {
   const std::string where = task.source.empty() ? task.name : task.source;
   if (!task.auto_loop) {
     return Error{where + ".outer_loop: only a task with \"outer_loop\": \"auto\" designs its loop"};
@@ -546,6 +585,24 @@ Result<std::vector<JointDesignRecord> > DesignTaskLoops(const Task& task,
       if (!rec) return Error{where + ": " + rec.error()};
       out.push_back(std::move(rec).value());
     }
+  }
+  return out;
+}
+
+Result<std::vector<BundleController>> TaskControllers(const Task& task, const RunOptions& options) {
+  const std::string where = task.source.empty() ? task.name : task.source;
+  const ControllerSettings settings = EffectiveSettings(task, options);
+  auto plant_or = Plant::Create(task, /*drawn=*/false);
+  if (!plant_or.ok()) return Error{plant_or.error()};
+  Plant& plant = **plant_or;
+  plant.Reset(options.seed);
+  double identify_s = 0;
+  std::vector<std::string> warnings;
+  auto channels = MakeChannels(task, settings, plant, options, where, identify_s, warnings);
+  if (!channels.ok()) return Error{channels.error()};
+  std::vector<BundleController> out;
+  for (int i = 0; i < plant.num_bundles(); ++i) {
+    out.push_back({plant.bundle_name(i), std::move((*channels)[i].controller)});
   }
   return out;
 }
@@ -606,6 +663,7 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
     sample.bundles[i].estimated_on = std::numeric_limits<double>::quiet_NaN();
   }
   std::vector<double> force_ref(nb, 0.0);
+  ControlInstant instant;
   const double h = plant.timestep();
   const long num_steps = std::lround(duration / h);
   // The metrics accumulate as the run goes: memory does not grow with its length.
@@ -623,13 +681,11 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
     if (sample.control_instant) {
       ++control_instants;
       next_control = control_instants * settings.dT;
-      ForceReferences(task, angle_loop, joint_loops ? &*joint_loops : nullptr, plant, channels, t,
-                      settings.dT, force_ref);
-      for (int i = 0; i < nb; ++i) {
-        if (Status st = ControlBundle(channels[i], plant, i, force_ref[i], sample.bundles[i]);
-            !st.ok()) {
-          return Error{where + ": " + st.error()};
-        }
+      if (Status st = ControlInstantStep(task, angle_loop, joint_loops ? &*joint_loops : nullptr,
+                                         plant, channels, t, settings.dT, options.control_hook,
+                                         instant, force_ref, sample);
+          !st.ok()) {
+        return Error{where + ": " + st.error()};
       }
       sample.p_on = sample.bundles[0].p_on;
       sample.p_off = sample.bundles[0].p_off;
