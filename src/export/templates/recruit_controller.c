@@ -39,8 +39,14 @@ struct recruit_bundle_params {
 
 /* Upper triangle packed by columns: (i, j), i <= j. */
 #define PK(i, j) ((j) * ((j) + 1) / 2 + (i))
-static recruit_real sym(const recruit_real *P, int i, int j) {
-  return i <= j ? P[PK(i, j)] : P[PK(j, i)];
+/* v = a P(:, c) (first) or v += a P(:, c), P symmetric packed: column c is contiguous down to
+ * the diagonal, then row c of the upper triangle (one step of l + 1 per entry). */
+static void column_axpy(recruit_real *v, const recruit_real *P, int m, int c, recruit_real a,
+                        int first) {
+  const recruit_real *col = P + PK(0, c);
+  int l, idx;
+  for (l = 0; l <= c; ++l) v[l] = first ? a * col[l] : v[l] + a * col[l];
+  for (idx = PK(c, c + 1); l < m; idx += ++l) v[l] = first ? a * P[idx] : v[l] + a * P[idx];
 }
 
 static recruit_real clampr(recruit_real v, recruit_real lo, recruit_real hi) {
@@ -144,7 +150,7 @@ static void reproject_symmetric(recruit_bundle *b, recruit_real *r, recruit_real
   int i, j;
   recenter(b->x, m, b->params->N, 1);
   for (j = 0; j < m; ++j) {
-    for (i = 0; i < m; ++i) col[i] = sym(b->P, i, j);
+    column_axpy(col, b->P, m, j, RK(1), 1);
     r[j] = lanesum(col, m);
   }
   s = lanesum(r, m) * inv_m * inv_m;
@@ -169,8 +175,9 @@ void recruit_bundle_init(recruit_bundle *b, int index) {
     recruit_real r[RECRUIT_MAX_STATES], s;
     recenter(b->x, m, p->N, 1);
     for (j = 0; j < m; ++j) {
-      recruit_real cs = RK(0);
-      for (i = 0; i < m; ++i) cs += sym(b->P, i, j);
+      recruit_real col[RECRUIT_MAX_STATES], cs = RK(0);
+      column_axpy(col, b->P, m, j, RK(1), 1);
+      for (i = 0; i < m; ++i) cs += col[i];
       r[j] = cs;
     }
     s = sum(r, m) * inv_m * inv_m;
@@ -187,11 +194,7 @@ static void kalman_update(recruit_bundle *b, recruit_work *w, const recruit_real
   const int m = p->m;
   recruit_real s, innov, root;
   int i, j;
-  for (i = 0; i < m; ++i) { /* u = P h, column by column */
-    recruit_real a = h[0] * sym(b->P, i, 0);
-    for (j = 1; j < m; ++j) a += h[j] * sym(b->P, i, j);
-    w->u[i] = a;
-  }
+  for (j = 0; j < m; ++j) column_axpy(w->u, b->P, m, j, h[j], j == 0); /* u = P h */
   s = dot(h, w->u, m) + R;
   innov = y - dot(h, b->x, m);
   for (i = 0; i < m; ++i) b->x[i] += innov * (w->u[i] / s);
@@ -288,14 +291,10 @@ static void kalman_predict(recruit_bundle *b, recruit_work *w, recruit_real p_on
   for (r = 0; r < m; ++r) {
     const int e0 = p->ptr[r], e1 = p->ptr[r + 1];
     int l;
-    for (l = 0; l < m; ++l) {
-      recruit_real a = RK(0);
-      if (e1 > e0) {
-        a = w->val[e0] * sym(w->M, l, p->col[e0]);
-        for (e = e0 + 1; e < e1; ++e) a += w->val[e] * sym(w->M, l, p->col[e]);
-      }
-      w->v[l] = a;
+    if (e1 == e0) {
+      for (l = 0; l < m; ++l) w->v[l] = RK(0);
     }
+    for (e = e0; e < e1; ++e) column_axpy(w->v, w->M, m, p->col[e], w->val[e], e == e0);
     for (j = r; j < m; ++j) {
       const int f0 = p->ptr[j], f1 = p->ptr[j + 1];
       recruit_real a = RK(0);
@@ -339,7 +338,10 @@ void recruit_bundle_step(recruit_bundle *b, recruit_work *w, recruit_real force_
     est = lanesum(w->s, m);
     for (j = 0; j < m; ++j) {
       if (!p->is_on[j]) continue;
-      for (i = 0; i < m; ++i) w->s[i] = p->is_on[i] ? sym(b->P, i, j) : RK(0);
+      column_axpy(w->s, b->P, m, j, RK(1), 1);
+      for (i = 0; i < m; ++i) {
+        if (!p->is_on[i]) w->s[i] = RK(0);
+      }
       var += lanesum(w->s, m);
     }
   } else {

@@ -60,7 +60,7 @@ int main(int argc, char **argv) {
   for (k = 0; k < n; ++k) {
     recruit_real v[3 + 2 * RECRUIT_NUM_BUNDLES];
     uint32_t t0, t1;
-    for (i = 0; i < 3 + 2 * nb; ++i) {
+    for (i = 0; i < 3 + 2 * RECRUIT_NUM_BUNDLES; ++i) {
       if (fscanf(f, "%lx", &b) != 1) return 5;
       v[i] = real_of(b);
     }
