@@ -19,10 +19,18 @@
 
 namespace recruit::exporter::testing {
 
-// A fresh folder under the build's temporary area.
+// A fresh folder in this process's temporary folder, which is removed when the process exits.
 inline std::filesystem::path FreshDir(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() /
-                   ("recruit_export_test_" + std::to_string(::getpid())) / name;
+  struct Root {
+    std::filesystem::path path = std::filesystem::temp_directory_path() /
+                                 ("recruit_export_test_" + std::to_string(::getpid()));
+    ~Root() {
+      std::error_code ec;
+      std::filesystem::remove_all(path, ec);
+    }
+  };
+  static const Root root;
+  const auto dir = root.path / name;
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir;

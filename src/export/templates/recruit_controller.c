@@ -169,16 +169,16 @@ void recruit_bundle_init(recruit_bundle *b, int index) {
   if (m == 0) return;
   for (i = 0; i < m; ++i) b->x[i] = p->x0[i];
   for (i = 0; i < m * (m + 1) / 2; ++i) b->P[i] = p->P0 ? p->P0[i] : RK(0);
-  /* Reproject (a general symmetric P): P_ij - (r_i + r_j) / m + s / m^2. */
-  {
+  recenter(b->x, m, p->N, 1);
+  if (p->P0) { /* Reproject (a symmetric P): P_ij - (r_i + r_j) / m + s / m^2, r its row sums */
     const recruit_real inv_m = RK(1) / RK(m);
     recruit_real r[RECRUIT_MAX_STATES], s;
-    recenter(b->x, m, p->N, 1);
+    for (j = 0; j < m; ++j) r[j] = RK(0);
     for (j = 0; j < m; ++j) {
-      recruit_real col[RECRUIT_MAX_STATES], cs = RK(0);
-      column_axpy(col, b->P, m, j, RK(1), 1);
-      for (i = 0; i < m; ++i) cs += col[i];
-      r[j] = cs;
+      for (i = 0; i <= j; ++i) {
+        r[j] += b->P[PK(i, j)];
+        if (i != j) r[i] += b->P[PK(i, j)];
+      }
     }
     s = sum(r, m) * inv_m * inv_m;
     for (j = 0; j < m; ++j) {
