@@ -187,7 +187,9 @@ TEST(ExportEquivalence, DoubleReproducesTheControllerOnRecordedRuns) {
       const auto log = Record(c, seed);
       ASSERT_GT(log.size(), 30u);
       // The uncertain start shows in the first estimate's variance (certain: 0).
-      if (!c.filter_model.empty()) EXPECT_GT(log.front().estimated_on_variance[0], 0.1);
+      if (!c.filter_model.empty()) {
+        EXPECT_GT(log.front().estimated_on_variance[0], 0.1);
+      }
       const Deviation d = Replay(*ctl, log);
       std::printf("%s %s%s seed %d: %zu instants, largest relative deviation %.3g\n",
                   c.task.c_str(), c.estimator.c_str(), c.filter_model.empty() ? "" : " (P0 > 0)",
