@@ -14,7 +14,9 @@
 
 static recruit_controller ctl; /* static: its size is the package's RAM (.bss) */
 
-static uint32_t bits(recruit_real f) {
+/* Float bit patterns in and out (a double package's outputs are rounded to float). */
+static uint32_t bits(recruit_real v) {
+  const float f = (float)v;
   uint32_t u;
   memcpy(&u, &f, sizeof u);
   return u;
@@ -22,9 +24,9 @@ static uint32_t bits(recruit_real f) {
 
 static recruit_real real_of(unsigned long b) {
   const uint32_t u = (uint32_t)b;
-  recruit_real f;
+  float f;
   memcpy(&f, &u, sizeof f);
-  return f;
+  return (recruit_real)f;
 }
 
 #ifdef M4_SYSTICK
