@@ -45,8 +45,13 @@ static void column_axpy(recruit_real *v, const recruit_real *P, int m, int c, re
                         int first) {
   const recruit_real *col = P + PK(0, c);
   int l, idx;
-  for (l = 0; l <= c; ++l) v[l] = first ? a * col[l] : v[l] + a * col[l];
-  for (idx = PK(c, c + 1); l < m; idx += ++l) v[l] = first ? a * P[idx] : v[l] + a * P[idx];
+  if (first) {
+    for (l = 0; l <= c; ++l) v[l] = a * col[l];
+    for (idx = PK(c, c + 1); l < m; idx += ++l) v[l] = a * P[idx];
+  } else {
+    for (l = 0; l <= c; ++l) v[l] += a * col[l];
+    for (idx = PK(c, c + 1); l < m; idx += ++l) v[l] += a * P[idx];
+  }
 }
 
 static recruit_real clampr(recruit_real v, recruit_real lo, recruit_real hi) {
