@@ -3,6 +3,7 @@
 // wire format's round trip and error detection, and the units' draws against the binomial law.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <iterator>
@@ -74,6 +75,19 @@ TEST(UnitPackage, FramesRoundTripAndEverySingleBitErrorIsCaught) {
   const recruit_wire_message over{0, 1, 40000, 0};
   recruit_wire_encode(&over, frame);
   EXPECT_EQ(recruit_wire_decode(frame, &back), -3);
+}
+
+// The examples of docs/broadcast-wire-format.md.
+TEST(UnitPackage, EncodesTheDocumentedExampleFrames) {
+  uint8_t frame[RECRUIT_WIRE_SIZE];
+  const recruit_wire_message a{0, 1, recruit_wire_quantize(0.2), 0};
+  recruit_wire_encode(&a, frame);
+  const uint8_t want_a[] = {0xA5, 0x00, 0x01, 0x00, 0x9A, 0x19, 0x00, 0x00, 0xF5};
+  EXPECT_TRUE(std::equal(frame, frame + RECRUIT_WIRE_SIZE, want_a));
+  const recruit_wire_message b{1, 42, 0, recruit_wire_quantize(1.0)};
+  recruit_wire_encode(&b, frame);
+  const uint8_t want_b[] = {0xA5, 0x01, 0x2A, 0x00, 0x00, 0x00, 0x00, 0x80, 0xFE};
+  EXPECT_TRUE(std::equal(frame, frame + RECRUIT_WIRE_SIZE, want_b));
 }
 
 TEST(UnitPackage, UnitsTakeEachFrameOnceAndOnlyTheirBundles) {
