@@ -351,7 +351,7 @@ void recruit_bundle_step(recruit_bundle *b, recruit_work *w, recruit_real force_
     }
   } else {
     est = b->count;
-    var = NAN;
+    var = (recruit_real)NAN;
   }
   expectation_law(target, est, p->N, p->lambda, p_on, p_off);
   if (m > 0) kalman_predict(b, w, *p_on, *p_off);
