@@ -179,10 +179,10 @@ void IdentificationWarning(const FilterModel& model, const std::string& bundle,
   if (std::find(warnings.begin(), warnings.end(), buf) == warnings.end()) warnings.push_back(buf);
 }
 
-Result<std::vector<Channel>> MakeChannels(const Task& task, const ControllerSettings& settings,
-                                          const Plant& plant, const RunOptions& options,
-                                          const std::string& where, double& identify_s,
-                                          std::vector<std::string>& warnings) {
+Result<std::vector<Channel> > MakeChannels(const Task& task, const ControllerSettings& settings,
+                                           const Plant& plant, const RunOptions& options,
+                                           const std::string& where, double& identify_s,
+                                           std::vector<std::string>& warnings) {
   auto spec = control::EstimatorSpec::Parse(settings.estimator, "extended", settings.filter_model,
                                             20, settings.force_noise_std);
   if (!spec.ok()) return Error{where + ".controller.estimator: " + spec.error()};
@@ -225,7 +225,7 @@ Result<std::vector<Channel>> MakeChannels(const Task& task, const ControllerSett
 
 // Each bundle's tension step response under the law (control/actuator_response.h), predicted on
 // the chain identified for it: the Kalman estimator's own model, else the identified one.
-Result<std::vector<control::ActuatorResponse>> ActuatorResponses(
+Result<std::vector<control::ActuatorResponse> > ActuatorResponses(
     const Task& task, const ControllerSettings& settings, const Plant& plant,
     const std::vector<Channel>& channels, const RunOptions& options, double& identify_s,
     std::vector<std::string>& warnings) {
@@ -311,7 +311,7 @@ void ForceReferences(const Task& task, AngleLoop& loop, JointLoops* joints, cons
 // broadcasts (or `hook` decides in their place, or records what they decided).
 Status ControlInstantStep(const Task& task, AngleLoop& loop, JointLoops* joints, Plant& plant,
                           std::vector<Channel>& channels, double t, double dT,
-                          ControlInstantHook* hook, ControlInstant& ci,
+                          ControlInstantHook* hook, ControlInstant& ci, std::vector<int>& on_before,
                           std::vector<double>& force_ref, TelemetrySample& sample) {
   const int nb = plant.num_bundles();
   ci.time = t;
@@ -324,15 +324,16 @@ Status ControlInstantStep(const Task& task, AngleLoop& loop, JointLoops* joints,
   ci.broadcast.resize(nb);
   ci.estimated_on.resize(nb);
   ci.estimated_on_variance.resize(nb);
-  std::vector<int> on_before(nb);  // the a-posteriori estimate is of the state before broadcasting
+  on_before.resize(nb);  // the a-posteriori estimate is of the state before broadcasting
   for (int i = 0; i < nb; ++i) {
     on_before[i] = plant.OnCount(i);
     ci.sensed_force[i] = channels[i].sensor.SampleAndHold(plant.Force(i));
     ci.tendon_length[i] = plant.UnitLength(i);
   }
   if (hook != nullptr && hook->Replaces()) {
-    if (joints != nullptr)
+    if (joints != nullptr) {
       return Error{"a replacing control hook cannot drive \"outer_loop\": \"auto\""};
+    }
     if (Status st = hook->OnInstant(ci); !st.ok()) return st;
     force_ref = ci.force_reference;
   } else {
@@ -549,8 +550,8 @@ class Progress {
 
 }  // namespace
 
-Result<std::vector<JointDesignRecord>> DesignTaskLoops(const Task& task,
-                                                       const RunOptions& options) {
+Result<std::vector<JointDesignRecord> > DesignTaskLoops(const Task& task,
+                                                        const RunOptions& options) {
   const std::string where = task.source.empty() ? task.name : task.source;
   if (!task.auto_loop) {
     return Error{where + ".outer_loop: only a task with \"outer_loop\": \"auto\" designs its loop"};
@@ -664,6 +665,7 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
   }
   std::vector<double> force_ref(nb, 0.0);
   ControlInstant instant;
+  std::vector<int> on_before;
   const double h = plant.timestep();
   const long num_steps = std::lround(duration / h);
   // The metrics accumulate as the run goes: memory does not grow with its length.
@@ -683,7 +685,7 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
       next_control = control_instants * settings.dT;
       if (Status st = ControlInstantStep(task, angle_loop, joint_loops ? &*joint_loops : nullptr,
                                          plant, channels, t, settings.dT, options.control_hook,
-                                         instant, force_ref, sample);
+                                         instant, on_before, force_ref, sample);
           !st.ok()) {
         return Error{where + ": " + st.error()};
       }
