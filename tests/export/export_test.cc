@@ -422,6 +422,13 @@ TEST(ExportM4, CrossCompilesWithinBudgetAndReplaysUnderQemu) {
     EXPECT_EQ(undefined.find(bad), std::string::npos) << undefined;
   }
 
+  // Both packages together, as firmware wires them (tests/export/m4/firmware.c): it runs.
+  ASSERT_TRUE(sh(std::string("arm-none-eabi-gcc ") + kM4Flags + " -I. -nostdlib -T " + m4 +
+                 "m4.ld -Wl,--gc-sections " + m4 + "startup.c " + m4 +
+                 "firmware.c recruit_controller.c recruit_unit.c -lm -lc -lgcc -o firmware.elf && "
+                 "timeout 60 qemu-system-arm -M mps2-an386 -nographic -no-reboot "
+                 "-semihosting-config enable=on,target=native -kernel firmware.elf"));
+
   // A recorded run as float bit patterns.
   const auto log = Record(c, 3);
   ASSERT_EQ(log.size(), 110u);

@@ -43,13 +43,13 @@ TEST(UnitPackage, Pcg32MatchesTheReferenceImplementation) {
 }
 
 TEST(UnitPackage, QuantizesProbabilitiesOntoTheWire) {
-  EXPECT_EQ(recruit_wire_quantize(0.0), 0);
-  EXPECT_EQ(recruit_wire_quantize(1.0), 32768);
-  EXPECT_EQ(recruit_wire_quantize(0.5), 16384);
-  EXPECT_EQ(recruit_wire_quantize(0.2), 6554);  // 6553.6 rounded
-  EXPECT_EQ(recruit_wire_quantize(1.5), 32768);
-  EXPECT_EQ(recruit_wire_quantize(-0.1), 0);
-  EXPECT_EQ(recruit_wire_quantize(std::nan("")), 0);
+  EXPECT_EQ(recruit_wire_quantize(0.0f), 0);
+  EXPECT_EQ(recruit_wire_quantize(1.0f), 32768);
+  EXPECT_EQ(recruit_wire_quantize(0.5f), 16384);
+  EXPECT_EQ(recruit_wire_quantize(0.2f), 6554);  // 6553.6 rounded
+  EXPECT_EQ(recruit_wire_quantize(1.5f), 32768);
+  EXPECT_EQ(recruit_wire_quantize(-0.1f), 0);
+  EXPECT_EQ(recruit_wire_quantize(std::nanf("")), 0);
 }
 
 TEST(UnitPackage, FramesRoundTripAndEverySingleBitErrorIsCaught) {
@@ -80,11 +80,11 @@ TEST(UnitPackage, FramesRoundTripAndEverySingleBitErrorIsCaught) {
 // The examples of docs/broadcast-wire-format.md.
 TEST(UnitPackage, EncodesTheDocumentedExampleFrames) {
   uint8_t frame[RECRUIT_WIRE_SIZE];
-  const recruit_wire_message a{0, 1, recruit_wire_quantize(0.2), 0};
+  const recruit_wire_message a{0, 1, recruit_wire_quantize(0.2f), 0};
   recruit_wire_encode(&a, frame);
   const uint8_t want_a[] = {0xA5, 0x00, 0x01, 0x00, 0x9A, 0x19, 0x00, 0x00, 0xF5};
   EXPECT_TRUE(std::equal(frame, frame + RECRUIT_WIRE_SIZE, want_a));
-  const recruit_wire_message b{1, 42, 0, recruit_wire_quantize(1.0)};
+  const recruit_wire_message b{1, 42, 0, recruit_wire_quantize(1.0f)};
   recruit_wire_encode(&b, frame);
   const uint8_t want_b[] = {0xA5, 0x01, 0x2A, 0x00, 0x00, 0x00, 0x00, 0x80, 0xFE};
   EXPECT_TRUE(std::equal(frame, frame + RECRUIT_WIRE_SIZE, want_b));
@@ -116,7 +116,7 @@ TEST(UnitPackage, TheNumberSwitchingIsBinomialWithTheBroadcastProbability) {
   const int n = 20000;
   std::vector<recruit_unit> units(n);
   for (int i = 0; i < n; ++i) recruit_unit_init(&units[i], 0, 12345, static_cast<uint64_t>(i));
-  const uint16_t q_on = recruit_wire_quantize(0.3), q_off = recruit_wire_quantize(0.05);
+  const uint16_t q_on = recruit_wire_quantize(0.3f), q_off = recruit_wire_quantize(0.05f);
   uint8_t frame[RECRUIT_WIRE_SIZE];
   const recruit_wire_message on{0, 1, q_on, q_off};
   recruit_wire_encode(&on, frame);

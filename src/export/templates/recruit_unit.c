@@ -15,10 +15,10 @@ uint8_t recruit_crc8(const uint8_t *data, int n) {
   return crc;
 }
 
-uint16_t recruit_wire_quantize(double p) {
+uint16_t recruit_wire_quantize(float p) {
   if (!(p > 0)) return 0; /* also NaN */
   if (p >= 1) return (uint16_t)RECRUIT_WIRE_ONE;
-  return (uint16_t)(p * RECRUIT_WIRE_ONE + 0.5);
+  return (uint16_t)(p * 32768.0f + 0.5f); /* p x 2^15 is exact; + 1/2 rounds */
 }
 
 void recruit_wire_encode(const recruit_wire_message *msg, uint8_t out[RECRUIT_WIRE_SIZE]) {

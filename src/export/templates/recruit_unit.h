@@ -26,7 +26,7 @@ typedef struct {
 } recruit_wire_message;
 
 /* A probability in [0, 1] on the wire: round(p x 32768), clamped (NaN: 0). */
-uint16_t recruit_wire_quantize(double p);
+uint16_t recruit_wire_quantize(float p);
 /* The frame of `msg` into out[0 .. 8]. */
 void recruit_wire_encode(const recruit_wire_message *msg, uint8_t out[RECRUIT_WIRE_SIZE]);
 /* 0 and *msg filled when in[] is a valid frame; -1 bad sync byte, -2 bad checksum, -3 a
