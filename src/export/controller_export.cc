@@ -172,9 +172,6 @@ std::string BundleBlock(const BundleConstants& b, int i, const Writer& w) {
                   (b.m > 0 ? std::to_string(b.m) + "-state population Kalman filter"
                            : std::string("output estimator")) +
                   ". */\n";
-  auto ptr = [&](const std::string& name, bool has) {
-    return has ? n + name : std::string("NULL");
-  };
   if (b.m > 0) {
     s += w.Array("uint16_t", n + "ptr", b.ptr, false);
     s += w.Array("uint8_t", n + "col", b.col, false);
@@ -189,15 +186,25 @@ std::string BundleBlock(const BundleConstants& b, int i, const Writer& w) {
     if (!b.gqg.empty()) s += w.Array("recruit_real", n + "gqg", b.gqg, true);
   }
   const bool kf = b.m > 0;
-  s += "static const recruit_bundle_params " + n + "params = {\n    " + std::to_string(b.m) + ", " +
-       w.Num(b.N) + ", " + w.Num(b.lambda) + ", " + w.Num(b.unit_force) + ",\n    " +
-       (b.length_aware ? "1" : "0") + ", " + w.Num(b.prestretch) + ", " + w.Num(b.ref_length) +
-       ", " + w.Num(b.on_k) + ", " + w.Num(b.on_c) + ",\n    " + ptr("ptr", kf) + ", " +
-       ptr("col", kf) + ", " + ptr("target", kf) + ", " + ptr("is_on", kf) + ", " +
-       ptr("base", kf) + ",\n    " + ptr("k", kf && !b.k.empty()) + ", " +
-       ptr("c", kf && !b.c.empty()) + ", " + ptr("h", kf) + ", " + w.Num(b.R) + ", " +
-       w.Num(b.relative_noise) + ",\n    " + ptr("x0", kf) + ", " + ptr("P0", kf && !b.P0.empty()) +
-       ", " + ptr("gqg", kf && !b.gqg.empty()) + "};\n\n";
+  auto field = [](const std::string& name, const std::string& value) {
+    return "    ." + name + " = " + value + ",\n";
+  };
+  s += "static const recruit_bundle_params " + n + "params = {\n";
+  s += field("m", std::to_string(b.m)) + field("N", w.Num(b.N)) + field("lambda", w.Num(b.lambda)) +
+       field("unit_force", w.Num(b.unit_force));
+  s += field("length_aware", b.length_aware ? "1" : "0") +
+       field("prestretch", w.Num(b.prestretch)) + field("ref_length", w.Num(b.ref_length)) +
+       field("on_k", w.Num(b.on_k)) + field("on_c", w.Num(b.on_c));
+  if (kf) {
+    s += field("ptr", n + "ptr") + field("col", n + "col") + field("target", n + "target") +
+         field("is_on", n + "is_on") + field("base", n + "base");
+    if (!b.k.empty()) s += field("k", n + "k") + field("c", n + "c");
+    s += field("h", n + "h") + field("R", w.Num(b.R)) +
+         field("relative_noise", w.Num(b.relative_noise)) + field("x0", n + "x0");
+    if (!b.P0.empty()) s += field("P0", n + "P0");
+    if (!b.gqg.empty()) s += field("gqg", n + "gqg");
+  }
+  s += "};\n\n";
   return s;
 }
 
@@ -340,7 +347,7 @@ Result<ExportedPackage> ExportController(const sim::Task& task, const sim::RunOp
   for (const BundleConstants& b : bundles) {
     jb.push_back({{"actuator", b.actuator},
                   {"states", b.m},
-                  {"units", b.N},
+                  {"units", static_cast<long>(b.N)},
                   {"length_aware", b.length_aware}});
   }
   manifest["bundles"] = jb;
