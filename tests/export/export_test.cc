@@ -226,6 +226,37 @@ TEST(ExportEquivalence, FloatStaysWithinItsStatedBound) {
   EXPECT_GT(worst.estimate, 0.0);
 }
 
+// Lost samples: a NaN force (the filter predicts only) and a NaN length (the model's reference
+// length), fed to the C++ controllers RunTask would build (sim::TaskControllers) and to the
+// package alike, on a force task's recorded instants.
+TEST(ExportEquivalence, DoubleHandlesLostSamplesAsTheController) {
+  for (const std::string estimator : {"kalman-augmented", "output"}) {
+    const Case c{"isometric_steps.json", estimator, 60};
+    auto log = Record(c, 5);
+    ASSERT_GT(log.size(), 30u);
+    for (size_t k = 0; k < log.size(); ++k) {
+      if (k % 7 == 3) log[k].sensed_force[0] = NAN;
+      if (k % 11 == 5) log[k].tendon_length[0] = NAN;
+    }
+    auto cpp = sim::TaskControllers(LoadTask(c.task), Options(c, 5));
+    ASSERT_TRUE(cpp.ok()) << cpp.error();
+    ASSERT_EQ(cpp->size(), 1u);
+    control::RecruitmentController& ctl = (*cpp)[0].controller;
+    auto pkg = Load(c, Precision::kDouble, "lost_" + estimator);
+    ASSERT_TRUE(pkg);
+    std::vector<double> out;
+    for (const sim::ControlInstant& k : log) {
+      const control::Broadcast b = ctl.Step(k.reference, k.sensed_force[0], k.tendon_length[0]);
+      pkg->Step({k.reference, 0, 0, k.sensed_force[0], k.tendon_length[0]}, out);
+      EXPECT_EQ(out[0], k.reference);
+      EXPECT_LE(Rel(out[1], b.p_on), 1e-12) << estimator << " t = " << k.time;
+      EXPECT_LE(Rel(out[2], b.p_off), 1e-12) << estimator << " t = " << k.time;
+      EXPECT_LE(Rel(out[3], ctl.estimated_on()), 1e-12) << estimator << " t = " << k.time;
+      EXPECT_LE(Rel(out[4], ctl.estimated_on_variance()), 1e-12) << estimator << " t = " << k.time;
+    }
+  }
+}
+
 Result<sim::RunSummary> RunWith(const Case& c, std::uint64_t seed, sim::ControlInstantHook* h) {
   sim::RunOptions o = Options(c, seed);
   o.control_hook = h;
