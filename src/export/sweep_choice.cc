@@ -106,6 +106,15 @@ Result<SweepSettings> SweepChoice(const std::string& dir, const sim::Task& task,
     }
   }
   if (best == nullptr) {
+    std::string swept;
+    for (const sweep::Recommendation& r : recs) {
+      if (swept.find(r.estimator) == std::string::npos)
+        swept += (swept.empty() ? "" : ", ") + r.estimator;
+    }
+    if (swept.find(estimator) == std::string::npos) {
+      return Error{dir + ": the sweep has no cell of estimator " + estimator + " (it swept " +
+                   swept + "; pass --estimator)"};
+    }
     return Error{dir + ": no cell of estimator " + estimator +
                  " meets the sweep's tracking criterion (nothing to recommend)"};
   }
