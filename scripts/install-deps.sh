@@ -35,6 +35,8 @@ PACKAGES=("${DEMO_PACKAGES[@]}"
   ffmpeg                    # the render tests decode the videos they write
   clang libclang-rt-14-dev  # the sanitized suite and the libFuzzer targets (tests/fuzz)
   slurm-wlm munge           # the single-node Slurm the sweep's job-array test runs on
+  gcc-arm-none-eabi libnewlib-arm-none-eabi  # the exported controller built for Cortex-M4F
+  qemu-system-arm                            # ... and run on an emulated MPS2 board (tests/export)
 )
 if [ "$MODE" = --demo ]; then
   PACKAGES=("${DEMO_PACKAGES[@]}")

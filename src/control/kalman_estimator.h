@@ -37,6 +37,9 @@ class KalmanOnCountEstimator final : public OnCountEstimator {
 
   const FilterModel& model() const { return model_; }
   const PopulationKalmanFilter& filter() const { return filter_; }
+  // The length-dependent output model (none: H fixed) and the relative noise of R (Create).
+  const std::optional<UnitForceMap>& output() const { return output_; }
+  double relative_noise() const { return relative_noise_; }
 
  private:
   KalmanOnCountEstimator(FilterModel model, PopulationKalmanFilter filter,

@@ -315,22 +315,62 @@ void ForceReferences(const Task& task, AngleLoop& loop, JointLoops* joints, cons
   }
 }
 
-// One control instant of bundle i: the load cell samples the tendon force, the encoder gives the
-// tendon length, the controller estimates and broadcasts.
-Status ControlBundle(Channel& ch, Plant& plant, int i, double force_ref, BundleTelemetry& bt) {
-  // The a-posteriori estimate is of the state at this instant, before its broadcast.
-  const int on_before = plant.OnCount(i);
-  const double sensed = ch.sensor.SampleAndHold(plant.Force(i));
-  const control::Broadcast bc = ch.controller.Step(force_ref, sensed, plant.UnitLength(i));
-  if (Status st = plant.Broadcast(i, bc.p_on, bc.p_off); !st.ok()) return st;
-  const double var = ch.controller.estimated_on_variance();
-  bt.estimated_on = ch.controller.estimated_on();
-  bt.estimated_on_std =
-      std::isfinite(var) ? std::sqrt(std::max(var, 0.0)) : std::numeric_limits<double>::quiet_NaN();
-  bt.p_on = bc.p_on;
-  bt.p_off = bc.p_off;
-  bt.force_reference = force_ref;
-  ch.score.Add(bt.estimated_on, on_before, var);
+// One control instant: each load cell samples its tendon's force and each encoder the tendon's
+// length; the outer loop sets the force references and each bundle's controller estimates and
+// broadcasts (or `hook` decides in their place, or records what they decided).
+Status ControlInstantStep(const Task& task, AngleLoop& loop, JointLoops* joints, Plant& plant,
+                          std::vector<Channel>& channels, double t, double dT,
+                          ControlInstantHook* hook, ControlInstant& ci, std::vector<int>& on_before,
+                          std::vector<double>& force_ref, TelemetrySample& sample) {
+  const int nb = plant.num_bundles();
+  ci.time = t;
+  ci.reference = task.reference(t);
+  ci.angle = plant.angle();
+  ci.angular_velocity = plant.angular_velocity();
+  ci.sensed_force.resize(nb);
+  ci.tendon_length.resize(nb);
+  ci.force_reference.resize(nb);
+  ci.broadcast.resize(nb);
+  ci.estimated_on.resize(nb);
+  ci.estimated_on_variance.resize(nb);
+  on_before.resize(nb);  // the a-posteriori estimate is of the state before broadcasting
+  for (int i = 0; i < nb; ++i) {
+    on_before[i] = plant.OnCount(i);
+    ci.sensed_force[i] = channels[i].sensor.SampleAndHold(plant.Force(i));
+    ci.tendon_length[i] = plant.UnitLength(i);
+  }
+  if (hook != nullptr && hook->Replaces()) {
+    if (joints != nullptr) {
+      return Error{"a replacing control hook cannot drive \"outer_loop\": \"auto\""};
+    }
+    if (Status st = hook->OnInstant(ci); !st.ok()) return st;
+    force_ref = ci.force_reference;
+  } else {
+    ForceReferences(task, loop, joints, plant, channels, t, dT, force_ref);
+    for (int i = 0; i < nb; ++i) {
+      control::RecruitmentController& c = channels[i].controller;
+      ci.force_reference[i] = force_ref[i];
+      ci.broadcast[i] = c.Step(force_ref[i], ci.sensed_force[i], ci.tendon_length[i]);
+      ci.estimated_on[i] = c.estimated_on();
+      ci.estimated_on_variance[i] = c.estimated_on_variance();
+    }
+    if (hook != nullptr) {
+      if (Status st = hook->OnInstant(ci); !st.ok()) return st;
+    }
+  }
+  for (int i = 0; i < nb; ++i) {
+    const control::Broadcast& bc = ci.broadcast[i];
+    if (Status st = plant.Broadcast(i, bc.p_on, bc.p_off); !st.ok()) return st;
+    const double var = ci.estimated_on_variance[i];
+    BundleTelemetry& bt = sample.bundles[i];
+    bt.estimated_on = ci.estimated_on[i];
+    bt.estimated_on_std = std::isfinite(var) ? std::sqrt(std::max(var, 0.0))
+                                             : std::numeric_limits<double>::quiet_NaN();
+    bt.p_on = bc.p_on;
+    bt.p_off = bc.p_off;
+    bt.force_reference = force_ref[i];
+    channels[i].score.Add(bt.estimated_on, on_before[i], var);
+  }
   return Status::Ok();
 }
 
@@ -577,6 +617,24 @@ Result<std::vector<JointDesignRecord> > DesignTaskLoops(const Task& task,
   return out;
 }
 
+Result<std::vector<BundleController>> TaskControllers(const Task& task, const RunOptions& options) {
+  const std::string where = task.source.empty() ? task.name : task.source;
+  const ControllerSettings settings = EffectiveSettings(task, options);
+  auto plant_or = Plant::Create(task, /*drawn=*/false);
+  if (!plant_or.ok()) return Error{plant_or.error()};
+  Plant& plant = **plant_or;
+  plant.Reset(options.seed);
+  double identify_s = 0;
+  std::vector<std::string> warnings;
+  auto channels = MakeChannels(task, settings, plant, options, where, identify_s, warnings);
+  if (!channels.ok()) return Error{channels.error()};
+  std::vector<BundleController> out;
+  for (int i = 0; i < plant.num_bundles(); ++i) {
+    out.push_back({plant.bundle_name(i), std::move((*channels)[i].controller)});
+  }
+  return out;
+}
+
 // The block diagram: at each control instant (every dT) the outer loop sets each bundle's force
 // reference, its load cell and encoder are sampled and its controller broadcasts; then the plant
 // steps (disturbances, physics) and the signals are recorded.
@@ -634,6 +692,8 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
     sample.bundles[i].estimated_on = std::numeric_limits<double>::quiet_NaN();
   }
   std::vector<double> force_ref(nb, 0.0);
+  ControlInstant instant;
+  std::vector<int> on_before;
   const double h = plant.timestep();
   const long num_steps = std::lround(duration / h);
   // The metrics accumulate as the run goes: memory does not grow with its length.
@@ -651,13 +711,11 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
     if (sample.control_instant) {
       ++control_instants;
       next_control = control_instants * settings.dT;
-      ForceReferences(task, angle_loop, joint_loops ? &*joint_loops : nullptr, plant, channels, t,
-                      settings.dT, force_ref);
-      for (int i = 0; i < nb; ++i) {
-        if (Status st = ControlBundle(channels[i], plant, i, force_ref[i], sample.bundles[i]);
-            !st.ok()) {
-          return Error{where + ": " + st.error()};
-        }
+      if (Status st = ControlInstantStep(task, angle_loop, joint_loops ? &*joint_loops : nullptr,
+                                         plant, channels, t, settings.dT, options.control_hook,
+                                         instant, on_before, force_ref, sample);
+          !st.ok()) {
+        return Error{where + ": " + st.error()};
       }
       sample.p_on = sample.bundles[0].p_on;
       sample.p_off = sample.bundles[0].p_off;

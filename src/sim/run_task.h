@@ -11,11 +11,38 @@
 
 #include "common/result.h"
 #include "common/step_observer.h"
+#include "control/broadcast.h"
+#include "control/recruitment_controller.h"
 #include "sim/metrics.h"
 #include "sim/run_metrics.h"
 #include "sim/task.h"
 
 namespace recruit::sim {
+
+// What the controllers see and decide at one control instant (ControlInstantHook), per bundle
+// (agonist first).
+struct ControlInstant {
+  double time = 0;                         // s
+  double reference = 0;                    // the task's reference at `time` (N or rad)
+  double angle = 0, angular_velocity = 0;  // the tracked joint's encoder (0 without one)
+  std::vector<double> sensed_force;        // N, each load cell's reading
+  std::vector<double> tendon_length;       // m, each bundle's length coordinate (UnitLength)
+  // Decided: each bundle's force reference, broadcast, on-count estimate and its variance.
+  std::vector<double> force_reference;
+  std::vector<control::Broadcast> broadcast;
+  std::vector<double> estimated_on, estimated_on_variance;
+};
+
+// A hook at the control instants of RunTask. Replaces() false: OnInstant sees what the task's
+// controllers decided (a recorder). True: OnInstant decides in their place, filling every
+// decided field (e.g. an exported controller under test, tests/export); hand-set and force
+// tasks only (not "outer_loop": "auto").
+class ControlInstantHook {
+ public:
+  virtual ~ControlInstantHook() = default;
+  virtual bool Replaces() const = 0;
+  virtual Status OnInstant(ControlInstant& instant) = 0;
+};
 
 // Settings of one run. Unset optionals keep the task file's values.
 struct RunOptions {
@@ -33,6 +60,7 @@ struct RunOptions {
   // `recruit` commands and the Python package do; a library user decides.
   bool identify_missing_models = false;
   bool quiet = false;  // no notes on stderr (e.g. that a model is being identified)
+  ControlInstantHook* control_hook = nullptr;  // not owned; null: none
 };
 
 // One bundle's scores: its estimate against the ground-truth count at the control instants, and
@@ -90,6 +118,15 @@ ControllerSettings EffectiveSettings(const Task& task, const RunOptions& options
 // "outer_loop": "auto" only.
 struct JointDesignRecord;
 Result<std::vector<JointDesignRecord>> DesignTaskLoops(const Task& task, const RunOptions& options);
+
+// One bundle's controller as RunTask builds it for a task (the estimator on the bundle's model,
+// the length-aware target), reset to its initial belief.
+struct BundleController {
+  std::string actuator;
+  control::RecruitmentController controller;
+};
+// Every bundle's (agonist first): what `recruit export` writes as C.
+Result<std::vector<BundleController>> TaskControllers(const Task& task, const RunOptions& options);
 
 Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
                            const std::vector<StepObserver*>& observers = {});
