@@ -9,19 +9,11 @@
 namespace recruit::sim {
 namespace {
 
-constexpr double kStiffnessStep = 1e-3;  // rad, for d tau_static / dq
-constexpr double kLengthStep = 1e-4;     // m, for a unit force map's slope
 // How far the bundles' tension may fall short of its reference at a hold, as a fraction: the
 // unit force map's error and the estimate's bias (MyoSuite's elbow, attached with --force 150:
 // 6-25 % at the holds of seed 401).
 constexpr double kForceError = 0.15;
-constexpr double kLeastStep = 0.05;  // rad: the least step a design assumes
-// A joint's stiffness at constant counts is kept at least this fraction of the sum of the
-// magnitudes it is made of (the limb's and each bundle's): with less, the errors of the model
-// (force map, moment arms) can make a pose the bundles hold unstable. 0.5 settled 7/16, 6/8
-// and 3/8 steps of the development cases at dT 1 (two-joint arm, MyoSuite elbow and finger,
-// seeds 401-402) against 4/16, 4/8 and 2/8 without; 0.25 gave 7/16, 4/8, 3/8.
-constexpr double kStiffnessMargin = 0.5;
+constexpr double kLeastStep = 0.05;    // rad: the least step a design assumes
 constexpr double kLimitMargin = 0.03;  // of a joint's range: the loop's reference stays inside
 
 }  // namespace
@@ -85,67 +77,8 @@ Result<JointLoops> JointLoops::Create(const Task& task, const Plant& plant,
   return loops;
 }
 
-JointLoops::Holding JointLoops::HoldingAt(const Plant& plant, int j,
-                                          const Eigen::VectorXd& r) const {
-  const int nb = plant.num_bundles();
-  const Eigen::MatrixXd arms = plant.MomentArmsAt(r);
-  const Eigen::VectorXd lengths = plant.UnitLengthsAt(r);
-  Eigen::VectorXd up = r, down = r;
-  up[j] += kStiffnessStep;
-  down[j] -= kStiffnessStep;
-  const Eigen::VectorXd arm_slope =
-      (plant.MomentArmsAt(up).row(j) - plant.MomentArmsAt(down).row(j)).transpose() /
-      (2 * kStiffnessStep);
-  // The tensions that hold the reference: its static torque shared as Step shares it.
-  control::AllocationProblem p;
-  p.arms = arms;
-  p.torque = plant.StaticTorque(r);
-  p.cap.resize(nb);
-  p.floor.resize(nb);
-  p.price = price_;
-  Eigen::VectorXd slope(nb);  // d ln(unit force) / dL, 1/m
-  for (int i = 0; i < nb; ++i) {
-    const double f = on_unit_force_[i](lengths[i]);
-    p.cap[i] = std::max(plant.num_units(i) * f, 1e-9);
-    p.floor[i] = task_->co_contraction * p.cap[i];
-    slope[i] = f > 0 ? (on_unit_force_[i](lengths[i] + kLengthStep) -
-                        on_unit_force_[i](lengths[i] - kLengthStep)) /
-                           (2 * kLengthStep * f)
-                     : 0.0;
-  }
-  // Torque tau_j = sum_i A_ji T_i with T_i = n_i f_i(L_i) and dL_i/dq_j = -A_ji (a bundle shortens
-  // as it pulls): at constant counts -dtau_j/dq_j = sum_i T_i (A_ji^2 f_i'/f_i - dA_ji/dq_j).
-  Holding h;
-  h.coef.resize(nb);
-  for (int i = 0; i < nb; ++i) h.coef[i] = arms(j, i) * arms(j, i) * slope[i] - arm_slope[i];
-  h.limb_stiffness =
-      (plant.StaticTorque(up)[j] - plant.StaticTorque(down)[j]) / (2 * kStiffnessStep);
-  std::vector<const Holding*> rows(plant.num_joints(), nullptr);
-  rows[j] = &h;
-  const Eigen::VectorXd tensions = Allocate(p, rows);
-  h.stiffness = h.coef.dot(tensions);
-  for (int i = 0; i < nb; ++i) h.torque += std::abs(arms(j, i) * tensions[i]);
-  return h;
-}
-
-Eigen::VectorXd JointLoops::Allocate(const control::AllocationProblem& p,
-                                     const std::vector<const Holding*>& holding) const {
-  Eigen::VectorXd t = control::AllocateTensions(p);
-  control::AllocationProblem q = p;
-  int added = 0;
-  for (size_t j = 0; j < holding.size(); ++j) {
-    const Holding* h = holding[j];
-    if (h == nullptr) continue;
-    const double least =
-        kStiffnessMargin * (std::abs(h->limb_stiffness) + h->coef.cwiseAbs().dot(t));
-    if (h->limb_stiffness + h->coef.dot(t) >= least) continue;
-    q.arms.conservativeResize(q.arms.rows() + 1, Eigen::NoChange);
-    q.torque.conservativeResize(q.torque.size() + 1);
-    q.arms.row(q.arms.rows() - 1) = h->coef.transpose();
-    q.torque[q.torque.size() - 1] = least - h->limb_stiffness;
-    ++added;
-  }
-  return added ? control::AllocateTensions(q) : t;
+JointHolding JointLoops::HoldingAt(const Plant& plant, int j, const Eigen::VectorXd& r) const {
+  return HoldJoint(plant, j, r, on_unit_force_, task_->co_contraction, price_);
 }
 
 Result<JointDesignRecord> JointLoops::Design(const Plant& plant, int j, const Eigen::VectorXd& r,
@@ -189,7 +122,7 @@ void JointLoops::Step(double t, const Plant& plant, const std::vector<double>& c
   const Eigen::VectorXd r = LoopReference(plant, t);
   // Gains for this pose: designed once per reference value (a step's target).
   std::vector<control::LoopGains> gains(nj);
-  std::vector<const Holding*> holding(nj, nullptr);
+  std::vector<const JointHolding*> holding(nj, nullptr);
   for (int j = 0; j < nj; ++j) {
     // The step a new reference value makes: from the last one, or from the limb at the start.
     const double from = std::isnan(last_target_[j]) ? plant.JointAngle(j) : last_target_[j];
@@ -234,7 +167,7 @@ void JointLoops::Step(double t, const Plant& plant, const std::vector<double>& c
     p.cap[i] = std::max(units[i] * unit_force[i], 1e-9);
     p.floor[i] = task_->co_contraction * p.cap[i];
   }
-  const Eigen::VectorXd continuous = Allocate(p, holding);
+  const Eigen::VectorXd continuous = AllocateHolding(p, holding);
   const Eigen::VectorXd achieved = p.arms * continuous;
   for (int j = 0; j < nj; ++j) {
     // Anti-windup: the integral grows only while the bundles can still deliver what it asks.

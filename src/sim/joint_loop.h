@@ -10,7 +10,6 @@
 // docs/controller.md, "The self-tuned outer loop".
 #pragma once
 
-#include <functional>
 #include <map>
 #include <string>
 #include <vector>
@@ -19,19 +18,11 @@
 #include "control/actuator_response.h"
 #include "control/loop_design.h"
 #include "control/torque_allocation.h"
+#include "sim/holding.h"
 #include "sim/plant.h"
 #include "sim/task.h"
 
 namespace recruit::sim {
-
-// How the bundles hold a joint at a pose, with the tensions the allocation gives there.
-struct JointHolding {
-  double stiffness = 0;  // N m/rad: the bundles' at constant on-counts
-  double torque = 0;     // N m: the sum of the bundles' torques' magnitudes
-  // Per bundle, N m/rad per newton: its stiffness on the joint per unit of its tension.
-  Eigen::VectorXd coef;
-  double limb_stiffness = 0;  // N m/rad: d tau_static / dq, the limb's own
-};
 
 // One design of one joint's loop: at which reference, on what model, with what prediction.
 struct JointDesignRecord {
@@ -51,8 +42,6 @@ struct JointDesignRecord {
 
 class JointLoops {
  public:
-  // Tension (N) of one unit that is on, at bundle length coordinate L (Plant::UnitLength).
-  using UnitForce = std::function<double(double L)>;
   // `responses`: each bundle's tension step response (control/actuator_response.h), and
   // `on_unit_force` each bundle's unit force map, in the plant's bundle order. `dT` the sampling
   // period.
@@ -73,9 +62,8 @@ class JointLoops {
   // other joints at theirs).
   Result<JointDesignRecord> Design(const Plant& plant, int j, const Eigen::VectorXd& r,
                                    double step) const;
-  // How the bundles hold joint j at pose r (JointHolding).
-  using Holding = JointHolding;
-  Holding HoldingAt(const Plant& plant, int j, const Eigen::VectorXd& r) const;
+  // How the bundles hold joint j at pose r (sim/holding.h).
+  JointHolding HoldingAt(const Plant& plant, int j, const Eigen::VectorXd& r) const;
 
  private:
   const Task* task_ = nullptr;
@@ -86,13 +74,9 @@ class JointLoops {
   // Per joint, by reference value: the loop's gains and how the bundles hold the pose.
   struct Setting {
     control::LoopGains gains;
-    Holding holding;
+    JointHolding holding;
   };
   std::vector<std::map<double, Setting>> settings_;
-  // The allocation with each joint's stiffness at least `least_stiffness` where the bundles can
-  // give it: one more row per joint that falls short.
-  Eigen::VectorXd Allocate(const control::AllocationProblem& p,
-                           const std::vector<const Holding*>& holding) const;
 
   std::vector<double> integral_;     // rad s, per joint
   std::vector<double> last_target_;  // rad, per joint: NaN before the first instant

@@ -179,10 +179,10 @@ void IdentificationWarning(const FilterModel& model, const std::string& bundle,
   if (std::find(warnings.begin(), warnings.end(), buf) == warnings.end()) warnings.push_back(buf);
 }
 
-Result<std::vector<Channel> > MakeChannels(const Task& task, const ControllerSettings& settings,
-                                           const Plant& plant, const RunOptions& options,
-                                           const std::string& where, double& identify_s,
-                                           std::vector<std::string>& warnings) {
+Result<std::vector<Channel>> MakeChannels(const Task& task, const ControllerSettings& settings,
+                                          const Plant& plant, const RunOptions& options,
+                                          const std::string& where, double& identify_s,
+                                          std::vector<std::string>& warnings) {
   auto spec = control::EstimatorSpec::Parse(settings.estimator, "extended", settings.filter_model,
                                             20, settings.force_noise_std);
   if (!spec.ok()) return Error{where + ".controller.estimator: " + spec.error()};
@@ -225,7 +225,7 @@ Result<std::vector<Channel> > MakeChannels(const Task& task, const ControllerSet
 
 // Each bundle's tension step response under the law (control/actuator_response.h), predicted on
 // the chain identified for it: the Kalman estimator's own model, else the identified one.
-Result<std::vector<control::ActuatorResponse> > ActuatorResponses(
+Result<std::vector<control::ActuatorResponse>> ActuatorResponses(
     const Task& task, const ControllerSettings& settings, const Plant& plant,
     const std::vector<Channel>& channels, const RunOptions& options, double& identify_s,
     std::vector<std::string>& warnings) {
@@ -277,8 +277,8 @@ Result<std::vector<control::ActuatorResponse> > ActuatorResponses(
 }
 
 // Each bundle's unit force map (its controller's), for the loop design.
-std::vector<JointLoops::UnitForce> UnitForces(const std::vector<Channel>& channels) {
-  std::vector<JointLoops::UnitForce> out;
+std::vector<UnitForce> UnitForces(const std::vector<Channel>& channels) {
+  std::vector<UnitForce> out;
   for (const Channel& c : channels) {
     out.push_back([&c](double L) { return c.controller.OnUnitForce(L); });
   }
@@ -573,8 +573,8 @@ class Progress {
 
 }  // namespace
 
-Result<std::vector<JointDesignRecord> > DesignTaskLoops(const Task& task,
-                                                        const RunOptions& options) {
+Result<std::vector<JointDesignRecord>> DesignTaskLoops(const Task& task,
+                                                       const RunOptions& options) {
   const std::string where = task.source.empty() ? task.name : task.source;
   if (!task.auto_loop) {
     return Error{where + ".outer_loop: only a task with \"outer_loop\": \"auto\" designs its loop"};
