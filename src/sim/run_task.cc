@@ -321,6 +321,7 @@ Status ControlBundle(Channel& ch, Plant& plant, int i, double force_ref, BundleT
   bt.p_on = bc.p_on;
   bt.p_off = bc.p_off;
   bt.force_reference = force_ref;
+  bt.sensed_force = sensed;
   ch.score.Add(bt.estimated_on, on_before, var);
   return Status::Ok();
 }
