@@ -15,5 +15,6 @@ void AddRenderCommand(CLI::App& app, int& exit_code);    // render_command.cc
 void AddPlotCommand(CLI::App& app, int& exit_code);      // plot_command.cc
 void AddTuneLoopCommand(CLI::App& app, int& exit_code);  // tune_loop_command.cc
 void AddAttachCommand(CLI::App& app, int& exit_code);    // attach_command.cc
+void AddReplayCommand(CLI::App& app, int& exit_code);    // replay_command.cc
 
 }  // namespace recruit::cli
