@@ -79,7 +79,8 @@ int RunReplayCommand(const ReplayArgs& a) {
     const auto& sig = result->plan.signals[s];
     std::cout << "  " << sig.name << ": RMSE " << c.recorded.rmse << " " << sig.unit << ", bias "
               << c.recorded.bias << " " << sig.unit << ", lag " << c.recorded.lag
-              << " s; RMSE / same plant's " << c.rmse_ratio << " (z " << c.rmse_z << ")"
+              << " s; RMSE / same plant's " << c.rmse_ratio << " (z " << c.rmse_z
+              << "), increments " << c.step_ratio << " (z " << c.step_z << ")"
               << (c.flagged ? "  FLAGGED" : "") << "\n";
   }
   std::cout << (result->flagged ? "the bench differs from the simulated plant"
@@ -119,8 +120,12 @@ void AddReplayCommand(CLI::App& app, int& exit_code) {
                   "Flag when the RMSE exceeds the same plant's by this ratio (and --z-band)")
       ->check(NumberIn(1, false, 1e6, "a number >= 1"))
       ->capture_default_str();
+  cmd->add_option("--step-ratio-band", args->options.criterion.step_ratio_band,
+                  "... or when the increments' RMSE exceeds the same plant's by this ratio")
+      ->check(NumberIn(1, false, 1e6, "a number >= 1"))
+      ->capture_default_str();
   cmd->add_option("--z-band", args->options.criterion.z_band,
-                  "... and by this many standard deviations of the same plant's RMSE")
+                  "... and (both) by this many standard deviations of the same plant's")
       ->check(NonNegative())
       ->capture_default_str();
   cmd->callback([args, &exit_code] { exit_code = RunReplayCommand(*args); });

@@ -31,6 +31,18 @@ Residual Compare(const std::vector<double>& a, const std::vector<double>& b, dou
   return {std::sqrt(sq / n), sum / n, Lag(a, b, dT, max_lag)};
 }
 
+std::vector<double> Increments(const std::vector<double>& x) {
+  std::vector<double> d;
+  for (size_t k = 1; k < x.size(); ++k) d.push_back(x[k] - x[k - 1]);
+  return d;
+}
+
+double Rmse(const std::vector<double>& a, const std::vector<double>& b) {
+  double sq = 0;
+  for (size_t k = 0; k < a.size(); ++k) sq += (a[k] - b[k]) * (a[k] - b[k]);
+  return a.empty() ? 0 : std::sqrt(sq / a.size());
+}
+
 void MeanSd(const std::vector<double>& v, double* mean, double* sd) {
   double m = 0;
   for (double x : v) m += x / v.size();
@@ -38,6 +50,14 @@ void MeanSd(const std::vector<double>& v, double* mean, double* sd) {
   for (double x : v) ss += (x - m) * (x - m);
   *mean = m;
   *sd = v.size() > 1 ? std::sqrt(ss / (v.size() - 1)) : 0;
+}
+
+// x / mean and (x - mean) / sd; a zero spread (a deterministic plant) makes any excess infinite.
+double Ratio(double x, double mean) {
+  return mean > 0 ? x / mean : (x > 0 ? std::numeric_limits<double>::infinity() : 1);
+}
+double Z(double x, double mean, double sd) {
+  return sd > 0 ? (x - mean) / sd : (x > mean ? std::numeric_limits<double>::infinity() : 0);
 }
 
 }  // namespace
@@ -77,9 +97,11 @@ Result<SignalComparison> CompareSignal(const std::vector<double>& recorded,
   }
   SignalComparison c;
   c.recorded = Compare(recorded, mean, dT, max_lag);
-  std::vector<double> rmse, bias, lag;
+  std::vector<double> rmse, bias, lag, step;
+  const std::vector<double> mean_steps = Increments(mean);
   for (const auto& r : runs) {
     for (size_t k = 0; k < n; ++k) others[k] = (S * mean[k] - r[k]) / (S - 1);
+    step.push_back(Rmse(Increments(r), Increments(others)) / std::sqrt(1.0 + 1.0 / (S - 1)));
     c.same_plant.push_back(Compare(r, others, dT, max_lag));
     rmse.push_back(c.same_plant.back().rmse / std::sqrt(1.0 + 1.0 / (S - 1)));
     bias.push_back(c.same_plant.back().bias);
@@ -89,13 +111,15 @@ Result<SignalComparison> CompareSignal(const std::vector<double>& recorded,
   MeanSd(rmse, &c.same_plant_rmse, &c.same_plant_rmse_sd);
   MeanSd(bias, &unused, &c.same_plant_bias_sd);
   MeanSd(lag, &unused, &c.same_plant_lag_sd);
+  MeanSd(step, &c.same_plant_step_rmse, &c.same_plant_step_rmse_sd);
+  c.step_rmse = Rmse(Increments(recorded), mean_steps) / std::sqrt(1.0 + 1.0 / S);
+  c.step_ratio = Ratio(c.step_rmse, c.same_plant_step_rmse);
+  c.step_z = Z(c.step_rmse, c.same_plant_step_rmse, c.same_plant_step_rmse_sd);
   const double rec = c.recorded.rmse / std::sqrt(1.0 + 1.0 / S);
-  const double excess = rec - c.same_plant_rmse;
-  c.rmse_ratio = c.same_plant_rmse > 0 ? rec / c.same_plant_rmse
-                                       : (rec > 0 ? std::numeric_limits<double>::infinity() : 1);
-  c.rmse_z = c.same_plant_rmse_sd > 0 ? excess / c.same_plant_rmse_sd
-                                      : (excess > 0 ? std::numeric_limits<double>::infinity() : 0);
-  c.flagged = c.rmse_ratio > criterion.ratio_band && c.rmse_z > criterion.z_band;
+  c.rmse_ratio = Ratio(rec, c.same_plant_rmse);
+  c.rmse_z = Z(rec, c.same_plant_rmse, c.same_plant_rmse_sd);
+  c.flagged = (c.rmse_ratio > criterion.ratio_band && c.rmse_z > criterion.z_band) ||
+              (c.step_ratio > criterion.step_ratio_band && c.step_z > criterion.z_band);
   return c;
 }
 

@@ -6,7 +6,8 @@
 // mean of the other S - 1. Were the rig the simulated plant, R would be one more such run, and
 // E|R - M|^2 / (1 + 1/S) = E|X_a - M_-a|^2 / (1 + 1/(S - 1)) (the means' own variance taken
 // out). The signal is flagged when R's normalised RMSE exceeds the runs' mean normalised RMSE
-// by the ratio band AND by z_band of their standard deviations. Pure: numbers in, numbers out.
+// by the ratio band AND by z_band of their standard deviations, or when the increments
+// x(k+1) - x(k) do so by step_ratio_band and z_band. Pure: numbers in, numbers out.
 #pragma once
 
 #include <string>
@@ -17,8 +18,9 @@
 namespace recruit::replay {
 
 struct Criterion {
-  double ratio_band = 1.5;  // normalised RMSE / the runs' mean normalised RMSE
-  double z_band = 4;        // standard deviations of the runs' normalised RMSE
+  double ratio_band = 2;         // normalised RMSE / the runs' mean normalised RMSE
+  double step_ratio_band = 1.5;  // the same for the increments
+  double z_band = 4;             // standard deviations of the runs' normalised RMSE (both)
 };
 
 struct Residual {
@@ -36,6 +38,11 @@ struct SignalComparison {
   double same_plant_rmse_sd = 0;
   double same_plant_bias_sd = 0;  // the runs' spread of bias and lag, for reading the others
   double same_plant_lag_sd = 0;
+  // The same test on the increments x(k+1) - x(k): the transients after each broadcast, without
+  // the slow drift of the on-count that dominates the level's spread in an open-loop replay.
+  double step_rmse = 0;  // recorded, normalised
+  double step_ratio = 0, step_z = 0;
+  double same_plant_step_rmse = 0, same_plant_step_rmse_sd = 0;
   bool flagged = false;
 };
 

@@ -77,6 +77,7 @@ nlohmann::json ReportJson(const ReplayResult& r) {
   j["seeds"] = seeds;
   j["max_lag"] = r.options.max_lag;
   j["criterion"] = {{"ratio_band", r.options.criterion.ratio_band},
+                    {"step_ratio_band", r.options.criterion.step_ratio_band},
                     {"z_band", r.options.criterion.z_band}};
   j["flagged"] = r.flagged;
   nlohmann::json signals = nlohmann::json::array();
@@ -93,6 +94,8 @@ nlohmann::json ReportJson(const ReplayResult& r) {
                        {"same_plant_rmse_sd", c.same_plant_rmse_sd},
                        {"same_plant_bias_sd", c.same_plant_bias_sd},
                        {"same_plant_lag_sd", c.same_plant_lag_sd},
+                       {"step_ratio", c.step_ratio},
+                       {"step_z", c.step_z},
                        {"same_plant", same},
                        {"flagged", c.flagged}});
   }

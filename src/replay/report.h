@@ -17,8 +17,9 @@
 namespace recruit::replay {
 
 struct ReplayOptions {
-  int num_seeds = 8;             // S >= 3 replays
-  std::uint64_t first_seed = 1;  // seeds first_seed .. first_seed + S - 1
+  int num_seeds = 16;             // S >= 3 replays
+  std::uint64_t first_seed = 101;  // seeds first_seed .. first_seed + S - 1 (apart from a
+                                   // simulated log's usual seeds)
   double max_lag = -1;           // s; < 0: 5 control periods
   Criterion criterion;
 };
