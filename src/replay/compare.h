@@ -18,8 +18,8 @@
 namespace recruit::replay {
 
 struct Criterion {
-  double ratio_band = 2;         // normalised RMSE / the runs' mean normalised RMSE
-  double step_ratio_band = 1.5;  // the same for the increments
+  double ratio_band = 4;         // normalised RMSE / the runs' mean normalised RMSE
+  double step_ratio_band = 2.5;  // the same for the increments
   double z_band = 4;             // standard deviations of the runs' normalised RMSE (both)
 };
 

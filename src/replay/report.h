@@ -17,10 +17,10 @@
 namespace recruit::replay {
 
 struct ReplayOptions {
-  int num_seeds = 16;             // S >= 3 replays
+  int num_seeds = 16;              // S >= 3 replays
   std::uint64_t first_seed = 101;  // seeds first_seed .. first_seed + S - 1 (apart from a
                                    // simulated log's usual seeds)
-  double max_lag = -1;           // s; < 0: 5 control periods
+  double max_lag = -1;             // s; < 0: 5 control periods
   Criterion criterion;
 };
 
