@@ -124,8 +124,9 @@ std::string SignalsCsv(const ReplayResult& r) {
 
 plot::Figure ReplayFigure(const ReplayResult& r) {
   plot::Figure fig;
+  const std::string file = r.log_path.substr(r.log_path.find_last_of('/') + 1);
   fig.title =
-      fmt::format("replay of {} on {}: {}", r.log_path, r.task_name,
+      fmt::format("replay of {} on {}: {}", file, r.task_name,
                   r.flagged ? "differs from the model (flagged)" : "consistent with the model");
   const plot::Color sim{0.13, 0.4, 0.75, 1}, band{0.13, 0.4, 0.75, 0.25}, rec{0, 0, 0, 1};
   for (size_t s = 0; s < r.plan.signals.size(); ++s) {
@@ -135,10 +136,13 @@ plot::Figure ReplayFigure(const ReplayResult& r) {
     const double scale = angle ? 180 / M_PI : 1;
     plot::Axes ax;
     ax.x_label = "time (s)";
-    ax.y_label = fmt::format("{} ({})", sig.name, angle ? "deg" : "N");
+    // "flexor force (N)", "angle (deg)", "wrist angle (deg)": the column name is too long.
+    const std::string who = sig.name.substr(0, sig.name.find('.'));
+    ax.y_label =
+        angle ? (who == "angle" ? "angle (deg)" : who + " angle (deg)") : who + " force (N)";
     plot::Band b{fmt::format("simulated, {} seeds (range)", r.options.num_seeds), {}, {}, {}, band};
     plot::Series m{"simulated mean", {}, {}, sim, plot::LineStyle::kSolid, 1.5};
-    plot::Series x{fmt::format("recorded: RMSE {:.3g}, bias {:.3g} {}, lag {:.3g} s{}",
+    plot::Series x{fmt::format("recorded: RMSE {0:.3g} {2}, bias {1:.3g} {2}, lag {3:.3g} s{4}",
                                c.recorded.rmse * scale, c.recorded.bias * scale,
                                angle ? "deg" : "N", c.recorded.lag, c.flagged ? " (flagged)" : ""),
                    {},
