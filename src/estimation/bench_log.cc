@@ -1,5 +1,7 @@
 #include "estimation/bench_log.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <charconv>
 #include <cmath>
@@ -167,9 +169,7 @@ Result<BenchLog> ParseBenchLog(const std::string& text, const std::string& path)
       if (BenchParseNumber(cells[col], v) && *v >= lo && *v <= hi) return Status::Ok();
       return Error{where + ": column '" + header[col] + "': '" + ShortText(cells[col]) +
                    "' is not a finite number" +
-                   (std::isfinite(lo) ? " in [" + ShortText(std::to_string(lo)) + ", " +
-                                            ShortText(std::to_string(hi)) + "]"
-                                      : std::string())};
+                   (std::isfinite(lo) ? fmt::format(" in [{:g}, {:g}]", lo, hi) : std::string())};
     };
     const double inf = INFINITY;
     double t;
@@ -203,8 +203,8 @@ Result<BenchLog> ParseBenchLog(const std::string& text, const std::string& path)
     const double step = log.time[k] - log.time[k - 1];
     if (std::abs(step - log.dT) > kBenchLogPeriodTolerance * log.dT) {
       return Error{path + ":" + std::to_string(log.line[k]) + ": control period " +
-                   ShortText(std::to_string(step)) + " s differs from the mean " +
-                   ShortText(std::to_string(log.dT)) +
+                   fmt::format("{:g}", step) + " s differs from the mean " +
+                   fmt::format("{:g}", log.dT) +
                    " s by more than 1 % (the control instants must be uniformly spaced)"};
     }
   }

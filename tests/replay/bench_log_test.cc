@@ -52,7 +52,7 @@ TEST(BenchLog, RejectsBadLogsNamingFileLineColumnAndValue) {
       {h + "0,0,0,0\n1,0,0,nan\n", "log.csv:3: column 'x.sensed_force': 'nan'"},
       {h + "0,0,0,0\n1,0,0\n", "log.csv:3: has 3 cells, the header 4"},
       {h + "0,0,0,0\n1,0,0,0\n2.5,0,0,0\n",
-       "log.csv:3: control period 1.000000 s differs from the mean 1.250000 s"},
+       "log.csv:3: control period 1 s differs from the mean 1.25 s"},
       {h + "0,0,0,0\n0,0,0,0\n", "log.csv:3: time 0 s does not increase"},
       {h + "0,0,0,0\n", "needs at least 2 control instants, has 1"},
       {"time,control_instant,x.p_on,x.p_off,x.sensed_force\n0,yes,0,0,0\n",
