@@ -88,9 +88,10 @@ Result<std::vector<std::vector<double>>> ReplayOnce(const sim::Task& task, const
     // The control instants at k dT (the log's period), as RunTask finds them.
     const bool instant = plant.time() + 0.5 * h >= k * plan.dT;
     if (instant) {
+      // Every load cell first, then every broadcast, as RunTask's control instant does.
+      for (int i = 0; i < nb; ++i) sensed[i] = sensors[i].SampleAndHold(plant.Force(i));
       for (int i = 0; i < nb; ++i) {
         const BenchLog::Bundle& b = log.bundles[plan.log_bundle[i]];
-        sensed[i] = sensors[i].SampleAndHold(plant.Force(i));
         if (Status st = plant.Broadcast(i, b.p_on[k], b.p_off[k]); !st.ok()) {
           return Error{log.path + ":" + std::to_string(log.line[k]) + ": " + st.error()};
         }
