@@ -1,8 +1,8 @@
 // `recruit filter` and `recruit identify --log` read a bench log as the file in their older
 // formats that holds its control instants (t,p_on,p_off,y and time,p_on,p_off,force), written
 // here from the bench log's rows: the same output, number for number.
-#include <gtest/gtest.h>
 #include <fmt/format.h>
+#include <gtest/gtest.h>
 
 #include <filesystem>
 #include <fstream>
@@ -53,8 +53,8 @@ TEST(BenchLogReaders, FilterReadsItAsItsOwnLog) {
   auto log = ParseBenchLog(csv, "sim.csv");
   ASSERT_TRUE(log.ok()) << log.error();
   ASSERT_EQ(log->size(), 60);
-  auto model = FilterModel::FromJson(kRoot +
-                                     "/models/identified/bundle_903e47abb54d0604_dt1_m20.json");
+  auto model =
+      FilterModel::FromJson(kRoot + "/models/identified/bundle_903e47abb54d0604_dt1_m20.json");
   ASSERT_TRUE(model.ok()) << model.error();
   auto f1 = MakeCountFilter(*model, {});
   auto f2 = MakeCountFilter(*model, {});
