@@ -34,6 +34,7 @@ class TraceRecorder : public StepObserver {
         }
       }
       names_.push_back("control_instant");
+      for (const auto& b : s.bundles) names_.push_back(b.actuator + ".sensed_force");
       cols_.resize(names_.size());
     }
     if (count_++ % every_ != 0 && !s.control_instant) return Status::Ok();
@@ -46,7 +47,8 @@ class TraceRecorder : public StepObserver {
         cols_[c++].push_back(v);
       }
     }
-    cols_[c].push_back(s.control_instant ? 1.0 : 0.0);
+    cols_[c++].push_back(s.control_instant ? 1.0 : 0.0);
+    for (const auto& b : s.bundles) cols_[c++].push_back(b.sensed_force);
     return Status::Ok();
   }
 

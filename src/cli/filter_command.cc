@@ -53,7 +53,7 @@ int RunFilter(const FilterArgs& a) {
   auto filter = MakeCountFilter(*model, a.options);
   if (!filter.ok()) return fail(filter.error());
   // Streamed: the log is read, stepped and written row by row (memory flat in its length).
-  auto log = FilterLogReader::OpenFile(a.log, *model);
+  auto log = FilterLogReader::OpenFile(a.log, *model, a.actuator);
   if (!log.ok()) return fail(log.error());
   AtomicFile out(a.out, std::ios::out | std::ios::binary);
   if (!out.ok()) return fail(out.error());
@@ -80,7 +80,8 @@ void AddFilterCommand(CLI::App& app, int& exit_code) {
       ->check(CLI::ExistingFile);
   cmd->add_option("--log", args->log,
                   "Log (CSV): optional t, the inputs of each step (p_on,p_off or A_i_j) and the "
-                  "measurement (y, or y_0..y_{r-1}; empty cells = no measurement that step)")
+                  "measurement (y, or y_0..y_{r-1}; empty cells = no measurement that step); or "
+                  "a bench log (docs/formats/bench_log.md), its bundle by --actuator")
       ->required()
       ->check(CLI::ExistingFile);
   cmd->add_option("--out", args->out,
@@ -91,7 +92,9 @@ void AddFilterCommand(CLI::App& app, int& exit_code) {
                   "MJCF model the log was recorded on: the model file must have been identified "
                   "on that plant's bundle (its identification.plant), else it is refused")
       ->check(CLI::ExistingFile);
-  cmd->add_option("--actuator", args->actuator, "--plant's bundle (default: its first)");
+  cmd->add_option(
+      "--actuator", args->actuator,
+      "--plant's bundle (default: its first), and a bench log's (default: its only one)");
   cmd->add_option("--estimator", args->options.estimator,
                   std::string("Estimator: ") + kEstimatorNames)
       ->check(CLI::IsMember({"extended", "conservative", "plain", "exact", "particle"}))

@@ -77,7 +77,7 @@ void PrintFit(const recruit::control::IdentificationResult& fit) {
 // --log: the chain fitted to a recorded switching log (plant unknown: no length model).
 Result<nlohmann::json> IdentifyFromLog(const IdentifyArgs& a, const std::string& command_line) {
   using namespace recruit::control;
-  auto log = SwitchingLog::FromCsv(a.log_in, a.units);
+  auto log = SwitchingLog::FromCsv(a.log_in, a.units, a.actuator);
   if (!log) return Error{log.error()};
   FitOptions opt;
   opt.num_states = a.states;
@@ -189,10 +189,13 @@ void AddIdentifyCommand(CLI::App& app, int& exit_code) {
       "save it as a filter model file");
   cmd->add_option("--bench", args->bench, "MJCF bench model with an SMA bundle")
       ->capture_default_str();
-  cmd->add_option("--actuator", args->actuator, "bundle's actuator name (default: the first)");
+  cmd->add_option(
+      "--actuator", args->actuator,
+      "bundle's actuator name (default: the first; with --log: a bench log's only one)");
   cmd->add_option("--log", args->log_in,
-                  "fit a recorded CSV log (columns time,p_on,p_off,force at the control "
-                  "instants) instead of running the bench")
+                  "fit a recorded CSV log instead of running the bench: a bench log "
+                  "(docs/formats/bench_log.md; its bundle by --actuator) or the columns "
+                  "time,p_on,p_off,force at the control instants")
       ->check(CLI::ExistingFile);
   cmd->add_option("--units", args->units, "units in the bundle of a --log")
       ->capture_default_str()

@@ -24,6 +24,9 @@ struct BundleTelemetry {
   double heat = std::numeric_limits<double>::quiet_NaN();
   double force_reference = 0;  // N, the force the bundle's recruitment controller tracks
   double p_on = 0, p_off = 0;  // the bundle's last broadcast
+  // N, the load cell's reading at the last control instant, as the controller saw it (held
+  // between instants; NaN before the first).
+  double sensed_force = std::numeric_limits<double>::quiet_NaN();
 };
 
 // A driven joint after the first of a several-joint task (the first is `reference`/`angle`).

@@ -7,6 +7,7 @@
 #include <cstring>
 #include <sstream>
 
+#include "estimation/bench_log.h"
 #include "estimation/json_matrix.h"
 #include "estimation/population_chain.h"
 #include "estimation/shortest_double.h"
@@ -50,9 +51,11 @@ FilterLogReader::~FilterLogReader() {
 }
 
 Result<std::unique_ptr<FilterLogReader>> FilterLogReader::OpenFile(const std::string& path,
-                                                                   const FilterModel& model) {
+                                                                   const FilterModel& model,
+                                                                   const std::string& bundle) {
   std::unique_ptr<FilterLogReader> r(new FilterLogReader);
   r->model_ = &model;
+  r->bundle_ = bundle;
   r->path_ = path;
   r->file_ = std::fopen(path.c_str(), "rb");
   if (r->file_ == nullptr) return Error{"cannot open '" + path + "': " + std::strerror(errno)};
@@ -63,9 +66,11 @@ Result<std::unique_ptr<FilterLogReader>> FilterLogReader::OpenFile(const std::st
 
 Result<std::unique_ptr<FilterLogReader>> FilterLogReader::OpenText(const std::string& text,
                                                                    const FilterModel& model,
-                                                                   const std::string& path) {
+                                                                   const std::string& path,
+                                                                   const std::string& bundle) {
   std::unique_ptr<FilterLogReader> r(new FilterLogReader);
   r->model_ = &model;
+  r->bundle_ = bundle;
   r->path_ = path;
   r->text_ = text;
   r->eof_ = true;
@@ -121,6 +126,7 @@ Status FilterLogReader::ReadHeader() {
   }
   if (file_ != nullptr && std::ferror(file_)) return Error{"cannot read '" + path_ + "'"};
   if (!found) return Error{path_ + ": empty log (expected a CSV header line)"};
+  if (IsBenchLogHeader(cells_)) return ReadBenchHeader();
 
   std::vector<std::string> y_names, input_names;
   if (r == 1) {
@@ -178,6 +184,28 @@ Status FilterLogReader::ReadHeader() {
   return Status::Ok();
 }
 
+Status FilterLogReader::ReadBenchHeader() {
+  const std::string where = path_ + ":" + std::to_string(line_no_);
+  if (model_->transition != TransitionSource::kBroadcast || model_->num_outputs() != 1) {
+    return Error{where +
+                 ": a bench log gives each bundle's broadcasts and one force: the model "
+                 "must have a broadcast transition and one output"};
+  }
+  names_.assign(cells_.begin(), cells_.end());
+  num_cols_ = names_.size();
+  auto cols = FindBenchLogColumns(names_, where);
+  if (!cols.ok()) return Error{cols.error()};
+  auto b = SelectBenchBundle(*cols, bundle_, path_);
+  if (!b.ok()) return Error{b.error()};
+  const BenchLogColumns::Bundle& c = cols->bundles[*b];
+  bench_ = true;
+  t_col_ = cols->time;
+  instant_col_ = cols->control_instant;
+  input_cols_ = {c.p_on, c.p_off};
+  y_cols_ = {c.sensed_force};
+  return Status::Ok();
+}
+
 Result<bool> FilterLogReader::Next(FilterLogRow& row) {
   const FilterModel& model = *model_;
   const int m = model.num_states();
@@ -189,7 +217,15 @@ Result<bool> FilterLogReader::Next(FilterLogRow& row) {
       return false;
     }
     line = Trim(line);
-    if (!line.empty() && line[0] != '#') break;
+    if (line.empty() || line[0] == '#') continue;
+    if (!bench_ || instant_col_ < 0) break;
+    // A bench log's rows between control instants are skipped.
+    SplitCsv(line, cells_);
+    if (cells_.size() != num_cols_) break;  // reported below
+    const std::string at = path_ + ":" + std::to_string(line_no_);
+    auto instant = ParseControlInstant(cells_[instant_col_], at);
+    if (!instant.ok()) return Error{instant.error()};
+    if (*instant) break;
   }
   auto where = [&] { return path_ + ":" + std::to_string(line_no_); };
   if (last_without_inputs_) {

@@ -37,14 +37,20 @@ struct FilterLogRow {
 
 // Reads a log row by row from a file or an in-memory text: the header first (Open), then
 // Next until it returns false. A UTF-8 byte-order mark before the header is skipped.
+// A bench log (estimation/bench_log.h: `time`, `<bundle>.sensed_force`, ...) is read too, for a
+// broadcast model with one output: its control instants are the steps, `time` is t, the bundle's
+// p_on, p_off the inputs and its sensed_force y; other columns are ignored. `bundle` names the
+// bundle (empty: the log's only one).
 class FilterLogReader {
  public:
   static Result<std::unique_ptr<FilterLogReader>> OpenFile(const std::string& path,
-                                                           const FilterModel& model);
+                                                           const FilterModel& model,
+                                                           const std::string& bundle = "");
   // `text` must outlive the reader; `path` only names it in messages.
   static Result<std::unique_ptr<FilterLogReader>> OpenText(const std::string& text,
                                                            const FilterModel& model,
-                                                           const std::string& path);
+                                                           const std::string& path,
+                                                           const std::string& bundle = "");
   ~FilterLogReader();
   FilterLogReader(const FilterLogReader&) = delete;
   FilterLogReader& operator=(const FilterLogReader&) = delete;
@@ -58,6 +64,7 @@ class FilterLogReader {
  private:
   FilterLogReader() = default;
   Status ReadHeader();
+  Status ReadBenchHeader();  // the cells_ of a bench log's header
   // The next line without its end-of-line; false at the end of the input.
   bool NextLine(std::string_view* line);
   bool Refill();
@@ -75,6 +82,9 @@ class FilterLogReader {
   std::vector<int> y_cols_, input_cols_;
   std::vector<std::string> names_;  // by column
   std::vector<std::string_view> cells_;
+  bool bench_ = false;    // a bench log
+  int instant_col_ = -1;  // its control_instant column
+  std::string bundle_;    // its bundle (empty: the only one)
   bool last_without_inputs_ = false;
   int last_data_line_ = 0;
 };

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "common/atomic_file.h"
+#include "estimation/bench_log.h"
 
 namespace recruit::control {
 namespace {
@@ -23,14 +24,38 @@ std::vector<std::string> SplitCsv(const std::string& line) {
   return out;
 }
 
+// A bench log's control instants, for the chosen bundle.
+Result<SwitchingLog> FromBenchLog(const std::string& path, int num_units,
+                                  const std::string& bundle) {
+  auto bench = ReadBenchLog(path);
+  if (!bench.ok()) return Error{bench.error()};
+  BenchLogColumns names;
+  for (const auto& b : bench->bundles) names.bundles.push_back({b.name});
+  auto i = SelectBenchBundle(names, bundle, path);
+  if (!i.ok()) return Error{i.error()};
+  const BenchLog::Bundle& b = bench->bundles[*i];
+  SwitchingLog log;
+  log.num_units = num_units;
+  log.dT = bench->dT;
+  log.time = bench->time;
+  log.p_on = b.p_on;
+  log.p_off = b.p_off;
+  log.force = b.sensed_force;
+  if (Status s = log.Validate(path); !s) return Error{s.error()};
+  return log;
+}
+
 }  // namespace
 
-Result<SwitchingLog> SwitchingLog::FromCsv(const std::string& path, int num_units) {
+Result<SwitchingLog> SwitchingLog::FromCsv(const std::string& path, int num_units,
+                                           const std::string& bundle) {
   std::ifstream in(path);
   if (!in) return Error{path + ": cannot open the switching log"};
   std::string line;
   if (!std::getline(in, line)) return Error{path + ": empty file (expected a CSV header)"};
+  if (line.substr(0, 3) == "\xEF\xBB\xBF") line.erase(0, 3);
   const auto header = SplitCsv(line);
+  if (IsBenchLogHeader(header)) return FromBenchLog(path, num_units, bundle);
   int col_t = -1, col_on = -1, col_off = -1, col_f = -1, col_true = -1, col_ron = -1, col_roff = -1;
   for (int i = 0; i < static_cast<int>(header.size()); ++i) {
     if (header[i] == "time") col_t = i;

@@ -5,6 +5,8 @@
 //   optional: true_on (units on at the instant, before the broadcast), realized_on,
 //   realized_off (the fraction of the off units that did switch on, of the on units that did
 //   switch off, at the broadcast: known on a bench through the plugin's per-unit debug state).
+// A bench log (estimation/bench_log.h, docs/formats/bench_log.md) is read too: its control
+// instants are the rows, the chosen bundle's sensed_force the force.
 // When the realized fractions are present the fit uses them as the inputs: the prediction is
 // then conditioned on how many units did switch, without the binomial noise of the draw.
 #pragma once
@@ -29,8 +31,10 @@ struct SwitchingLog {
   double InputOff(int k) const { return has_realized() ? realized_off[k] : p_off[k]; }
 
   int size() const { return static_cast<int>(force.size()); }
-  // Reads the CSV; dT is taken from the time column (uniform spacing checked).
-  static Result<SwitchingLog> FromCsv(const std::string& path, int num_units);
+  // Reads the CSV; dT is taken from the time column (uniform spacing checked). `bundle`: a bench
+  // log's bundle (empty: its only one); the older format has one bundle and ignores it.
+  static Result<SwitchingLog> FromCsv(const std::string& path, int num_units,
+                                      const std::string& bundle = "");
   // Checks sizes, probabilities in [0, 1], finite forces, at least 2 rows.
   Status Validate(const std::string& where) const;
   Status SaveCsv(const std::string& path) const;  // atomically

@@ -27,7 +27,10 @@ Status CsvStepWriter::OnStep(const mjModel*, const mjData*, const TelemetrySampl
         header += fmt::format(",{}.{}", b.actuator, col);
       }
     }
-    header += ",control_instant\n";
+    header += ",control_instant";
+    // Added after every older column, so that readers by position keep working.
+    for (const auto& b : s.bundles) header += fmt::format(",{}.sensed_force", b.actuator);
+    header += '\n';
     Reserve(header.size());
     std::memcpy(buffer_.data() + used_, header.data(), header.size());
     used_ += header.size();
@@ -39,8 +42,8 @@ Status CsvStepWriter::OnStep(const mjModel*, const mjData*, const TelemetrySampl
   // (references, estimates, broadcasts): a column equal to its last value reuses its text, and
   // one equal to the number formatted just before in the row (an angle task's measured value and
   // angle, a force task's measured value and force) copies that one's.
-  Reserve(8 + (4 + 2 * s.joints.size() + 8 * s.bundles.size()) * kFormatGMax);
-  cache_.resize(4 + 2 * s.joints.size() + 7 * s.bundles.size());
+  Reserve(8 + (4 + 2 * s.joints.size() + 9 * s.bundles.size()) * kFormatGMax);
+  cache_.resize(4 + 2 * s.joints.size() + 8 * s.bundles.size());
   char* p = buffer_.data() + used_;
   Column* col = cache_.data();
   const Column* last = nullptr;  // the number formatted last in this row
@@ -107,6 +110,14 @@ Status CsvStepWriter::OnStep(const mjModel*, const mjData*, const TelemetrySampl
   }
   *p++ = ',';
   *p++ = s.control_instant ? '1' : '0';
+  for (const auto& b : s.bundles) {
+    comma();
+    if (std::isfinite(b.sensed_force)) {
+      num(b.sensed_force, 9);
+    } else {
+      ++col;
+    }
+  }
   *p++ = '\n';
   used_ = static_cast<std::size_t>(p - buffer_.data());
   if (used_ > kFlushBytes) Flush();

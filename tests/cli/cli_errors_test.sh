@@ -45,7 +45,7 @@ usage_range)  # range errors: exit 2, say what is allowed, never print DBL_MAX
   [ ! -e o ] || fail "a usage error created --out"
   ;;
 usage_same_code_everywhere)  # an unknown option and a missing input: 2 for every command
-  for c in simulate sweep render identify filter plot; do
+  for c in simulate sweep render identify filter plot replay; do
     expect 2 "$RECRUIT" $c --no-such-option
   done
   expect 2 "$RECRUIT" simulate --task /no/such/task.json
@@ -152,6 +152,25 @@ sweep_edited_task_reruns)  # resume reuses runs only when the task content is un
   expect 0 "$RECRUIT" $args
   grep -q "2 runs made, 0 reused" out || fail "edited task served stale runs: $(cat out)"
   [ -z "$(find s -name '*.tmp.*')" ] || fail "temporary files left"
+  ;;
+replay_errors)  # replay: bad log content 3, outputs that would replace an input or escape 2
+  printf 'time,bundle.p_on,bundle.p_off,bundle.sensed_force\n0,0.2,0,0\n1,0.2,0,nan\n' > b.csv
+  expect 3 "$RECRUIT" replay --log b.csv --task "$TASK" --out o
+  grep -q "b.csv:3: column 'bundle.sensed_force': 'nan'" err || fail "cell not named"
+  printf 'time,flexor.p_on,flexor.p_off,flexor.sensed_force\n0,0.2,0,0\n1,0.2,0,1\n' > f.csv
+  expect 3 "$RECRUIT" replay --log f.csv --task "$TASK" --out o
+  grep -q "no columns for the task's bundle 'bundle'" err || fail "missing bundle not named"
+  [ ! -e o ] || fail "replay created --out on error"
+  printf 'time,bundle.p_on,bundle.p_off,bundle.sensed_force\n0,0.2,0,0\n1,0.2,0,1\n2,0,0,2\n' > r_replay.csv
+  cp r_replay.csv before.csv
+  expect 2 "$RECRUIT" replay --log r_replay.csv --task "$TASK" --prefix r --out .
+  grep -q "refusing to overwrite an input" err || fail "unclear message"
+  cmp -s r_replay.csv before.csv || fail "the log changed"
+  expect 2 "$RECRUIT" replay --log r_replay.csv --task "$TASK" --prefix ../x --out o
+  expect 2 "$RECRUIT" replay --log r_replay.csv --task "$TASK" --seeds 2 --out o
+  [ ! -e o ] && [ ! -e ../x_replay.json ] || fail "wrote on a usage error"
+  expect 0 "$RECRUIT" replay --log r_replay.csv --task "$TASK" --seeds 3 --out o
+  [ "$(ls o | wc -l)" -eq 3 ] || fail "outputs: $(ls o)"
   ;;
 *)
   echo "unknown case $CASE"; exit 1 ;;

@@ -32,7 +32,8 @@ def _fmt(name, v):
     if name == "control_instant" or name.endswith(".true_on"):
         return str(int(v))
     if name in ("reference", "measured", "angle") or name.endswith((".force",
-                                                                     ".force_reference")):
+                                                                     ".force_reference",
+                                                                     ".sensed_force")):
         return format(v, ".9g")
     if name.endswith((".estimated_on", ".estimated_on_std")) and not np.isfinite(v):
         return ""  # non-finite estimates are left empty

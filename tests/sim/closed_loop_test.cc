@@ -68,6 +68,7 @@ TEST(ClosedLoop, SimulateWritesCsvWhoseSignalsReproduceTheSummary) {
   };
   const int t_col = col("time"), r_col = col("reference"), y_col = col("measured");
   const int on_col = col("bundle.true_on"), est_col = col("bundle.estimated_on");
+  const int instant_col = col("control_instant");
   col("bundle.p_on");
   col("bundle.p_off");
   col("angle");
@@ -95,7 +96,8 @@ TEST(ClosedLoop, SimulateWritesCsvWhoseSignalsReproduceTheSummary) {
   // the 12 N hold the estimate is within 2 units of the truth.
   int k_last = -1;
   for (size_t k = 1; k < rows.size(); ++k) {
-    if (std::stod(rows[k][t_col]) < 19.95 && !rows[k][est_col].empty() && rows[k].back() == "1") {
+    if (std::stod(rows[k][t_col]) < 19.95 && !rows[k][est_col].empty() &&
+        rows[k][instant_col] == "1") {
       k_last = static_cast<int>(k);
     }
   }

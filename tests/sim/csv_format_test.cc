@@ -109,7 +109,12 @@ std::string ReferenceRow(const TelemetrySample& s) {
     if (std::isfinite(b.estimated_on_std)) fmt::format_to(out, "{:.6g}", b.estimated_on_std);
     fmt::format_to(out, ",{:.6g},{:.6g},{:.6g}", b.p_on, b.p_off, b.mean_temperature);
   }
-  fmt::format_to(out, ",{}\n", s.control_instant ? 1 : 0);
+  fmt::format_to(out, ",{}", s.control_instant ? 1 : 0);
+  for (const auto& b : s.bundles) {
+    row += ',';
+    if (std::isfinite(b.sensed_force)) fmt::format_to(out, "{:.9g}", b.sensed_force);
+  }
+  row += '\n';
   return row;
 }
 
@@ -129,7 +134,7 @@ TEST(CsvStepWriter, WritesThePreviousWritersRowsByteForByte) {
       "flexor.estimated_on,flexor.estimated_on_std,flexor.p_on,flexor.p_off,"
       "flexor.mean_temperature,extensor.force,extensor.force_reference,extensor.true_on,"
       "extensor.estimated_on,extensor.estimated_on_std,extensor.p_on,extensor.p_off,"
-      "extensor.mean_temperature,control_instant\n";
+      "extensor.mean_temperature,control_instant,flexor.sensed_force,extensor.sensed_force\n";
   const double nan = std::numeric_limits<double>::quiet_NaN();
   for (int step = 0; step < 3000; ++step) {
     s.time = 0.002 * (step + 1);
@@ -147,6 +152,8 @@ TEST(CsvStepWriter, WritesThePreviousWritersRowsByteForByte) {
         b.estimated_on_std = step % 3 == 0 ? nan : std::abs(n(rng)) * 1e-3;
         b.p_on = std::abs(n(rng)) / 100;
         b.p_off = step % 2 ? 0.0 : -0.0;
+        // The load cell's reading: none before the first instant, then quantised.
+        b.sensed_force = step == 0 ? nan : 0.0125 * std::round(n(rng) / 0.0125);
       }
     }
     // Equal values in other columns of the row: the writer may copy the text it formatted just
@@ -155,6 +162,8 @@ TEST(CsvStepWriter, WritesThePreviousWritersRowsByteForByte) {
     if (step % 4 == 2) s.bundles[0].force = s.measured;
     if (step % 4 == 3) s.bundles[0].mean_temperature = s.bundles[0].force;  // %.6g after %.9g
     if (step % 8 == 5) s.bundles[1].force = s.bundles[0].mean_temperature;  // %.9g after %.6g
+    if (step % 7 == 0 && step > 0)
+      s.bundles[0].sensed_force = s.bundles[1].mean_temperature;  // the same
     ASSERT_TRUE(writer.OnStep(nullptr, nullptr, s).ok());
     expected += ReferenceRow(s);
   }
