@@ -15,13 +15,12 @@
 #include <utility>
 
 #include "common/rng.h"
+#include "common/short_text.h"
 #include "plugin/design_limits.h"
 #include "plugin/tendon_range.h"
 
 namespace recruit::sma {
 namespace {
-
-std::string Short(const std::string& v) { return v.size() <= 40 ? v : v.substr(0, 37) + "..."; }
 
 std::string ActuatorName(const mjModel* m, int a) {
   const char* n = mj_id2name(m, mjOBJ_ACTUATOR, a);
@@ -39,7 +38,7 @@ Result<std::uint64_t> ParseSeed(const std::string& where, const std::string& v) 
   char* end = nullptr;
   const unsigned long long s = std::strtoull(v.c_str(), &end, 10);
   if (v[0] == '-' || end == v.c_str() || *end != '\0' || errno == ERANGE) {
-    return Error{where + "config seed=" + Short(v) +
+    return Error{where + "config seed=" + ShortText(v) +
                  " is invalid: must be a whole number in [0, 18446744073709551615]"};
   }
   return static_cast<std::uint64_t>(s);
@@ -51,7 +50,7 @@ Result<double> ParsePeriod(const std::string& where, const std::string& v) {
   char* end = nullptr;
   const double p = std::strtod(v.c_str(), &end);
   if (end == v.c_str() || *end != '\0' || errno == ERANGE || !(p >= 0 && p <= 1e6)) {
-    return Error{where + "config broadcast_period=" + Short(v) +
+    return Error{where + "config broadcast_period=" + ShortText(v) +
                  " is invalid: must be a number of seconds in [0, 1e6] (0 = every timestep)"};
   }
   return p;

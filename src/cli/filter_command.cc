@@ -7,6 +7,7 @@
 
 #include "cli/commands.h"
 #include "common/atomic_file.h"
+#include "common/short_text.h"
 #include "estimation/count_filter.h"
 #include "estimation/filter_log.h"
 #include "estimation/filter_model.h"
@@ -28,8 +29,8 @@ Status CheckOutputIsNoInput(const std::string& out, const FilterArgs& a) {
   for (const auto& [option, input] : {std::pair{"--log", a.log}, std::pair{"--model", a.model}}) {
     std::error_code ec;
     if (out == input || std::filesystem::equivalent(out, input, ec)) {
-      return Error{"--out '" + json_io::ShortValue(out) + "' is the same file as " + option + " '" +
-                   json_io::ShortValue(input) + "'; refusing to overwrite an input"};
+      return Error{"--out '" + ShortText(out) + "' is the same file as " + option + " '" +
+                   ShortText(input) + "'; refusing to overwrite an input"};
     }
   }
   return Status::Ok();

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <nlohmann/json.hpp>
 
+#include "common/short_text.h"
 #include "estimation/json_matrix.h"
 #include "estimation/population_chain.h"
 
@@ -95,9 +96,8 @@ Status BroadcastTransitionModel::Validate(const std::string& where) const {
     const char* field = is_on[j] ? ".off_target" : ".on_target";
     if (t < 0 || t >= m) {
       return Error{where + field + "[" + std::to_string(j) + "] = " + std::to_string(t) +
-                   " (state '" + json_io::ShortValue(state_names[j]) + "', " +
-                   (is_on[j] ? "on" : "off") + ") must be a state index in [0, " +
-                   std::to_string(m - 1) + "]"};
+                   " (state '" + ShortText(state_names[j]) + "', " + (is_on[j] ? "on" : "off") +
+                   ") must be a state index in [0, " + std::to_string(m - 1) + "]"};
     }
   }
   if (!(std::isfinite(dt) && dt > 0.0)) {

@@ -1,6 +1,7 @@
 #include "estimation/count_filter.h"
 
 #include "common/rng.h"
+#include "common/short_text.h"
 #include "estimation/exact_filter.h"
 #include "estimation/json_matrix.h"
 #include "estimation/particle_filter.h"
@@ -111,7 +112,7 @@ Result<std::unique_ptr<CountFilter>> MakeCountFilter(const FilterModel& model,
     if (!f.ok()) return Error{f.error()};
     return std::unique_ptr<CountFilter>(new ParticleAdapter(std::move(*f), rng));
   }
-  return Error{"estimator '" + json_io::ShortValue(e) + "' is not one of " + kEstimatorNames};
+  return Error{"estimator '" + ShortText(e) + "' is not one of " + kEstimatorNames};
 }
 
 }  // namespace recruit

@@ -7,6 +7,7 @@
 #include <cstring>
 #include <sstream>
 
+#include "common/short_text.h"
 #include "estimation/json_matrix.h"
 #include "estimation/population_chain.h"
 #include "estimation/shortest_double.h"
@@ -149,14 +150,14 @@ Status FilterLogReader::ReadHeader() {
   for (size_t c = 0; c < num_cols_; ++c) {
     const std::string& h = names_[c];
     if (static_cast<size_t>(find(h)) != c) {
-      return Error{where + ": duplicate column '" + json_io::ShortValue(h) + "'"};
+      return Error{where + ": duplicate column '" + ShortText(h) + "'"};
     }
     const bool known = h == "t" ||
                        std::find(input_names.begin(), input_names.end(), h) != input_names.end() ||
                        std::find(y_names.begin(), y_names.end(), h) != y_names.end();
     if (!known) {
-      return Error{where + ": unknown column '" + json_io::ShortValue(h) +
-                   "'; this model's log has columns: " + json_io::ShortValue(expected, 200)};
+      return Error{where + ": unknown column '" + ShortText(h) +
+                   "'; this model's log has columns: " + ShortText(expected, 200)};
     }
   }
   auto require = [&](const std::vector<std::string>& names, std::vector<int>& cols) -> Status {
@@ -164,8 +165,7 @@ Status FilterLogReader::ReadHeader() {
     for (const auto& n : names) {
       const int c = find(n);
       if (c == static_cast<int>(num_cols_)) {
-        return Error{path_ + ": missing column '" + n +
-                     "'; columns: " + json_io::ShortValue(expected, 200)};
+        return Error{path_ + ": missing column '" + n + "'; columns: " + ShortText(expected, 200)};
       }
       cols.push_back(c);
     }
@@ -206,7 +206,7 @@ Result<bool> FilterLogReader::Next(FilterLogRow& row) {
   auto number = [&](int col, double* v) -> Status {
     if (ParseNumber(cells_[col], v)) return Status::Ok();
     return Error{where() + ": column '" + names_[col] + "': '" +
-                 json_io::ShortValue(std::string(cells_[col])) + "' is not a finite number"};
+                 ShortText(std::string(cells_[col])) + "' is not a finite number"};
   };
   if (t_col_ >= 0) {
     if (Status s = number(t_col_, &row.t); !s.ok()) return Error{s.error()};

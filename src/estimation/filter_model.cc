@@ -6,6 +6,7 @@
 #include <set>
 
 #include "common/atomic_file.h"
+#include "common/short_text.h"
 #include "estimation/json_matrix.h"
 #include "estimation/population_chain.h"
 
@@ -24,7 +25,7 @@ Status FilterModel::Validate(const std::string& where) const {
   for (const auto& s : state_names) {
     if (s.empty()) return Error{where + ": states: names must be non-empty"};
     if (!seen.insert(s).second)
-      return Error{where + ": states: duplicate name '" + json_io::ShortValue(s) + "'"};
+      return Error{where + ": states: duplicate name '" + ShortText(s) + "'"};
   }
   if (N < 1)
     return Error{where + ": N: must be a positive number of agents, got " + std::to_string(N)};
@@ -204,7 +205,7 @@ Result<FilterModel> FilterModel::FromJsonValue(const nlohmann::json& j, const st
     if (!A.ok()) return Error{A.error()};
     f.A = *A;
   } else {
-    return Error{where + ": transition.type: \"" + json_io::ShortValue(type) +
+    return Error{where + ": transition.type: \"" + ShortText(type) +
                  "\" is not one of \"broadcast\", \"explicit\", \"constant\""};
   }
   f.x0 = Eigen::VectorXd::Zero(m);

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "common/atomic_file.h"
+#include "common/short_text.h"
 #include "plot/column_figure.h"
 #include "plot/render.h"
 #include "plot/run_data.h"
@@ -27,8 +28,8 @@ Result<std::vector<Format>> ParseFormats(const std::string& list) {
     else if (item == "svg")
       out.push_back(Format::kSvg);
     else
-      return Error{
-          fmt::format("--format: '{}' is not allowed (png, svg, or both: png,svg)", Shorten(item))};
+      return Error{fmt::format("--format: '{}' is not allowed (png, svg, or both: png,svg)",
+                               ShortText(item))};
   }
   if (out.empty()) return Error{"--format: empty (png, svg, or both: png,svg)"};
   return out;
@@ -62,7 +63,7 @@ Result<std::vector<std::string>> WriteAll(const std::string& out_dir,
   fs::create_directories(out_dir, ec);
   if (ec)
     return Error{
-        fmt::format("--out: cannot create directory '{}': {}", Shorten(out_dir), ec.message())};
+        fmt::format("--out: cannot create directory '{}': {}", ShortText(out_dir), ec.message())};
   std::vector<std::string> written;
   for (const Rendered& r : files) {
     if (Status s = WriteFileAtomically(r.path, r.bytes); !s.ok()) return Error{s.error()};
@@ -139,8 +140,8 @@ Result<std::vector<std::string>> RunPlot(const PlotOptions& o) {
       known = known || f.name == o.figure;
     }
     if (!known) {
-      return Error{
-          fmt::format("--figure: '{}' is not a figure of this run ({})", Shorten(o.figure), names)};
+      return Error{fmt::format("--figure: '{}' is not a figure of this run ({})",
+                               ShortText(o.figure), names)};
     }
   }
   for (const NamedFigure& f : figures) {

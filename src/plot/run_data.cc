@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "common/atomic_file.h"
+#include "common/short_text.h"
 
 namespace recruit::plot {
 namespace {
@@ -65,10 +66,6 @@ void FindBundles(RunCsv& csv) {
 
 }  // namespace
 
-std::string Shorten(const std::string& value) {
-  return value.size() <= 40 ? value : value.substr(0, 37) + "...";
-}
-
 const std::vector<double>* RunCsv::Find(const std::string& name) const {
   for (size_t i = 0; i < names.size(); ++i) {
     if (names[i] == name) return &columns[i];
@@ -103,7 +100,7 @@ Result<RunCsv> ParseCsvTable(const std::string& text, const std::string& path) {
       double v;
       if (!ParseCell(cells[c], v)) {
         return Error{fmt::format("{} line {}, column '{}': '{}' is not a number", path, line_no,
-                                 csv.names[c], Shorten(cells[c]))};
+                                 csv.names[c], ShortText(cells[c]))};
       }
       csv.columns[c].push_back(v);
     }
@@ -155,7 +152,7 @@ Status Field(const nlohmann::json& j, const char* key, const std::string& path, 
       std::is_same_v<typename T::value_type, std::string> ? v.is_string() : v.is_number();
   if (!ok) {
     return Error{
-        fmt::format("{}: field '{}' is {} ({} allowed)", path, key, Shorten(v.dump()), allowed)};
+        fmt::format("{}: field '{}' is {} ({} allowed)", path, key, ShortText(v.dump()), allowed)};
   }
   out = v.get<typename T::value_type>();
   return Status::Ok();
@@ -184,7 +181,7 @@ Result<RunInfo> ReadRunSummary(const std::string& path) {
   info.unit = unit.value_or("");
   if (!info.unit.empty() && info.unit != "N" && info.unit != "rad") {
     return Error{fmt::format("{}: field 'unit' is '{}' (\"N\" or \"rad\" allowed)", path,
-                             Shorten(info.unit))};
+                             ShortText(info.unit))};
   }
   return info;
 }
