@@ -20,9 +20,9 @@ inline int Fail(const std::string& command, const std::string& message, int code
   std::cerr << "recruit " << command << ": " << ShortenLongTokens(message, 200) << "\n";
   return code;
 }
-// Same, with the class read from the message (I/O wording -> 4, else bad input -> 3).
-inline int Fail(const std::string& command, const std::string& message) {
-  return Fail(command, message, exit_code::FromMessage(message));
+// Same, with the exit code of the error's class (common/exit_codes.h).
+inline int Fail(const std::string& command, const Error& error) {
+  return Fail(command, error.message, exit_code::Of(error));
 }
 
 // Numeric option checks with our own messages: CLI11's ranges print their bounds, which for

@@ -119,8 +119,8 @@ Result<Prepared> Prepare(const SweepArgs& a, int* code) {
   if (!a.sweep_file.empty()) {
     auto f = sweep::SweepFile::FromFile(a.sweep_file);
     if (!f.ok()) {
-      *code = exit_code::FromMessage(f.error());
-      return Error{f.error()};
+      *code = exit_code::Of(f.code());
+      return Error{f.error(), f.code()};
     }
     p.file = std::move(f).value();
   }
@@ -132,10 +132,10 @@ Result<Prepared> Prepare(const SweepArgs& a, int* code) {
   auto task_text = ReadFile(p.task_path);
   if (!task_text.ok()) {
     *code = exit_code::kIo;
-    return Error{task_text.error()};
+    return Error{task_text.error(), task_text.code()};
   }
   auto task = sim::Task::FromJsonText(*task_text, p.task_path);
-  if (!task.ok()) return Error{task.error()};
+  if (!task.ok()) return Error{task.error(), task.code()};
   p.task = std::move(task).value();
 
   // Controller axes: the command line's when given, else the sweep file's, else the defaults.
@@ -164,7 +164,7 @@ Result<Prepared> Prepare(const SweepArgs& a, int* code) {
   }
 
   auto points = sweep::PlantPoints(p.file);
-  if (!points.ok()) return Error{points.error()};
+  if (!points.ok()) return Error{points.error(), points.code()};
   spec.plant = p.file.axes.empty() ? std::vector<sim::PlantPoint>{} : *points;
 
   // Each plant point: apply it, write an edited model under <out>/models (named by its content),
@@ -175,7 +175,7 @@ Result<Prepared> Prepare(const SweepArgs& a, int* code) {
     auto m = ReadFile(p.task.model_path);
     if (!m.ok()) {
       *code = exit_code::kIo;
-      return Error{m.error()};
+      return Error{m.error(), m.code()};
     }
     model_text = *m;
   }
@@ -193,7 +193,7 @@ Result<Prepared> Prepare(const SweepArgs& a, int* code) {
     std::string label = where + ": plant point " + std::to_string(i);
     for (const auto& [name, v] : pt.values) label += fmt::format(" {}={:g}", name, v);
     auto in = sweep::ApplyPlantPoint(*task_text, model_text, p.file.axes, pt, where);
-    if (!in.ok()) return Error{in.error()};
+    if (!in.ok()) return Error{in.error(), in.code()};
     pl.task_text = in->task_text;
     pl.model_text = in->model_text;
     std::string text = in->task_text;
@@ -214,13 +214,13 @@ Result<Prepared> Prepare(const SweepArgs& a, int* code) {
       if (!fs::exists(file, ec)) {
         if (Status s = WriteFileAtomically(file.string(), in->model_text); !s.ok()) {
           *code = exit_code::kIo;
-          return Error{s.error()};
+          return Error{s.error(), s.code()};
         }
         auto m = LoadModel(file.string());
         if (!m.ok()) {
           std::error_code ignore;
           fs::remove(file, ignore);
-          return Error{label + ": the edited model does not load: " + m.error()};
+          return Error{label + ": the edited model does not load: " + m.error(), m.code()};
         }
       }
       auto doc = nlohmann::json::parse(text);
@@ -228,14 +228,14 @@ Result<Prepared> Prepare(const SweepArgs& a, int* code) {
       text = doc.dump(1);
     }
     auto t = sim::Task::FromJsonText(text, p.task_path);
-    if (!t.ok()) return Error{label + ": " + t.error()};
+    if (!t.ok()) return Error{label + ": " + t.error(), t.code()};
     pl.task = std::move(t).value();
     p.plant.push_back(std::move(pl));
   }
   auto grid = sim::ExpandGrid(spec);
   if (!grid.ok()) {
     *code = exit_code::kUsage;
-    return Error{grid.error()};
+    return Error{grid.error(), grid.code()};
   }
   p.grid = std::move(grid).value();
   for (auto& g : p.grid) g.input_hash = RunInputHash(p.plant[g.plant], spec, g, contents);
@@ -268,14 +268,17 @@ int WriteReports(const std::string& cmd, const Prepared& p,
     const plot::PlotOptions map =
         sweep::StabilityMapOptions(out, p.task.name, static_cast<int>(p.spec.estimators.size()));
     std::vector<std::string> written;
-    plot->run(&map, &written, &error);
-    if (!error.empty()) return Fail(cmd, "stability map: " + error, exit_code::kIo);
+    Error failed;
+    plot->run(&map, &written, &failed);
+    if (!failed.message.empty())
+      return Fail(cmd, "stability map: " + failed.message, exit_code::kIo);
   }
   auto render = [plot](const plot::Figure& fig, int w, int h,
                        plot::Format f) -> Result<std::string> {
-    std::string bytes, why;
+    std::string bytes;
+    Error why;
     plot->figure(&fig, w, h, f, &bytes, &why);
-    if (!why.empty()) return Error{why};
+    if (!why.message.empty()) return why;
     return bytes;
   };
   sweep::ReportInput in{p.task.name, p.description, p.criterion, cells, {}};
@@ -306,12 +309,13 @@ Result<FileLock> OpenOut(const std::string& out, const Prepared& p, const SweepA
                                 {"--sweep", a.sweep_file},
                                 {"--filter-model", a.filter_model},
                                 {"the task's model", p.task.model_path}});
-    if (!s.ok()) return Error{s.error()};
+    if (!s.ok()) return Error{s.error(), s.code()};
   }
   *code = exit_code::kIo;
   std::error_code ec;
   fs::create_directories(out, ec);
-  if (ec) return Error{"cannot create --out '" + ShortText(out) + "': " + ec.message()};
+  if (ec)
+    return Error{"cannot create --out '" + ShortText(out) + "': " + ec.message(), ErrorCode::kIo};
   return FileLock::TryLock((fs::path(out) / "sweep.lock").string());
 }
 
@@ -345,7 +349,7 @@ int RunSweepCommand(const SweepArgs& a) {
   std::error_code ec;  // a path the system refuses fails below, when the sweep writes it
   if (fs::exists(id_path, ec)) {
     auto old = LoadJsonFile(id_path);
-    if (!old.ok()) return Fail(cmd, old.error());
+    if (!old.ok()) return Fail(cmd, old.failure());
     if (*old != id) {
       return Fail(
           cmd,
@@ -388,7 +392,8 @@ int RunSweepCommand(const SweepArgs& a) {
             << ")\n";
   auto outcome = sim::RunSweep(todo, a.out, run, a.threads, report);
   if (!outcome.ok()) {
-    return Fail(cmd, outcome.error() + " (finished runs are kept; run again to resume)");
+    return Fail(cmd, outcome.error() + " (finished runs are kept; run again to resume)",
+                exit_code::Of(outcome.code()));
   }
   double wall = 0, simulated = 0;
   for (const auto& r : outcome->runs) {
@@ -441,7 +446,7 @@ int RunMergeCommand(const SweepArgs& a) {
       continue;
     }
     auto m = LoadJsonFile(mpath);
-    if (!m.ok()) return Fail(cmd, m.error());
+    if (!m.ok()) return Fail(cmd, m.failure());
     if (!m->is_object() || !m->contains("sweep_id") || !m->contains("shard") ||
         !m->contains("of") || !(*m)["shard"].is_number_integer() ||
         !(*m)["of"].is_number_integer()) {

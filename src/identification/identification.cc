@@ -309,7 +309,7 @@ FitMetrics Score(const Eigen::VectorXd& predicted, const SwitchingLog& log, int 
 
 Result<IdentificationResult> IdentifyTransientModel(const SwitchingLog& log,
                                                     const FitOptions& opt) {
-  if (Status s = log.Validate("switching log"); !s) return Error{s.error()};
+  if (Status s = log.Validate("switching log"); !s) return Error{s.error(), s.code()};
   if (opt.num_states < 4 || opt.num_states % 2 != 0) {
     return Error{"identify: num_states = " + std::to_string(opt.num_states) +
                  " must be even and >= 4"};

@@ -58,10 +58,10 @@ Result<std::string> FindOrIdentifyModel(const ModelRequest& r, bool identify, st
   }
   const fs::path cache = dirs.back();
   fs::create_directories(cache, ec);
-  if (ec) return Error{"model cache " + cache.string() + ": " + ec.message()};
+  if (ec) return Error{"model cache " + cache.string() + ": " + ec.message(), CodeOf(ec)};
   const fs::path file = cache / name;
   auto lock = FileLock::Lock((cache / (name + ".lock")).string());
-  if (!lock) return Error{lock.error()};
+  if (!lock) return Error{lock.error(), lock.code()};
   if (fs::exists(file, ec)) return file.string();  // made while we waited
   if (log) {
     std::fprintf(log, "recruit: identifying the %s model for dT = %g s on %s (cached as %s)\n",
@@ -72,9 +72,10 @@ Result<std::string> FindOrIdentifyModel(const ModelRequest& r, bool identify, st
   o.num_states = r.num_states;
   auto id = IdentifyOnPlant(r.model_path, r.actuator, o, "identified on demand (model cache)");
   if (!id)
-    return Error{"identifying a model for dT = " + std::to_string(r.dT) + " s: " + id.error()};
+    return Error{"identifying a model for dT = " + std::to_string(r.dT) + " s: " + id.error(),
+                 id.code()};
   if (Status s = WriteFileAtomically(file.string(), id->model.dump(2) + "\n"); !s) {
-    return Error{s.error()};
+    return Error{s.error(), s.code()};
   }
   return file.string();
 }

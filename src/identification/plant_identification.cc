@@ -170,16 +170,16 @@ Result<PlantIdentification> IdentifyOnPlant(const std::string& model_path,
   }
   // 1-2. The chain and its forces, held at the longest tendon.
   auto rec = RecordBench(model_path, actuator, ExcitationFor(o, o.duration, o.seed), o.dT, o.seed);
-  if (!rec) return Error{rec.error()};
+  if (!rec) return Error{rec.error(), rec.code()};
   FitOptions fo;
   fo.num_states = o.num_states;
   fo.holdout_fraction = o.holdout;
   fo.smoothness = o.smoothness;
   auto fit = IdentifyTransientModel(rec->log, fo);
-  if (!fit) return Error{fit.error()};
+  if (!fit) return Error{fit.error(), fit.code()};
   const TransientChain& c = fit->chain;
   auto map = UnitForceMap::FromForces(rec->geometry, rec->stretch, c.force);
-  if (!map) return Error{"identify: " + map.error()};
+  if (!map) return Error{"identify: " + map.error(), map.code()};
 
   // 3. Recordings at other lengths and in motion (a limb only): the fractions refined on the
   // first part of every recording, the checks scored on the rest.
@@ -193,7 +193,7 @@ Result<PlantIdentification> IdentifyOnPlant(const std::string& model_path,
       const std::uint64_t seed = o.seed + 1 + i;
       auto chk = RecordBench(model_path, actuator, ExcitationFor(o, o.check_duration, seed), o.dT,
                              seed, plan[i]);
-      if (!chk) return Error{chk.error()};
+      if (!chk) return Error{chk.error(), chk.code()};
       char moving[80];
       std::snprintf(moving, sizeof moving, "moving over the range, period %g s", o.sweep_period);
       poses.push_back(plan[i].sweep_period > 0 ? moving : chk->pose);
@@ -202,7 +202,7 @@ Result<PlantIdentification> IdentifyOnPlant(const std::string& model_path,
     const double train = 1.0 - o.holdout;
     auto refined =
         UnitForceMap::FromFractions(rec->geometry, RefineFractions(c, *map, recordings, train));
-    if (!refined) return Error{"identify: " + refined.error()};
+    if (!refined) return Error{"identify: " + refined.error(), refined.code()};
     map = std::move(refined);
   }
 
@@ -223,7 +223,7 @@ Result<PlantIdentification> IdentifyOnPlant(const std::string& model_path,
   map->Forces(rec->tendon_length, exported.force);
   const FilterModel model =
       ToFilterModel(exported, rec->log.num_units, rec->log.dT, fit->force_noise_var);
-  if (Status s = model.Validate("identified model"); !s) return Error{s.error()};
+  if (Status s = model.Validate("identified model"); !s) return Error{s.error(), s.code()};
   // 4. R's part that grows with the force, by maximum likelihood over every recording.
   const double rho = FitRelativeNoise(model, *map, recordings);
 

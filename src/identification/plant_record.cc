@@ -27,7 +27,7 @@ Result<LoadedBundle> LoadBundle(const std::string& model_path, const std::string
   out.model.reset(mj_loadXML(model_path.c_str(), nullptr, err, sizeof err));
   if (!out.model) return Error{model_path + ": " + err};
   auto host = sma::SmaHost::Create(out.model.get());
-  if (!host) return Error{model_path + ": " + host.error()};
+  if (!host) return Error{model_path + ": " + host.error(), host.code()};
   out.host = std::move(host).value();
   const sma::SmaHost& h = *out.host;
   if (h.num_bundles() == 0) return Error{model_path + ": no SMA bundle (recruit.sma)"};
@@ -42,7 +42,7 @@ Result<LoadedBundle> LoadBundle(const std::string& model_path, const std::string
 
 Result<nlohmann::json> PlantRecordOf(const std::string& model_path, const std::string& actuator) {
   auto loaded = LoadBundle(model_path, actuator);
-  if (!loaded) return Error{loaded.error()};
+  if (!loaded) return Error{loaded.error(), loaded.code()};
   return PlantRecord(*loaded->host, loaded->bundle, model_path);
 }
 

@@ -113,7 +113,7 @@ Result<RunCsv> ParseCsvTable(const std::string& text, const std::string& path) {
 
 Result<RunCsv> ParseRunCsv(const std::string& text, const std::string& path) {
   auto table = ParseCsvTable(text, path);
-  if (!table.ok()) return Error{table.error()};
+  if (!table.ok()) return Error{table.error(), table.code()};
   RunCsv csv = std::move(*table);
   FindBundles(csv);
   if (csv.bundles.empty()) {
@@ -125,19 +125,19 @@ Result<RunCsv> ParseRunCsv(const std::string& text, const std::string& path) {
       csv.columns.emplace_back(csv.columns[0].size(), NAN);
     }
   }
-  if (Status s = CheckColumns(csv); !s.ok()) return Error{s.error()};
+  if (Status s = CheckColumns(csv); !s.ok()) return Error{s.error(), s.code()};
   return csv;
 }
 
 Result<RunCsv> ReadCsvTable(const std::string& path) {
   auto text = ReadFile(path);
-  if (!text.ok()) return Error{text.error()};
+  if (!text.ok()) return Error{text.error(), text.code()};
   return ParseCsvTable(*text, path);
 }
 
 Result<RunCsv> ReadRunCsv(const std::string& path) {
   auto text = ReadFile(path);
-  if (!text.ok()) return Error{text.error()};
+  if (!text.ok()) return Error{text.error(), text.code()};
   return ParseRunCsv(*text, path);
 }
 
@@ -162,7 +162,7 @@ Status Field(const nlohmann::json& j, const char* key, const std::string& path, 
 
 Result<RunInfo> ReadRunSummary(const std::string& path) {
   auto text = ReadFile(path);
-  if (!text.ok()) return Error{text.error()};
+  if (!text.ok()) return Error{text.error(), text.code()};
   nlohmann::json j = nlohmann::json::parse(*text, nullptr, false);
   if (j.is_discarded() || !j.is_object()) {
     return Error{path + ": not a JSON object (expected `recruit simulate`'s summary)"};
@@ -175,7 +175,7 @@ Result<RunInfo> ReadRunSummary(const std::string& path) {
                    Field(j, "dT", path, info.dT, "a number, s"),
                    Field(j, "lambda", path, info.lambda, "a number"),
                    Field(j, "seed", path, info.seed, "an integer")}) {
-    if (!s.ok()) return Error{s.error()};
+    if (!s.ok()) return Error{s.error(), s.code()};
   }
   info.task = task.value_or(""), info.estimator = estimator.value_or("");
   info.unit = unit.value_or("");

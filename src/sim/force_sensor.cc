@@ -43,7 +43,7 @@ nlohmann::json SensorParams::ToJson() const {
 
 Result<ForceSensor> ForceSensor::Create(const SensorParams& params, std::uint64_t seed) {
   auto p = SensorParams::Create(params.noise_std, params.resolution);
-  if (!p.ok()) return Error{"sensor: " + p.error()};
+  if (!p.ok()) return Error{"sensor: " + p.error(), p.code()};
   return ForceSensor(*p, seed);
 }
 

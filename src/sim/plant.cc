@@ -240,11 +240,11 @@ Result<std::unique_ptr<Plant>> Plant::Create(const Task& task, bool drawn) {
   p->gate_ = LimitsThatAloneConstrain(m);
   if (p->gate_ && AnyLimitReached(m, *p->gate_, m->qpos0)) p->gate_.reset();
   auto host = sma::SmaHost::Create(m);
-  if (!host.ok()) return Error{where + ".model: " + host.error()};
+  if (!host.ok()) return Error{where + ".model: " + host.error(), host.code()};
   p->host_ = std::move(host).value();
 
-  if (Status st = p->FindBundles(task, where); !st.ok()) return Error{st.error()};
-  if (Status st = p->FindJoints(task, where); !st.ok()) return Error{st.error()};
+  if (Status st = p->FindBundles(task, where); !st.ok()) return Error{st.error(), st.code()};
+  if (Status st = p->FindJoints(task, where); !st.ok()) return Error{st.error(), st.code()};
   if (!task.joint.empty()) {
     const int joint = mj_name2id(m, mjOBJ_JOINT, task.joint.c_str());
     if (joint < 0) {
@@ -330,14 +330,14 @@ Status Plant::FindJoints(const Task& task, const std::string& where) {
   };
   if (!task.joint.empty()) {
     auto joint = hinge(task.joint, task.auto_loop ? "joints[0].joint" : "joint");
-    if (!joint.ok()) return Error{joint.error()};
+    if (!joint.ok()) return Error{joint.error(), joint.code()};
     qadr_ = m->jnt_qposadr[*joint];
     dadr_ = m->jnt_dofadr[*joint];
   }
   if (!task.auto_loop) return Status::Ok();
   for (size_t j = 0; j < task.joints.size(); ++j) {
     auto joint = hinge(task.joints[j].joint, "joints[" + std::to_string(j) + "].joint");
-    if (!joint.ok()) return Error{joint.error()};
+    if (!joint.ok()) return Error{joint.error(), joint.code()};
     joints_.push_back(*joint);
   }
   return Status::Ok();

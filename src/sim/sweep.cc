@@ -154,7 +154,9 @@ Result<SweepOutcome> RunSweep(const std::vector<SweepRun>& grid, const std::stri
   const fs::path runs_dir = fs::path(out_dir) / "runs";
   std::error_code ec;
   fs::create_directories(runs_dir, ec);
-  if (ec) return Error{"sweep: cannot create '" + runs_dir.string() + "': " + ec.message()};
+  if (ec)
+    return Error{"sweep: cannot create '" + runs_dir.string() + "': " + ec.message(),
+                 ErrorCode::kIo};
 
   SweepOutcome outcome;
   outcome.runs.resize(grid.size());
@@ -204,7 +206,7 @@ Result<SweepOutcome> RunSweep(const std::vector<SweepRun>& grid, const std::stri
       record["input_hash"] = g.input_hash;
       st = WriteFileAtomically((runs_dir / (g.Key() + ".json")).string(), record.dump(1));
     } else {
-      st = Error{"sweep run " + g.Key() + ": " + s.error()};
+      st = Error{"sweep run " + g.Key() + ": " + s.error(), s.code()};
     }
     std::lock_guard<std::mutex> lock(mu);
     if (!st.ok()) {

@@ -101,17 +101,17 @@ Result<Reference> ReadReference(const json& r, const std::string& where, Tracked
   json body = r;
   if (body.is_object()) body.erase("unit");
   auto ref = Reference::FromJson(body, where, scale);
-  if (!ref.ok()) return Error{ref.error()};
+  if (!ref.ok()) return Error{ref.error(), ref.code()};
   if (tracked == Tracked::kForce && ref->MinValue() < 0) {
     return Error{where + ": a force reference must be >= 0 N (a bundle can only pull)"};
   }
   return ref;
 }
 
-#define RECRUIT_TRY(expr)                   \
-  do {                                      \
-    Status _s = (expr);                     \
-    if (!_s.ok()) return Error{_s.error()}; \
+#define RECRUIT_TRY(expr)                              \
+  do {                                                 \
+    Status _s = (expr);                                \
+    if (!_s.ok()) return Error{_s.error(), _s.code()}; \
   } while (0)
 
 // The several-joint form: "joints": [{"joint", "reference"}, ...] and optional "bundles"; the
@@ -140,7 +140,7 @@ Status ReadJointsForm(const json& j, const std::string& file, Task& task) {
     }
     if (!js[i].contains("reference")) return Error{where + ": missing field 'reference'"};
     auto ref = ReadReference(js[i]["reference"], where + ".reference", Tracked::kAngle);
-    if (!ref.ok()) return Error{ref.error()};
+    if (!ref.ok()) return Error{ref.error(), ref.code()};
     d.reference = std::move(ref).value();
     task.joints.push_back(std::move(d));
   }
@@ -171,14 +171,14 @@ Status ReadJointsForm(const json& j, const std::string& file, Task& task) {
 
 Result<Task> Task::FromFile(const std::string& path) {
   auto text = ReadFile(path);
-  if (!text.ok()) return Error{"task file: " + text.error()};
+  if (!text.ok()) return Error{"task file: " + text.error(), text.code()};
   return FromJsonText(*text, path);
 }
 
 Result<Task> Task::FromJsonText(const std::string& text, const std::string& source) {
   const std::string file = source.empty() ? std::string("<task>") : source;
   auto parsed = ParseJsonText(text, file);  // depth, size, 1e999 and BOM checked
-  if (!parsed.ok()) return Error{parsed.error()};
+  if (!parsed.ok()) return Error{parsed.error(), parsed.code()};
   json j = std::move(parsed).value();
   if (!j.is_object()) return Error{file + ": the task must be a JSON object"};
   RECRUIT_TRY(
@@ -199,7 +199,8 @@ Result<Task> Task::FromJsonText(const std::string& text, const std::string& sour
   std::error_code ec;
   if (!fs::exists(task.model_path, ec)) {
     return Error{file + ".model: model file '" + ShortText(task.model_path, 120) +
-                 "' does not exist" + (ec ? " (" + ec.message() + ")" : "")};
+                     "' does not exist" + (ec ? " (" + ec.message() + ")" : ""),
+                 ec ? CodeOf(ec) : ErrorCode::kBadInput};
   }
   std::string tracked;
   RECRUIT_TRY(String(j, "tracked", file, &tracked, true));
@@ -233,7 +234,7 @@ Result<Task> Task::FromJsonText(const std::string& text, const std::string& sour
   if (!j.contains("joints")) {
     if (!j.contains("reference")) return Error{file + ": missing field 'reference'"};
     auto ref = ReadReference(j["reference"], file + ".reference", task.tracked);
-    if (!ref.ok()) return Error{ref.error()};
+    if (!ref.ok()) return Error{ref.error(), ref.code()};
     task.reference = std::move(ref).value();
   }
 
@@ -254,7 +255,7 @@ Result<Task> Task::FromJsonText(const std::string& text, const std::string& sour
 
   if (j.contains("sensor")) {
     auto sensor = SensorParams::FromJson(j["sensor"], file + ".sensor");
-    if (!sensor.ok()) return Error{sensor.error()};
+    if (!sensor.ok()) return Error{sensor.error(), sensor.code()};
     task.sensor = *sensor;
   }
 

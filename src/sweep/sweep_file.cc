@@ -123,20 +123,20 @@ double PlantAxis::FromUnit(double u) const {
 
 Result<SweepFile> SweepFile::FromFile(const std::string& path) {
   auto text = ReadFile(path);
-  if (!text.ok()) return Error{"sweep file: " + text.error()};
+  if (!text.ok()) return Error{"sweep file: " + text.error(), text.code()};
   return FromJsonText(*text, path);
 }
 
 Result<SweepFile> SweepFile::FromJsonText(const std::string& text, const std::string& source) {
   const std::string file = "sweep file '" + (source.empty() ? "<sweep>" : source) + "'";
   auto parsed = ParseJsonText(text, source.empty() ? "<sweep>" : source);
-  if (!parsed.ok()) return Error{parsed.error()};
+  if (!parsed.ok()) return Error{parsed.error(), parsed.code()};
   const json j = std::move(parsed).value();
   if (!j.is_object()) return Error{file + ": must be a JSON object"};
   if (Status s =
           CheckKeys(j, {"task", "duration", "controller", "plant", "criterion", "comment"}, file);
       !s.ok())
-    return Error{s.error()};
+    return Error{s.error(), s.code()};
   SweepFile f;
   f.source = source;
   if (j.contains("task")) {
@@ -156,10 +156,10 @@ Result<SweepFile> SweepFile::FromJsonText(const std::string& text, const std::st
     if (!c.is_object()) return Error{where + ": must be an object"};
     if (Status s = CheckKeys(c, {"dT", "lambda", "estimator", "seeds", "base_seed"}, where);
         !s.ok())
-      return Error{s.error()};
+      return Error{s.error(), s.code()};
     if (c.contains("dT")) {
       auto v = ParseValues(c["dT"], where + ".dT", true);
-      if (!v.ok()) return Error{v.error()};
+      if (!v.ok()) return Error{v.error(), v.code()};
       for (double x : v->values) {
         if (!(x > 0 && x <= 1000)) {
           return Error{fmt::format("{}.dT: value {:g} is out of range; allowed: 0 < dT <= 1000 s",
@@ -170,7 +170,7 @@ Result<SweepFile> SweepFile::FromJsonText(const std::string& text, const std::st
     }
     if (c.contains("lambda")) {
       auto v = ParseValues(c["lambda"], where + ".lambda", true);
-      if (!v.ok()) return Error{v.error()};
+      if (!v.ok()) return Error{v.error(), v.code()};
       for (double x : v->values) {
         if (!(x > 0 && x <= 1)) {
           return Error{fmt::format(
@@ -215,7 +215,7 @@ Result<SweepFile> SweepFile::FromJsonText(const std::string& text, const std::st
     const std::string where = file + ".criterion";
     if (!c.is_object()) return Error{where + ": must be an object"};
     if (Status s = CheckKeys(c, {"max_overshoot", "min_settled"}, where); !s.ok())
-      return Error{s.error()};
+      return Error{s.error(), s.code()};
     sim::TrackingCriterion crit;
     if (c.contains("max_overshoot")) {
       if (!c["max_overshoot"].is_number() || !(c["max_overshoot"].get<double>() >= 0)) {
@@ -237,7 +237,7 @@ Result<SweepFile> SweepFile::FromJsonText(const std::string& text, const std::st
     const std::string where = file + ".plant";
     if (!p.is_object()) return Error{where + ": must be an object"};
     if (Status s = CheckKeys(p, {"sampling", "samples", "seed", "axes"}, where); !s.ok())
-      return Error{s.error()};
+      return Error{s.error(), s.code()};
     if (p.contains("sampling")) {
       const json& s = p["sampling"];
       if (s == "grid") {
@@ -273,7 +273,7 @@ Result<SweepFile> SweepFile::FromJsonText(const std::string& text, const std::st
       if (Status s =
               CheckKeys(a, {"name", "path", "values", "range", "steps", "scale", "integer"}, aw);
           !s.ok())
-        return Error{s.error()};
+        return Error{s.error(), s.code()};
       PlantAxis ax;
       if (!a.contains("path") || !a["path"].is_string() || a["path"].get<std::string>().empty()) {
         return Error{aw +
@@ -314,7 +314,7 @@ Result<SweepFile> SweepFile::FromJsonText(const std::string& text, const std::st
         ax.integer = a["integer"];
       }
       auto v = ParseValues(a, aw, f.sampling == Sampling::kGrid);
-      if (!v.ok()) return Error{v.error()};
+      if (!v.ok()) return Error{v.error(), v.code()};
       ax.values = v->values;
       ax.lo = v->lo;
       ax.hi = v->hi;
@@ -363,7 +363,7 @@ Result<std::vector<sim::PlantPoint>> PlantPoints(const SweepFile& f) {
     u = LatinHypercube(f.samples, dims, f.sample_seed);
   } else {
     auto s = Sobol(f.samples, dims, f.sample_seed);
-    if (!s.ok()) return Error{"sweep file '" + f.source + "': " + s.error()};
+    if (!s.ok()) return Error{"sweep file '" + f.source + "': " + s.error(), s.code()};
     u = std::move(s).value();
   }
   for (const auto& row : u) {
@@ -444,7 +444,7 @@ Result<PlantInputs> ApplyPlantPoint(const std::string& task_text, const std::str
                                           FormatValue(v, a.integer));
     if (a.is_model()) {
       auto xml = SetPluginConfig(out.model_text, a.instance, a.key, FormatValue(v, a.integer));
-      if (!xml.ok()) return Error{label + ": " + xml.error()};
+      if (!xml.ok()) return Error{label + ": " + xml.error(), xml.code()};
       out.model_text = std::move(xml).value();
       out.model_edited = true;
       continue;
