@@ -91,3 +91,10 @@ class [[nodiscard]] Status {
 };
 
 }  // namespace recruit
+
+// Returns the failure of a Status-valued expression from the enclosing function (which returns
+// a Status or a Result), its code kept.
+#define RECRUIT_TRY(expr)                                                                     \
+  do {                                                                                        \
+    if (::recruit::Status _recruit_s = (expr); !_recruit_s.ok()) return _recruit_s.failure(); \
+  } while (0)

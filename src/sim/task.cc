@@ -6,6 +6,7 @@
 #include <set>
 
 #include "common/atomic_file.h"
+#include "common/json_fields.h"
 #include "common/json_file.h"
 #include "common/short_text.h"
 
@@ -14,68 +15,10 @@ namespace {
 
 using nlohmann::json;
 namespace fs = std::filesystem;
-
-std::string Join(const std::set<std::string>& s) {
-  std::string out;
-  for (const auto& x : s) out += (out.empty() ? "" : ", ") + x;
-  return out;
-}
-
-Status CheckKeys(const json& j, const std::set<std::string>& allowed, const std::string& where) {
-  for (auto it = j.begin(); it != j.end(); ++it) {
-    if (!allowed.count(it.key())) {
-      return Error{where + ": unknown field '" + it.key() + "'; allowed: " + Join(allowed)};
-    }
-  }
-  return Status::Ok();
-}
-
-// Reads an optional number at j[key] into *out, checking lo <= x (lo_open: lo < x) and x <= hi.
-Status Number(const json& j, const std::string& key, const std::string& where, double* out,
-              bool required, double lo, double hi, bool lo_open, const std::string& allowed) {
-  if (!j.contains(key)) {
-    if (required) return Error{where + ": missing field '" + key + "' (" + allowed + ")"};
-    return Status::Ok();
-  }
-  const json& v = j.at(key);
-  if (!v.is_number()) {
-    return Error{where + "." + key + ": must be a number (" + allowed + "), got " + v.dump()};
-  }
-  const double x = v.get<double>();
-  if (!std::isfinite(x) || x < lo || (lo_open && x == lo) || x > hi) {
-    return Error{where + "." + key + ": " + v.dump() + " is out of range; allowed: " + allowed};
-  }
-  *out = x;
-  return Status::Ok();
-}
-
-Status String(const json& j, const std::string& key, const std::string& where, std::string* out,
-              bool required) {
-  if (!j.contains(key)) {
-    if (required) return Error{where + ": missing field '" + key + "' (a string)"};
-    return Status::Ok();
-  }
-  if (!j.at(key).is_string() || j.at(key).get<std::string>().empty()) {
-    return Error{where + "." + key + ": must be a non-empty string, got " + j.at(key).dump()};
-  }
-  *out = j.at(key).get<std::string>();
-  return Status::Ok();
-}
-
-Status Vec3(const json& j, const std::string& key, const std::string& where, Eigen::Vector3d* out) {
-  if (!j.contains(key)) return Status::Ok();
-  const json& v = j.at(key);
-  if (!v.is_array() || v.size() != 3) {
-    return Error{where + "." + key + ": must be an array of 3 numbers [x, y, z], got " + v.dump()};
-  }
-  for (int i = 0; i < 3; ++i) {
-    if (!v[i].is_number() || !std::isfinite(v[i].get<double>())) {
-      return Error{where + "." + key + ": must be an array of 3 finite numbers, got " + v.dump()};
-    }
-    (*out)[i] = v[i].get<double>();
-  }
-  return Status::Ok();
-}
+using json_fields::CheckKeys;
+using json_fields::Number;
+using json_fields::String;
+using json_fields::Vec3;
 
 std::string Resolve(const std::string& path, const std::string& source) {
   if (path.empty() || fs::path(path).is_absolute() || source.empty()) return path;
@@ -107,12 +50,6 @@ Result<Reference> ReadReference(const json& r, const std::string& where, Tracked
   }
   return ref;
 }
-
-#define RECRUIT_TRY(expr)                              \
-  do {                                                 \
-    Status _s = (expr);                                \
-    if (!_s.ok()) return Error{_s.error(), _s.code()}; \
-  } while (0)
 
 // The several-joint form: "joints": [{"joint", "reference"}, ...] and optional "bundles"; the
 // one-joint fields are not allowed beside it.
