@@ -247,9 +247,9 @@ Result<BundleConfig> BundleConfig::FromPairs(
     c.unit.prestretch = prestrain * c.unit.wire_length * c.unit.series;  // whole unit
   }
   auto check = UnitModel::Create(c.unit);
-  if (!check.ok()) return Error{where + check.error()};
+  if (!check.ok()) return Error{where + check.error(), check.code()};
   Status domain = CheckDomain(c, given, where);
-  if (!domain.ok()) return Error{domain.error()};
+  if (!domain.ok()) return Error{domain.error(), domain.code()};
   return c;
 }
 

@@ -265,20 +265,20 @@ Result<std::unique_ptr<SmaInstance>> SmaInstance::Build(const mjModel* m, int in
     const std::string where = "recruit.sma actuator '" + name + "': ";
     if (p->actuators_.empty()) {
       auto seed = ParseSeed(where, Config(m, instance, kSeedKey));
-      if (!seed.ok()) return Error{seed.error()};
+      if (!seed.ok()) return Error{seed.error(), seed.code()};
       auto period = ParsePeriod(where, Config(m, instance, kBroadcastPeriodKey));
-      if (!period.ok()) return Error{period.error()};
+      if (!period.ok()) return Error{period.error(), period.code()};
       p->seed_ = *seed;
       p->broadcast_period_ = *period;
     }
     if (check_actuators) {
       Status ok = CheckActuator(m, a, where);
-      if (!ok.ok()) return Error{ok.error()};
+      if (!ok.ok()) return Error{ok.error(), ok.code()};
     }
     auto cfg = BundleConfig::FromPairs(name, where + "config ", pairs);
-    if (!cfg.ok()) return Error{cfg.error()};
+    if (!cfg.ok()) return Error{cfg.error(), cfg.code()};
     auto bundle = SmaBundle::Create(*cfg, m->opt.timestep);
-    if (!bundle.ok()) return Error{where + bundle.error()};
+    if (!bundle.ok()) return Error{where + bundle.error(), bundle.code()};
     SmaActuator act{a, m->actuator_trnid[2 * a], BundleIndexOf(m, a), offset, 0,
                     0, std::move(bundle).value()};
     // In actuator length (gear x tendon length), as the units see it; ref_length is a tendon

@@ -192,7 +192,7 @@ Result<SweepOutcome> RunSweep(const std::vector<SweepRun>& grid, const std::stri
   std::FILE* log = std::fopen((fs::path(out_dir) / "progress.log").c_str(), "a");
   const auto t0 = std::chrono::steady_clock::now();
   std::mutex mu;
-  std::string first_error;
+  Error first_error;
   std::atomic<bool> failed{false};
   int done = outcome.reused;
   const int total = static_cast<int>(grid.size());
@@ -210,7 +210,7 @@ Result<SweepOutcome> RunSweep(const std::vector<SweepRun>& grid, const std::stri
     }
     std::lock_guard<std::mutex> lock(mu);
     if (!st.ok()) {
-      if (!failed.exchange(true)) first_error = st.error();
+      if (!failed.exchange(true)) first_error = st.failure();
       return;
     }
     outcome.runs[todo[t]] = std::move(s).value();
@@ -243,7 +243,7 @@ Result<SweepOutcome> RunSweep(const std::vector<SweepRun>& grid, const std::stri
                       });
   });
   if (log) std::fclose(log);
-  if (failed) return Error{first_error};
+  if (failed) return first_error;
   return outcome;
 }
 
