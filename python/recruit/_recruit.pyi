@@ -196,5 +196,5 @@ def attach(model: Union[str, "os.PathLike[str]"], muscles: Union[str, Sequence[s
 
 # sim::kMetricFields: per metric {"name", "unit", "integer", "may_be_nan"}.
 METRIC_FIELDS: Tuple[Dict[str, Any], ...]
-# sim::CellColumns(): the columns of table.csv and of aggregate(...).
+# sweep::CellColumns(): the columns of table.csv and of aggregate(...).
 CELL_COLUMNS: Tuple[str, ...]

@@ -25,10 +25,11 @@
 #include "common/json_file.h"
 #include "common/mujoco_load.h"
 #include "common/output_path.h"
-#include "sim/sweep.h"
+#include "sweep/grid.h"
 #include "sweep/latency.h"
 #include "sweep/sweep_file.h"
 #include "sweep/sweep_report.h"
+#include "sweep/table.h"
 
 namespace recruit::cli {
 namespace {
@@ -47,7 +48,7 @@ struct SweepArgs {
   int threads = 0;
   double duration = 0;
   std::string filter_model;
-  sim::TrackingCriterion criterion;
+  sweep::TrackingCriterion criterion;
   bool progress = false;
   std::string shard;                // "K/N"
   std::vector<std::string> shards;  // merge: the shards' output folders
@@ -76,7 +77,7 @@ struct PlantTask {
 // run's options and the code version), so an edited input or a new build is never served an old
 // result. Without a filter model file, kalman-augmented finds or identifies the model of the
 // plant and dT (identification/model_cache.h): both are in the hash already.
-std::string RunInputHash(const PlantTask& p, const sim::SweepSpec& spec, const sim::SweepRun& g,
+std::string RunInputHash(const PlantTask& p, const sweep::SweepSpec& spec, const sweep::SweepRun& g,
                          std::map<std::string, std::string>& cache) {
   sim::RunOptions o;
   o.estimator = g.estimator;
@@ -101,10 +102,10 @@ struct Prepared {
   sweep::SweepFile file;
   std::string task_path;
   sim::Task task;  // the task as given
-  sim::SweepSpec spec;
-  sim::TrackingCriterion criterion;
+  sweep::SweepSpec spec;
+  sweep::TrackingCriterion criterion;
   std::vector<PlantTask> plant;
-  std::vector<sim::SweepRun> grid;
+  std::vector<sweep::SweepRun> grid;
   std::string description;
 };
 
@@ -142,7 +143,7 @@ Result<Prepared> Prepare(const SweepArgs& a, int* code) {
   auto pick = [&](const char* name, const auto& cli, const auto& file) {
     return a.given.count(name) || file.empty() ? cli : file;
   };
-  sim::SweepSpec& spec = p.spec;
+  sweep::SweepSpec& spec = p.spec;
   spec.dTs = pick("dT", a.dTs, p.file.dTs);
   spec.lambdas = pick("lambda", a.lambdas, p.file.lambdas);
   spec.estimators = pick("estimator", a.estimators, p.file.estimators);
@@ -165,7 +166,7 @@ Result<Prepared> Prepare(const SweepArgs& a, int* code) {
 
   auto points = sweep::PlantPoints(p.file);
   if (!points.ok()) return Error{points.error(), points.code()};
-  spec.plant = p.file.axes.empty() ? std::vector<sim::PlantPoint>{} : *points;
+  spec.plant = p.file.axes.empty() ? std::vector<sweep::PlantPoint>{} : *points;
 
   // Each plant point: apply it, write an edited model under <out>/models (named by its content),
   // and parse the task, so a bad path or value fails now, naming the axis and value.
@@ -181,7 +182,7 @@ Result<Prepared> Prepare(const SweepArgs& a, int* code) {
   }
   std::map<std::string, std::string> contents;
   for (size_t i = 0; i < points->size(); ++i) {
-    const sim::PlantPoint& pt = (*points)[i];
+    const sweep::PlantPoint& pt = (*points)[i];
     PlantTask pl;
     if (p.file.axes.empty()) {
       pl.task = p.task;
@@ -232,7 +233,7 @@ Result<Prepared> Prepare(const SweepArgs& a, int* code) {
     pl.task = std::move(t).value();
     p.plant.push_back(std::move(pl));
   }
-  auto grid = sim::ExpandGrid(spec);
+  auto grid = sweep::ExpandGrid(spec);
   if (!grid.ok()) {
     *code = exit_code::kUsage;
     return Error{grid.error(), grid.code()};
@@ -256,8 +257,8 @@ Result<Prepared> Prepare(const SweepArgs& a, int* code) {
 // Table, stability map and the report with figures.
 int WriteReports(const std::string& cmd, const Prepared& p,
                  const std::vector<sim::RunSummary>& runs, const std::string& out) {
-  const auto cells = sim::Aggregate(p.grid, runs, p.criterion);
-  if (Status s = sim::WriteSweepReport(cells, p.criterion, out, p.task.name); !s.ok()) {
+  const auto cells = sweep::Aggregate(p.grid, runs, p.criterion);
+  if (Status s = sweep::WriteTables(cells, p.criterion, out, p.task.name); !s.ok()) {
     return Fail(cmd, s.error(), exit_code::kIo);
   }
   // The figures are drawn by the plot module (cairo), opened only now.
@@ -327,12 +328,12 @@ int RunSweepCommand(const SweepArgs& a) {
   const Prepared& p = *prep;
   int shard_k = 1, shard_n = 1;
   if (!a.shard.empty()) {
-    auto s = sim::ParseShard(a.shard);
+    auto s = sweep::ParseShard(a.shard);
     if (!s.ok()) return Fail(cmd, s.error(), exit_code::kUsage);
     std::tie(shard_k, shard_n) = *s;
   }
-  const std::vector<sim::SweepRun> todo =
-      a.shard.empty() ? p.grid : sim::ShardOf(p.grid, shard_k, shard_n);
+  const std::vector<sweep::SweepRun> todo =
+      a.shard.empty() ? p.grid : sweep::ShardOf(p.grid, shard_k, shard_n);
 
   // One sweep per folder at a time: the lock is held until the process ends.
   int lock_code = 0;
@@ -360,9 +361,9 @@ int RunSweepCommand(const SweepArgs& a) {
     return Fail(cmd, s.error(), exit_code::kIo);
   }
 
-  sim::SweepSpec spec = p.spec;
-  auto run = [&p, &spec](const sim::SweepRun& g) {
-    return sim::RunTask(p.plant[g.plant].task, sim::RunOptionsFor(g, spec));
+  sweep::SweepSpec spec = p.spec;
+  auto run = [&p, &spec](const sweep::SweepRun& g) {
+    return sim::RunTask(p.plant[g.plant].task, sweep::RunOptionsFor(g, spec));
   };
   // Progress and the remaining time on stderr: in place on a terminal, else (a batch job's log)
   // a line at most every 10 s. The estimate uses the runs made now (not those reused).
@@ -390,7 +391,7 @@ int RunSweepCommand(const SweepArgs& a) {
                     : " (shard " + a.shard + " of " + std::to_string(p.grid.size()) + ")")
             << " into " << a.out << " (per-run log: " << (fs::path(a.out) / "progress.log").string()
             << ")\n";
-  auto outcome = sim::RunSweep(todo, a.out, run, a.threads, report);
+  auto outcome = sweep::RunSweep(todo, a.out, run, a.threads, report);
   if (!outcome.ok()) {
     return Fail(cmd, outcome.error() + " (finished runs are kept; run again to resume)",
                 exit_code::Of(outcome.code()));
@@ -402,7 +403,7 @@ int RunSweepCommand(const SweepArgs& a) {
   }
   if (!a.shard.empty()) {
     // The shard's manifest: merge checks it belongs to the same sweep.
-    nlohmann::json m = {{"sweep_id", sim::SweepId(p.grid)},
+    nlohmann::json m = {{"sweep_id", sweep::SweepId(p.grid)},
                         {"shard", shard_k},
                         {"of", shard_n},
                         {"runs", todo.size()}};
@@ -435,7 +436,7 @@ int RunMergeCommand(const SweepArgs& a) {
   auto prep = Prepare(a, &code);
   if (!prep.ok()) return Fail(cmd, prep.error(), code);
   const Prepared& p = *prep;
-  const std::string id = sim::SweepId(p.grid);
+  const std::string id = sweep::SweepId(p.grid);
   std::map<int, fs::path> dirs;
   int n = 0;
   for (const auto& d : a.shards) {
@@ -508,10 +509,10 @@ int RunMergeCommand(const SweepArgs& a) {
                 exit_code::kBadInput);
   }
   // Every run is now recorded in --out: RunSweep only reads them back.
-  auto none = [](const sim::SweepRun& g) -> Result<sim::RunSummary> {
+  auto none = [](const sweep::SweepRun& g) -> Result<sim::RunSummary> {
     return Error{"run " + g.Key() + " missing after merge"};
   };
-  auto outcome = sim::RunSweep(p.grid, a.out, none, 1);
+  auto outcome = sweep::RunSweep(p.grid, a.out, none, 1);
   if (!outcome.ok()) return Fail(cmd, outcome.error(), exit_code::kInternal);
   if (int rc = WriteReports(cmd, p, outcome->runs, a.out); rc != 0) return rc;
   std::cout << "recruit sweep merge: " << n << " shards, " << outcome->reused

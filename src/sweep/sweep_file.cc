@@ -197,7 +197,7 @@ Result<SweepFile> SweepFile::FromJsonText(const std::string& text, const std::st
     const std::string where = file + ".criterion";
     if (!c.is_object()) return Error{where + ": must be an object"};
     RECRUIT_TRY(CheckKeys(c, {"max_overshoot", "min_settled"}, where));
-    sim::TrackingCriterion crit;
+    sweep::TrackingCriterion crit;
     RECRUIT_TRY(json_fields::Number(c, "max_overshoot", where, &crit.max_overshoot, false, 0,
                                     std::numeric_limits<double>::max(), false, "a number >= 0"));
     RECRUIT_TRY(json_fields::Number(c, "min_settled", where, &crit.min_settled, false, 0, 1, false,
@@ -296,9 +296,9 @@ Result<SweepFile> SweepFile::FromJsonText(const std::string& text, const std::st
   return f;
 }
 
-Result<std::vector<sim::PlantPoint>> PlantPoints(const SweepFile& f) {
-  std::vector<sim::PlantPoint> points;
-  if (f.axes.empty()) return std::vector<sim::PlantPoint>{sim::PlantPoint{}};
+Result<std::vector<sweep::PlantPoint>> PlantPoints(const SweepFile& f) {
+  std::vector<sweep::PlantPoint> points;
+  if (f.axes.empty()) return std::vector<sweep::PlantPoint>{sweep::PlantPoint{}};
   if (f.sampling == Sampling::kGrid) {
     size_t total = 1;
     for (const auto& a : f.axes) {
@@ -306,7 +306,7 @@ Result<std::vector<sim::PlantPoint>> PlantPoints(const SweepFile& f) {
       if (total > 10000000) return Error{"sweep file '" + f.source + "': the grid is too large"};
     }
     for (size_t i = 0; i < total; ++i) {
-      sim::PlantPoint p;
+      sweep::PlantPoint p;
       size_t rem = i;
       std::vector<size_t> idx(f.axes.size());
       for (size_t k = f.axes.size(); k-- > 0;) {  // last axis fastest
@@ -330,7 +330,7 @@ Result<std::vector<sim::PlantPoint>> PlantPoints(const SweepFile& f) {
     u = std::move(s).value();
   }
   for (const auto& row : u) {
-    sim::PlantPoint p;
+    sweep::PlantPoint p;
     for (int k = 0; k < dims; ++k)
       p.values.emplace_back(f.axes[k].name, f.axes[k].FromUnit(row[k]));
     points.push_back(p);
@@ -391,7 +391,7 @@ Result<std::string> SetPluginConfig(const std::string& xml, const std::string& i
 
 Result<PlantInputs> ApplyPlantPoint(const std::string& task_text, const std::string& model_text,
                                     const std::vector<PlantAxis>& axes,
-                                    const sim::PlantPoint& point, const std::string& where) {
+                                    const sweep::PlantPoint& point, const std::string& where) {
   PlantInputs out;
   out.model_text = model_text;
   json doc;
