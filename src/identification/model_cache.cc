@@ -6,6 +6,7 @@
 
 #include "common/atomic_file.h"
 #include "common/file_lock.h"
+#include "common/json_file.h"
 
 namespace recruit::control {
 namespace fs = std::filesystem;
@@ -43,13 +44,25 @@ std::vector<std::string> ModelSearchPath() {
   return dirs;
 }
 
+bool MadeByThisIdentification(const std::string& path) {
+  auto j = LoadJsonFile(path);
+  if (!j.ok() || !j->is_object()) return false;
+  const auto id = j->find("identification");
+  if (id == j->end() || !id->is_object()) return false;
+  const auto v = id->find("version");
+  return v != id->end() && v->is_number_integer() && v->get<int>() == kIdentificationVersion;
+}
+
 Result<std::string> FindOrIdentifyModel(const ModelRequest& r, bool identify, std::FILE* log) {
   const std::string name = ModelFileName(r.plant, r.dT, r.num_states);
   const std::vector<std::string> dirs = ModelSearchPath();
   std::error_code ec;
-  for (const std::string& d : dirs) {
-    const fs::path f = fs::path(d) / name;
-    if (fs::exists(f, ec)) return f.string();
+  // The folders before the cache hold models put there on purpose: taken as they are. The
+  // cache's were made on demand: only one this build would make is used.
+  for (size_t i = 0; i < dirs.size(); ++i) {
+    const fs::path f = fs::path(dirs[i]) / name;
+    if (!fs::exists(f, ec)) continue;
+    if (i + 1 < dirs.size() || MadeByThisIdentification(f.string())) return f.string();
   }
   if (!identify) {
     return Error{"no identified model " + name + " on the model search path (" + dirs.front() +
@@ -62,7 +75,8 @@ Result<std::string> FindOrIdentifyModel(const ModelRequest& r, bool identify, st
   const fs::path file = cache / name;
   auto lock = FileLock::Lock((cache / (name + ".lock")).string());
   if (!lock) return Error{lock.error(), lock.code()};
-  if (fs::exists(file, ec)) return file.string();  // made while we waited
+  // Made while we waited?
+  if (fs::exists(file, ec) && MadeByThisIdentification(file.string())) return file.string();
   if (log) {
     std::fprintf(log, "recruit: identifying the %s model for dT = %g s on %s (cached as %s)\n",
                  r.actuator.c_str(), r.dT, r.model_path.c_str(), file.string().c_str());

@@ -4,7 +4,9 @@
 // RECRUIT_MODEL_PATH (colon-separated), the shipped models/identified/ and the user's cache
 // (RECRUIT_MODEL_CACHE, else $XDG_CACHE_HOME/recruit/models, else ~/.cache/recruit/models).
 // When none holds it, it is identified on the plant (plant_identification.h) and written to the
-// cache, under a lock, so that concurrent runs identify it once.
+// cache, under a lock, so that concurrent runs identify it once. A cached model records the
+// identification version it was made with ("identification.version"); one of another version
+// is made again, not used.
 #pragma once
 
 #include <nlohmann/json.hpp>
@@ -29,6 +31,10 @@ struct ModelRequest {
   double dT = 0.5;
   int num_states = 20;
 };
+
+// Whether the model file at `path` was made by this build's identification
+// (kIdentificationVersion).
+bool MadeByThisIdentification(const std::string& path);
 
 // The model file for the request: found on the search path, or identified and cached when
 // `identify` is true (else an error saying how to make one). `log` (may be null) is told when

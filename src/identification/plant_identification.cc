@@ -230,6 +230,7 @@ Result<PlantIdentification> IdentifyOnPlant(const std::string& model_path,
   const Eigen::VectorXd& xi = map->fractions();
   nlohmann::json j = model.ToJson();
   j["identification"] = {
+      {"version", kIdentificationVersion},
       {"command", command},
       {"source", model_path},
       {"dT", rec->log.dT},

@@ -20,6 +20,12 @@
 
 namespace recruit::control {
 
+// The version of what IdentifyOnPlant makes, recorded in each model as
+// "identification.version": raise it whenever a change to the recording, the fit or the export
+// changes the model it makes, so that models cached by an older build are made again
+// (model_cache.h).
+constexpr int kIdentificationVersion = 1;
+
 struct PlantIdentificationOptions {
   double dT = 0.5;        // s
   int num_states = 20;    // even, >= 4
