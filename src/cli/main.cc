@@ -12,6 +12,7 @@
 #include "cli/commands.h"
 #include "cli/errors.h"
 #include "common/atomic_file.h"
+#include "common/data_path.h"
 #include "common/version.h"
 
 namespace {
@@ -32,6 +33,7 @@ std::string VersionText() {
 int main(int argc, char** argv) {
   using namespace recruit;
   InstallTempFileCleanupOnSignals();
+  SetDataDir(RECRUIT_DATA_DIR_DEFAULT);  // models/identified/ of the tree it was built from
   CLI::App app{
       "Recruit: stochastic recruitment control of SMA muscle bundles in MuJoCo, with the "
       "population Kalman filter of Odhner and Asada (ACC 2010).\n"

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "common/atomic_file.h"
+#include "common/data_path.h"
 #include "control/kalman_estimator.h"
 #include "control/model_plant.h"
 #include "control/on_count_estimator.h"
@@ -19,16 +20,17 @@
 namespace recruit::control {
 namespace {
 
-// A relative path is tried from the working directory, then from the source tree (so that the
-// shipped models/identified/ files are found from a build directory too).
+// A relative path is tried from the working directory, then from the data folder the program
+// set (common/data_path.h), so that the shipped models/identified/ files are found from a build
+// directory too.
 std::string ResolveModelPath(const std::string& path) {
   namespace fs = std::filesystem;
   std::error_code ec;
   if (path.empty() || fs::path(path).is_absolute() || fs::exists(path, ec)) return path;
-#ifdef RECRUIT_SOURCE_DIR
-  const fs::path alt = fs::path(RECRUIT_SOURCE_DIR) / path;
-  if (fs::exists(alt, ec)) return alt.string();
-#endif
+  if (const std::string data = DataDir(); !data.empty()) {
+    const fs::path alt = fs::path(data) / path;
+    if (fs::exists(alt, ec)) return alt.string();
+  }
   return path;
 }
 

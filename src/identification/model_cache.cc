@@ -5,6 +5,7 @@
 #include <filesystem>
 
 #include "common/atomic_file.h"
+#include "common/data_path.h"
 #include "common/file_lock.h"
 #include "common/json_file.h"
 
@@ -29,9 +30,9 @@ std::vector<std::string> ModelSearchPath() {
       start = end + 1;
     }
   }
-#ifdef RECRUIT_SOURCE_DIR
-  dirs.push_back(std::string(RECRUIT_SOURCE_DIR) + "/models/identified");
-#endif
+  if (const std::string data = DataDir(); !data.empty()) {
+    dirs.push_back(data + "/models/identified");
+  }
   if (const char* c = std::getenv("RECRUIT_MODEL_CACHE"); c && *c) {
     dirs.push_back(c);
   } else if (const char* x = std::getenv("XDG_CACHE_HOME"); x && *x) {

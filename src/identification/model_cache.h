@@ -1,7 +1,8 @@
 // Where the estimator's identified models are found, and made when missing: a model is keyed
 // by the plant it describes (its unit's hash), the bundle's actuator, dT and its number of states,
 // e.g. "flexor_3f2a9c0d12ab45ef_dt0.5_m20.json". Looked up, in order, in the folders of
-// RECRUIT_MODEL_PATH (colon-separated), the shipped models/identified/ and the user's cache
+// RECRUIT_MODEL_PATH (colon-separated), the shipped models/identified/ (under the data folder
+// the program set, common/data_path.h; none when it set none) and the user's cache
 // (RECRUIT_MODEL_CACHE, else $XDG_CACHE_HOME/recruit/models, else ~/.cache/recruit/models).
 // When none holds it, it is identified on the plant (plant_identification.h) and written to the
 // cache, under a lock, so that concurrent runs identify it once. A cached model records the
