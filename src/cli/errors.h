@@ -12,6 +12,7 @@
 
 #include "common/exit_codes.h"
 #include "common/short_text.h"
+#include "control/sampling_period.h"
 
 namespace recruit::cli {
 
@@ -51,5 +52,9 @@ inline CLI::Validator NonNegative() {
   return NumberIn(0, false, std::numeric_limits<double>::max(), "a finite number >= 0");
 }
 inline CLI::Validator Fraction() { return NumberIn(0, true, 1, "in (0, 1]"); }
+// The controller's sampling period (control/sampling_period.h).
+inline CLI::Validator SamplingPeriod() {
+  return NumberIn(0, true, control::kMaxDT, "a finite number > 0 and <= 1000 (seconds)");
+}
 
 }  // namespace recruit::cli

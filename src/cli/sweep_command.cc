@@ -156,9 +156,9 @@ void AddDefinitionOptions(CLI::App* cmd, sweep::SweepDefinition* a) {
                   "Sweep file (JSON, docs/sweep.md): task, controller and plant axes; options "
                   "given here override its values")
       ->check(CLI::ExistingFile);
-  track(cmd->add_option("--dT", a->dTs, "Sampling periods, s, comma separated")
+  track(cmd->add_option("--dT", a->dTs, "Sampling periods, s, in (0, 1000], comma separated")
             ->delimiter(',')
-            ->check(Positive())
+            ->check(SamplingPeriod())
             ->capture_default_str(),
         "dT");
   track(cmd->add_option("--lambda", a->lambdas, "Law gains in (0, 1], comma separated")

@@ -13,6 +13,7 @@
 #include "control/model_plant.h"
 #include "control/on_count_estimator.h"
 #include "control/output_estimator.h"
+#include "control/sampling_period.h"
 #include "estimation/filter_model.h"
 #include "estimation/json_matrix.h"
 #include "estimation/population_kalman_filter.h"
@@ -184,7 +185,7 @@ Result<std::unique_ptr<OnCountEstimator>> MakeEstimator(const EstimatorSpec& spe
   if (!std::isfinite(unit_force) || unit_force <= 0) {
     return Error{"estimator: unit_force must be finite and > 0 N"};
   }
-  if (!std::isfinite(dT) || dT <= 0) return Error{"estimator: dT must be finite and > 0 s"};
+  RECRUIT_TRY(CheckDT(dT, "estimator"));
   // The settled on unit's force as a function of length, for the length-aware output estimator.
   std::optional<UnitForceMap> on_force;
   if (geometry) {

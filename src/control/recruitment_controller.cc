@@ -13,9 +13,7 @@ Status ControllerParams::Validate() const {
     return Error{"controller: unit_force = " + std::to_string(unit_force) +
                  " N must be finite and > 0"};
   }
-  if (!std::isfinite(dT) || dT <= 0) {
-    return Error{"controller: dT = " + std::to_string(dT) + " s must be finite and > 0"};
-  }
+  RECRUIT_TRY(CheckDT(dT, "controller"));
   if (!std::isfinite(lambda) || lambda <= 0 || lambda > 1) {
     return Error{"controller: lambda = " + std::to_string(lambda) + " must be in (0, 1]"};
   }

@@ -560,7 +560,7 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
   const ControllerSettings settings = EffectiveSettings(task, options);
   const double duration = options.duration ? *options.duration : task.duration;
   if (!(duration > 0)) return Error{where + ": duration must be > 0 s"};
-  if (!(settings.dT > 0)) return Error{where + ": controller.dT must be > 0 s"};
+  RECRUIT_TRY(control::CheckDT(settings.dT, where + ": controller"));
   if (!(settings.lambda > 0 && settings.lambda <= 1)) {
     return Error{where + ": controller.lambda must be in (0, 1]"};
   }

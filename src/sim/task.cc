@@ -184,8 +184,8 @@ Result<Task> Task::FromJsonText(const std::string& text, const std::string& sour
     RECRUIT_TRY(String(c, "estimator", where, &task.controller.estimator, false));
     RECRUIT_TRY(String(c, "filter_model", where, &task.controller.filter_model, false));
     task.controller.filter_model = Resolve(task.controller.filter_model, source);
-    RECRUIT_TRY(Number(c, "dT", where, &task.controller.dT, false, 0, 1000, true,
-                       "seconds, 0 < dT <= 1000"));
+    RECRUIT_TRY(Number(c, "dT", where, &task.controller.dT, false, 0, control::kMaxDT, true,
+                       control::kDTAllowed));
     RECRUIT_TRY(
         Number(c, "lambda", where, &task.controller.lambda, false, 0, 1, true, "0 < lambda <= 1"));
   }

@@ -22,6 +22,7 @@
 #include "common/content_hash.h"
 #include "common/json_file.h"
 #include "common/rng.h"
+#include "control/sampling_period.h"
 
 namespace recruit::sweep {
 namespace fs = std::filesystem;
@@ -57,7 +58,7 @@ Result<std::vector<SweepRun>> ExpandGrid(const SweepSpec& spec) {
   if (spec.estimators.empty()) return Error{"sweep: no estimators (--estimator)"};
   if (spec.seeds < 1) return Error{"sweep: --seeds must be >= 1"};
   for (double x : spec.dTs) {
-    if (!(x > 0) || !std::isfinite(x)) return Error{fmt::format("sweep: dT {} must be > 0", x)};
+    RECRUIT_TRY(control::CheckDT(x, "sweep"));
   }
   for (double x : spec.lambdas) {
     if (!(x > 0 && x <= 1)) return Error{fmt::format("sweep: lambda {} must be in (0, 1]", x)};

@@ -11,6 +11,7 @@
 #include "common/json_fields.h"
 #include "common/json_file.h"
 #include "common/short_text.h"
+#include "control/sampling_period.h"
 #include "sweep/sampling.h"
 
 namespace recruit::sweep {
@@ -148,9 +149,9 @@ Result<SweepFile> SweepFile::FromJsonText(const std::string& text, const std::st
       auto v = ParseValues(c["dT"], where + ".dT", true);
       if (!v.ok()) return Error{v.error(), v.code()};
       for (double x : v->values) {
-        if (!(x > 0 && x <= 1000)) {
-          return Error{fmt::format("{}.dT: value {:g} is out of range; allowed: 0 < dT <= 1000 s",
-                                   where, x)};
+        if (!control::ValidDT(x)) {
+          return Error{fmt::format("{}.dT: value {:g} is out of range; allowed: {}", where, x,
+                                   control::kDTAllowed)};
         }
       }
       f.dTs = v->values;
