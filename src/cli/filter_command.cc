@@ -45,7 +45,7 @@ int RunFilter(const FilterArgs& a) {
   // A model identified on another plant than the log's is refused (its H and chain describe
   // other units), as simulate and sweep refuse it.
   if (!a.plant.empty()) {
-    auto record = control::PlantRecordOf(a.plant, a.actuator);
+    auto record = identification::PlantRecordOf(a.plant, a.actuator);
     if (!record.ok()) return fail(record.failure().In("--plant: "));
     if (Status s = control::CheckModelPlant(a.model, *record); !s.ok()) return fail(s.failure());
   }

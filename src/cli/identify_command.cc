@@ -45,7 +45,7 @@ struct IdentifyArgs {
 // shortest text that reads back as the written double, so the table is the file's H exactly:
 // clamped to >= 0 and, from the bench, carried onto the force law), on/off and the advance
 // probability from the fitted chain.
-void PrintModel(const recruit::control::TransientChain& c, const nlohmann::json& model) {
+void PrintModel(const recruit::identification::TransientChain& c, const nlohmann::json& model) {
   const nlohmann::json& names = model.at("states");
   const nlohmann::json& H = model.at("H").at(0);
   std::printf("%-8s %-4s %24s %10s\n", "state", "on", "H (N)", "advance");
@@ -63,7 +63,7 @@ void PrintModel(const recruit::control::TransientChain& c, const nlohmann::json&
   }
 }
 
-void PrintFit(const recruit::control::IdentificationResult& fit) {
+void PrintFit(const recruit::identification::IdentificationResult& fit) {
   std::printf("train:   %d samples, RMSE %.3f N, R^2 %.4f\n", fit.train.samples, fit.train.rmse,
               fit.train.r2);
   std::printf(
@@ -77,6 +77,7 @@ void PrintFit(const recruit::control::IdentificationResult& fit) {
 // --log: the chain fitted to a recorded switching log (plant unknown: no length model).
 Result<nlohmann::json> IdentifyFromLog(const IdentifyArgs& a, const std::string& command_line) {
   using namespace recruit::control;
+  using namespace recruit::identification;
   auto log = SwitchingLog::FromCsv(a.log_in, a.units);
   if (!log) return Error{log.error(), log.code()};
   FitOptions opt;
@@ -110,6 +111,7 @@ Result<nlohmann::json> IdentifyFromLog(const IdentifyArgs& a, const std::string&
 // --bench: the shared pipeline on the MuJoCo plant (identification/plant_identification.h).
 Result<nlohmann::json> IdentifyFromBench(const IdentifyArgs& a, const std::string& command_line) {
   using namespace recruit::control;
+  using namespace recruit::identification;
   PlantIdentificationOptions o;
   o.dT = a.dT;
   o.num_states = a.states;
@@ -147,6 +149,7 @@ Result<nlohmann::json> IdentifyFromBench(const IdentifyArgs& a, const std::strin
 
 int RunIdentify(const IdentifyArgs& a, const std::string& command_line) {
   using namespace recruit::control;
+  using namespace recruit::identification;
   if (a.states < 4 || a.states % 2 != 0) {
     return Fail("identify", "--states " + std::to_string(a.states) + ": must be even and >= 4",
                 exit_code::kUsage);

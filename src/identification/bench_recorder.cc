@@ -12,7 +12,7 @@
 #include "identification/plant_record.h"
 #include "plugin/sma_host.h"
 
-namespace recruit::control {
+namespace recruit::identification {
 namespace {
 
 struct HeldPose {
@@ -155,4 +155,4 @@ Result<BenchRecording> RecordBench(const std::string& model_path, const std::str
   return rec;
 }
 
-}  // namespace recruit::control
+}  // namespace recruit::identification

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <limits>
 
-namespace recruit::control {
+namespace recruit::identification {
 namespace {
 
 // Mean state trajectory: row k is x_k^T (counts), from all units cold.
@@ -380,4 +380,4 @@ Result<IdentificationResult> IdentifyTransientModel(const SwitchingLog& log,
   return best;
 }
 
-}  // namespace recruit::control
+}  // namespace recruit::identification

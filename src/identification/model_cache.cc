@@ -9,7 +9,7 @@
 #include "common/file_lock.h"
 #include "common/json_file.h"
 
-namespace recruit::control {
+namespace recruit::identification {
 namespace fs = std::filesystem;
 
 std::string ModelFileName(const nlohmann::json& plant, double dT, int num_states) {
@@ -95,4 +95,4 @@ Result<std::string> FindOrIdentifyModel(const ModelRequest& r, bool identify, st
   return file.string();
 }
 
-}  // namespace recruit::control
+}  // namespace recruit::identification

@@ -17,7 +17,7 @@
 #include "common/result.h"
 #include "identification/plant_identification.h"
 
-namespace recruit::control {
+namespace recruit::identification {
 
 // "<actuator>_<hash>_dt<dT>_m<states>.json" for a PlantRecord `plant`.
 std::string ModelFileName(const nlohmann::json& plant, double dT, int num_states);
@@ -42,4 +42,4 @@ bool MadeByThisIdentification(const std::string& path);
 // an identification starts, as it takes a while (seconds to a minute).
 Result<std::string> FindOrIdentifyModel(const ModelRequest& request, bool identify, std::FILE* log);
 
-}  // namespace recruit::control
+}  // namespace recruit::identification

@@ -18,7 +18,7 @@
 #include "common/result.h"
 #include "identification/identification.h"
 
-namespace recruit::control {
+namespace recruit::identification {
 
 // The version of what IdentifyOnPlant makes, recorded in each model as
 // "identification.version": raise it whenever a change to the recording, the fit or the export
@@ -63,4 +63,4 @@ Result<PlantIdentification> IdentifyOnPlant(const std::string& model_path,
 // The record of a fit's quality: {"samples", "rmse_N", "r2"}.
 nlohmann::json MetricsJson(const FitMetrics& m);
 
-}  // namespace recruit::control
+}  // namespace recruit::identification

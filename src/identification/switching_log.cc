@@ -8,7 +8,7 @@
 
 #include "common/atomic_file.h"
 
-namespace recruit::control {
+namespace recruit::identification {
 namespace {
 
 std::vector<std::string> SplitCsv(const std::string& line) {
@@ -146,4 +146,4 @@ Status SwitchingLog::SaveCsv(const std::string& path) const {
   return f.Commit();
 }
 
-}  // namespace recruit::control
+}  // namespace recruit::identification

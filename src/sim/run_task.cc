@@ -141,14 +141,14 @@ Result<std::string> BundleModelFile(const Task& task, const ControllerSettings& 
     file.replace(at, key.size(), host.bundle_name(b));
   }
   if (!file.empty()) return file;
-  control::ModelRequest req{task.model_path, host.bundle_name(b),
-                            control::PlantRecord(host, b, task.model_path), settings.dT,
-                            spec.num_states};
-  auto found = control::FindOrIdentifyModel(req, /*identify=*/false, nullptr);
+  identification::ModelRequest req{task.model_path, host.bundle_name(b),
+                                   identification::PlantRecord(host, b, task.model_path),
+                                   settings.dT, spec.num_states};
+  auto found = identification::FindOrIdentifyModel(req, /*identify=*/false, nullptr);
   if (found.ok() || !options.identify_missing_models) return found;
   // Not on the search path: identified now; the time it takes is reported apart.
   const auto start = std::chrono::steady_clock::now();
-  found = control::FindOrIdentifyModel(req, true, options.quiet ? nullptr : stderr);
+  found = identification::FindOrIdentifyModel(req, true, options.quiet ? nullptr : stderr);
   identify_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return found;
 }
@@ -200,7 +200,7 @@ Result<std::vector<Channel> > MakeChannels(const Task& task, const ControllerSet
     // A model identified on another plant (unit, geometry) is refused with both named.
     control::EstimatorSpec bundle_spec = *spec;
     bundle_spec.sensor_variance = task.sensor.Variance();
-    bundle_spec.plant = control::PlantRecord(host, b, task.model_path);
+    bundle_spec.plant = identification::PlantRecord(host, b, task.model_path);
     if (bundle_spec.kind == control::EstimatorKind::kKalmanAugmented ||
         !bundle_spec.model_file.empty()) {
       auto file = BundleModelFile(task, settings, plant, i, options, bundle_spec, identify_s);

@@ -8,7 +8,7 @@
 
 #include "common/atomic_file.h"
 
-namespace recruit::control {
+namespace recruit::identification {
 namespace {
 
 namespace fs = std::filesystem;
@@ -47,4 +47,4 @@ TEST(ModelCache, ACachedModelOfAnotherIdentificationVersionIsNotUsed) {
 }
 
 }  // namespace
-}  // namespace recruit::control
+}  // namespace recruit::identification
