@@ -19,11 +19,11 @@
 #include "sweep/sweep_report.h"
 #include "sweep/table.h"
 
-namespace recruit::sim {
+namespace recruit::sweep {
 namespace {
 
 namespace fs = std::filesystem;
-using namespace ::recruit::sweep;  // NOLINT: the sweep code under test (src/sweep)
+using namespace ::recruit::sim;  // NOLINT: tasks and runs the sweeps are made of
 
 fs::path FreshDir(const std::string& name) {
   const fs::path dir = fs::temp_directory_path() / ("recruit_sweep_numbers_" + name);
@@ -226,4 +226,4 @@ TEST(SweepReportLinks, NoStabilityMapNoLink) {
 }
 
 }  // namespace
-}  // namespace recruit::sim
+}  // namespace recruit::sweep

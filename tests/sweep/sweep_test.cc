@@ -28,11 +28,11 @@
 #include "sweep/sweep_report.h"
 #include "sweep/table.h"
 
-namespace recruit::sim {
+namespace recruit::sweep {
 namespace {
 
 namespace fs = std::filesystem;
-using namespace ::recruit::sweep;  // NOLINT: the sweep code under test (src/sweep)
+using namespace ::recruit::sim;  // NOLINT: tasks and runs the sweeps are made of
 
 fs::path TempDir(const std::string& name) {
   const fs::path p = fs::temp_directory_path() / ("recruit_sweep_test_" + name);
@@ -666,4 +666,4 @@ TEST(SweepSensitivity, SyntheticPlantGivesItsClosedFormElasticities) {
 }
 
 }  // namespace
-}  // namespace recruit::sim
+}  // namespace recruit::sweep
