@@ -61,7 +61,7 @@ SmaBundle::SmaBundle(BundleConfig c, UnitModel u, double dt)
 
 Result<SmaBundle> SmaBundle::Create(const BundleConfig& config, double dt) {
   auto unit = UnitModel::Create(config.unit);
-  if (!unit.ok()) return Error{"actuator '" + config.actuator + "': " + unit.error()};
+  if (!unit.ok()) return Error{"actuator '" + config.actuator + "': " + unit.error(), unit.code()};
   if (!(dt > 0)) return Error{"actuator '" + config.actuator + "': timestep must be > 0"};
   return SmaBundle(config, std::move(unit.value()), dt);
 }

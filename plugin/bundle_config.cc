@@ -22,9 +22,6 @@ struct Key {
   std::function<void(BundleConfig&, double)> set;
 };
 
-// A value as quoted in a message: at most 40 characters.
-std::string Short(const std::string& v) { return v.size() <= 40 ? v : v.substr(0, 37) + "..."; }
-
 #define UNIT_FIELD(f) [](BundleConfig& c, double v) { c.unit.f = v; }
 
 const std::vector<Key>& NumericKeys() {
@@ -79,7 +76,7 @@ std::string Given(const std::map<std::string, std::string>& given,
   for (const char* k : keys) {
     names += (names.empty() ? "" : ", ") + std::string(k);
     const auto it = given.find(k);
-    if (it != given.end()) s += (s.empty() ? "" : " ") + it->first + "=" + Short(it->second);
+    if (it != given.end()) s += (s.empty() ? "" : " ") + it->first + "=" + ShortText(it->second);
   }
   return s.empty() ? names + " (defaults)" : s;
 }
@@ -177,10 +174,10 @@ Result<BundleConfig> BundleConfig::FromText(const std::string& actuator, const s
   while (in >> token) {
     const auto eq = token.find('=');
     if (eq != std::string::npos && eq > 0 && eq + 1 == token.size()) {
-      return Error{where + Short(token) + " has no value: give one, or leave the key out"};
+      return Error{where + ShortText(token) + " has no value: give one, or leave the key out"};
     }
     if (eq == std::string::npos || eq == 0) {
-      return Error{where + "'" + Short(token) + "' is not key=value"};
+      return Error{where + "'" + ShortText(token) + "' is not key=value"};
     }
     pairs.emplace_back(token.substr(0, eq), token.substr(eq + 1));
   }
@@ -197,7 +194,7 @@ Result<BundleConfig> BundleConfig::FromPairs(
   for (const auto& [key, value] : pairs) {
     if (value.empty()) continue;  // an unset MJCF config key: keep the default
     if (!given.emplace(key, value).second) {
-      return Error{where + "key '" + Short(key) + "' given twice"};
+      return Error{where + "key '" + ShortText(key) + "' given twice"};
     }
     if (key == "law") {
       if (value == "wire") {
@@ -205,7 +202,7 @@ Result<BundleConfig> BundleConfig::FromPairs(
       } else if (value == "spring") {
         c.unit.law = ForceLaw::kSpring;
       } else {
-        return Error{where + "law=" + Short(value) +
+        return Error{where + "law=" + ShortText(value) +
                      " is invalid: allowed values are wire, spring"};
       }
       continue;
@@ -217,22 +214,22 @@ Result<BundleConfig> BundleConfig::FromPairs(
     if (spec == nullptr) {
       std::string allowed;
       for (const std::string& k : Keys()) allowed += (allowed.empty() ? "" : ", ") + k;
-      return Error{where + "unknown key '" + Short(key) + "' (allowed: " + allowed + ")"};
+      return Error{where + "unknown key '" + ShortText(key) + "' (allowed: " + allowed + ")"};
     }
     errno = 0;
     char* end = nullptr;
     const double v = std::strtod(value.c_str(), &end);
     if (end == value.c_str() || *end != '\0' || errno == ERANGE || !std::isfinite(v)) {
-      return Error{where + key + "=" + Short(value) + " is not a finite number"};
+      return Error{where + key + "=" + ShortText(value) + " is not a finite number"};
     }
     const bool low_bad = spec->lo_open ? !(v > spec->lo) : !(v >= spec->lo);
     if (low_bad || v > spec->hi) {
-      return Error{where + key + "=" + Short(value) + " is out of range: must be in " +
+      return Error{where + key + "=" + ShortText(value) + " is out of range: must be in " +
                    (spec->lo_open ? "(" : "[") + GText(spec->lo) + ", " + GText(spec->hi) + "]" +
                    (spec->unit[0] ? std::string(" ") + spec->unit : std::string())};
     }
     if ((key == "units" || key == "series" || key == "parallel") && v != std::floor(v)) {
-      return Error{where + key + "=" + Short(value) + " must be a whole number"};
+      return Error{where + key + "=" + ShortText(value) + " must be a whole number"};
     }
     if (key == "prestrain") {
       prestrain = v;
@@ -250,9 +247,9 @@ Result<BundleConfig> BundleConfig::FromPairs(
     c.unit.prestretch = prestrain * c.unit.wire_length * c.unit.series;  // whole unit
   }
   auto check = UnitModel::Create(c.unit);
-  if (!check.ok()) return Error{where + check.error()};
+  if (!check.ok()) return Error{where + check.error(), check.code()};
   Status domain = CheckDomain(c, given, where);
-  if (!domain.ok()) return Error{domain.error()};
+  if (!domain.ok()) return Error{domain.error(), domain.code()};
   return c;
 }
 

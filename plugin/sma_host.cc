@@ -16,7 +16,7 @@ Result<std::unique_ptr<SmaHost>> SmaHost::Create(const mjModel* m) {
   for (int i = 0; i < m->nplugin; ++i) {
     if (!IsSmaInstance(m, i)) continue;
     auto inst = SmaInstance::Create(m, i);
-    if (!inst.ok()) return Error{inst.error()};
+    if (!inst.ok()) return Error{inst.error(), inst.code()};
     h.instances_.push_back(std::shared_ptr<const SmaInstance>(std::move(inst).value()));
   }
   // Bundles in actuator order, whatever the order of the instances.

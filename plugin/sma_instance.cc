@@ -15,13 +15,12 @@
 #include <utility>
 
 #include "common/rng.h"
+#include "common/short_text.h"
 #include "plugin/design_limits.h"
 #include "plugin/tendon_range.h"
 
 namespace recruit::sma {
 namespace {
-
-std::string Short(const std::string& v) { return v.size() <= 40 ? v : v.substr(0, 37) + "..."; }
 
 std::string ActuatorName(const mjModel* m, int a) {
   const char* n = mj_id2name(m, mjOBJ_ACTUATOR, a);
@@ -39,7 +38,7 @@ Result<std::uint64_t> ParseSeed(const std::string& where, const std::string& v) 
   char* end = nullptr;
   const unsigned long long s = std::strtoull(v.c_str(), &end, 10);
   if (v[0] == '-' || end == v.c_str() || *end != '\0' || errno == ERANGE) {
-    return Error{where + "config seed=" + Short(v) +
+    return Error{where + "config seed=" + ShortText(v) +
                  " is invalid: must be a whole number in [0, 18446744073709551615]"};
   }
   return static_cast<std::uint64_t>(s);
@@ -51,7 +50,7 @@ Result<double> ParsePeriod(const std::string& where, const std::string& v) {
   char* end = nullptr;
   const double p = std::strtod(v.c_str(), &end);
   if (end == v.c_str() || *end != '\0' || errno == ERANGE || !(p >= 0 && p <= 1e6)) {
-    return Error{where + "config broadcast_period=" + Short(v) +
+    return Error{where + "config broadcast_period=" + ShortText(v) +
                  " is invalid: must be a number of seconds in [0, 1e6] (0 = every timestep)"};
   }
   return p;
@@ -266,20 +265,20 @@ Result<std::unique_ptr<SmaInstance>> SmaInstance::Build(const mjModel* m, int in
     const std::string where = "recruit.sma actuator '" + name + "': ";
     if (p->actuators_.empty()) {
       auto seed = ParseSeed(where, Config(m, instance, kSeedKey));
-      if (!seed.ok()) return Error{seed.error()};
+      if (!seed.ok()) return Error{seed.error(), seed.code()};
       auto period = ParsePeriod(where, Config(m, instance, kBroadcastPeriodKey));
-      if (!period.ok()) return Error{period.error()};
+      if (!period.ok()) return Error{period.error(), period.code()};
       p->seed_ = *seed;
       p->broadcast_period_ = *period;
     }
     if (check_actuators) {
       Status ok = CheckActuator(m, a, where);
-      if (!ok.ok()) return Error{ok.error()};
+      if (!ok.ok()) return Error{ok.error(), ok.code()};
     }
     auto cfg = BundleConfig::FromPairs(name, where + "config ", pairs);
-    if (!cfg.ok()) return Error{cfg.error()};
+    if (!cfg.ok()) return Error{cfg.error(), cfg.code()};
     auto bundle = SmaBundle::Create(*cfg, m->opt.timestep);
-    if (!bundle.ok()) return Error{where + bundle.error()};
+    if (!bundle.ok()) return Error{where + bundle.error(), bundle.code()};
     SmaActuator act{a, m->actuator_trnid[2 * a], BundleIndexOf(m, a), offset, 0,
                     0, std::move(bundle).value()};
     // In actuator length (gear x tendon length), as the units see it; ref_length is a tendon

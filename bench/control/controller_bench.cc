@@ -43,7 +43,7 @@ BENCHMARK_CAPTURE(ControllerStep, augmented20_conservative, std::string("kalman-
                   std::string("conservative"));
 
 void ChainPropagateMean(benchmark::State& state) {
-  TransientChain c = TransientChain::Uniform(20, 0.7);
+  identification::TransientChain c = identification::TransientChain::Uniform(20, 0.7);
   Eigen::VectorXd x = Eigen::VectorXd::Zero(20);
   x[0] = 60;
   for (auto _ : state) {
@@ -54,7 +54,7 @@ void ChainPropagateMean(benchmark::State& state) {
 BENCHMARK(ChainPropagateMean);
 
 void ChainDenseMatrixTimesX(benchmark::State& state) {
-  TransientChain c = TransientChain::Uniform(20, 0.7);
+  identification::TransientChain c = identification::TransientChain::Uniform(20, 0.7);
   Eigen::VectorXd x = Eigen::VectorXd::Zero(20);
   x[0] = 60;
   for (auto _ : state) {

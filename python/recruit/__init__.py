@@ -61,6 +61,11 @@ if _recruit.mujoco_version() != _mujoco.mj_versionString():
         "built with")
 
 from ._version import __version__  # noqa: E402  (the CMake project version)
+from ._version import _DATA_DIR  # noqa: E402
+
+# The shipped models/identified/ are found under this folder (RECRUIT_DATA_DIR overrides it).
+if _os.path.isdir(_DATA_DIR):
+    _recruit.set_data_dir(_DATA_DIR)
 
 _h = _recruit.mujoco_header_version()  # mjVERSION_HEADER: major * 1e6 + minor * 1e3 + patch
 MUJOCO_BUILD_VERSION = f"{_h // 1000000}.{_h // 1000 % 1000}.{_h % 1000}"

@@ -13,18 +13,18 @@
 #include "attach/attach.h"
 #include "attach/report.h"
 #include "bindings.h"
-#include "common/exit_codes.h"
+#include "common/result.h"
 #include "convert.h"
 
 namespace recruit::py_bind {
 namespace {
 
-[[noreturn]] void Raise(const std::string& message) {
-  if (exit_code::FromMessage(message) == exit_code::kIo) {
-    PyErr_SetString(PyExc_OSError, message.c_str());
+[[noreturn]] void Raise(const Error& error) {
+  if (error.code == ErrorCode::kIo) {
+    PyErr_SetString(PyExc_OSError, error.message.c_str());
     throw py::error_already_set();
   }
-  Fail(message);
+  Fail(error.message);
 }
 
 // A path (str or os.PathLike); None -> "".
@@ -81,7 +81,7 @@ py::object Attach(const py::object& model, const py::object& muscles, const py::
     py::gil_scoped_release release;
     r.emplace(attach::Attach(o));
   }
-  if (!r->ok()) Raise(r->error());
+  if (!r->ok()) Raise(r->failure());
   return py::module_::import("json").attr("loads")(attach::ReportJson(**r).dump());
 }
 

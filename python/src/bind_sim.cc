@@ -12,8 +12,9 @@
 #include "common/step_observer.h"
 #include "convert.h"
 #include "sim/run_task.h"
-#include "sim/sweep.h"
 #include "sim/task.h"
+#include "sweep/grid.h"
+#include "sweep/table.h"
 
 namespace recruit::py_bind {
 namespace {
@@ -126,7 +127,7 @@ std::string Sweep(const std::string& task_path, const std::vector<double>& dTs,
                   const py::object& filter_model, int threads, const std::string& out_dir) {
   if (threads < 0) Fail("threads: must be >= 0 (0: all cores)");
   const sim::Task task = Take(sim::Task::FromFile(task_path));
-  sim::SweepSpec spec;
+  sweep::SweepSpec spec;
   spec.identify_missing_models = true;  // as `recruit sweep` does
   spec.dTs = dTs;
   spec.lambdas = lambdas;
@@ -135,17 +136,17 @@ std::string Sweep(const std::string& task_path, const std::vector<double>& dTs,
   spec.base_seed = base_seed;
   spec.duration = Opt<double>(duration);
   spec.filter_model = Opt<std::string>(filter_model);
-  const std::vector<sim::SweepRun> grid = Take(sim::ExpandGrid(spec));
+  const std::vector<sweep::SweepRun> grid = Take(sweep::ExpandGrid(spec));
   // As `recruit sweep` runs each grid point (src/cli/sweep_command.cc).
-  auto run = [&task, &spec](const sim::SweepRun& g) {
-    return sim::RunTask(task, sim::RunOptionsFor(g, spec));
+  auto run = [&task, &spec](const sweep::SweepRun& g) {
+    return sim::RunTask(task, sweep::RunOptionsFor(g, spec));
   };
-  std::optional<Result<sim::SweepOutcome>> outcome;
+  std::optional<Result<sweep::SweepOutcome>> outcome;
   {
     py::gil_scoped_release release;
-    outcome.emplace(sim::RunSweep(grid, out_dir, run, threads));
+    outcome.emplace(sweep::RunSweep(grid, out_dir, run, threads));
   }
-  const sim::SweepOutcome o = Take(std::move(*outcome));
+  const sweep::SweepOutcome o = Take(std::move(*outcome));
   nlohmann::json runs = nlohmann::json::array();
   for (size_t i = 0; i < o.runs.size(); ++i) {
     nlohmann::json j = o.runs[i].ToJson();
@@ -179,11 +180,11 @@ py::dict AggregateColumns(const py::dict& runs, double max_overshoot, double min
     const Eigen::VectorXd v = column(f.name);
     for (Eigen::Index i = 0; i < n; ++i) sim::SetMetric(rs[i].metrics, f, v(i));
   }
-  sim::TrackingCriterion criterion;
+  sweep::TrackingCriterion criterion;
   criterion.max_overshoot = max_overshoot;
   criterion.min_settled = min_settled;
-  const std::vector<sim::CellStats> cells = sim::Aggregate(rs, criterion);
-  // Column names and order as table.csv (sim::CellColumns).
+  const std::vector<sweep::CellStats> cells = sweep::Aggregate(rs, criterion);
+  // Column names and order as table.csv (sweep::CellColumns).
   const std::vector<std::string> names = sim::CellMetricColumns();
   std::vector<std::string> estimators;
   std::vector<bool> meets;
@@ -195,7 +196,7 @@ py::dict AggregateColumns(const py::dict& runs, double max_overshoot, double min
     lambdas.push_back(c.lambda);
     estimators.push_back(c.estimator);
     nseeds.push_back(c.seeds);
-    const std::vector<double> row = sim::CellMetricValues(c);
+    const std::vector<double> row = sweep::CellMetricValues(c);
     for (size_t k = 0; k < names.size(); ++k) metrics[k].push_back(row[k]);
     meets.push_back(c.meets);
     margins.push_back(c.margin);
@@ -246,7 +247,7 @@ void BindSim(py::module_& mod) {
           py::arg("min_settled") = 0.90,
           "A sweep's run columns -> cell columns (as `recruit sweep`'s table.csv).");
   mod.attr("METRIC_FIELDS") = MetricFields();
-  const std::vector<std::string> columns = sim::CellColumns();
+  const std::vector<std::string> columns = sweep::CellColumns();
   mod.attr("CELL_COLUMNS") = py::tuple(py::cast(columns));
 }
 

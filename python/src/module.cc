@@ -3,6 +3,7 @@
 // valid (no crash on bad input). recruit/__init__.py registers the plugin and adds the
 // Python-side helpers.
 #include "bindings.h"
+#include "common/data_path.h"
 
 PYBIND11_MODULE(_recruit, mod) {
   mod.doc() = "Recruit's C++ core (see the recruit package for documentation).";
@@ -11,4 +12,7 @@ PYBIND11_MODULE(_recruit, mod) {
   recruit::py_bind::BindControl(mod);
   recruit::py_bind::BindSim(mod);
   recruit::py_bind::BindAttach(mod);
+  mod.def(
+      "set_data_dir", &recruit::SetDataDir, pybind11::arg("folder"),
+      "The folder holding the shipped models/ (common/data_path.h; RECRUIT_DATA_DIR overrides)");
 }

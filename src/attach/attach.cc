@@ -26,7 +26,7 @@ Status CheckPaths(const AttachOptions& o) {
   if (o.model.empty()) return Error{"no model given"};
   std::error_code ec;
   if (!fs::is_regular_file(o.model, ec))
-    return Error{"cannot open model '" + o.model + "': no such file"};
+    return Error{"cannot open model '" + o.model + "': no such file", ErrorCode::kIo};
   if (o.muscles.empty()) return Error{"no muscle given (--muscles NAME[,NAME...] or all)"};
   if (!o.size_only && o.output.empty()) return Error{"no output model given (-o OUT.xml)"};
   for (const std::string* p : {&o.output, &o.task, &o.report}) {
@@ -46,7 +46,7 @@ Result<std::vector<std::string>> SelectActuators(const mjSpec* spec, const Attac
   }
   for (const std::string& n : o.muscles) {
     auto a = FindTendonActuator(spec, n);
-    if (!a.ok()) return Error{"'" + o.model + "': " + a.error()};
+    if (!a.ok()) return Error{"'" + o.model + "': " + a.error(), a.code()};
     if (std::find(names.begin(), names.end(), n) == names.end()) names.push_back(n);
   }
   return names;
@@ -77,10 +77,10 @@ Result<double> PeakForce(const mjModel* m, int a, const std::string& name, doubl
 Result<std::vector<BundleReport>> Probe(const mjSpec* spec, const std::vector<std::string>& names,
                                         const AttachOptions& o) {
   auto copy = CopySpec(spec);
-  if (!copy.ok()) return Error{copy.error()};
+  if (!copy.ok()) return Error{copy.error(), copy.code()};
   (*copy)->compiler.LRopt.mode = mjLRMODE_NONE;
   auto m = CompileSpec(copy->get());
-  if (!m.ok()) return Error{"'" + o.model + "' does not compile: " + m.error()};
+  if (!m.ok()) return Error{"'" + o.model + "' does not compile: " + m.error(), m.code()};
   DataPtr d(mj_makeData(m->get()));
   if (!d) return Error{"cannot make data for '" + o.model + "'"};
   std::vector<BundleReport> out;
@@ -94,7 +94,7 @@ Result<std::vector<BundleReport>> Probe(const mjSpec* spec, const std::vector<st
     b.tendon = tn != nullptr ? tn : "#" + std::to_string(b.tendon_id);
     b.replaced = mm->actuator_gaintype[a] == mjGAIN_MUSCLE ? "muscle" : "general";
     auto f = PeakForce(mm, a, name, o.force, &b.force_source);
-    if (!f.ok()) return Error{"'" + o.model + "': " + f.error()};
+    if (!f.ok()) return Error{"'" + o.model + "': " + f.error(), f.code()};
     b.peak_force = *f;
     const sma::TendonRange r = sma::SampleTendonRange(mm, d.get(), b.tendon_id);
     for (std::size_t i = 0; i < r.joints.size(); ++i) {
@@ -122,7 +122,7 @@ Status Size(std::vector<BundleReport>& bundles, const SizingLimits& limits) {
     SizingInput in{b.name,       b.peak_force, b.length_max - b.length_min,
                    b.length_min, b.length_max, b.ref_length};
     auto design = SizeBundle(in, limits);
-    if (!design.ok()) return Error{design.error()};
+    if (!design.ok()) return Error{design.error(), design.code()};
     b.design = std::move(design).value();
   }
   return Status::Ok();
@@ -132,10 +132,10 @@ Status Size(std::vector<BundleReport>& bundles, const SizingLimits& limits) {
 Status WriteChecked(const std::string& path, const std::string& text,
                     Status (*check)(const std::string& temp)) {
   AtomicFile file(path);
-  if (!file.ok()) return Error{file.error()};
+  if (!file.ok()) return Error{file.error(), file.code()};
   file.stream() << text;
   file.stream().flush();
-  if (!file.stream()) return Error{"cannot write '" + path + "'"};
+  if (!file.stream()) return Error{"cannot write '" + path + "'", ErrorCode::kIo};
   if (check != nullptr) {
     Status ok = check(file.temp_path());
     if (!ok.ok()) return ok;
@@ -155,16 +155,16 @@ Status LoadsFromFile(const std::string& temp) {
 
 Result<AttachReport> Attach(const AttachOptions& o) {
   Status paths = CheckPaths(o);
-  if (!paths.ok()) return Error{paths.error()};
+  if (!paths.ok()) return Error{paths.error(), paths.code()};
   sma::RegisterSmaPlugin();
   auto spec = ParseSpec(o.model);
-  if (!spec.ok()) return Error{spec.error()};
+  if (!spec.ok()) return Error{spec.error(), spec.code()};
   auto names = SelectActuators(spec->get(), o);
-  if (!names.ok()) return Error{names.error()};
+  if (!names.ok()) return Error{names.error(), names.code()};
   auto bundles = Probe(spec->get(), *names, o);
-  if (!bundles.ok()) return Error{bundles.error()};
+  if (!bundles.ok()) return Error{bundles.error(), bundles.code()};
   Status sized = Size(*bundles, o.limits);
-  if (!sized.ok()) return Error{sized.error()};
+  if (!sized.ok()) return Error{sized.error(), sized.code()};
 
   AttachReport report;
   report.model = o.model;
@@ -184,14 +184,15 @@ Result<AttachReport> Attach(const AttachOptions& o) {
       b.sensor = UniqueName(s, mjOBJ_SENSOR, b.name + "_truth");
       Status ok = ReplaceWithBundle(
           s, {b.name, b.instance, b.sensor, b.design.gear, b.design.ConfigPairs()});
-      if (!ok.ok()) return Error{ok.error()};
+      if (!ok.ok()) return Error{ok.error(), ok.code()};
     }
     RebaseAssetDirs(s, o.model, o.output);
     auto fixes = CheckLengthRanges(s, o.lengthrange_from_joints);
-    if (!fixes.ok()) return Error{"'" + o.model + "': " + fixes.error()};
+    if (!fixes.ok()) return Error{"'" + o.model + "': " + fixes.error(), fixes.code()};
     report.lengthranges = std::move(fixes).value();
     auto compiled = CompileSpec(s);
-    if (!compiled.ok()) return Error{"the edited model does not compile: " + compiled.error()};
+    if (!compiled.ok())
+      return Error{"the edited model does not compile: " + compiled.error(), compiled.code()};
     for (const BundleReport& b : report.bundles) {
       const int a = mj_name2id(compiled->get(), mjOBJ_ACTUATOR, b.name.c_str());
       if (a < 0 || (*compiled)->actuator_trnid[2 * a] != b.tendon_id) {
@@ -199,24 +200,24 @@ Result<AttachReport> Attach(const AttachOptions& o) {
       }
     }
     auto xml = SaveXmlString(s);
-    if (!xml.ok()) return Error{xml.error()};
+    if (!xml.ok()) return Error{xml.error(), xml.code()};
     report.changes = ChangeLines(report, s);
     if (!o.task.empty()) {
       auto task = StarterTask(report, o.lock, o.task);
-      if (!task.ok()) return Error{task.error()};
+      if (!task.ok()) return Error{task.error(), task.code()};
       report.task = o.task;
       Status w = WriteChecked(o.output, *xml, &LoadsFromFile);
-      if (!w.ok()) return Error{w.error()};
+      if (!w.ok()) return Error{w.error(), w.code()};
       Status t = WriteFileAtomically(o.task, task->dump(2) + "\n");
-      if (!t.ok()) return Error{t.error()};
+      if (!t.ok()) return Error{t.error(), t.code()};
     } else {
       Status w = WriteChecked(o.output, *xml, &LoadsFromFile);
-      if (!w.ok()) return Error{w.error()};
+      if (!w.ok()) return Error{w.error(), w.code()};
     }
   }
   if (!o.report.empty()) {
     Status r = WriteFileAtomically(o.report, ReportJson(report).dump(2) + "\n");
-    if (!r.ok()) return Error{r.error()};
+    if (!r.ok()) return Error{r.error(), r.code()};
   }
   return report;
 }

@@ -46,7 +46,7 @@ Result<std::vector<LengthRangeFix>> CheckLengthRanges(mjSpec* spec, bool apply) 
   ModelPtr plain;  // compiled without lengthrange computation, for the joint sampling
   while (true) {
     auto trial = CopySpec(spec);
-    if (!trial.ok()) return Error{trial.error()};
+    if (!trial.ok()) return Error{trial.error(), trial.code()};
     for (const LengthRangeFix& f : fixes) {
       mjsActuator* a = FindActuator(trial->get(), f.actuator);
       a->lengthrange[0] = f.lo;
@@ -56,18 +56,18 @@ Result<std::vector<LengthRangeFix>> CheckLengthRanges(mjSpec* spec, bool apply) 
     if (m.ok()) break;
     const int k = FailingActuator(m.error());
     if (k < 0 || k >= static_cast<int>(names.size()) || fixes.size() >= names.size()) {
-      return Error{m.error()};
+      return Error{m.error(), m.code()};
     }
     if (!plain) {
       auto copy = CopySpec(spec);
-      if (!copy.ok()) return Error{copy.error()};
+      if (!copy.ok()) return Error{copy.error(), copy.code()};
       (*copy)->compiler.LRopt.mode = mjLRMODE_NONE;
       auto p = CompileSpec(copy->get());
-      if (!p.ok()) return Error{p.error()};
+      if (!p.ok()) return Error{p.error(), p.code()};
       plain = std::move(p).value();
     }
     auto fix = FromJoints(plain.get(), k, names[k]);
-    if (!fix.ok()) return Error{fix.error()};
+    if (!fix.ok()) return Error{fix.error(), fix.code()};
     fixes.push_back(*fix);
   }
   if (fixes.empty()) return fixes;

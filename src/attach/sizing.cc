@@ -32,7 +32,7 @@ Result<sma::UnitModel> DesignUnit(double d, double length, int series, const Siz
   for (int i = 0; i < 60; ++i) {
     p.current = 0.5 * (lo + hi);
     auto u = sma::UnitModel::Create(p);
-    if (!u.ok()) return Error{u.error()};
+    if (!u.ok()) return Error{u.error(), u.code()};
     (u->on_temperature() > limits.steady_temperature ? hi : lo) = p.current;
   }
   // Never above Dynalloy's 1 s contraction current; a wire that then settles too cool to
@@ -113,7 +113,7 @@ Result<BundleDesign> SizeBundle(const SizingInput& in, const SizingLimits& limit
     auto unit = DesignUnit(stock[i], length, series, limits);
     if (!unit.ok()) {
       if (i + 1 < stock.size() || fast_found) continue;
-      return Error{where + unit.error()};
+      return Error{where + unit.error(), unit.code()};
     }
     const double s_mid = unit->params().prestretch - out.gear * (in.length_max - l_mid);
     const double per_wire = out.gear * unit->Tension(0.0, s_mid);
@@ -147,7 +147,7 @@ Result<BundleDesign> SizeBundle(const SizingInput& in, const SizingLimits& limit
   }
   if (!chosen) return Error{where + "no stock wire meets the force"};
   auto u = sma::UnitModel::Create(out.unit);
-  if (!u.ok()) return Error{where + u.error()};
+  if (!u.ok()) return Error{where + u.error(), u.code()};
   const sma::UnitLimits datasheet = sma::UnitLimits::ForWire(out.unit.wire_diameter);
   auto stretch = [&](double l) { return out.unit.prestretch + out.gear * (l - in.ref_length); };
   const double n = out.units;

@@ -142,7 +142,7 @@ static mjsDefault* BundleClass(mjSpec* spec) {
 
 Status ReplaceWithBundle(mjSpec* spec, const BundleEdit& edit) {
   auto found = FindTendonActuator(spec, edit.actuator);
-  if (!found.ok()) return Error{found.error()};
+  if (!found.ok()) return Error{found.error(), found.code()};
   mjsActuator* a = *found;
   if (mjs_activatePlugin(spec, "recruit.sma") != 0) {
     return Error{"the recruit.sma plugin is not registered in this process"};
@@ -231,7 +231,7 @@ Result<std::string> SaveXmlString(const mjSpec* spec) {
     xml.assign(need + 1, '\0');
     need = mj_saveXMLString(spec, xml.data(), static_cast<int>(xml.size()), error, sizeof error);
   }
-  if (need != 0) return Error{std::string("cannot write the model: ") + error};
+  if (need != 0) return Error{std::string("cannot write the model: ") + error, ErrorCode::kIo};
   xml.resize(std::char_traits<char>::length(xml.c_str()));
   return xml;
 }

@@ -56,7 +56,7 @@ int RunAttach(AttachArgs& a) {
     }
   }
   auto report = attach::Attach(o);
-  if (!report.ok()) return Fail(cmd, report.error());
+  if (!report.ok()) return Fail(cmd, report.failure());
   for (const std::string& line : report->changes) std::cout << "changed: " << line << "\n";
   std::cout << attach::DesignTable(*report);
   if (!report->output.empty()) std::cout << "wrote " << report->output << "\n";

@@ -56,13 +56,13 @@ extern "C" {
 // librecruit-plot.so: recruit::plot::RenderFigure (`bytes` on success, else `error`).
 using RecruitPlotFigureFn = void (*)(const recruit::plot::Figure* figure, int width, int height,
                                      recruit::plot::Format format, std::string* bytes,
-                                     std::string* error);
+                                     recruit::Error* error);
 // librecruit-render.so: checks the options and the camera and opens the outputs.
 using RecruitRenderOpenFn = void (*)(const recruit::cli::RenderOpenRequest* request,
                                      recruit::cli::RenderOpenResult* result);
 // librecruit-plot.so: recruit::plot::RunPlot.
 using RecruitPlotRunFn = void (*)(const recruit::plot::PlotOptions* options,
-                                  std::vector<std::string>* written, std::string* error);
+                                  std::vector<std::string>* written, recruit::Error* error);
 }
 
 namespace recruit::cli {

@@ -12,6 +12,7 @@
 
 #include "common/exit_codes.h"
 #include "common/short_text.h"
+#include "control/sampling_period.h"
 
 namespace recruit::cli {
 
@@ -20,9 +21,9 @@ inline int Fail(const std::string& command, const std::string& message, int code
   std::cerr << "recruit " << command << ": " << ShortenLongTokens(message, 200) << "\n";
   return code;
 }
-// Same, with the class read from the message (I/O wording -> 4, else bad input -> 3).
-inline int Fail(const std::string& command, const std::string& message) {
-  return Fail(command, message, exit_code::FromMessage(message));
+// Same, with the exit code of the error's class (common/exit_codes.h).
+inline int Fail(const std::string& command, const Error& error) {
+  return Fail(command, error.message, exit_code::Of(error));
 }
 
 // Numeric option checks with our own messages: CLI11's ranges print their bounds, which for
@@ -51,5 +52,9 @@ inline CLI::Validator NonNegative() {
   return NumberIn(0, false, std::numeric_limits<double>::max(), "a finite number >= 0");
 }
 inline CLI::Validator Fraction() { return NumberIn(0, true, 1, "in (0, 1]"); }
+// The controller's sampling period (control/sampling_period.h).
+inline CLI::Validator SamplingPeriod() {
+  return NumberIn(0, true, control::kMaxDT, "a finite number > 0 and <= 1000 (seconds)");
+}
 
 }  // namespace recruit::cli

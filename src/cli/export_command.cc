@@ -27,12 +27,12 @@ int RunExport(const ExportArgs& a) {
   auto precision = exporter::ParsePrecision(a.precision);
   if (!precision) return Fail(cmd, "--precision: " + precision.error(), exit_code::kUsage);
   auto task = sim::Task::FromFile(a.task);
-  if (!task.ok()) return Fail(cmd, task.error());
+  if (!task.ok()) return Fail(cmd, task.failure());
   sim::RunOptions run = a.run;
   if (!a.sweep.empty()) {
     const sim::ControllerSettings s = sim::EffectiveSettings(*task, run);
     auto choice = exporter::SweepChoice(a.sweep, *task, s.estimator);
-    if (!choice) return Fail(cmd, "--sweep: " + choice.error());
+    if (!choice) return Fail(cmd, choice.failure().In("--sweep: "));
     run.dT = choice->dT;
     run.lambda = choice->lambda;
     std::cout << "sweep " << a.sweep << " recommends dT " << choice->dT << " s, lambda "
@@ -44,7 +44,7 @@ int RunExport(const ExportArgs& a) {
       {"the task's model", task->model_path},
       {"the filter model", settings.filter_model}};
   auto pkg = exporter::ExportController(*task, run, *precision);
-  if (!pkg.ok()) return Fail(cmd, pkg.error());
+  if (!pkg.ok()) return Fail(cmd, pkg.failure());
   const std::filesystem::path out(a.out);
   for (const exporter::ExportedFile& f : pkg->files) {
     if (Status s = CheckNotAnInput((out / f.name).string(), "--out", inputs); !s.ok()) {

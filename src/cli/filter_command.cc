@@ -7,6 +7,7 @@
 
 #include "cli/commands.h"
 #include "common/atomic_file.h"
+#include "common/short_text.h"
 #include "estimation/count_filter.h"
 #include "estimation/filter_log.h"
 #include "estimation/filter_model.h"
@@ -28,39 +29,37 @@ Status CheckOutputIsNoInput(const std::string& out, const FilterArgs& a) {
   for (const auto& [option, input] : {std::pair{"--log", a.log}, std::pair{"--model", a.model}}) {
     std::error_code ec;
     if (out == input || std::filesystem::equivalent(out, input, ec)) {
-      return Error{"--out '" + json_io::ShortValue(out) + "' is the same file as " + option + " '" +
-                   json_io::ShortValue(input) + "'; refusing to overwrite an input"};
+      return Error{"--out '" + ShortText(out) + "' is the same file as " + option + " '" +
+                       ShortText(input) + "'; refusing to overwrite an input",
+                   ErrorCode::kUsage};
     }
   }
   return Status::Ok();
 }
 
 int RunFilter(const FilterArgs& a) {
-  auto fail = [](const std::string& msg) {
-    std::cerr << "recruit filter: " << msg << "\n";
-    return 1;
-  };
-  if (Status s = CheckOutputIsNoInput(a.out, a); !s.ok()) return fail(s.error());
+  auto fail = [](const Error& e) { return Fail("filter", e); };
+  if (Status s = CheckOutputIsNoInput(a.out, a); !s.ok()) return fail(s.failure());
   auto model = FilterModel::FromJson(a.model);
-  if (!model.ok()) return fail(model.error());
+  if (!model.ok()) return fail(model.failure());
   // A model identified on another plant than the log's is refused (its H and chain describe
   // other units), as simulate and sweep refuse it.
   if (!a.plant.empty()) {
-    auto record = control::PlantRecordOf(a.plant, a.actuator);
-    if (!record.ok()) return fail("--plant: " + record.error());
-    if (Status s = control::CheckModelPlant(a.model, *record); !s.ok()) return fail(s.error());
+    auto record = identification::PlantRecordOf(a.plant, a.actuator);
+    if (!record.ok()) return fail(record.failure().In("--plant: "));
+    if (Status s = control::CheckModelPlant(a.model, *record); !s.ok()) return fail(s.failure());
   }
   auto filter = MakeCountFilter(*model, a.options);
-  if (!filter.ok()) return fail(filter.error());
+  if (!filter.ok()) return fail(filter.failure());
   // Streamed: the log is read, stepped and written row by row (memory flat in its length).
   auto log = FilterLogReader::OpenFile(a.log, *model, a.actuator);
-  if (!log.ok()) return fail(log.error());
+  if (!log.ok()) return fail(log.failure());
   AtomicFile out(a.out, std::ios::out | std::ios::binary);
-  if (!out.ok()) return fail(out.error());
+  if (!out.ok()) return fail(out.failure());
   if (Status s = RunFilterStream(*model, **log, **filter, out.stream()); !s.ok()) {
-    return fail(s.error());  // AtomicFile removes its temporary file: nothing is written
+    return fail(s.failure());  // AtomicFile removes its temporary file: nothing is written
   }
-  if (Status s = out.Commit(); !s.ok()) return fail(s.error());
+  if (Status s = out.Commit(); !s.ok()) return fail(s.failure());
   return 0;
 }
 

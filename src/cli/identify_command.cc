@@ -45,7 +45,7 @@ struct IdentifyArgs {
 // shortest text that reads back as the written double, so the table is the file's H exactly:
 // clamped to >= 0 and, from the bench, carried onto the force law), on/off and the advance
 // probability from the fitted chain.
-void PrintModel(const recruit::control::TransientChain& c, const nlohmann::json& model) {
+void PrintModel(const recruit::identification::TransientChain& c, const nlohmann::json& model) {
   const nlohmann::json& names = model.at("states");
   const nlohmann::json& H = model.at("H").at(0);
   std::printf("%-8s %-4s %24s %10s\n", "state", "on", "H (N)", "advance");
@@ -63,7 +63,7 @@ void PrintModel(const recruit::control::TransientChain& c, const nlohmann::json&
   }
 }
 
-void PrintFit(const recruit::control::IdentificationResult& fit) {
+void PrintFit(const recruit::identification::IdentificationResult& fit) {
   std::printf("train:   %d samples, RMSE %.3f N, R^2 %.4f\n", fit.train.samples, fit.train.rmse,
               fit.train.r2);
   std::printf(
@@ -77,20 +77,21 @@ void PrintFit(const recruit::control::IdentificationResult& fit) {
 // --log: the chain fitted to a recorded switching log (plant unknown: no length model).
 Result<nlohmann::json> IdentifyFromLog(const IdentifyArgs& a, const std::string& command_line) {
   using namespace recruit::control;
+  using namespace recruit::identification;
   auto log = SwitchingLog::FromCsv(a.log_in, a.units, a.actuator);
-  if (!log) return Error{log.error()};
+  if (!log) return Error{log.error(), log.code()};
   FitOptions opt;
   opt.num_states = a.states;
   opt.holdout_fraction = a.holdout;
   opt.smoothness = a.smoothness;
   auto fit = IdentifyTransientModel(*log, opt);
-  if (!fit) return Error{fit.error()};
+  if (!fit) return Error{fit.error(), fit.code()};
   // Forces below zero (a few hundredths of a newton in the cooling tail) are none: H >= 0. With
   // the plant unknown, no force law carries H to other lengths (that needs --bench).
   TransientChain c = fit->chain;
   c.force = c.force.cwiseMax(0.0);
   const FilterModel model = ToFilterModel(c, log->num_units, log->dT, fit->force_noise_var);
-  if (Status s = model.Validate("identified model"); !s) return Error{s.error()};
+  if (Status s = model.Validate("identified model"); !s) return Error{s.error(), s.code()};
   nlohmann::json j = model.ToJson();
   j["identification"] = {{"command", command_line},
                          {"source", a.log_in},
@@ -110,6 +111,7 @@ Result<nlohmann::json> IdentifyFromLog(const IdentifyArgs& a, const std::string&
 // --bench: the shared pipeline on the MuJoCo plant (identification/plant_identification.h).
 Result<nlohmann::json> IdentifyFromBench(const IdentifyArgs& a, const std::string& command_line) {
   using namespace recruit::control;
+  using namespace recruit::identification;
   PlantIdentificationOptions o;
   o.dT = a.dT;
   o.num_states = a.states;
@@ -121,12 +123,12 @@ Result<nlohmann::json> IdentifyFromBench(const IdentifyArgs& a, const std::strin
   std::cerr << "recruit identify: recording " << a.duration << " s on " << a.bench
             << " at dT = " << a.dT << " s, then checks at other tendon lengths\n";
   auto id = IdentifyOnPlant(a.bench, a.actuator, o, command_line);
-  if (!id) return Error{id.error()};
+  if (!id) return Error{id.error(), id.code()};
   if (!a.save_log.empty()) {
     if (Status s = CheckNotAnInput(a.save_log, "--save-log", {{"--bench", a.bench}}); !s.ok()) {
-      return Error{s.error()};
+      return Error{s.error(), s.code()};
     }
-    if (Status s = id->log.SaveCsv(a.save_log); !s) return Error{s.error()};
+    if (Status s = id->log.SaveCsv(a.save_log); !s) return Error{s.error(), s.code()};
   }
   const nlohmann::json& ident = id->model["identification"];
   std::printf("identified %d-state model, N = %d, dT = %g s, on %s %s (held at %s)\n",
@@ -147,6 +149,7 @@ Result<nlohmann::json> IdentifyFromBench(const IdentifyArgs& a, const std::strin
 
 int RunIdentify(const IdentifyArgs& a, const std::string& command_line) {
   using namespace recruit::control;
+  using namespace recruit::identification;
   if (a.states < 4 || a.states % 2 != 0) {
     return Fail("identify", "--states " + std::to_string(a.states) + ": must be even and >= 4",
                 exit_code::kUsage);
@@ -163,7 +166,7 @@ int RunIdentify(const IdentifyArgs& a, const std::string& command_line) {
     }
   }
   auto j = a.log_in.empty() ? IdentifyFromBench(a, command_line) : IdentifyFromLog(a, command_line);
-  if (!j) return Fail("identify", j.error());
+  if (!j) return Fail("identify", j.failure());
   if (out.empty()) {
     // The model cache, where simulate and sweep look for it (identification/model_cache.h).
     const auto& plant = (*j)["identification"]["plant"];

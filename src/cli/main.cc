@@ -12,32 +12,10 @@
 #include "cli/commands.h"
 #include "cli/errors.h"
 #include "common/atomic_file.h"
+#include "common/data_path.h"
 #include "common/version.h"
 
 namespace {
-
-// Keeps a copy of what a command writes to stderr, so the exit code of commands that report
-// failure as 1 (filter, plot) can be mapped to the class their message names.
-class TeeBuf : public std::streambuf {
- public:
-  explicit TeeBuf(std::streambuf* to) : to_(to) {}
-  const std::string& text() const { return text_; }
-
- protected:
-  int overflow(int c) override {
-    if (c != EOF && text_.size() < 65536) text_ += static_cast<char>(c);
-    return c == EOF ? 0 : to_->sputc(static_cast<char>(c));
-  }
-  std::streamsize xsputn(const char* s, std::streamsize n) override {
-    if (text_.size() < 65536) text_.append(s, static_cast<size_t>(n));
-    return to_->sputn(s, n);
-  }
-  int sync() override { return to_->pubsync(); }
-
- private:
-  std::streambuf* to_;
-  std::string text_;
-};
 
 // `recruit --version`: this build's version and the MuJoCo it was compiled against (its header)
 // and runs with (the libmujoco loaded). mjVERSION_HEADER is major * 1e6 + minor * 1e3 + patch.
@@ -55,6 +33,7 @@ std::string VersionText() {
 int main(int argc, char** argv) {
   using namespace recruit;
   InstallTempFileCleanupOnSignals();
+  SetDataDir(RECRUIT_DATA_DIR_DEFAULT);  // models/identified/ of the tree it was built from
   CLI::App app{
       "Recruit: stochastic recruitment control of SMA muscle bundles in MuJoCo, with the "
       "population Kalman filter of Odhner and Asada (ACC 2010).\n"
@@ -86,12 +65,6 @@ int main(int argc, char** argv) {
     std::cout << app.help();
     return 0;
   }
-  TeeBuf tee(std::cerr.rdbuf());
-  std::streambuf* old = std::cerr.rdbuf(&tee);
-  struct Restore {
-    std::streambuf* old;
-    ~Restore() { std::cerr.rdbuf(old); }
-  } restore{old};
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -114,12 +87,6 @@ int main(int argc, char** argv) {
     std::cerr << "recruit: internal error (please report it): " << ShortenLongTokens(e.what())
               << "\n";
     return exit_code::kInternal;
-  }
-  // filter and plot report every failure as 1: map it to the class their message names.
-  if (exit_code == 1) {
-    exit_code = tee.text().find("refusing to overwrite an input") != std::string::npos
-                    ? exit_code::kUsage
-                    : exit_code::FromMessage(tee.text());
   }
   return exit_code;
 }

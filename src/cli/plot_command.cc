@@ -65,10 +65,10 @@ void AddPlotCommand(CLI::App& app, int& exit_code) {
       return;
     }
     std::vector<std::string> written;
-    module->run(o.get(), &written, &error);
-    if (!error.empty()) {
-      std::cerr << "recruit plot: " << error << "\n";
-      exit_code = 1;
+    Error failed;
+    module->run(o.get(), &written, &failed);
+    if (!failed.message.empty()) {
+      exit_code = Fail("plot", failed);
       return;
     }
     for (const auto& p : written) std::cout << p << "\n";

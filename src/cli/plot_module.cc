@@ -10,22 +10,22 @@
 
 extern "C" __attribute__((visibility("default"))) void recruit_plot_run(
     const recruit::plot::PlotOptions* options, std::vector<std::string>* written,
-    std::string* error) {
+    recruit::Error* error) {
   auto r = recruit::plot::RunPlot(*options);
   if (r.ok()) {
     *written = std::move(*r);
   } else {
-    *error = r.error();
+    *error = r.failure();
   }
 }
 
 extern "C" __attribute__((visibility("default"))) void recruit_plot_figure(
     const recruit::plot::Figure* figure, int width, int height, recruit::plot::Format format,
-    std::string* bytes, std::string* error) {
+    std::string* bytes, recruit::Error* error) {
   auto r = recruit::plot::RenderFigure(*figure, width, height, format);
   if (r.ok()) {
     *bytes = std::move(*r);
   } else {
-    *error = r.error();
+    *error = r.failure();
   }
 }

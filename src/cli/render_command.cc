@@ -34,7 +34,7 @@ struct RenderArgs {
 int Run(RenderArgs& a) {
   auto task = sim::Task::FromFile(a.task);
   if (!task.ok()) {
-    return Fail("render", task.error());
+    return Fail("render", task.failure());
   }
   render::VideoOptions& v = a.video;
   v.mp4_path = a.out;
@@ -99,10 +99,10 @@ int Run(RenderArgs& a) {
   run.progress = run.progress || ::isatty(STDERR_FILENO);
   auto result = sim::RunTask(*task, run, {&session});
   if (!result.ok()) {
-    return Fail("render", result.error());
+    return Fail("render", result.failure());
   }
   if (Status s = session.Finish(); !s.ok()) {
-    return Fail("render", s.error());
+    return Fail("render", s.failure());
   }
   std::cout << "task " << result->task << ", seed " << result->seed << ": " << session.Report()
             << "\n  " << result->duration << " s simulated and rendered in " << result->wall_seconds

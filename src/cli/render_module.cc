@@ -72,7 +72,7 @@ void Open(const RenderOpenRequest& req, RenderOpenResult* out) {
   auto recorder = render::VideoRecorder::Create(v);
   if (!recorder.ok()) {
     out->error = recorder.error();
-    out->exit_code = exit_code::FromMessage(recorder.error());
+    out->exit_code = exit_code::Of(recorder.code());
     return;
   }
   out->session = std::make_unique<Session>(std::move(*recorder), v);

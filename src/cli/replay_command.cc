@@ -31,7 +31,7 @@ int RunReplayCommand(const ReplayArgs& a) {
     return Fail(cmd, s.error() + " (name the outputs with --prefix)", exit_code::kUsage);
   }
   auto task = sim::Task::FromFile(a.task);
-  if (!task.ok()) return Fail(cmd, task.error());
+  if (!task.ok()) return Fail(cmd, task.failure());
   const fs::path out(a.out);
   const std::string json = (out / (prefix + "_replay.json")).string();
   const std::string csv = (out / (prefix + "_replay.csv")).string();
@@ -43,18 +43,21 @@ int RunReplayCommand(const ReplayArgs& a) {
     if (!s.ok()) return Fail(cmd, s.error(), exit_code::kUsage);
   }
   auto log = ReadBenchLog(a.log);
-  if (!log.ok()) return Fail(cmd, log.error());
+  if (!log.ok()) return Fail(cmd, log.failure());
   auto result = replay::RunReplay(*task, *log, a.options);
-  if (!result.ok()) return Fail(cmd, result.error());
+  if (!result.ok()) return Fail(cmd, result.failure());
   // Every output is made before any is written: an error leaves nothing behind.
   std::string error;
   const PlotModule* plot = OpenPlotModule(&error);
   if (!plot) return Fail(cmd, error, exit_code::kIo);
   const plot::Figure fig = replay::ReplayFigure(*result);
   std::string bytes;
+  Error failed;
   plot->figure(&fig, 1000, 260 + 220 * static_cast<int>(fig.panels.size()), plot::Format::kPng,
-               &bytes, &error);
-  if (!error.empty()) return Fail(cmd, "figure: " + error, exit_code::kInternal);
+               &bytes, &failed);
+  if (!failed.message.empty()) {
+    return Fail(cmd, "figure: " + failed.message, exit_code::kInternal);
+  }
   std::error_code ec;
   fs::create_directories(out, ec);
   if (ec) return Fail(cmd, "cannot create --out '" + ShortText(a.out) + "': " + ec.message(), 4);

@@ -22,9 +22,9 @@ void AddRunOptions(CLI::App* cmd, sim::RunOptions* options) {
       ->check(CLI::ExistingFile);
   cmd->add_option_function<double>(
          "--dT", [options](double v) { options->dT = v; },
-         "Controller sampling period, s (> 0) [default: the task file's]")
+         "Controller sampling period, s, in (0, 1000] [default: the task file's]")
       ->type_name("SECONDS")
-      ->check(Positive());
+      ->check(SamplingPeriod());
   cmd->add_option_function<double>(
          "--lambda", [options](double v) { options->lambda = v; },
          "Gain of the expectation law, in (0, 1] [default: the task file's]")

@@ -26,7 +26,7 @@ struct SimulateArgs {
 int RunSimulate(const SimulateArgs& a) {
   const std::string cmd = "simulate";
   auto task = sim::Task::FromFile(a.task);
-  if (!task.ok()) return Fail(cmd, task.error());
+  if (!task.ok()) return Fail(cmd, task.failure());
   // The task's name becomes part of the default output names: it must stay inside --out.
   if (a.csv.empty() || a.summary.empty()) {
     if (Status s = CheckFileNameComponent(task->name, a.task + ": name"); !s.ok()) {
@@ -61,7 +61,7 @@ int RunSimulate(const SimulateArgs& a) {
   if (!summary_file.ok()) return Fail(cmd, summary_file.error(), exit_code::kIo);
   sim::CsvStepWriter writer(csv, a.csv_every);
   auto result = sim::RunTask(*task, run, {&writer});
-  if (!result.ok()) return Fail(cmd, result.error());
+  if (!result.ok()) return Fail(cmd, result.failure());
   summary_file.stream() << result->ToJson().dump(2) << "\n";
   // Both or neither: the summary first (a failure leaves the CSV's temporary file, removed with
   // the writer), then the CSV (a failure removes the summary just written).

@@ -42,9 +42,9 @@ void PrintDesign(const sim::JointDesignRecord& r, bool response) {
 int RunTuneLoop(const TuneLoopArgs& a) {
   const std::string cmd = "tune-loop";
   auto task = sim::Task::FromFile(a.task);
-  if (!task.ok()) return Fail(cmd, task.error());
+  if (!task.ok()) return Fail(cmd, task.failure());
   auto designs = sim::DesignTaskLoops(*task, a.run);
-  if (!designs.ok()) return Fail(cmd, designs.error());
+  if (!designs.ok()) return Fail(cmd, designs.failure());
   const sim::ControllerSettings s = sim::EffectiveSettings(*task, a.run);
   std::printf(
       "task %s: dT %g s, lambda %g, estimator %s; target: overshoot <= 5 %%, settle into "

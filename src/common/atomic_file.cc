@@ -84,15 +84,17 @@ AtomicFile::~AtomicFile() {
 }
 
 Status AtomicFile::Commit() {
-  if (!ok()) return Error{error_};
+  if (!ok()) return IoError(error_);
   out_.flush();
   const bool good = out_.good();
   out_.close();  // close() flushes the last buffer: a full disk can show only here
   if (!good || out_.fail()) {
-    return Error{"cannot write '" + path_ + "': the write failed (disk full or file too large?)"};
+    return Error{"cannot write '" + path_ + "': the write failed (disk full or file too large?)",
+                 ErrorCode::kIo};
   }
   if (std::rename(temp_path_.c_str(), path_.c_str()) != 0) {
-    return Error{"cannot rename '" + temp_path_ + "' to '" + path_ + "': " + std::strerror(errno)};
+    return Error{"cannot rename '" + temp_path_ + "' to '" + path_ + "': " + std::strerror(errno),
+                 ErrorCode::kIo};
   }
   committed_ = true;
   UnregisterTempFile(slot_);
@@ -102,17 +104,17 @@ Status AtomicFile::Commit() {
 
 Status WriteFileAtomically(const std::string& path, const std::string& contents) {
   AtomicFile f(path, std::ios::binary);
-  if (!f.ok()) return Error{f.error()};
+  if (!f.ok()) return Error{f.error(), f.code()};
   f.stream() << contents;
   return f.Commit();
 }
 
 Result<std::string> ReadFile(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
-  if (!in) return Error{"cannot open '" + path + "': " + std::strerror(errno)};
+  if (!in) return Error{"cannot open '" + path + "': " + std::strerror(errno), ErrorCode::kIo};
   std::ostringstream ss;
   ss << in.rdbuf();
-  if (in.bad()) return Error{"cannot read '" + path + "'"};
+  if (in.bad()) return Error{"cannot read '" + path + "'", ErrorCode::kIo};
   return ss.str();
 }
 

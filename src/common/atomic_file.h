@@ -21,6 +21,8 @@ class AtomicFile {
 
   bool ok() const { return error_.empty(); }
   const std::string& error() const { return error_; }
+  ErrorCode code() const { return ErrorCode::kIo; }  // when !ok(): an I/O failure
+  Error failure() const { return IoError(error_); }
   std::ofstream& stream() { return out_; }
   const std::string& path() const { return path_; }
   const std::string& temp_path() const { return temp_path_; }

@@ -1,7 +1,8 @@
 // One exit code per class of failure, the same for every `recruit` command (docs/reliability.md).
+// The class travels with the error (ErrorCode, common/result.h), never in its wording.
 #pragma once
 
-#include <string>
+#include "common/result.h"
 
 namespace recruit::exit_code {
 
@@ -11,15 +12,19 @@ constexpr int kBadInput = 3;  // an input file's content is invalid (task, model
 constexpr int kIo = 4;        // a file cannot be read or written (permissions, full disk, ...)
 constexpr int kInternal = 5;  // a bug: an unexpected exception; please report it
 
-// Classifies an error message of a Result/Status: I/O failures (the wording of AtomicFile,
-// ReadFile, the JSON loader and the filesystem calls) are kIo, everything else is kBadInput.
-inline int FromMessage(const std::string& message) {
-  for (const char* marker :
-       {"cannot open", "cannot write", "cannot read", "cannot rename", "cannot create", "disk full",
-        "No space left", "File too large", "Permission denied", "Read-only file system"}) {
-    if (message.find(marker) != std::string::npos) return kIo;
+inline int Of(ErrorCode code) {
+  switch (code) {
+    case ErrorCode::kBadInput:
+      return kBadInput;
+    case ErrorCode::kUsage:
+      return kUsage;
+    case ErrorCode::kIo:
+      return kIo;
+    case ErrorCode::kInternal:
+      return kInternal;
   }
-  return kBadInput;
+  return kInternal;
 }
+inline int Of(const Error& e) { return Of(e.code); }
 
 }  // namespace recruit::exit_code

@@ -11,7 +11,8 @@ namespace recruit {
 
 Result<FileLock> FileLock::TryLock(const std::string& path) {
   const int fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
-  if (fd < 0) return Error{"cannot open lock file '" + path + "': " + std::strerror(errno)};
+  if (fd < 0)
+    return Error{"cannot open lock file '" + path + "': " + std::strerror(errno), ErrorCode::kIo};
   if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
     const int err = errno;
     char pid[32] = "";
@@ -24,7 +25,8 @@ Result<FileLock> FileLock::TryLock(const std::string& path) {
                    "): another sweep is writing into this folder; wait for it or use another "
                    "--out"};
     }
-    return Error{"cannot lock '" + path + "': " + std::strerror(err)};
+    return Error{"cannot lock '" + path + "': " + std::strerror(err),
+                 CodeOf(std::error_code(err, std::generic_category()))};
   }
   const std::string me = std::to_string(::getpid()) + "\n";
   if (::ftruncate(fd, 0) == 0) {
@@ -35,7 +37,8 @@ Result<FileLock> FileLock::TryLock(const std::string& path) {
 
 Result<FileLock> FileLock::Lock(const std::string& path) {
   const int fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
-  if (fd < 0) return Error{"cannot open lock file '" + path + "': " + std::strerror(errno)};
+  if (fd < 0)
+    return Error{"cannot open lock file '" + path + "': " + std::strerror(errno), ErrorCode::kIo};
   int rc;
   do {
     rc = ::flock(fd, LOCK_EX);
@@ -43,7 +46,8 @@ Result<FileLock> FileLock::Lock(const std::string& path) {
   if (rc != 0) {
     const int err = errno;
     ::close(fd);
-    return Error{"cannot lock '" + path + "': " + std::strerror(err)};
+    return Error{"cannot lock '" + path + "': " + std::strerror(err),
+                 CodeOf(std::error_code(err, std::generic_category()))};
   }
   return FileLock(fd);
 }

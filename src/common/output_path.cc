@@ -33,7 +33,8 @@ Status CheckNotAnInput(const std::string& out, const std::string& out_label,
         fs::absolute(out, ec).lexically_normal() == fs::absolute(input, ec).lexically_normal();
     if (same_path || fs::equivalent(out, input, ec)) {
       return Error{out_label + " '" + ShortText(out) + "' is the same file as " + label + " '" +
-                   ShortText(input) + "'; refusing to overwrite an input"};
+                       ShortText(input) + "'; refusing to overwrite an input",
+                   ErrorCode::kUsage};
     }
   }
   return Status::Ok();

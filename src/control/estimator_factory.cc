@@ -8,10 +8,12 @@
 #include <string>
 
 #include "common/atomic_file.h"
+#include "common/data_path.h"
 #include "control/kalman_estimator.h"
 #include "control/model_plant.h"
 #include "control/on_count_estimator.h"
 #include "control/output_estimator.h"
+#include "control/sampling_period.h"
 #include "estimation/filter_model.h"
 #include "estimation/json_matrix.h"
 #include "estimation/population_kalman_filter.h"
@@ -19,16 +21,17 @@
 namespace recruit::control {
 namespace {
 
-// A relative path is tried from the working directory, then from the source tree (so that the
-// shipped models/identified/ files are found from a build directory too).
+// A relative path is tried from the working directory, then from the data folder the program
+// set (common/data_path.h), so that the shipped models/identified/ files are found from a build
+// directory too.
 std::string ResolveModelPath(const std::string& path) {
   namespace fs = std::filesystem;
   std::error_code ec;
   if (path.empty() || fs::path(path).is_absolute() || fs::exists(path, ec)) return path;
-#ifdef RECRUIT_SOURCE_DIR
-  const fs::path alt = fs::path(RECRUIT_SOURCE_DIR) / path;
-  if (fs::exists(alt, ec)) return alt.string();
-#endif
+  if (const std::string data = DataDir(); !data.empty()) {
+    const fs::path alt = fs::path(data) / path;
+    if (fs::exists(alt, ec)) return alt.string();
+  }
   return path;
 }
 
@@ -58,7 +61,7 @@ Result<EstimatorSpec> EstimatorSpec::Parse(const std::string& kind, const std::s
                                            const std::string& model_file, int num_states,
                                            double force_noise_std) {
   auto k = ParseEstimatorKind(kind);
-  if (!k) return Error{k.error()};
+  if (!k) return Error{k.error(), k.code()};
   auto c = ParseCovarianceMode(covariance);
   if (!c) {
     return Error{"estimator: covariance \"" + covariance +
@@ -95,9 +98,9 @@ Result<EstimatorSpec> EstimatorSpec::FromJson(const nlohmann::json& j, const std
     out = j[key].get<std::string>();
     return Status::Ok();
   };
-  if (Status s = str("kind", d.kind); !s) return Error{s.error()};
-  if (Status s = str("covariance", d.covariance); !s) return Error{s.error()};
-  if (Status s = str("model_file", d.model_file); !s) return Error{s.error()};
+  if (Status s = str("kind", d.kind); !s) return Error{s.error(), s.code()};
+  if (Status s = str("covariance", d.covariance); !s) return Error{s.error(), s.code()};
+  if (Status s = str("model_file", d.model_file); !s) return Error{s.error(), s.code()};
   if (j.contains("num_states")) {
     if (!j["num_states"].is_number_integer()) {
       return Error{where + ": estimator.num_states must be an integer"};
@@ -119,7 +122,7 @@ Result<EstimatorSpec> EstimatorSpec::FromJson(const nlohmann::json& j, const std
     }
   }
   auto r = Parse(d.kind, d.covariance, d.model_file, d.num_states, d.force_noise_std);
-  if (!r) return Error{where + ": " + r.error()};
+  if (!r) return Error{where + ": " + r.error(), r.code()};
   return r;
 }
 
@@ -161,7 +164,7 @@ Result<UnitForceMap> ModelForceMap(const FilterModel& model, const nlohmann::jso
       xi[i] = f[i].get<double>();
     }
     auto map = UnitForceMap::FromFractions(g, xi);
-    if (!map) return Error{file + ": identification.output_fractions: " + map.error()};
+    if (!map) return Error{file + ": identification.output_fractions: " + map.error(), map.code()};
     return map;
   }
   const double stretch = ident.contains("stretch") && ident["stretch"].is_number()
@@ -177,18 +180,18 @@ Result<std::unique_ptr<OnCountEstimator>> MakeEstimator(const EstimatorSpec& spe
                                                         const UnitGeometry* geometry) {
   auto checked = EstimatorSpec::Parse(EstimatorKindName(spec.kind), ToString(spec.covariance),
                                       spec.model_file, spec.num_states, spec.force_noise_std);
-  if (!checked) return Error{checked.error()};
+  if (!checked) return Error{checked.error(), checked.code()};
   if (num_units < 1) return Error{"estimator: num_units must be >= 1"};
   if (!std::isfinite(unit_force) || unit_force <= 0) {
     return Error{"estimator: unit_force must be finite and > 0 N"};
   }
-  if (!std::isfinite(dT) || dT <= 0) return Error{"estimator: dT must be finite and > 0 s"};
+  RECRUIT_TRY(CheckDT(dT, "estimator"));
   // The settled on unit's force as a function of length, for the length-aware output estimator.
   std::optional<UnitForceMap> on_force;
   if (geometry) {
     auto map = UnitForceMap::FromForces(*geometry, geometry->unit.prestretch,
                                         Eigen::VectorXd::Constant(1, unit_force));
-    if (!map) return Error{"estimator: " + map.error()};
+    if (!map) return Error{"estimator: " + map.error(), map.code()};
     on_force = std::move(map).value();
   }
   if (spec.kind == EstimatorKind::kOutput) {
@@ -205,7 +208,7 @@ Result<std::unique_ptr<OnCountEstimator>> MakeEstimator(const EstimatorSpec& spe
     if (geometry) {
       auto map = UnitForceMap::FromForces(*geometry, geometry->unit.prestretch,
                                           Eigen::Vector2d(0.0, unit_force));
-      if (!map) return Error{"estimator: " + map.error()};
+      if (!map) return Error{"estimator: " + map.error(), map.code()};
       output = std::move(map).value();
     }
   } else {
@@ -213,20 +216,22 @@ Result<std::unique_ptr<OnCountEstimator>> MakeEstimator(const EstimatorSpec& spe
         spec.model_file.empty() ? DefaultModelFile(dT, spec.num_states) : spec.model_file);
     // The file is read and parsed once, for the model, its plant and its identification record.
     auto text = ReadFile(file);
-    auto json = text.ok() ? json_io::ParseJson(*text, file) : Error{text.error()};
-    auto loaded = json.ok() ? FilterModel::FromJsonValue(*json, file) : Error{json.error()};
+    auto json = text.ok() ? json_io::ParseJson(*text, file) : Error{text.error(), text.code()};
+    auto loaded =
+        json.ok() ? FilterModel::FromJsonValue(*json, file) : Error{json.error(), json.code()};
     if (!loaded) {
       return Error{"estimator: " + loaded.error() +
-                   (spec.model_file.empty()
-                        ? " (no identified model for this dT and number of states: make one "
-                          "with `recruit identify --dt DT --states M -o FILE` and pass it as "
-                          "the model file)"
-                        : "")};
+                       (spec.model_file.empty()
+                            ? " (no identified model for this dT and number of states: make one "
+                              "with `recruit identify --dt DT --states M -o FILE` and pass it as "
+                              "the model file)"
+                            : ""),
+                   loaded.code()};
     }
     model = std::move(loaded).value();
     if (!spec.plant.is_null()) {
       if (Status s = CheckModelPlant(file, *json, spec.plant); !s) {
-        return Error{"estimator: " + s.error()};
+        return Error{"estimator: " + s.error(), s.code()};
       }
     }
     if (model.transition != TransitionSource::kBroadcast) {
@@ -253,7 +258,7 @@ Result<std::unique_ptr<OnCountEstimator>> MakeEstimator(const EstimatorSpec& spe
     const nlohmann::json ident = IdentificationOf(*json);
     if (geometry) {
       auto map = ModelForceMap(model, ident, *geometry, file);
-      if (!map) return Error{"estimator: " + map.error()};
+      if (!map) return Error{"estimator: " + map.error(), map.code()};
       output = std::move(map).value();
       // H >= 0 at the reference length, whatever the file held.
       auto h = model.H.row(0);
@@ -269,7 +274,7 @@ Result<std::unique_ptr<OnCountEstimator>> MakeEstimator(const EstimatorSpec& spe
   }
   model.R(0, 0) += spec.sensor_variance;
   auto est = KalmanOnCountEstimator::Create(model, mode, std::move(output), relative_noise);
-  if (!est) return Error{"estimator: " + est.error()};
+  if (!est) return Error{"estimator: " + est.error(), est.code()};
   return std::unique_ptr<OnCountEstimator>(std::move(est).value());
 }
 

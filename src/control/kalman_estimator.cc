@@ -7,7 +7,7 @@ namespace recruit::control {
 Result<std::unique_ptr<KalmanOnCountEstimator>> KalmanOnCountEstimator::Create(
     const FilterModel& model, CovarianceMode mode, std::optional<UnitForceMap> output,
     double relative_noise) {
-  if (Status s = model.Validate(); !s) return Error{s.error()};
+  if (Status s = model.Validate(); !s) return Error{s.error(), s.code()};
   if (model.transition != TransitionSource::kBroadcast) {
     return Error{
         "estimator: the filter model's transition must be of type \"broadcast\" (the "
@@ -26,7 +26,7 @@ Result<std::unique_ptr<KalmanOnCountEstimator>> KalmanOnCountEstimator::Create(
                  " must be finite and >= 0"};
   }
   auto filter = PopulationKalmanFilter::Create(model, mode);
-  if (!filter) return Error{filter.error()};
+  if (!filter) return Error{filter.error(), filter.code()};
   return std::unique_ptr<KalmanOnCountEstimator>(new KalmanOnCountEstimator(
       model, std::move(filter).value(), std::move(output), relative_noise));
 }

@@ -60,7 +60,7 @@ std::string Describe(const nlohmann::json& p) {
 
 Status CheckModelPlant(const std::string& model_file, const nlohmann::json& plant) {
   std::ifstream in(model_file);
-  if (!in) return Error{model_file + ": cannot open"};
+  if (!in) return Error{model_file + ": cannot open", ErrorCode::kIo};
   nlohmann::json j;
   try {
     j = nlohmann::json::parse(in);

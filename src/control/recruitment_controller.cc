@@ -13,9 +13,7 @@ Status ControllerParams::Validate() const {
     return Error{"controller: unit_force = " + std::to_string(unit_force) +
                  " N must be finite and > 0"};
   }
-  if (!std::isfinite(dT) || dT <= 0) {
-    return Error{"controller: dT = " + std::to_string(dT) + " s must be finite and > 0"};
-  }
+  RECRUIT_TRY(CheckDT(dT, "controller"));
   if (!std::isfinite(lambda) || lambda <= 0 || lambda > 1) {
     return Error{"controller: lambda = " + std::to_string(lambda) + " must be in (0, 1]"};
   }
@@ -24,13 +22,13 @@ Status ControllerParams::Validate() const {
 
 Result<RecruitmentController> RecruitmentController::Create(
     const ControllerParams& params, std::unique_ptr<OnCountEstimator> estimator) {
-  if (Status s = params.Validate(); !s) return Error{s.error()};
+  if (Status s = params.Validate(); !s) return Error{s.error(), s.code()};
   if (!estimator) return Error{"controller: no estimator"};
   std::optional<UnitForceMap> on_force;
   if (params.geometry) {
     auto map = UnitForceMap::FromForces(*params.geometry, params.geometry->unit.prestretch,
                                         Eigen::VectorXd::Constant(1, params.unit_force));
-    if (!map) return Error{"controller: " + map.error()};
+    if (!map) return Error{"controller: " + map.error(), map.code()};
     on_force = std::move(map).value();
   }
   RecruitmentController c(params, std::move(estimator), std::move(on_force));
@@ -40,10 +38,10 @@ Result<RecruitmentController> RecruitmentController::Create(
 
 Result<RecruitmentController> RecruitmentController::Create(const ControllerParams& params,
                                                             const EstimatorSpec& spec) {
-  if (Status s = params.Validate(); !s) return Error{s.error()};
+  if (Status s = params.Validate(); !s) return Error{s.error(), s.code()};
   auto est = MakeEstimator(spec, params.num_units, params.unit_force, params.dT,
                            params.geometry ? &*params.geometry : nullptr);
-  if (!est) return Error{est.error()};
+  if (!est) return Error{est.error(), est.code()};
   return Create(params, std::move(est).value());
 }
 

@@ -10,19 +10,21 @@
 #include "common/result.h"
 #include "control/broadcast.h"
 #include "control/on_count_estimator.h"
+#include "control/sampling_period.h"
 
 namespace recruit::control {
 
 struct ControllerParams {
-  int num_units = 60;     // N, units in the bundle
-  double unit_force = 0;  // N, settled force of one unit whose heater is on
-  double dT = 0.5;        // s, sampling period
-  double lambda = 0.2;    // gain of the expectation law, in (0, 1]
+  int num_units = 60;      // N, units in the bundle
+  double unit_force = 0;   // N, settled force of one unit whose heater is on
+  double dT = kDefaultDT;  // s, sampling period (control/sampling_period.h)
+  double lambda = 0.2;     // gain of the expectation law, in (0, 1]
   // The bundle's unit and tendon geometry: when set, the target count and the estimator use the
   // settled on unit's force at the measured tendon length (UnitForceMap), not at ref_length.
   std::optional<UnitGeometry> geometry;
 
-  // Checks N >= 1, unit_force > 0, dT > 0, 0 < lambda <= 1 (finite); the message names the field.
+  // Checks N >= 1, unit_force > 0, dT (CheckDT), 0 < lambda <= 1 (finite); the message names the
+  // field.
   Status Validate() const;
 };
 

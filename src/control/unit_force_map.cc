@@ -7,7 +7,7 @@ namespace recruit::control {
 
 Result<UnitForceMap> UnitForceMap::FromFractions(const UnitGeometry& g, const Eigen::VectorXd& xi) {
   auto unit = sma::UnitModel::Create(g.unit);
-  if (!unit) return Error{"unit force map: " + unit.error()};
+  if (!unit) return Error{"unit force map: " + unit.error(), unit.code()};
   if (!std::isfinite(g.ref_length) || g.ref_length <= 0) {
     return Error{"unit force map: ref_length = " + std::to_string(g.ref_length) +
                  " m must be finite and > 0"};
@@ -24,7 +24,7 @@ Result<UnitForceMap> UnitForceMap::FromFractions(const UnitGeometry& g, const Ei
 Result<UnitForceMap> UnitForceMap::FromForces(const UnitGeometry& g, double stretch,
                                               const Eigen::VectorXd& forces) {
   auto unit = sma::UnitModel::Create(g.unit);
-  if (!unit) return Error{"unit force map: " + unit.error()};
+  if (!unit) return Error{"unit force map: " + unit.error(), unit.code()};
   if (!std::isfinite(stretch)) return Error{"unit force map: the extension must be finite"};
   Eigen::VectorXd xi(forces.size());
   for (Eigen::Index i = 0; i < forces.size(); ++i) {

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <nlohmann/json.hpp>
 
+#include "common/short_text.h"
 #include "estimation/json_matrix.h"
 #include "estimation/population_chain.h"
 
@@ -95,9 +96,8 @@ Status BroadcastTransitionModel::Validate(const std::string& where) const {
     const char* field = is_on[j] ? ".off_target" : ".on_target";
     if (t < 0 || t >= m) {
       return Error{where + field + "[" + std::to_string(j) + "] = " + std::to_string(t) +
-                   " (state '" + json_io::ShortValue(state_names[j]) + "', " +
-                   (is_on[j] ? "on" : "off") + ") must be a state index in [0, " +
-                   std::to_string(m - 1) + "]"};
+                   " (state '" + ShortText(state_names[j]) + "', " + (is_on[j] ? "on" : "off") +
+                   ") must be a state index in [0, " + std::to_string(m - 1) + "]"};
     }
   }
   if (!(std::isfinite(dt) && dt > 0.0)) {
@@ -162,7 +162,7 @@ Result<BroadcastTransitionModel> BroadcastTransitionModel::FromJsonValue(
   }
   if (j.contains("interior")) {
     auto I = json_io::ReadMatrix(j["interior"], where + ".interior", m, m);
-    if (!I.ok()) return Error{I.error()};
+    if (!I.ok()) return Error{I.error(), I.code()};
     b.interior = *I;
   } else {
     b.interior = Eigen::MatrixXd::Identity(m, m);
@@ -172,7 +172,7 @@ Result<BroadcastTransitionModel> BroadcastTransitionModel::FromJsonValue(
       return Error{where + "." + key + ": required (state index, or array with one per state)"};
     }
     auto t = ReadTargets(j[key], where + "." + key, m);
-    if (!t.ok()) return Error{t.error()};
+    if (!t.ok()) return Error{t.error(), t.code()};
     (std::string(key) == "on_target" ? b.on_target : b.off_target) = *t;
   }
   // Entries that do not apply (on_target of an on state, ...) are normalised to -1.
@@ -182,7 +182,7 @@ Result<BroadcastTransitionModel> BroadcastTransitionModel::FromJsonValue(
     else
       b.off_target[i] = -1;
   }
-  if (Status s = b.Validate(where); !s.ok()) return Error{s.error()};
+  if (Status s = b.Validate(where); !s.ok()) return Error{s.error(), s.code()};
   return b;
 }
 

@@ -1,6 +1,7 @@
 #include "estimation/count_filter.h"
 
 #include "common/rng.h"
+#include "common/short_text.h"
 #include "estimation/exact_filter.h"
 #include "estimation/json_matrix.h"
 #include "estimation/particle_filter.h"
@@ -47,7 +48,7 @@ class KalmanAdapter final : public CountFilter {
 template <int M, int R>
 Result<std::unique_ptr<CountFilter>> MakeKalman(const FilterModel& model, CovarianceMode mode) {
   auto f = PopulationKalmanFilterT<M, R>::Create(model, mode);
-  if (!f.ok()) return Error{f.error()};
+  if (!f.ok()) return Error{f.error(), f.code()};
   return std::unique_ptr<CountFilter>(
       new KalmanAdapter<PopulationKalmanFilterT<M, R>>(std::move(*f)));
 }
@@ -100,7 +101,7 @@ Result<std::unique_ptr<CountFilter>> MakeCountFilter(const FilterModel& model,
     ExactFilterOptions o;
     o.max_states = options.max_states;
     auto f = ExactBayesFilter::Create(model, o);
-    if (!f.ok()) return Error{f.error()};
+    if (!f.ok()) return Error{f.error(), f.code()};
     return std::unique_ptr<CountFilter>(new ExactAdapter(std::move(*f)));
   }
   if (e == "particle") {
@@ -108,10 +109,10 @@ Result<std::unique_ptr<CountFilter>> MakeCountFilter(const FilterModel& model,
     ParticleFilterOptions o;
     o.num_particles = options.particles;
     auto f = ParticleFilter::Create(model, o, rng);
-    if (!f.ok()) return Error{f.error()};
+    if (!f.ok()) return Error{f.error(), f.code()};
     return std::unique_ptr<CountFilter>(new ParticleAdapter(std::move(*f), rng));
   }
-  return Error{"estimator '" + json_io::ShortValue(e) + "' is not one of " + kEstimatorNames};
+  return Error{"estimator '" + ShortText(e) + "' is not one of " + kEstimatorNames};
 }
 
 }  // namespace recruit

@@ -32,7 +32,7 @@ void ForEachComposition(int n, int m, const std::function<void(const std::vector
 
 Result<ExactBayesFilter> ExactBayesFilter::Create(const FilterModel& model,
                                                   const ExactFilterOptions& options) {
-  if (Status s = model.Validate(); !s.ok()) return Error{s.error()};
+  if (Status s = model.Validate(); !s.ok()) return Error{s.error(), s.code()};
   const int m = model.num_states();
   const int64_t N = model.N;
   const uint64_t S = CountStateVectors(N, m, options.max_states);

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "estimation/bench_log.h"
+#include "common/short_text.h"
 #include "estimation/json_matrix.h"
 #include "estimation/population_chain.h"
 #include "estimation/shortest_double.h"
@@ -58,9 +59,10 @@ Result<std::unique_ptr<FilterLogReader>> FilterLogReader::OpenFile(const std::st
   r->bundle_ = bundle;
   r->path_ = path;
   r->file_ = std::fopen(path.c_str(), "rb");
-  if (r->file_ == nullptr) return Error{"cannot open '" + path + "': " + std::strerror(errno)};
+  if (r->file_ == nullptr)
+    return Error{"cannot open '" + path + "': " + std::strerror(errno), ErrorCode::kIo};
   r->buf_.resize(kChunk);
-  if (Status s = r->ReadHeader(); !s.ok()) return Error{s.error()};
+  if (Status s = r->ReadHeader(); !s.ok()) return Error{s.error(), s.code()};
   return r;
 }
 
@@ -74,7 +76,7 @@ Result<std::unique_ptr<FilterLogReader>> FilterLogReader::OpenText(const std::st
   r->path_ = path;
   r->text_ = text;
   r->eof_ = true;
-  if (Status s = r->ReadHeader(); !s.ok()) return Error{s.error()};
+  if (Status s = r->ReadHeader(); !s.ok()) return Error{s.error(), s.code()};
   return r;
 }
 
@@ -124,7 +126,8 @@ Status FilterLogReader::ReadHeader() {
     found = true;
     break;
   }
-  if (file_ != nullptr && std::ferror(file_)) return Error{"cannot read '" + path_ + "'"};
+  if (file_ != nullptr && std::ferror(file_))
+    return Error{"cannot read '" + path_ + "'", ErrorCode::kIo};
   if (!found) return Error{path_ + ": empty log (expected a CSV header line)"};
   if (IsBenchLogHeader(cells_)) return ReadBenchHeader();
 
@@ -155,14 +158,14 @@ Status FilterLogReader::ReadHeader() {
   for (size_t c = 0; c < num_cols_; ++c) {
     const std::string& h = names_[c];
     if (static_cast<size_t>(find(h)) != c) {
-      return Error{where + ": duplicate column '" + json_io::ShortValue(h) + "'"};
+      return Error{where + ": duplicate column '" + ShortText(h) + "'"};
     }
     const bool known = h == "t" ||
                        std::find(input_names.begin(), input_names.end(), h) != input_names.end() ||
                        std::find(y_names.begin(), y_names.end(), h) != y_names.end();
     if (!known) {
-      return Error{where + ": unknown column '" + json_io::ShortValue(h) +
-                   "'; this model's log has columns: " + json_io::ShortValue(expected, 200)};
+      return Error{where + ": unknown column '" + ShortText(h) +
+                   "'; this model's log has columns: " + ShortText(expected, 200)};
     }
   }
   auto require = [&](const std::vector<std::string>& names, std::vector<int>& cols) -> Status {
@@ -170,8 +173,7 @@ Status FilterLogReader::ReadHeader() {
     for (const auto& n : names) {
       const int c = find(n);
       if (c == static_cast<int>(num_cols_)) {
-        return Error{path_ + ": missing column '" + n +
-                     "'; columns: " + json_io::ShortValue(expected, 200)};
+        return Error{path_ + ": missing column '" + n + "'; columns: " + ShortText(expected, 200)};
       }
       cols.push_back(c);
     }
@@ -213,7 +215,8 @@ Result<bool> FilterLogReader::Next(FilterLogRow& row) {
   std::string_view line;
   for (;;) {
     if (!NextLine(&line)) {
-      if (file_ != nullptr && std::ferror(file_)) return Error{"cannot read '" + path_ + "'"};
+      if (file_ != nullptr && std::ferror(file_))
+        return Error{"cannot read '" + path_ + "'", ErrorCode::kIo};
       return false;
     }
     line = Trim(line);
@@ -242,10 +245,10 @@ Result<bool> FilterLogReader::Next(FilterLogRow& row) {
   auto number = [&](int col, double* v) -> Status {
     if (ParseNumber(cells_[col], v)) return Status::Ok();
     return Error{where() + ": column '" + names_[col] + "': '" +
-                 json_io::ShortValue(std::string(cells_[col])) + "' is not a finite number"};
+                 ShortText(std::string(cells_[col])) + "' is not a finite number"};
   };
   if (t_col_ >= 0) {
-    if (Status s = number(t_col_, &row.t); !s.ok()) return Error{s.error()};
+    if (Status s = number(t_col_, &row.t); !s.ok()) return Error{s.error(), s.code()};
   }
   // Measurement: all cells or none.
   int present = 0;
@@ -257,7 +260,7 @@ Result<bool> FilterLogReader::Next(FilterLogRow& row) {
   if (row.has_y) {
     row.y.resize(r);
     for (int i = 0; i < r; ++i) {
-      if (Status s = number(y_cols_[i], &row.y(i)); !s.ok()) return Error{s.error()};
+      if (Status s = number(y_cols_[i], &row.y(i)); !s.ok()) return Error{s.error(), s.code()};
     }
   }
   // Inputs.
@@ -271,24 +274,24 @@ Result<bool> FilterLogReader::Next(FilterLogRow& row) {
   } else if (given != static_cast<int>(input_cols_.size())) {
     return Error{where() + ": input cells must be all given or all empty (last row only)"};
   } else if (model.transition == TransitionSource::kBroadcast) {
-    if (Status s = number(input_cols_[0], &row.p_on); !s.ok()) return Error{s.error()};
-    if (Status s = number(input_cols_[1], &row.p_off); !s.ok()) return Error{s.error()};
+    if (Status s = number(input_cols_[0], &row.p_on); !s.ok()) return Error{s.error(), s.code()};
+    if (Status s = number(input_cols_[1], &row.p_off); !s.ok()) return Error{s.error(), s.code()};
     if (Status s = BroadcastTransitionModel::ValidateInputs(row.p_on, row.p_off, where());
         !s.ok()) {
-      return Error{s.error()};
+      return Error{s.error(), s.code()};
     }
   } else {
     row.A.resize(m, m);
     for (int i = 0; i < m; ++i) {
       for (int j = 0; j < m; ++j) {
         if (Status s = number(input_cols_[i * m + j], &row.A(i, j)); !s.ok()) {
-          return Error{s.error()};
+          return Error{s.error(), s.code()};
         }
       }
     }
     if (Status s = ValidateColumnStochastic(row.A, kStochasticTolerance, m, where() + ": A");
         !s.ok()) {
-      return Error{s.error()};
+      return Error{s.error(), s.code()};
     }
   }
   return true;
@@ -312,7 +315,7 @@ Status RunFilterStream(const FilterModel& model, FilterLogReader& log, CountFilt
   auto flush = [&]() -> Status {
     out.write(buf.data(), static_cast<std::streamsize>(buf.size()));
     buf.clear();
-    if (!out) return Error{"writing the output failed (disk full?)"};
+    if (!out) return Error{"writing the output failed (disk full?)", ErrorCode::kIo};
     return Status::Ok();
   };
   FilterLogRow row, prev;
@@ -320,7 +323,7 @@ Status RunFilterStream(const FilterModel& model, FilterLogReader& log, CountFilt
   uint64_t k = 0;
   for (;; ++k) {
     auto more = log.Next(row);
-    if (!more.ok()) return Error{more.error()};
+    if (!more.ok()) return Error{more.error(), more.code()};
     if (!*more) break;
     if (k > 0) {  // A(k - 1): the inputs of the previous row
       switch (model.transition) {
@@ -375,9 +378,10 @@ Status RunFilterStream(const FilterModel& model, FilterLogReader& log, CountFilt
 Result<std::string> RunFilterOverText(const FilterModel& model, const std::string& text,
                                       const std::string& path, CountFilter& filter) {
   auto log = FilterLogReader::OpenText(text, model, path);
-  if (!log.ok()) return Error{log.error()};
+  if (!log.ok()) return Error{log.error(), log.code()};
   std::ostringstream out;
-  if (Status s = RunFilterStream(model, **log, filter, out); !s.ok()) return Error{s.error()};
+  if (Status s = RunFilterStream(model, **log, filter, out); !s.ok())
+    return Error{s.error(), s.code()};
   return out.str();
 }
 

@@ -6,6 +6,7 @@
 #include <set>
 
 #include "common/atomic_file.h"
+#include "common/short_text.h"
 #include "estimation/json_matrix.h"
 #include "estimation/population_chain.h"
 
@@ -24,7 +25,7 @@ Status FilterModel::Validate(const std::string& where) const {
   for (const auto& s : state_names) {
     if (s.empty()) return Error{where + ": states: names must be non-empty"};
     if (!seen.insert(s).second)
-      return Error{where + ": states: duplicate name '" + json_io::ShortValue(s) + "'"};
+      return Error{where + ": states: duplicate name '" + ShortText(s) + "'"};
   }
   if (N < 1)
     return Error{where + ": N: must be a positive number of agents, got " + std::to_string(N)};
@@ -130,9 +131,9 @@ FilterModel FilterModel::WithPopulation(int64_t N_new) const {
 
 Result<FilterModel> FilterModel::FromJson(const std::string& path) {
   auto text = ReadFile(path);
-  if (!text.ok()) return Error{text.error()};
+  if (!text.ok()) return Error{text.error(), text.code()};
   auto j = json_io::ParseJson(*text, path);
-  if (!j.ok()) return Error{j.error()};
+  if (!j.ok()) return Error{j.error(), j.code()};
   return FromJsonValue(*j, path);
 }
 
@@ -157,7 +158,7 @@ Result<FilterModel> FilterModel::FromJsonValue(const nlohmann::json& j, const st
   f.N = j["N"].get<int64_t>();
   if (!j.contains("H")) return Error{where + ": H: required, r x " + std::to_string(m) + " matrix"};
   auto H = json_io::ReadMatrix(j["H"], where + ": H", -1, m);
-  if (!H.ok()) return Error{H.error()};
+  if (!H.ok()) return Error{H.error(), H.code()};
   f.H = *H;
   const int r = static_cast<int>(f.H.rows());
   if (r < 1) return Error{where + ": H: needs at least one row (output)"};
@@ -165,18 +166,18 @@ Result<FilterModel> FilterModel::FromJsonValue(const nlohmann::json& j, const st
     return Error{where + ": R: required, " + std::to_string(r) + " x " + std::to_string(r) +
                  " measurement noise covariance"};
   auto R = json_io::ReadMatrix(j["R"], where + ": R", r, r);
-  if (!R.ok()) return Error{R.error()};
+  if (!R.ok()) return Error{R.error(), R.code()};
   f.R = *R;
   if (j.contains("G") != j.contains("Qw")) {
     return Error{where + ": G and Qw: give both or neither (no process noise)"};
   }
   if (j.contains("G")) {
     auto G = json_io::ReadMatrix(j["G"], where + ": G", m, -1);
-    if (!G.ok()) return Error{G.error()};
+    if (!G.ok()) return Error{G.error(), G.code()};
     f.G = *G;
     const int q = static_cast<int>(f.G.cols());
     auto Qw = json_io::ReadMatrix(j["Qw"], where + ": Qw", q, q);
-    if (!Qw.ok()) return Error{Qw.error()};
+    if (!Qw.ok()) return Error{Qw.error(), Qw.code()};
     f.Qw = *Qw;
   } else {
     f.G = Eigen::MatrixXd::Zero(m, 0);
@@ -193,7 +194,7 @@ Result<FilterModel> FilterModel::FromJsonValue(const nlohmann::json& j, const st
   if (type == "broadcast") {
     f.transition = TransitionSource::kBroadcast;
     auto b = BroadcastTransitionModel::FromJsonValue(t, f.state_names, where + ": transition");
-    if (!b.ok()) return Error{b.error()};
+    if (!b.ok()) return Error{b.error(), b.code()};
     f.broadcast = *b;
   } else if (type == "explicit") {
     f.transition = TransitionSource::kExplicit;
@@ -201,10 +202,10 @@ Result<FilterModel> FilterModel::FromJsonValue(const nlohmann::json& j, const st
     f.transition = TransitionSource::kConstant;
     if (!t.contains("A")) return Error{where + ": transition.A: required for type \"constant\""};
     auto A = json_io::ReadMatrix(t["A"], where + ": transition.A", m, m);
-    if (!A.ok()) return Error{A.error()};
+    if (!A.ok()) return Error{A.error(), A.code()};
     f.A = *A;
   } else {
-    return Error{where + ": transition.type: \"" + json_io::ShortValue(type) +
+    return Error{where + ": transition.type: \"" + ShortText(type) +
                  "\" is not one of \"broadcast\", \"explicit\", \"constant\""};
   }
   f.x0 = Eigen::VectorXd::Zero(m);
@@ -215,16 +216,16 @@ Result<FilterModel> FilterModel::FromJsonValue(const nlohmann::json& j, const st
     if (!in.is_object()) return Error{where + ": initial: must be an object {x0, P0}"};
     if (in.contains("x0")) {
       auto x0 = json_io::ReadVector(in["x0"], where + ": initial.x0", m);
-      if (!x0.ok()) return Error{x0.error()};
+      if (!x0.ok()) return Error{x0.error(), x0.code()};
       f.x0 = *x0;
     }
     if (in.contains("P0")) {
       auto P0 = json_io::ReadMatrix(in["P0"], where + ": initial.P0", m, m);
-      if (!P0.ok()) return Error{P0.error()};
+      if (!P0.ok()) return Error{P0.error(), P0.code()};
       f.P0 = *P0;
     }
   }
-  if (Status s = f.Validate(where); !s.ok()) return Error{s.error()};
+  if (Status s = f.Validate(where); !s.ok()) return Error{s.error(), s.code()};
   const nlohmann::json* r2 = &j;
   for (const char* key : {"identification", "holdout", "r2"}) {
     r2 = r2->is_object() && r2->contains(key) ? &(*r2)[key] : nullptr;

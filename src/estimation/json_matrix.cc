@@ -3,12 +3,9 @@
 #include <cmath>
 #include <vector>
 
-namespace recruit::json_io {
+#include "common/short_text.h"
 
-std::string ShortValue(const std::string& s, size_t max) {
-  if (s.size() <= max) return s;
-  return s.substr(0, max) + "... (" + std::to_string(s.size()) + " characters)";
-}
+namespace recruit::json_io {
 
 namespace {
 
@@ -41,7 +38,7 @@ class CheckingSax final : public nlohmann::json_sax<nlohmann::json> {
   bool parse_error(std::size_t position, const std::string& last_token,
                    const nlohmann::detail::exception& ex) override {
     if (ex.id == 406) {  // out_of_range: number overflow
-      error = Field() + "number '" + ShortValue(last_token) +
+      error = Field() + "number '" + ShortText(last_token) +
               "' is too large for a double (finite numbers only)";
     } else {
       std::string what = ex.what();
@@ -50,7 +47,7 @@ class CheckingSax final : public nlohmann::json_sax<nlohmann::json> {
       if (lr != std::string::npos) {
         std::string tok = what.substr(lr + 12);
         if (!tok.empty() && tok.back() == '\'') tok.pop_back();
-        what = what.substr(0, lr + 12) + ShortValue(tok) + "'";
+        what = what.substr(0, lr + 12) + ShortText(tok) + "'";
       }
       error = "malformed JSON: " + Field() + what;
     }
@@ -88,7 +85,7 @@ class CheckingSax final : public nlohmann::json_sax<nlohmann::json> {
       if (fr.array) {
         f += "[" + std::to_string(fr.index) + "]";
       } else if (!fr.key.empty()) {
-        f += (f.empty() ? "" : ".") + ShortValue(fr.key);
+        f += (f.empty() ? "" : ".") + ShortText(fr.key);
       }
     }
     return f.empty() ? "" : "field " + f + ": ";

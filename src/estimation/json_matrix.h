@@ -22,12 +22,8 @@ inline constexpr int kMaxJsonDepth = 64;
 // (line, column), a number too large for a double (e.g. 1e999) and nesting deeper than
 // kMaxJsonDepth (checked as the tree is built, level by level, so that a 70,000-deep document
 // cannot exhaust the stack) each name the file and the field path (e.g.
-// "transition.interior[1][0]"), with the offending text shortened (ShortValue).
+// "transition.interior[1][0]"), with the offending text shortened (ShortText, common/short_text.h).
 Result<nlohmann::json> ParseJson(const std::string& text, const std::string& path);
-
-// `s` for an error message: at most `max` characters, longer values cut with "..." and their
-// length, so that a 2 MB field does not come back whole.
-std::string ShortValue(const std::string& s, size_t max = 40);
 
 nlohmann::json WriteMatrix(const Eigen::MatrixXd& M);
 nlohmann::json WriteVector(const Eigen::VectorXd& v);

@@ -23,7 +23,7 @@ Eigen::VectorXd RoundToCounts(const Eigen::VectorXd& x, int64_t N) {
 
 Result<ParticleFilter> ParticleFilter::Create(const FilterModel& model,
                                               const ParticleFilterOptions& options, Rng& rng) {
-  if (Status s = model.Validate(); !s.ok()) return Error{s.error()};
+  if (Status s = model.Validate(); !s.ok()) return Error{s.error(), s.code()};
   if (options.num_particles < 1) return Error{"particle filter: needs at least one particle"};
   if (!(options.resample_threshold >= 0.0 && options.resample_threshold <= 1.0)) {
     return Error{"particle filter: resample_threshold must be in [0, 1]"};

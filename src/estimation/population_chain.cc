@@ -179,7 +179,7 @@ Eigen::VectorXd ProjectOntoSimplex(const Eigen::VectorXd& x, double N) {
 }
 
 Result<Eigen::VectorXd> StationaryDistribution(const Eigen::MatrixXd& A) {
-  if (Status s = ValidateColumnStochastic(A); !s.ok()) return Error{s.error()};
+  if (Status s = ValidateColumnStochastic(A); !s.ok()) return Error{s.error(), s.code()};
   const Eigen::Index m = A.rows();
   Eigen::MatrixXd M = A - Eigen::MatrixXd::Identity(m, m);
   M.row(m - 1).setOnes();
@@ -203,7 +203,7 @@ Eigen::MatrixXd EquilibriumCovariance(const Eigen::VectorXd& pi, double N) {
 }
 
 Result<GammaBound> ComputeGammaBound(const Eigen::MatrixXd& A, const Eigen::MatrixXd& Qmax) {
-  if (Status s = ValidateColumnStochastic(A); !s.ok()) return Error{s.error()};
+  if (Status s = ValidateColumnStochastic(A); !s.ok()) return Error{s.error(), s.code()};
   const Eigen::Index m = A.rows();
   Eigen::EigenSolver<Eigen::MatrixXd> es(A.transpose());
   if (es.info() != Eigen::Success) return Error{"Gamma bound: eigen-decomposition failed"};

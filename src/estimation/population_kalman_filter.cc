@@ -1,5 +1,6 @@
 #include "estimation/population_kalman_filter.h"
 
+#include "common/short_text.h"
 #include "estimation/json_matrix.h"
 
 namespace recruit {
@@ -20,7 +21,7 @@ Result<CovarianceMode> ParseCovarianceMode(const std::string& name) {
   if (name == "extended") return CovarianceMode::kExtended;
   if (name == "conservative") return CovarianceMode::kConservative;
   if (name == "plain") return CovarianceMode::kPlain;
-  return Error{"covariance mode '" + json_io::ShortValue(name) +
+  return Error{"covariance mode '" + ShortText(name) +
                "' is not one of extended, conservative, plain"};
 }
 

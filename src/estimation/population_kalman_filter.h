@@ -285,7 +285,7 @@ template <int M, int R>
 Result<PopulationKalmanFilterT<M, R>> PopulationKalmanFilterT<M, R>::Create(
     const FilterModel& model, CovarianceMode mode, const Eigen::VectorXd& x0,
     const Eigen::MatrixXd& P0) {
-  if (Status s = model.Validate(); !s.ok()) return Error{s.error()};
+  if (Status s = model.Validate(); !s.ok()) return Error{s.error(), s.code()};
   const int m = model.num_states();
   const int r = model.num_outputs();
   if (M != Eigen::Dynamic && m != M) {

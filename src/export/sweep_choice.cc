@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "common/atomic_file.h"
-#include "sim/sweep.h"
+#include "sweep/table.h"
 #include "sweep/recommend.h"
 
 namespace recruit::exporter {
@@ -30,7 +30,7 @@ Result<double> Number(const std::string& text, const std::string& where) {
 }
 
 // The cells of table.csv (dT, lambda, estimator, seeds, meets_criterion, margin).
-Result<std::vector<sim::CellStats>> ReadCells(const std::string& path) {
+Result<std::vector<sweep::CellStats>> ReadCells(const std::string& path) {
   auto text = ReadFile(path);
   if (!text) return Error{text.error()};
   std::stringstream in(*text);
@@ -55,7 +55,7 @@ Result<std::vector<sim::CellStats>> ReadCells(const std::string& path) {
                  ": not a sweep table (needs the columns dT, lambda, estimator, seeds, "
                  "meets_criterion, margin)"};
   }
-  std::vector<sim::CellStats> cells;
+  std::vector<sweep::CellStats> cells;
   for (int row = 2; std::getline(in, line); ++row) {
     if (line.empty()) continue;
     const std::vector<std::string> f = SplitCsv(line);
@@ -63,7 +63,7 @@ Result<std::vector<sim::CellStats>> ReadCells(const std::string& path) {
     if (f.size() != head.size())
       return Error{where + ": " + std::to_string(f.size()) + " fields, the header has " +
                    std::to_string(head.size())};
-    sim::CellStats c;
+    sweep::CellStats c;
     auto dt = Number(f[c_dt], where + ", dT");
     auto l = Number(f[c_l], where + ", lambda");
     auto s = Number(f[c_s], where + ", seeds");

@@ -12,7 +12,7 @@
 #include "identification/plant_record.h"
 #include "plugin/sma_host.h"
 
-namespace recruit::control {
+namespace recruit::identification {
 namespace {
 
 struct HeldPose {
@@ -87,7 +87,7 @@ Result<BenchRecording> RecordBench(const std::string& model_path, const std::str
                                    const Excitation& excitation, double dT, std::uint64_t seed,
                                    const RecordOptions& options) {
   auto loaded = LoadBundle(model_path, actuator);
-  if (!loaded) return Error{loaded.error()};
+  if (!loaded) return Error{loaded.error(), loaded.code()};
   const ModelPtr& m = loaded->model;
   const sma::SmaHost& p = *loaded->host;
   const int b = loaded->bundle;
@@ -134,7 +134,7 @@ Result<BenchRecording> RecordBench(const std::string& model_path, const std::str
     const int n = p.num_units(b);
     for (int i = 0; i < n; ++i) was_on[i] = p.UnitOn(d.get(), b, i);
     if (Status s = p.Broadcast(d.get(), b, excitation.p_on[k], excitation.p_off[k]); !s) {
-      return Error{"identify: broadcast " + std::to_string(k) + ": " + s.error()};
+      return Error{"identify: broadcast " + std::to_string(k) + ": " + s.error(), s.code()};
     }
     int on_before = 0, turned_on = 0, turned_off = 0;
     for (int i = 0; i < n; ++i) {
@@ -155,4 +155,4 @@ Result<BenchRecording> RecordBench(const std::string& model_path, const std::str
   return rec;
 }
 
-}  // namespace recruit::control
+}  // namespace recruit::identification

@@ -17,7 +17,7 @@
 #include "identification/excitation.h"
 #include "identification/switching_log.h"
 
-namespace recruit::control {
+namespace recruit::identification {
 
 struct BenchRecording {
   SwitchingLog log;
@@ -26,10 +26,10 @@ struct BenchRecording {
   nlohmann::json plant;      // the bundle it was recorded on (identification/plant_record.h)
   double tendon_length = 0;  // m, held: the bundle's length coordinate (gear x its tendon's length,
                              // SmaHost::UnitLength) at the recorded pose, at t = 0
-  std::vector<double> lengths;  // m, the tendon's length at each sample
-  double stretch = 0;           // m, the units' extension there
-  std::string pose;             // e.g. "elbow 0.0 deg", empty when nothing was held
-  UnitGeometry geometry;        // the bundle's unit and reference length
+  std::vector<double> lengths;     // m, the tendon's length at each sample
+  double stretch = 0;              // m, the units' extension there
+  std::string pose;                // e.g. "elbow 0.0 deg", empty when nothing was held
+  control::UnitGeometry geometry;  // the bundle's unit and reference length
 };
 
 struct RecordOptions {
@@ -48,4 +48,4 @@ Result<BenchRecording> RecordBench(const std::string& model_path, const std::str
                                    const Excitation& excitation, double dT, std::uint64_t seed,
                                    const RecordOptions& options = {});
 
-}  // namespace recruit::control
+}  // namespace recruit::identification

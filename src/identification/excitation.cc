@@ -4,7 +4,7 @@
 
 #include "common/rng.h"
 
-namespace recruit::control {
+namespace recruit::identification {
 
 Excitation MakeExcitation(int settle, int total, std::uint64_t seed) {
   settle = std::max(settle, 2);
@@ -44,4 +44,4 @@ Excitation MakeExcitation(int settle, int total, std::uint64_t seed) {
   return e;
 }
 
-}  // namespace recruit::control
+}  // namespace recruit::identification

@@ -11,7 +11,7 @@
 #include <cstdint>
 #include <vector>
 
-namespace recruit::control {
+namespace recruit::identification {
 
 struct Excitation {
   std::vector<double> p_on, p_off;
@@ -21,4 +21,4 @@ struct Excitation {
 // settle: periods to hold for a unit to settle (e.g. 8 s / dT); total: number of instants.
 Excitation MakeExcitation(int settle, int total, std::uint64_t seed);
 
-}  // namespace recruit::control
+}  // namespace recruit::identification

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <limits>
 
-namespace recruit::control {
+namespace recruit::identification {
 namespace {
 
 // Mean state trajectory: row k is x_k^T (counts), from all units cold.
@@ -309,7 +309,7 @@ FitMetrics Score(const Eigen::VectorXd& predicted, const SwitchingLog& log, int 
 
 Result<IdentificationResult> IdentifyTransientModel(const SwitchingLog& log,
                                                     const FitOptions& opt) {
-  if (Status s = log.Validate("switching log"); !s) return Error{s.error()};
+  if (Status s = log.Validate("switching log"); !s) return Error{s.error(), s.code()};
   if (opt.num_states < 4 || opt.num_states % 2 != 0) {
     return Error{"identify: num_states = " + std::to_string(opt.num_states) +
                  " must be even and >= 4"};
@@ -380,4 +380,4 @@ Result<IdentificationResult> IdentifyTransientModel(const SwitchingLog& log,
   return best;
 }
 
-}  // namespace recruit::control
+}  // namespace recruit::identification

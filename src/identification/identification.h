@@ -14,7 +14,7 @@
 #include "identification/switching_log.h"
 #include "identification/transient_chain.h"
 
-namespace recruit::control {
+namespace recruit::identification {
 
 struct FitOptions {
   int num_states = 20;            // m (even, >= 4)
@@ -61,4 +61,4 @@ double MaxLikelihoodNoise(const TransientChain& chain, const SwitchingLog& log, 
 // RMSE and R^2 of `predicted` against log.force over samples [begin, end).
 FitMetrics Score(const Eigen::VectorXd& predicted, const SwitchingLog& log, int begin, int end);
 
-}  // namespace recruit::control
+}  // namespace recruit::identification

@@ -5,9 +5,11 @@
 #include <filesystem>
 
 #include "common/atomic_file.h"
+#include "common/data_path.h"
 #include "common/file_lock.h"
+#include "common/json_file.h"
 
-namespace recruit::control {
+namespace recruit::identification {
 namespace fs = std::filesystem;
 
 std::string ModelFileName(const nlohmann::json& plant, double dT, int num_states) {
@@ -28,9 +30,9 @@ std::vector<std::string> ModelSearchPath() {
       start = end + 1;
     }
   }
-#ifdef RECRUIT_SOURCE_DIR
-  dirs.push_back(std::string(RECRUIT_SOURCE_DIR) + "/models/identified");
-#endif
+  if (const std::string data = DataDir(); !data.empty()) {
+    dirs.push_back(data + "/models/identified");
+  }
   if (const char* c = std::getenv("RECRUIT_MODEL_CACHE"); c && *c) {
     dirs.push_back(c);
   } else if (const char* x = std::getenv("XDG_CACHE_HOME"); x && *x) {
@@ -43,13 +45,25 @@ std::vector<std::string> ModelSearchPath() {
   return dirs;
 }
 
+bool MadeByThisIdentification(const std::string& path) {
+  auto j = LoadJsonFile(path);
+  if (!j.ok() || !j->is_object()) return false;
+  const auto id = j->find("identification");
+  if (id == j->end() || !id->is_object()) return false;
+  const auto v = id->find("version");
+  return v != id->end() && v->is_number_integer() && v->get<int>() == kIdentificationVersion;
+}
+
 Result<std::string> FindOrIdentifyModel(const ModelRequest& r, bool identify, std::FILE* log) {
   const std::string name = ModelFileName(r.plant, r.dT, r.num_states);
   const std::vector<std::string> dirs = ModelSearchPath();
   std::error_code ec;
-  for (const std::string& d : dirs) {
-    const fs::path f = fs::path(d) / name;
-    if (fs::exists(f, ec)) return f.string();
+  // The folders before the cache hold models put there on purpose: taken as they are. The
+  // cache's were made on demand: only one this build would make is used.
+  for (size_t i = 0; i < dirs.size(); ++i) {
+    const fs::path f = fs::path(dirs[i]) / name;
+    if (!fs::exists(f, ec)) continue;
+    if (i + 1 < dirs.size() || MadeByThisIdentification(f.string())) return f.string();
   }
   if (!identify) {
     return Error{"no identified model " + name + " on the model search path (" + dirs.front() +
@@ -58,11 +72,12 @@ Result<std::string> FindOrIdentifyModel(const ModelRequest& r, bool identify, st
   }
   const fs::path cache = dirs.back();
   fs::create_directories(cache, ec);
-  if (ec) return Error{"model cache " + cache.string() + ": " + ec.message()};
+  if (ec) return Error{"model cache " + cache.string() + ": " + ec.message(), CodeOf(ec)};
   const fs::path file = cache / name;
   auto lock = FileLock::Lock((cache / (name + ".lock")).string());
-  if (!lock) return Error{lock.error()};
-  if (fs::exists(file, ec)) return file.string();  // made while we waited
+  if (!lock) return Error{lock.error(), lock.code()};
+  // Made while we waited?
+  if (fs::exists(file, ec) && MadeByThisIdentification(file.string())) return file.string();
   if (log) {
     std::fprintf(log, "recruit: identifying the %s model for dT = %g s on %s (cached as %s)\n",
                  r.actuator.c_str(), r.dT, r.model_path.c_str(), file.string().c_str());
@@ -72,11 +87,12 @@ Result<std::string> FindOrIdentifyModel(const ModelRequest& r, bool identify, st
   o.num_states = r.num_states;
   auto id = IdentifyOnPlant(r.model_path, r.actuator, o, "identified on demand (model cache)");
   if (!id)
-    return Error{"identifying a model for dT = " + std::to_string(r.dT) + " s: " + id.error()};
+    return Error{"identifying a model for dT = " + std::to_string(r.dT) + " s: " + id.error(),
+                 id.code()};
   if (Status s = WriteFileAtomically(file.string(), id->model.dump(2) + "\n"); !s) {
-    return Error{s.error()};
+    return Error{s.error(), s.code()};
   }
   return file.string();
 }
 
-}  // namespace recruit::control
+}  // namespace recruit::identification

@@ -1,10 +1,13 @@
 // Where the estimator's identified models are found, and made when missing: a model is keyed
 // by the plant it describes (its unit's hash), the bundle's actuator, dT and its number of states,
 // e.g. "flexor_3f2a9c0d12ab45ef_dt0.5_m20.json". Looked up, in order, in the folders of
-// RECRUIT_MODEL_PATH (colon-separated), the shipped models/identified/ and the user's cache
+// RECRUIT_MODEL_PATH (colon-separated), the shipped models/identified/ (under the data folder
+// the program set, common/data_path.h; none when it set none) and the user's cache
 // (RECRUIT_MODEL_CACHE, else $XDG_CACHE_HOME/recruit/models, else ~/.cache/recruit/models).
 // When none holds it, it is identified on the plant (plant_identification.h) and written to the
-// cache, under a lock, so that concurrent runs identify it once.
+// cache, under a lock, so that concurrent runs identify it once. A cached model records the
+// identification version it was made with ("identification.version"); one of another version
+// is made again, not used.
 #pragma once
 
 #include <nlohmann/json.hpp>
@@ -14,7 +17,7 @@
 #include "common/result.h"
 #include "identification/plant_identification.h"
 
-namespace recruit::control {
+namespace recruit::identification {
 
 // "<actuator>_<hash>_dt<dT>_m<states>.json" for a PlantRecord `plant`.
 std::string ModelFileName(const nlohmann::json& plant, double dT, int num_states);
@@ -30,9 +33,13 @@ struct ModelRequest {
   int num_states = 20;
 };
 
+// Whether the model file at `path` was made by this build's identification
+// (kIdentificationVersion).
+bool MadeByThisIdentification(const std::string& path);
+
 // The model file for the request: found on the search path, or identified and cached when
 // `identify` is true (else an error saying how to make one). `log` (may be null) is told when
 // an identification starts, as it takes a while (seconds to a minute).
 Result<std::string> FindOrIdentifyModel(const ModelRequest& request, bool identify, std::FILE* log);
 
-}  // namespace recruit::control
+}  // namespace recruit::identification

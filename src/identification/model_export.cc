@@ -1,6 +1,6 @@
 #include "identification/model_export.h"
 
-namespace recruit::control {
+namespace recruit::identification {
 
 FilterModel ToFilterModel(const TransientChain& chain, std::int64_t num_units, double dT,
                           double force_noise_var) {
@@ -26,4 +26,4 @@ FilterModel ToFilterModel(const TransientChain& chain, std::int64_t num_units, d
   return f;
 }
 
-}  // namespace recruit::control
+}  // namespace recruit::identification

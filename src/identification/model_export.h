@@ -6,7 +6,7 @@
 #include "estimation/filter_model.h"
 #include "identification/transient_chain.h"
 
-namespace recruit::control {
+namespace recruit::identification {
 
 // states = chain.StateNames(), H = chain.force^T (1 x m), R = [force_noise_var],
 // no process noise, transition "broadcast" with the chain's interior, is_on and switching
@@ -14,4 +14,4 @@ namespace recruit::control {
 FilterModel ToFilterModel(const TransientChain& chain, std::int64_t num_units, double dT,
                           double force_noise_var);
 
-}  // namespace recruit::control
+}  // namespace recruit::identification

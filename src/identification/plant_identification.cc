@@ -11,7 +11,7 @@
 #include "identification/excitation.h"
 #include "identification/model_export.h"
 
-namespace recruit::control {
+namespace recruit::identification {
 namespace {
 
 Excitation ExcitationFor(const PlantIdentificationOptions& o, double duration, std::uint64_t seed) {
@@ -35,7 +35,7 @@ Eigen::MatrixXd MeanCounts(const TransientChain& chain, const SwitchingLog& log)
 }
 
 // R^2 and RMSE of the mean force the chain and the map predict over samples [begin, end).
-FitMetrics CheckAtLength(const TransientChain& chain, const UnitForceMap& map,
+FitMetrics CheckAtLength(const TransientChain& chain, const control::UnitForceMap& map,
                          const BenchRecording& rec, int begin, int end) {
   const Eigen::MatrixXd X = MeanCounts(chain, rec.log);
   Eigen::RowVectorXd h(chain.num_states());
@@ -51,7 +51,7 @@ FitMetrics CheckAtLength(const TransientChain& chain, const UnitForceMap& map,
 // bounded Gauss-Newton (Levenberg-Marquardt damping) on sum_k (y_k - sum_i x_ki T(xi_i, s_k))^2
 // from xi0. Recordings at several lengths and in motion pin what one length cannot: states
 // slack at the longest tendon, and the stress each state's transformation sees in use.
-Eigen::VectorXd RefineFractions(const TransientChain& chain, const UnitForceMap& map0,
+Eigen::VectorXd RefineFractions(const TransientChain& chain, const control::UnitForceMap& map0,
                                 const std::vector<BenchRecording>& recs, double fraction) {
   const int m = chain.num_states();
   const sma::UnitModel& unit = map0.unit();
@@ -110,15 +110,15 @@ Eigen::VectorXd RefineFractions(const TransientChain& chain, const UnitForceMap&
 
 // Negative log-likelihood of recordings under the length-aware filter with
 // R = R0 + rho^2 (H x^-)^2, the filter driven by the broadcasts as in operation.
-double NegLogLikelihood(const FilterModel& model, const UnitForceMap& map,
+double NegLogLikelihood(const FilterModel& model, const control::UnitForceMap& map,
                         const std::vector<BenchRecording>& recs, double rho) {
   double total = 0;
   const double r0 = model.R(0, 0);
   Eigen::RowVectorXd h(model.num_states());
   for (const BenchRecording& rec : recs) {
-    auto est = KalmanOnCountEstimator::Create(model, CovarianceMode::kExtended, map, rho);
+    auto est = control::KalmanOnCountEstimator::Create(model, CovarianceMode::kExtended, map, rho);
     if (!est) return std::numeric_limits<double>::infinity();
-    KalmanOnCountEstimator& e = **est;
+    control::KalmanOnCountEstimator& e = **est;
     const SwitchingLog& log = rec.log;
     for (int k = 0; k < log.size(); ++k) {
       map.Forces(rec.lengths[k], h);
@@ -137,7 +137,7 @@ double NegLogLikelihood(const FilterModel& model, const UnitForceMap& map,
 
 // The rho in [0, 0.5] of the largest likelihood (golden section): the part of the force model's
 // error that grows with the force, seen when it is carried to other lengths.
-double FitRelativeNoise(const FilterModel& model, const UnitForceMap& map,
+double FitRelativeNoise(const FilterModel& model, const control::UnitForceMap& map,
                         const std::vector<BenchRecording>& recs) {
   double a = 0, b = 0.5;
   const double g = (std::sqrt(5.0) - 1) / 2;
@@ -170,16 +170,16 @@ Result<PlantIdentification> IdentifyOnPlant(const std::string& model_path,
   }
   // 1-2. The chain and its forces, held at the longest tendon.
   auto rec = RecordBench(model_path, actuator, ExcitationFor(o, o.duration, o.seed), o.dT, o.seed);
-  if (!rec) return Error{rec.error()};
+  if (!rec) return Error{rec.error(), rec.code()};
   FitOptions fo;
   fo.num_states = o.num_states;
   fo.holdout_fraction = o.holdout;
   fo.smoothness = o.smoothness;
   auto fit = IdentifyTransientModel(rec->log, fo);
-  if (!fit) return Error{fit.error()};
+  if (!fit) return Error{fit.error(), fit.code()};
   const TransientChain& c = fit->chain;
-  auto map = UnitForceMap::FromForces(rec->geometry, rec->stretch, c.force);
-  if (!map) return Error{"identify: " + map.error()};
+  auto map = control::UnitForceMap::FromForces(rec->geometry, rec->stretch, c.force);
+  if (!map) return Error{"identify: " + map.error(), map.code()};
 
   // 3. Recordings at other lengths and in motion (a limb only): the fractions refined on the
   // first part of every recording, the checks scored on the rest.
@@ -193,16 +193,16 @@ Result<PlantIdentification> IdentifyOnPlant(const std::string& model_path,
       const std::uint64_t seed = o.seed + 1 + i;
       auto chk = RecordBench(model_path, actuator, ExcitationFor(o, o.check_duration, seed), o.dT,
                              seed, plan[i]);
-      if (!chk) return Error{chk.error()};
+      if (!chk) return Error{chk.error(), chk.code()};
       char moving[80];
       std::snprintf(moving, sizeof moving, "moving over the range, period %g s", o.sweep_period);
       poses.push_back(plan[i].sweep_period > 0 ? moving : chk->pose);
       recordings.push_back(std::move(chk).value());
     }
     const double train = 1.0 - o.holdout;
-    auto refined =
-        UnitForceMap::FromFractions(rec->geometry, RefineFractions(c, *map, recordings, train));
-    if (!refined) return Error{"identify: " + refined.error()};
+    auto refined = control::UnitForceMap::FromFractions(
+        rec->geometry, RefineFractions(c, *map, recordings, train));
+    if (!refined) return Error{"identify: " + refined.error(), refined.code()};
     map = std::move(refined);
   }
 
@@ -223,13 +223,14 @@ Result<PlantIdentification> IdentifyOnPlant(const std::string& model_path,
   map->Forces(rec->tendon_length, exported.force);
   const FilterModel model =
       ToFilterModel(exported, rec->log.num_units, rec->log.dT, fit->force_noise_var);
-  if (Status s = model.Validate("identified model"); !s) return Error{s.error()};
+  if (Status s = model.Validate("identified model"); !s) return Error{s.error(), s.code()};
   // 4. R's part that grows with the force, by maximum likelihood over every recording.
   const double rho = FitRelativeNoise(model, *map, recordings);
 
   const Eigen::VectorXd& xi = map->fractions();
   nlohmann::json j = model.ToJson();
   j["identification"] = {
+      {"version", kIdentificationVersion},
       {"command", command},
       {"source", model_path},
       {"dT", rec->log.dT},
@@ -254,4 +255,4 @@ Result<PlantIdentification> IdentifyOnPlant(const std::string& model_path,
   return out;
 }
 
-}  // namespace recruit::control
+}  // namespace recruit::identification

@@ -18,7 +18,13 @@
 #include "common/result.h"
 #include "identification/identification.h"
 
-namespace recruit::control {
+namespace recruit::identification {
+
+// The version of what IdentifyOnPlant makes, recorded in each model as
+// "identification.version": raise it whenever a change to the recording, the fit or the export
+// changes the model it makes, so that models cached by an older build are made again
+// (model_cache.h).
+constexpr int kIdentificationVersion = 1;
 
 struct PlantIdentificationOptions {
   double dT = 0.5;        // s
@@ -57,4 +63,4 @@ Result<PlantIdentification> IdentifyOnPlant(const std::string& model_path,
 // The record of a fit's quality: {"samples", "rmse_N", "r2"}.
 nlohmann::json MetricsJson(const FitMetrics& m);
 
-}  // namespace recruit::control
+}  // namespace recruit::identification

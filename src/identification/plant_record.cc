@@ -5,10 +5,10 @@
 #include <cstdio>
 #include <fstream>
 
-namespace recruit::control {
+namespace recruit::identification {
 
 nlohmann::json PlantRecord(const sma::SmaHost& host, int b, const std::string& model_path) {
-  const nlohmann::json unit = UnitRecord(host.bundle(b).config().unit);
+  const nlohmann::json unit = control::UnitRecord(host.bundle(b).config().unit);
   const mjModel* m = host.model();
   const int tendon = host.tendon_id(b);
   const char* tendon_name = tendon >= 0 ? mj_id2name(m, mjOBJ_TENDON, tendon) : nullptr;
@@ -18,7 +18,7 @@ nlohmann::json PlantRecord(const sma::SmaHost& host, int b, const std::string& m
           {"num_units", host.num_units(b)},
           {"settled_unit_force_N", host.SettledUnitForce(b)},
           {"unit", unit},
-          {"hash", PlantHash(unit)}};
+          {"hash", control::PlantHash(unit)}};
 }
 
 Result<LoadedBundle> LoadBundle(const std::string& model_path, const std::string& actuator) {
@@ -27,7 +27,7 @@ Result<LoadedBundle> LoadBundle(const std::string& model_path, const std::string
   out.model.reset(mj_loadXML(model_path.c_str(), nullptr, err, sizeof err));
   if (!out.model) return Error{model_path + ": " + err};
   auto host = sma::SmaHost::Create(out.model.get());
-  if (!host) return Error{model_path + ": " + host.error()};
+  if (!host) return Error{model_path + ": " + host.error(), host.code()};
   out.host = std::move(host).value();
   const sma::SmaHost& h = *out.host;
   if (h.num_bundles() == 0) return Error{model_path + ": no SMA bundle (recruit.sma)"};
@@ -42,8 +42,8 @@ Result<LoadedBundle> LoadBundle(const std::string& model_path, const std::string
 
 Result<nlohmann::json> PlantRecordOf(const std::string& model_path, const std::string& actuator) {
   auto loaded = LoadBundle(model_path, actuator);
-  if (!loaded) return Error{loaded.error()};
+  if (!loaded) return Error{loaded.error(), loaded.code()};
   return PlantRecord(*loaded->host, loaded->bundle, model_path);
 }
 
-}  // namespace recruit::control
+}  // namespace recruit::identification

@@ -14,7 +14,7 @@
 #include "control/model_plant.h"
 #include "plugin/sma_host.h"
 
-namespace recruit::control {
+namespace recruit::identification {
 
 // {"model": ..., "actuator": ..., "tendon": ..., "num_units": N, "settled_unit_force_N": f,
 //  "unit": {key: value, ...}, "hash": "16 hex digits"}.
@@ -33,4 +33,4 @@ Result<LoadedBundle> LoadBundle(const std::string& model_path, const std::string
 // The PlantRecord of that bundle.
 Result<nlohmann::json> PlantRecordOf(const std::string& model_path, const std::string& actuator);
 
-}  // namespace recruit::control
+}  // namespace recruit::identification

@@ -9,7 +9,7 @@
 #include "common/atomic_file.h"
 #include "estimation/bench_log.h"
 
-namespace recruit::control {
+namespace recruit::identification {
 namespace {
 
 std::vector<std::string> SplitCsv(const std::string& line) {
@@ -50,7 +50,7 @@ Result<SwitchingLog> FromBenchLog(const std::string& path, int num_units,
 Result<SwitchingLog> SwitchingLog::FromCsv(const std::string& path, int num_units,
                                            const std::string& bundle) {
   std::ifstream in(path);
-  if (!in) return Error{path + ": cannot open the switching log"};
+  if (!in) return Error{path + ": cannot open the switching log", ErrorCode::kIo};
   std::string line;
   if (!std::getline(in, line)) return Error{path + ": empty file (expected a CSV header)"};
   if (line.substr(0, 3) == "\xEF\xBB\xBF") line.erase(0, 3);
@@ -93,18 +93,18 @@ Result<SwitchingLog> SwitchingLog::FromCsv(const std::string& path, int num_unit
       return Status::Ok();
     };
     double t, on, off, f, tr = 0;
-    if (Status s = get(col_t, "time", t); !s) return Error{s.error()};
-    if (Status s = get(col_on, "p_on", on); !s) return Error{s.error()};
-    if (Status s = get(col_off, "p_off", off); !s) return Error{s.error()};
-    if (Status s = get(col_f, "force", f); !s) return Error{s.error()};
+    if (Status s = get(col_t, "time", t); !s) return Error{s.error(), s.code()};
+    if (Status s = get(col_on, "p_on", on); !s) return Error{s.error(), s.code()};
+    if (Status s = get(col_off, "p_off", off); !s) return Error{s.error(), s.code()};
+    if (Status s = get(col_f, "force", f); !s) return Error{s.error(), s.code()};
     if (col_true >= 0) {
-      if (Status s = get(col_true, "true_on", tr); !s) return Error{s.error()};
+      if (Status s = get(col_true, "true_on", tr); !s) return Error{s.error(), s.code()};
       log.true_on.push_back(tr);
     }
     if (col_ron >= 0) {
       double ron, roff;
-      if (Status s = get(col_ron, "realized_on", ron); !s) return Error{s.error()};
-      if (Status s = get(col_roff, "realized_off", roff); !s) return Error{s.error()};
+      if (Status s = get(col_ron, "realized_on", ron); !s) return Error{s.error(), s.code()};
+      if (Status s = get(col_roff, "realized_off", roff); !s) return Error{s.error(), s.code()};
       log.realized_on.push_back(ron);
       log.realized_off.push_back(roff);
     }
@@ -123,7 +123,7 @@ Result<SwitchingLog> SwitchingLog::FromCsv(const std::string& path, int num_unit
                    " s (rows must be the control instants, uniformly spaced)"};
     }
   }
-  if (Status s = log.Validate(path); !s) return Error{s.error()};
+  if (Status s = log.Validate(path); !s) return Error{s.error(), s.code()};
   return log;
 }
 
@@ -157,7 +157,7 @@ Status SwitchingLog::Validate(const std::string& where) const {
 
 Status SwitchingLog::SaveCsv(const std::string& path) const {
   AtomicFile f(path);
-  if (!f.ok()) return Error{f.error()};
+  if (!f.ok()) return Error{f.error(), f.code()};
   auto& o = f.stream();
   o << "time,p_on,p_off,force" << (true_on.empty() ? "" : ",true_on")
     << (has_realized() ? ",realized_on,realized_off" : "") << "\n";
@@ -171,4 +171,4 @@ Status SwitchingLog::SaveCsv(const std::string& path) const {
   return f.Commit();
 }
 
-}  // namespace recruit::control
+}  // namespace recruit::identification

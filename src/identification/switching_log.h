@@ -16,7 +16,7 @@
 
 #include "common/result.h"
 
-namespace recruit::control {
+namespace recruit::identification {
 
 struct SwitchingLog {
   int num_units = 60;
@@ -40,4 +40,4 @@ struct SwitchingLog {
   Status SaveCsv(const std::string& path) const;  // atomically
 };
 
-}  // namespace recruit::control
+}  // namespace recruit::identification

@@ -2,7 +2,7 @@
 
 #include <algorithm>
 
-namespace recruit::control {
+namespace recruit::identification {
 
 TransientChain TransientChain::Uniform(int num_states, double advance) {
   TransientChain c;
@@ -121,4 +121,4 @@ Eigen::MatrixXd TransientChain::TransitionCovariance(double p_on, double p_off,
   return q;
 }
 
-}  // namespace recruit::control
+}  // namespace recruit::identification

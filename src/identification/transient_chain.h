@@ -23,7 +23,7 @@
 #include <string>
 #include <vector>
 
-namespace recruit::control {
+namespace recruit::identification {
 
 struct TransientChain {
   int chain_length = 9;          // K (m = 2K + 2; K = 9 gives the paper's 20 states)
@@ -62,4 +62,4 @@ struct TransientChain {
   Eigen::MatrixXd TransitionCovariance(double p_on, double p_off, const Eigen::VectorXd& x) const;
 };
 
-}  // namespace recruit::control
+}  // namespace recruit::identification

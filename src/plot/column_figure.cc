@@ -6,6 +6,8 @@
 #include <cstdlib>
 #include <sstream>
 
+#include "common/short_text.h"
+
 namespace recruit::plot {
 namespace {
 
@@ -32,7 +34,7 @@ Result<PanelSpec> ParsePanelSpec(const std::string& spec) {
   if (eq == std::string::npos || Trim(spec.substr(0, eq)).empty()) {
     return Error{fmt::format(
         "--panel '{}': expected LABEL=COLUMN[*SCALE][,COLUMN...], e.g. 'force (N)=tension'",
-        Shorten(spec))};
+        ShortText(spec))};
   }
   PanelSpec p;
   p.y_label = Trim(spec.substr(0, eq));
@@ -48,16 +50,16 @@ Result<PanelSpec> ParsePanelSpec(const std::string& spec) {
       c.scale = std::strtod(num.c_str(), &end);
       if (num.empty() || *end != '\0' || !std::isfinite(c.scale) || c.scale == 0) {
         return Error{fmt::format("--panel '{}': scale '{}' is not a finite non-zero number",
-                                 Shorten(spec), Shorten(num))};
+                                 ShortText(spec), ShortText(num))};
       }
     }
     if (c.column.empty()) {
-      return Error{fmt::format("--panel '{}': empty column name", Shorten(spec))};
+      return Error{fmt::format("--panel '{}': empty column name", ShortText(spec))};
     }
     p.columns.push_back(c);
   }
   if (p.columns.empty()) {
-    return Error{fmt::format("--panel '{}': no column after '='", Shorten(spec))};
+    return Error{fmt::format("--panel '{}': no column after '='", ShortText(spec))};
   }
   return p;
 }
@@ -67,7 +69,7 @@ Result<Figure> MakeColumnFigure(const RunCsv& table, const std::string& x,
                                 const std::string& title) {
   const std::vector<double>* xs = table.Find(x);
   if (!xs) {
-    return Error{fmt::format("{}: no column '{}' for x (columns: {})", table.path, Shorten(x),
+    return Error{fmt::format("{}: no column '{}' for x (columns: {})", table.path, ShortText(x),
                              Columns(table))};
   }
   Figure fig;
@@ -80,8 +82,8 @@ Result<Figure> MakeColumnFigure(const RunCsv& table, const std::string& x,
     for (const ColumnRef& c : spec.columns) {
       const std::vector<double>* ys = table.Find(c.column);
       if (!ys) {
-        return Error{fmt::format("{}: no column '{}' (columns: {})", table.path, Shorten(c.column),
-                                 Columns(table))};
+        return Error{fmt::format("{}: no column '{}' (columns: {})", table.path,
+                                 ShortText(c.column), Columns(table))};
       }
       Series s;
       s.label = c.scale == 1 ? c.column : fmt::format("{} x {:g}", c.column, c.scale);

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "common/atomic_file.h"
+#include "common/short_text.h"
 #include "plot/column_figure.h"
 #include "plot/render.h"
 #include "plot/run_data.h"
@@ -27,8 +28,8 @@ Result<std::vector<Format>> ParseFormats(const std::string& list) {
     else if (item == "svg")
       out.push_back(Format::kSvg);
     else
-      return Error{
-          fmt::format("--format: '{}' is not allowed (png, svg, or both: png,svg)", Shorten(item))};
+      return Error{fmt::format("--format: '{}' is not allowed (png, svg, or both: png,svg)",
+                               ShortText(item))};
   }
   if (out.empty()) return Error{"--format: empty (png, svg, or both: png,svg)"};
   return out;
@@ -62,10 +63,11 @@ Result<std::vector<std::string>> WriteAll(const std::string& out_dir,
   fs::create_directories(out_dir, ec);
   if (ec)
     return Error{
-        fmt::format("--out: cannot create directory '{}': {}", Shorten(out_dir), ec.message())};
+        fmt::format("--out: cannot create directory '{}': {}", ShortText(out_dir), ec.message()),
+        ErrorCode::kIo};
   std::vector<std::string> written;
   for (const Rendered& r : files) {
-    if (Status s = WriteFileAtomically(r.path, r.bytes); !s.ok()) return Error{s.error()};
+    if (Status s = WriteFileAtomically(r.path, r.bytes); !s.ok()) return Error{s.error(), s.code()};
     written.push_back(r.path);
   }
   return written;
@@ -75,24 +77,24 @@ Result<std::vector<std::string>> WriteAll(const std::string& out_dir,
 
 Result<std::vector<std::string>> RunPlot(const PlotOptions& o) {
   auto formats = ParseFormats(o.formats);
-  if (!formats.ok()) return Error{formats.error()};
+  if (!formats.ok()) return Error{formats.error(), formats.code()};
   for (Status s :
        {CheckSize("--width", o.width, kMinWidth), CheckSize("--height", o.height, kMinHeight)}) {
-    if (!s.ok()) return Error{s.error()};
+    if (!s.ok()) return Error{s.error(), s.code()};
   }
   if (o.out_dir.empty()) return Error{"--out: empty (a directory for the figures)"};
   std::vector<Rendered> files;
   if (!o.stability_map.empty()) {
     auto text = ReadFile(o.stability_map);
-    if (!text.ok()) return Error{text.error()};
+    if (!text.ok()) return Error{text.error(), text.code()};
     auto panels = ParseStabilityDat(*text, o.stability_map);
-    if (!panels.ok()) return Error{panels.error()};
+    if (!panels.ok()) return Error{panels.error(), panels.code()};
     const std::string map_name = o.name.empty() ? "stability" : o.name;
     const std::string title =
         o.title.empty() ? "mean step overshoot (%), ring = meets the sweep's criterion" : o.title;
     for (Format fmt : *formats) {
       auto bytes = RenderStabilityMap(*panels, title, o.width, o.height, fmt);
-      if (!bytes.ok()) return Error{bytes.error()};
+      if (!bytes.ok()) return Error{bytes.error(), bytes.code()};
       const char* ext = fmt == Format::kPng ? "png" : "svg";
       files.push_back({(fs::path(o.out_dir) / fmt::format("{}.{}", map_name, ext)).string(),
                        std::move(*bytes)});
@@ -104,18 +106,18 @@ Result<std::vector<std::string>> RunPlot(const PlotOptions& o) {
     std::vector<PanelSpec> specs;
     for (const std::string& p : o.panels) {
       auto spec = ParsePanelSpec(p);
-      if (!spec.ok()) return Error{spec.error()};
+      if (!spec.ok()) return Error{spec.error(), spec.code()};
       specs.push_back(*spec);
     }
     auto table = ReadCsvTable(o.csv);
-    if (!table.ok()) return Error{table.error()};
+    if (!table.ok()) return Error{table.error(), table.code()};
     auto fig = MakeColumnFigure(*table, o.x, o.x_label, specs, o.title);
-    if (!fig.ok()) return Error{fig.error()};
+    if (!fig.ok()) return Error{fig.error(), fig.code()};
     const double per_panel = specs.size() == 1 ? 1.0 : o.width < 640 ? 1.0 : 0.55;
     const int h = std::min(kMaxSide, static_cast<int>(per_panel * specs.size() * o.height));
     for (Format fmt : *formats) {
       auto bytes = RenderFigure(*fig, o.width, h, fmt);
-      if (!bytes.ok()) return Error{bytes.error()};
+      if (!bytes.ok()) return Error{bytes.error(), bytes.code()};
       const char* ext = fmt == Format::kPng ? "png" : "svg";
       files.push_back(
           {(fs::path(o.out_dir) / fmt::format("{}.{}", name, ext)).string(), std::move(*bytes)});
@@ -123,11 +125,11 @@ Result<std::vector<std::string>> RunPlot(const PlotOptions& o) {
     return WriteAll(o.out_dir, files);
   }
   auto csv = ReadRunCsv(o.csv);
-  if (!csv.ok()) return Error{csv.error()};
+  if (!csv.ok()) return Error{csv.error(), csv.code()};
   RunInfo info;
   if (!o.summary.empty()) {
     auto s = ReadRunSummary(o.summary);
-    if (!s.ok()) return Error{s.error()};
+    if (!s.ok()) return Error{s.error(), s.code()};
     info = *s;
   }
   const std::vector<NamedFigure> figures = MakeRunFigures(*csv, info);
@@ -139,8 +141,8 @@ Result<std::vector<std::string>> RunPlot(const PlotOptions& o) {
       known = known || f.name == o.figure;
     }
     if (!known) {
-      return Error{
-          fmt::format("--figure: '{}' is not a figure of this run ({})", Shorten(o.figure), names)};
+      return Error{fmt::format("--figure: '{}' is not a figure of this run ({})",
+                               ShortText(o.figure), names)};
     }
   }
   for (const NamedFigure& f : figures) {
@@ -152,7 +154,8 @@ Result<std::vector<std::string>> RunPlot(const PlotOptions& o) {
     const int h = std::min(kMaxSide, static_cast<int>(scale * o.height));
     for (Format fmt : *formats) {
       auto bytes = RenderFigure(f.figure, o.width, h, fmt);
-      if (!bytes.ok()) return Error{fmt::format("figure '{}': {}", f.name, bytes.error())};
+      if (!bytes.ok())
+        return Error{fmt::format("figure '{}': {}", f.name, bytes.error()), bytes.code()};
       const char* ext = fmt == Format::kPng ? "png" : "svg";
       const std::string file = o.figure.empty() ? fmt::format("{}_{}.{}", name, f.name, ext)
                                                 : fmt::format("{}.{}", name, ext);

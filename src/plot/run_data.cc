@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "common/atomic_file.h"
+#include "common/short_text.h"
 
 namespace recruit::plot {
 namespace {
@@ -65,10 +66,6 @@ void FindBundles(RunCsv& csv) {
 
 }  // namespace
 
-std::string Shorten(const std::string& value) {
-  return value.size() <= 40 ? value : value.substr(0, 37) + "...";
-}
-
 const std::vector<double>* RunCsv::Find(const std::string& name) const {
   for (size_t i = 0; i < names.size(); ++i) {
     if (names[i] == name) return &columns[i];
@@ -103,7 +100,7 @@ Result<RunCsv> ParseCsvTable(const std::string& text, const std::string& path) {
       double v;
       if (!ParseCell(cells[c], v)) {
         return Error{fmt::format("{} line {}, column '{}': '{}' is not a number", path, line_no,
-                                 csv.names[c], Shorten(cells[c]))};
+                                 csv.names[c], ShortText(cells[c]))};
       }
       csv.columns[c].push_back(v);
     }
@@ -116,7 +113,7 @@ Result<RunCsv> ParseCsvTable(const std::string& text, const std::string& path) {
 
 Result<RunCsv> ParseRunCsv(const std::string& text, const std::string& path) {
   auto table = ParseCsvTable(text, path);
-  if (!table.ok()) return Error{table.error()};
+  if (!table.ok()) return Error{table.error(), table.code()};
   RunCsv csv = std::move(*table);
   FindBundles(csv);
   if (csv.bundles.empty()) {
@@ -128,19 +125,19 @@ Result<RunCsv> ParseRunCsv(const std::string& text, const std::string& path) {
       csv.columns.emplace_back(csv.columns[0].size(), NAN);
     }
   }
-  if (Status s = CheckColumns(csv); !s.ok()) return Error{s.error()};
+  if (Status s = CheckColumns(csv); !s.ok()) return Error{s.error(), s.code()};
   return csv;
 }
 
 Result<RunCsv> ReadCsvTable(const std::string& path) {
   auto text = ReadFile(path);
-  if (!text.ok()) return Error{text.error()};
+  if (!text.ok()) return Error{text.error(), text.code()};
   return ParseCsvTable(*text, path);
 }
 
 Result<RunCsv> ReadRunCsv(const std::string& path) {
   auto text = ReadFile(path);
-  if (!text.ok()) return Error{text.error()};
+  if (!text.ok()) return Error{text.error(), text.code()};
   return ParseRunCsv(*text, path);
 }
 
@@ -155,7 +152,7 @@ Status Field(const nlohmann::json& j, const char* key, const std::string& path, 
       std::is_same_v<typename T::value_type, std::string> ? v.is_string() : v.is_number();
   if (!ok) {
     return Error{
-        fmt::format("{}: field '{}' is {} ({} allowed)", path, key, Shorten(v.dump()), allowed)};
+        fmt::format("{}: field '{}' is {} ({} allowed)", path, key, ShortText(v.dump()), allowed)};
   }
   out = v.get<typename T::value_type>();
   return Status::Ok();
@@ -165,7 +162,7 @@ Status Field(const nlohmann::json& j, const char* key, const std::string& path, 
 
 Result<RunInfo> ReadRunSummary(const std::string& path) {
   auto text = ReadFile(path);
-  if (!text.ok()) return Error{text.error()};
+  if (!text.ok()) return Error{text.error(), text.code()};
   nlohmann::json j = nlohmann::json::parse(*text, nullptr, false);
   if (j.is_discarded() || !j.is_object()) {
     return Error{path + ": not a JSON object (expected `recruit simulate`'s summary)"};
@@ -178,13 +175,13 @@ Result<RunInfo> ReadRunSummary(const std::string& path) {
                    Field(j, "dT", path, info.dT, "a number, s"),
                    Field(j, "lambda", path, info.lambda, "a number"),
                    Field(j, "seed", path, info.seed, "an integer")}) {
-    if (!s.ok()) return Error{s.error()};
+    if (!s.ok()) return Error{s.error(), s.code()};
   }
   info.task = task.value_or(""), info.estimator = estimator.value_or("");
   info.unit = unit.value_or("");
   if (!info.unit.empty() && info.unit != "N" && info.unit != "rad") {
     return Error{fmt::format("{}: field 'unit' is '{}' (\"N\" or \"rad\" allowed)", path,
-                             Shorten(info.unit))};
+                             ShortText(info.unit))};
   }
   return info;
 }

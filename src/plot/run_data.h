@@ -47,7 +47,4 @@ Result<RunInfo> ReadRunSummary(const std::string& path);
 // "task isometric_paper, estimator output, dT = 0.5 s, lambda = 0.2, seed 1" (the parts known).
 std::string TitleOf(const RunInfo& info);
 
-// `value` cut to about 40 characters for messages.
-std::string Shorten(const std::string& value);
-
 }  // namespace recruit::plot

@@ -10,6 +10,7 @@
 #include <set>
 #include <sstream>
 
+#include "common/short_text.h"
 #include "plot/cairo_text.h"
 #include "plot/run_data.h"
 
@@ -124,7 +125,7 @@ Result<std::vector<StabilityPanel>> ParseStabilityDat(const std::string& text,
         (meets != 0 && meets != 1) || !(c.dT > 0) || !std::isfinite(c.lambda)) {
       return Error{fmt::format(
           "{} line {}: '{}' is not 'dT lambda overshoot_percent meets(0/1)' with dT > 0", path,
-          line_no, Shorten(line))};
+          line_no, ShortText(line))};
     }
     c.meets = meets == 1;
     panels.back().cells.push_back(c);

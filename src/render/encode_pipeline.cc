@@ -31,7 +31,7 @@ EncodePipeline::~EncodePipeline() {
 Result<Frame*> EncodePipeline::Acquire() {
   std::unique_lock<std::mutex> lock(mu_);
   cv_.wait(lock, [this] { return !free_.empty() || !error_.ok(); });
-  if (!error_.ok()) return Error{error_.error()};
+  if (!error_.ok()) return Error{error_.error(), error_.code()};
   Frame* f = free_.back();
   free_.pop_back();
   f->still_path.clear();

@@ -138,7 +138,7 @@ Result<std::unique_ptr<GifWriter>> GifWriter::Open(const std::string& path, int 
       2, static_cast<int>(std::lround(static_cast<double>(in_height) * out_width / in_width)));
   w->frame_seconds_ = frame_seconds;
   auto output = LibavOutput::Open(path, "gif");
-  if (!output.ok()) return Error{output.error()};
+  if (!output.ok()) return Error{output.error(), output.code()};
   w->output_ = std::move(*output);
 
   w->codec_ = avcodec_alloc_context3(codec);
@@ -148,9 +148,9 @@ Result<std::unique_ptr<GifWriter>> GifWriter::Open(const std::string& path, int 
   w->codec_->pix_fmt = AV_PIX_FMT_PAL8;
   w->codec_->time_base = AVRational{1, 100};  // GIF delays are in 1/100 s
   int err = avcodec_open2(w->codec_, codec, nullptr);
-  if (err < 0) return Error{"cannot open the GIF encoder: " + AvError(err)};
-  if (Status s = w->output_->AddStream(w->codec_); !s.ok()) return Error{s.error()};
-  if (Status s = w->output_->WriteHeader(nullptr); !s.ok()) return Error{s.error()};
+  if (err < 0) return Error{"cannot open the GIF encoder: " + AvError(err), ErrorCode::kIo};
+  if (Status s = w->output_->AddStream(w->codec_); !s.ok()) return Error{s.error(), s.code()};
+  if (Status s = w->output_->WriteHeader(nullptr); !s.ok()) return Error{s.error(), s.code()};
 
   w->pal_frame_ = av_frame_alloc();
   if (!w->pal_frame_) return Error{"out of memory"};
@@ -158,10 +158,10 @@ Result<std::unique_ptr<GifWriter>> GifWriter::Open(const std::string& path, int 
   w->pal_frame_->width = w->out_width_;
   w->pal_frame_->height = w->out_height_;
   err = av_frame_get_buffer(w->pal_frame_, 0);
-  if (err < 0) return Error{"cannot allocate a GIF frame: " + AvError(err)};
+  if (err < 0) return Error{"cannot allocate a GIF frame: " + AvError(err), AvCode(err)};
   w->sws_ = sws_getContext(in_width, in_height, AV_PIX_FMT_RGB24, w->out_width_, w->out_height_,
                            AV_PIX_FMT_RGB24, SWS_AREA, nullptr, nullptr, nullptr);
-  if (!w->sws_) return Error{"cannot create the GIF scaler"};
+  if (!w->sws_) return Error{"cannot create the GIF scaler", ErrorCode::kIo};
   w->scaled_.resize(static_cast<size_t>(w->out_width_) * w->out_height_ * 3);
   return w;
 }
@@ -187,7 +187,7 @@ Status GifWriter::Write(const Frame& frame) {
         std::make_unique<Palette>(Palette::FromImage(scaled_.data(), scaled_.size() / 3, reserved));
   }
   int err = av_frame_make_writable(pal_frame_);
-  if (err < 0) return Error{"'" + path() + "': " + AvError(err)};
+  if (err < 0) return Error{"'" + path() + "': " + AvError(err), AvCode(err)};
   uint32_t* pal = reinterpret_cast<uint32_t*>(pal_frame_->data[1]);
   for (int i = 0; i < 256; ++i) {
     const auto& c = palette_->colours()[i];

@@ -84,6 +84,7 @@ struct EglApi {
 Result<EglApi*> LoadEgl() {
   static EglApi api;
   static std::string error;
+  static ErrorCode code = ErrorCode::kBadInput;
   static std::once_flag once;
   std::call_once(once, [] {
     // RTLD_GLOBAL: MuJoCo's loader looks up eglGetProcAddress among the global symbols.
@@ -91,6 +92,7 @@ Result<EglApi*> LoadEgl() {
     if (!api.lib) {
       error = std::string("GL back end 'egl': cannot open libEGL.so.1 (") + dlerror() +
               "); install a GPU driver's EGL (or libegl1) or use --gl osmesa";
+      code = ErrorCode::kIo;
       return;
     }
     auto sym = [](const char* name) { return dlsym(api.lib, name); };
@@ -114,7 +116,7 @@ Result<EglApi*> LoadEgl() {
     api.GetPlatformDisplay = reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(
         api.GetProcAddress("eglGetPlatformDisplayEXT"));
   });
-  if (!error.empty()) return Error{error};
+  if (!error.empty()) return Error{error, code};
   return &api;
 }
 
@@ -130,7 +132,7 @@ class EglContext final : public GlContext {
 
   Status Init() {
     auto api = LoadEgl();
-    if (!api.ok()) return Error{api.error()};
+    if (!api.ok()) return Error{api.error(), api.code()};
     api_ = *api;
     display_ = EGL_NO_DISPLAY;
     // Prefer the first EGL device (a GPU, or Mesa's software device): no window system needed.
@@ -235,7 +237,8 @@ Result<GlBackend> GlBackendFromEnvironment() {
     const char* value = std::getenv(var);
     if (value && *value) {
       auto b = ParseGlBackend(value);
-      if (!b.ok()) return Error{std::string("environment variable ") + var + ": " + b.error()};
+      if (!b.ok())
+        return Error{std::string("environment variable ") + var + ": " + b.error(), b.code()};
       return b;
     }
   }
@@ -247,14 +250,14 @@ Result<std::unique_ptr<GlContext>> GlContext::Create(GlBackend backend, int widt
     return Error{"GL context size must be positive, got " + std::to_string(width) + "x" +
                  std::to_string(height)};
   }
-  if (Status s = ClaimBackend(backend); !s.ok()) return Error{s.error()};
+  if (Status s = ClaimBackend(backend); !s.ok()) return Error{s.error(), s.code()};
   if (backend == GlBackend::kEgl) {
     auto ctx = std::make_unique<EglContext>();
-    if (Status s = ctx->Init(); !s.ok()) return Error{s.error()};
+    if (Status s = ctx->Init(); !s.ok()) return Error{s.error(), s.code()};
     return std::unique_ptr<GlContext>(std::move(ctx));
   }
   auto ctx = std::make_unique<OsMesaContext>();
-  if (Status s = ctx->Init(width, height); !s.ok()) return Error{s.error()};
+  if (Status s = ctx->Init(width, height); !s.ok()) return Error{s.error(), s.code()};
   return std::unique_ptr<GlContext>(std::move(ctx));
 }
 

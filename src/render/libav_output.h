@@ -20,6 +20,8 @@ namespace recruit::render {
 
 // "av error text" for a libav return code.
 std::string AvError(int code);
+// The class of a libav error code (an errno one like EACCES or ENOSPC is I/O).
+ErrorCode AvCode(int code);
 
 class LibavOutput {
  public:

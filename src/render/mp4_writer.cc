@@ -45,7 +45,7 @@ Mp4Writer::~Mp4Writer() {
 
 Result<std::unique_ptr<Mp4Writer>> Mp4Writer::Open(const std::string& path, int width, int height,
                                                    int fps, const H264Options& options) {
-  if (Status s = options.Validate(); !s.ok()) return Error{s.error()};
+  if (Status s = options.Validate(); !s.ok()) return Error{s.error(), s.code()};
   if (width <= 0 || height <= 0 || width % 2 || height % 2) {
     return Error{"video size " + std::to_string(width) + "x" + std::to_string(height) +
                  ": H.264 in yuv420p needs an even width and height"};
@@ -60,7 +60,7 @@ Result<std::unique_ptr<Mp4Writer>> Mp4Writer::Open(const std::string& path, int 
   w->width_ = width;
   w->height_ = height;
   auto output = LibavOutput::Open(path, "mp4");
-  if (!output.ok()) return Error{output.error()};
+  if (!output.ok()) return Error{output.error(), output.code()};
   w->output_ = std::move(*output);
 
   w->codec_ = avcodec_alloc_context3(codec);
@@ -81,13 +81,13 @@ Result<std::unique_ptr<Mp4Writer>> Mp4Writer::Open(const std::string& path, int 
   av_opt_set(c->priv_data, "preset", options.preset.c_str(), 0);
   av_opt_set_int(c->priv_data, "crf", options.crf, 0);
   int err = avcodec_open2(c, codec, nullptr);
-  if (err < 0) return Error{"cannot open the H.264 encoder: " + AvError(err)};
-  if (Status s = w->output_->AddStream(c); !s.ok()) return Error{s.error()};
+  if (err < 0) return Error{"cannot open the H.264 encoder: " + AvError(err), ErrorCode::kIo};
+  if (Status s = w->output_->AddStream(c); !s.ok()) return Error{s.error(), s.code()};
   AVDictionary* mux_options = nullptr;
   av_dict_set(&mux_options, "movflags", "+faststart", 0);
   Status header = w->output_->WriteHeader(&mux_options);
   av_dict_free(&mux_options);
-  if (!header.ok()) return Error{header.error()};
+  if (!header.ok()) return Error{header.error(), header.code()};
 
   w->yuv_ = av_frame_alloc();
   if (!w->yuv_) return Error{"out of memory"};
@@ -95,10 +95,10 @@ Result<std::unique_ptr<Mp4Writer>> Mp4Writer::Open(const std::string& path, int 
   w->yuv_->width = width;
   w->yuv_->height = height;
   err = av_frame_get_buffer(w->yuv_, 0);
-  if (err < 0) return Error{"cannot allocate a video frame: " + AvError(err)};
+  if (err < 0) return Error{"cannot allocate a video frame: " + AvError(err), AvCode(err)};
   w->sws_ = sws_getContext(width, height, AV_PIX_FMT_RGB24, width, height, AV_PIX_FMT_YUV420P,
                            SWS_BILINEAR, nullptr, nullptr, nullptr);
-  if (!w->sws_) return Error{"cannot create the RGB to YUV converter"};
+  if (!w->sws_) return Error{"cannot create the RGB to YUV converter", ErrorCode::kIo};
   // Full-range RGB in, limited-range BT.709 YUV out, matching the stream's tags.
   sws_setColorspaceDetails(w->sws_, sws_getCoefficients(SWS_CS_ITU709), 1,
                            sws_getCoefficients(SWS_CS_ITU709), 0, 0, 1 << 16, 1 << 16);
@@ -110,7 +110,7 @@ Status Mp4Writer::Write(const Frame& frame) {
     return Error{"'" + path() + "': frame size changed during the video"};
   }
   const int err = av_frame_make_writable(yuv_);
-  if (err < 0) return Error{"'" + path() + "': " + AvError(err)};
+  if (err < 0) return Error{"'" + path() + "': " + AvError(err), AvCode(err)};
   // Negative stride from the top row: the bottom-up GL rows come out top-down, no copy.
   const uint8_t* src[1] = {frame.TopRow()};
   const int stride[1] = {-3 * width_};

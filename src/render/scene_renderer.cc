@@ -85,14 +85,14 @@ Result<std::unique_ptr<SceneRenderer>> SceneRenderer::Create(const mjModel* m,
                                                              const RenderOptions& options,
                                                              const RunLabel& label) {
   if (!m) return Error{"render: no model"};
-  if (Status s = options.Validate(); !s.ok()) return Error{s.error()};
+  if (Status s = options.Validate(); !s.ok()) return Error{s.error(), s.code()};
   auto camera = ResolveCamera(m, options.camera);
-  if (!camera.ok()) return Error{camera.error()};
+  if (!camera.ok()) return Error{camera.error(), camera.code()};
 
   std::unique_ptr<SceneRenderer> r(new SceneRenderer(options, label));
   r->camera_ = *camera;
   auto gl = GlContext::Create(options.backend, options.width, options.height);
-  if (!gl.ok()) return Error{gl.error()};
+  if (!gl.ok()) return Error{gl.error(), gl.code()};
   r->gl_ = std::move(*gl);
   r->gl_description_ = r->gl_->Description();
   const int max_side = r->gl_->MaxRenderbufferSize();

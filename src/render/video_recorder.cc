@@ -81,13 +81,13 @@ Status VideoOptions::Validate() const {
 }
 
 Result<std::unique_ptr<VideoRecorder>> VideoRecorder::Create(const VideoOptions& options) {
-  if (Status s = options.Validate(); !s.ok()) return Error{s.error()};
+  if (Status s = options.Validate(); !s.ok()) return Error{s.error(), s.code()};
   std::unique_ptr<VideoRecorder> r(new VideoRecorder(options));
   const int w = options.render.width, h = options.render.height;
   std::unique_ptr<Mp4Writer> mp4;
   if (!options.mp4_path.empty()) {
     auto opened = Mp4Writer::Open(options.mp4_path, w, h, options.fps, options.h264);
-    if (!opened.ok()) return Error{opened.error()};
+    if (!opened.ok()) return Error{opened.error(), opened.code()};
     mp4 = std::move(*opened);
   }
   std::unique_ptr<GifWriter> gif;
@@ -95,7 +95,7 @@ Result<std::unique_ptr<VideoRecorder>> VideoRecorder::Create(const VideoOptions&
     const int stride = GifStride(options);
     auto opened = GifWriter::Open(options.gif_path, w, h, options.gif_width,
                                   static_cast<double>(stride) / options.fps);
-    if (!opened.ok()) return Error{opened.error()};
+    if (!opened.ok()) return Error{opened.error(), opened.code()};
     gif = std::move(*opened);
   }
   r->pipeline_ = std::make_unique<EncodePipeline>(w, h, std::move(mp4), std::move(gif),
@@ -108,7 +108,7 @@ Result<std::unique_ptr<VideoRecorder>> VideoRecorder::Create(const VideoOptions&
 Status VideoRecorder::Prepare(const mjModel* m) {
   if (renderer_) return Status::Ok();
   auto renderer = SceneRenderer::Create(m, options_.render, options_.label);
-  if (!renderer.ok()) return Error{renderer.error()};
+  if (!renderer.ok()) return Error{renderer.error(), renderer.code()};
   renderer_ = std::move(*renderer);
   return Status::Ok();
 }
@@ -140,7 +140,7 @@ Status VideoRecorder::OnStep(const mjModel* m, const mjData* d, const TelemetryS
   if (Status s = Prepare(m); !s.ok()) return s;
 
   auto frame = pipeline_->Acquire();
-  if (!frame.ok()) return Error{frame.error()};
+  if (!frame.ok()) return Error{frame.error(), frame.code()};
   renderer_->AddPlotPoint(sample);
   if (Status s = renderer_->Render(m, d, &sample, (*frame)->rgb.data()); !s.ok()) {
     (void)pipeline_->Submit(*frame);  // hand the buffer back; the error stops the run
@@ -160,7 +160,7 @@ Status VideoRecorder::OnStep(const mjModel* m, const mjData* d, const TelemetryS
   if (Status s = pipeline_->Submit(first); !s.ok()) return s;
   while (static_cast<double>(next_index_) / options_.fps <= d->time + slack) {
     auto dup = pipeline_->Acquire();
-    if (!dup.ok()) return Error{dup.error()};
+    if (!dup.ok()) return Error{dup.error(), dup.code()};
     std::memcpy((*dup)->rgb.data(), copy.data(), copy.size());
     (*dup)->index = next_index_++;
     (*dup)->time = d->time;

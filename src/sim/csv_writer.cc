@@ -17,7 +17,7 @@ CsvStepWriter::CsvStepWriter(std::string path, int every)
 }
 
 Status CsvStepWriter::OnStep(const mjModel*, const mjData*, const TelemetrySample& s) {
-  if (!file_.ok()) return Error{file_.error()};
+  if (!file_.ok()) return Error{file_.error(), file_.code()};
   if (!header_written_) {
     std::string header = "time,reference,measured,angle";
     for (const auto& j : s.joints) header += fmt::format(",{0}.reference,{0}.angle", j.joint);
@@ -134,13 +134,13 @@ void CsvStepWriter::Flush() {
 }
 
 Status CsvStepWriter::Finish() {
-  if (!file_.ok()) return Error{file_.error()};
+  if (!file_.ok()) return Error{file_.error(), file_.code()};
   Flush();
   return Status::Ok();
 }
 
 Status CsvStepWriter::Commit() {
-  if (!file_.ok()) return Error{file_.error()};
+  if (!file_.ok()) return Error{file_.error(), file_.code()};
   return file_.Commit();
 }
 

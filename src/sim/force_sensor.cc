@@ -2,16 +2,9 @@
 
 #include <cmath>
 
+#include "common/short_text.h"
+
 namespace recruit::sim {
-namespace {
-
-std::string Short(const nlohmann::json& v) {
-  std::string s = v.dump();
-  return s.size() > 40 ? s.substr(0, 37) + "..." : s;
-}
-
-}  // namespace
-
 Result<SensorParams> SensorParams::Create(double noise_std, double resolution) {
   if (!(noise_std >= 0 && std::isfinite(noise_std))) {
     return Error{"noise_std must be a finite number >= 0 N, got " + std::to_string(noise_std)};
@@ -25,7 +18,7 @@ Result<SensorParams> SensorParams::Create(double noise_std, double resolution) {
 Result<SensorParams> SensorParams::FromJson(const nlohmann::json& j, const std::string& where) {
   if (!j.is_object()) {
     return Error{where + ": must be an object {\"noise_std\": N, \"resolution\": N}, got " +
-                 Short(j)};
+                 ShortText(j.dump())};
   }
   SensorParams p;
   for (const auto& [key, value] : j.items()) {
@@ -36,7 +29,8 @@ Result<SensorParams> SensorParams::FromJson(const nlohmann::json& j, const std::
       return Error{where + "." + key + ": unknown key; allowed: noise_std, resolution"};
     }
     if (!value.is_number() || !(value.get<double>() >= 0) || !std::isfinite(value.get<double>())) {
-      return Error{where + "." + key + ": must be a number >= 0 (N), got " + Short(value)};
+      return Error{where + "." + key + ": must be a number >= 0 (N), got " +
+                   ShortText(value.dump())};
     }
     *field = value.get<double>();
   }
@@ -49,7 +43,7 @@ nlohmann::json SensorParams::ToJson() const {
 
 Result<ForceSensor> ForceSensor::Create(const SensorParams& params, std::uint64_t seed) {
   auto p = SensorParams::Create(params.noise_std, params.resolution);
-  if (!p.ok()) return Error{"sensor: " + p.error()};
+  if (!p.ok()) return Error{"sensor: " + p.error(), p.code()};
   return ForceSensor(*p, seed);
 }
 

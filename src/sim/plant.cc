@@ -209,6 +209,22 @@ bool AnyLimitReached(const mjModel* m, const std::vector<int>& joints, const mjt
   return false;
 }
 
+// MuJoCo's constraint stage switched off (when `off`) until the end of the scope: the model's
+// stage switches are restored as they were (plant.h says where the plant changes its model).
+class DisableForOneCall {
+ public:
+  DisableForOneCall(mjModel* m, bool off) : m_(m), flags_(m->opt.disableflags) {
+    if (off) m_->opt.disableflags |= mjDSBL_CONSTRAINT;
+  }
+  ~DisableForOneCall() { m_->opt.disableflags = flags_; }
+  DisableForOneCall(const DisableForOneCall&) = delete;
+  DisableForOneCall& operator=(const DisableForOneCall&) = delete;
+
+ private:
+  mjModel* m_;
+  const int flags_;
+};
+
 }  // namespace
 
 Result<std::unique_ptr<Plant>> Plant::Create(const Task& task, bool drawn) {
@@ -240,11 +256,11 @@ Result<std::unique_ptr<Plant>> Plant::Create(const Task& task, bool drawn) {
   p->gate_ = LimitsThatAloneConstrain(m);
   if (p->gate_ && AnyLimitReached(m, *p->gate_, m->qpos0)) p->gate_.reset();
   auto host = sma::SmaHost::Create(m);
-  if (!host.ok()) return Error{where + ".model: " + host.error()};
+  if (!host.ok()) return Error{where + ".model: " + host.error(), host.code()};
   p->host_ = std::move(host).value();
 
-  if (Status st = p->FindBundles(task, where); !st.ok()) return Error{st.error()};
-  if (Status st = p->FindJoints(task, where); !st.ok()) return Error{st.error()};
+  if (Status st = p->FindBundles(task, where); !st.ok()) return Error{st.error(), st.code()};
+  if (Status st = p->FindJoints(task, where); !st.ok()) return Error{st.error(), st.code()};
   if (!task.joint.empty()) {
     const int joint = mj_name2id(m, mjOBJ_JOINT, task.joint.c_str());
     if (joint < 0) {
@@ -276,8 +292,8 @@ Result<std::unique_ptr<Plant>> Plant::Create(const Task& task, bool drawn) {
   p->body_inertia0_.assign(m->body_inertia, m->body_inertia + 3 * m->nbody);
   p->data_.reset(mj_makeData(m));
   if (!p->joints_.empty()) p->scratch_.reset(mj_makeData(m));
-  p->observed_.resize(p->bundles_.size());
-  p->ForgetObserved();
+  p->telemetry_.resize(p->bundles_.size());
+  p->ForgetTelemetry();
   return p;
 }
 
@@ -330,14 +346,14 @@ Status Plant::FindJoints(const Task& task, const std::string& where) {
   };
   if (!task.joint.empty()) {
     auto joint = hinge(task.joint, task.auto_loop ? "joints[0].joint" : "joint");
-    if (!joint.ok()) return Error{joint.error()};
+    if (!joint.ok()) return Error{joint.error(), joint.code()};
     qadr_ = m->jnt_qposadr[*joint];
     dadr_ = m->jnt_dofadr[*joint];
   }
   if (!task.auto_loop) return Status::Ok();
   for (size_t j = 0; j < task.joints.size(); ++j) {
     auto joint = hinge(task.joints[j].joint, "joints[" + std::to_string(j) + "].joint");
-    if (!joint.ok()) return Error{joint.error()};
+    if (!joint.ok()) return Error{joint.error(), joint.code()};
     joints_.push_back(*joint);
   }
   return Status::Ok();
@@ -401,11 +417,11 @@ void Plant::PoseScratch(const Eigen::VectorXd& q) const {
 Eigen::VectorXd Plant::StaticTorque(const Eigen::VectorXd& q) const {
   mjModel* m = model_.get();
   PoseScratch(q);
-  // Without constraint rows: a limit the pose touches would otherwise take part of the load.
-  const int flags = m->opt.disableflags;
-  m->opt.disableflags |= mjDSBL_CONSTRAINT;
-  mj_inverse(m, scratch_.get());
-  m->opt.disableflags = flags;
+  {
+    // Without constraint rows: a limit the pose touches would otherwise take part of the load.
+    DisableForOneCall off(m, true);
+    mj_inverse(m, scratch_.get());
+  }
   Eigen::VectorXd tau(num_joints());
   for (int j = 0; j < num_joints(); ++j) {
     tau[j] = scratch_->qfrc_inverse[m->jnt_dofadr[joints_[j]]];
@@ -432,7 +448,7 @@ void Plant::Reset(std::uint64_t seed) {
   ApplyPayloads();
   host_->Reset(data_.get(), seed);
   mj_forward(m, data_.get());
-  ForgetObserved();
+  ForgetTelemetry();
   peak_temperature_.assign(bundles_.size(), -std::numeric_limits<double>::infinity());
   peak_stress_.assign(bundles_.size(), 0.0);
   TrackPeaks();
@@ -445,21 +461,20 @@ void Plant::Step() {
   // Joint limits the only rows there can be, and none reached: MuJoCo's constraint stage would
   // make no row and leave qacc = qacc_smooth, as it does disabled. Visiting it anyway was 5 % of
   // an arm step (docs/benchmarks.md).
-  const int flags = m->opt.disableflags;
-  if (gate_ && !AnyLimitReached(m, *gate_, data_->qpos)) {
-    m->opt.disableflags |= mjDSBL_CONSTRAINT;
-    ++skipped_;
+  const bool skip = gate_ && !AnyLimitReached(m, *gate_, data_->qpos);
+  if (skip) ++skipped_;
+  {
+    DisableForOneCall off(m, skip);
+    mj_step(m, data_.get());
   }
-  mj_step(m, data_.get());
-  m->opt.disableflags = flags;
-  ForgetObserved();
+  ForgetTelemetry();
   TrackPeaks();
 }
 
-const sma::SmaBundle::Telemetry& Plant::ObserveNow(int i) const {
-  observed_[i] = host_->Observe(data_.get(), bundles_[i]);
-  observed_valid_[i] = true;
-  return observed_[i];
+const sma::SmaBundle::Telemetry& Plant::ReadBundleTelemetry(int i) const {
+  telemetry_[i] = host_->Observe(data_.get(), bundles_[i]);
+  telemetry_valid_[i] = true;
+  return telemetry_[i];
 }
 
 void Plant::ApplyPayloads() {
@@ -496,7 +511,7 @@ void Plant::ApplyPushes() {
 
 void Plant::TrackPeaks() {
   for (int i = 0; i < num_bundles(); ++i) {
-    const sma::SmaBundle::Telemetry& now = Observed(i);
+    const sma::SmaBundle::Telemetry& now = BundleTelemetry(i);
     peak_temperature_[i] = std::max(peak_temperature_[i], now.max_temperature);
     peak_stress_[i] = std::max(peak_stress_[i], now.max_wire_stress);
   }

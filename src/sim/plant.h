@@ -55,14 +55,14 @@ class Plant {
   int bundle_index(int i) const { return bundles_[i]; }  // in the host
   const std::string& bundle_name(int i) const { return host_->bundle_name(bundles_[i]); }
   int num_units(int i) const { return host_->num_units(bundles_[i]); }
-  double Force(int i) const { return Observed(i).tension; }  // exact, N
+  double Force(int i) const { return BundleTelemetry(i).tension; }  // exact, N
   // Bundle i's length coordinate (gear x tendon length, SmaHost::UnitLength): what the joint
   // encoders give the controller, and the length its unit force map reads.
   double UnitLength(int i) const { return host_->UnitLength(data_.get(), bundles_[i]); }
-  int OnCount(int i) const { return Observed(i).on_count; }
-  double MeanTemperature(int i) const { return Observed(i).mean_temperature; }  // C
+  int OnCount(int i) const { return BundleTelemetry(i).on_count; }
+  double MeanTemperature(int i) const { return BundleTelemetry(i).mean_temperature; }  // C
   Status Broadcast(int i, double p_on, double p_off) {
-    observed_valid_[i] = false;  // the units' states change
+    telemetry_valid_[i] = false;  // the units' states change
     return host_->Broadcast(data_.get(), bundles_[i], p_on, p_off);
   }
 
@@ -119,13 +119,22 @@ class Plant {
   // them several times a step (measurement, telemetry, peaks): one pass, ~280 instructions for
   // 60 units (callgrind, arm_push), instead of four.
   // The kept pass is read inline; only a new pass is a call.
-  const sma::SmaBundle::Telemetry& Observed(int i) const {
-    return observed_valid_[i] ? observed_[i] : ObserveNow(i);
+  const sma::SmaBundle::Telemetry& BundleTelemetry(int i) const {
+    return telemetry_valid_[i] ? telemetry_[i] : ReadBundleTelemetry(i);
   }
-  const sma::SmaBundle::Telemetry& ObserveNow(int i) const;
-  void ForgetObserved() { observed_valid_.assign(bundles_.size(), false); }
+  const sma::SmaBundle::Telemetry& ReadBundleTelemetry(int i) const;
+  void ForgetTelemetry() { telemetry_valid_.assign(bundles_.size(), false); }
 
   const Task* task_ = nullptr;
+  // The plant's own copy of the task's model (Create loads it; it is never shared, and model()
+  // hands out a const view). It is changed in these places only, each because MuJoCo keeps the
+  // setting in mjModel and nowhere else:
+  //  - Create: task.timestep, and the stages the model has nothing for disabled (sensors,
+  //    friction loss, equality, islands; mjOption is part of mjModel);
+  //  - Step and StaticTorque: the constraint stage switched off for one call and restored
+  //    (DisableForOneCall in plant.cc), as stage switches exist only in mjModel.opt;
+  //  - ApplyPayloads: a payload body's mass and inertia (MuJoCo has no per-mjData mass); Reset
+  //    restores them from body_mass0_ and body_inertia0_, so runs from a Reset are alike.
   ModelPtr model_;
   DataPtr data_;
   std::unique_ptr<sma::SmaHost> host_;
@@ -139,8 +148,8 @@ class Plant {
   std::optional<std::vector<int>> gate_;
   long skipped_ = 0;
   std::vector<double> peak_temperature_, peak_stress_;
-  mutable std::vector<sma::SmaBundle::Telemetry> observed_;  // a cache: see Observed
-  mutable std::vector<unsigned char> observed_valid_;
+  mutable std::vector<sma::SmaBundle::Telemetry> telemetry_;  // a cache: see BundleTelemetry
+  mutable std::vector<unsigned char> telemetry_valid_;
   // Each payload body's mass and inertia as loaded (Reset restores them).
   std::vector<double> body_mass0_, body_inertia0_;
 };

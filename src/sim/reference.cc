@@ -111,23 +111,23 @@ Result<Reference> Reference::FromJson(const nlohmann::json& j, const std::string
   const std::string type = j["type"];
   const std::string w = where;
   auto wrap = [&](Result<Reference> r) -> Result<Reference> {
-    if (!r.ok()) return Error{w + ": " + r.error()};
+    if (!r.ok()) return Error{w + ": " + r.error(), r.code()};
     return r;
   };
   if (type == "constant") {
     auto v = GetNumber(j, "value", w);
-    if (!v.ok()) return Error{v.error()};
+    if (!v.ok()) return Error{v.error(), v.code()};
     return Constant(*v * scale);
   }
   if (type == "steps") {
     auto times = GetNumbers(j, "times", w);
-    if (!times.ok()) return Error{times.error()};
+    if (!times.ok()) return Error{times.error(), times.code()};
     auto values = GetNumbers(j, "values", w);
-    if (!values.ok()) return Error{values.error()};
+    if (!values.ok()) return Error{values.error(), values.code()};
     double initial = 0;
     if (j.contains("initial")) {
       auto i = GetNumber(j, "initial", w);
-      if (!i.ok()) return Error{i.error()};
+      if (!i.ok()) return Error{i.error(), i.code()};
       initial = *i;
     }
     for (double& v : *values) v *= scale;
@@ -138,7 +138,7 @@ Result<Reference> Reference::FromJson(const nlohmann::json& j, const std::string
     const char* keys[4] = {"start", "end", "from", "to"};
     for (int k = 0; k < 4; ++k) {
       auto v = GetNumber(j, keys[k], w);
-      if (!v.ok()) return Error{v.error()};
+      if (!v.ok()) return Error{v.error(), v.code()};
       vals[k] = *v;
     }
     if (!(vals[1] > vals[0])) return Error{w + ".end: must be greater than 'start'"};

@@ -1,6 +1,6 @@
 // RunMetrics: the scores of one closed-loop run, and kMetricFields, the one table of its fields.
 // The table drives the summary JSON's "metrics" object (writer and reader), the sweep's per-cell
-// columns (table.csv, sim/sweep.h CellStats) and the Python package's metric names and aggregate
+// columns (table.csv, sweep/table.h CellStats) and the Python package's metric names and aggregate
 // columns: a metric added to the struct and to the table appears in all of them
 // (tests/sim/run_metrics_test.cc fails if the struct has a field the table lacks).
 #pragma once

@@ -141,14 +141,14 @@ Result<std::string> BundleModelFile(const Task& task, const ControllerSettings& 
     file.replace(at, key.size(), host.bundle_name(b));
   }
   if (!file.empty()) return file;
-  control::ModelRequest req{task.model_path, host.bundle_name(b),
-                            control::PlantRecord(host, b, task.model_path), settings.dT,
-                            spec.num_states};
-  auto found = control::FindOrIdentifyModel(req, /*identify=*/false, nullptr);
+  identification::ModelRequest req{task.model_path, host.bundle_name(b),
+                                   identification::PlantRecord(host, b, task.model_path),
+                                   settings.dT, spec.num_states};
+  auto found = identification::FindOrIdentifyModel(req, /*identify=*/false, nullptr);
   if (found.ok() || !options.identify_missing_models) return found;
   // Not on the search path: identified now; the time it takes is reported apart.
   const auto start = std::chrono::steady_clock::now();
-  found = control::FindOrIdentifyModel(req, true, options.quiet ? nullptr : stderr);
+  found = identification::FindOrIdentifyModel(req, true, options.quiet ? nullptr : stderr);
   identify_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return found;
 }
@@ -185,7 +185,7 @@ Result<std::vector<Channel>> MakeChannels(const Task& task, const ControllerSett
                                           std::vector<std::string>& warnings) {
   auto spec = control::EstimatorSpec::Parse(settings.estimator, "extended", settings.filter_model,
                                             20, settings.force_noise_std);
-  if (!spec.ok()) return Error{where + ".controller.estimator: " + spec.error()};
+  if (!spec.ok()) return Error{where + ".controller.estimator: " + spec.error(), spec.code()};
   const sma::SmaHost& host = plant.host();
   std::vector<Channel> channels;
   for (int i = 0; i < plant.num_bundles(); ++i) {
@@ -200,15 +200,15 @@ Result<std::vector<Channel>> MakeChannels(const Task& task, const ControllerSett
     // A model identified on another plant (unit, geometry) is refused with both named.
     control::EstimatorSpec bundle_spec = *spec;
     bundle_spec.sensor_variance = task.sensor.Variance();
-    bundle_spec.plant = control::PlantRecord(host, b, task.model_path);
+    bundle_spec.plant = identification::PlantRecord(host, b, task.model_path);
     if (bundle_spec.kind == control::EstimatorKind::kKalmanAugmented ||
         !bundle_spec.model_file.empty()) {
       auto file = BundleModelFile(task, settings, plant, i, options, bundle_spec, identify_s);
-      if (!file) return Error{where + ".controller: " + file.error()};
+      if (!file) return Error{where + ".controller: " + file.error(), file.code()};
       bundle_spec.model_file = *file;
     }
     auto c = control::RecruitmentController::Create(p, bundle_spec);
-    if (!c.ok()) return Error{where + ".controller: " + c.error()};
+    if (!c.ok()) return Error{where + ".controller: " + c.error(), c.code()};
     if (const auto* k = dynamic_cast<const control::KalmanOnCountEstimator*>(&c->estimator())) {
       IdentificationWarning(k->model(), host.bundle_name(b), warnings);
     }
@@ -216,7 +216,7 @@ Result<std::vector<Channel>> MakeChannels(const Task& task, const ControllerSett
     // streams use the seed itself).
     auto sensor =
         ForceSensor::Create(task.sensor, Rng::DeriveSeed(options.seed, kSensorStream + i));
-    if (!sensor.ok()) return Error{where + ".sensor: " + sensor.error()};
+    if (!sensor.ok()) return Error{where + ".sensor: " + sensor.error(), sensor.code()};
     channels.push_back({std::move(sensor).value(), std::move(c).value(), {}, {}});
     channels.back().switches.Add(plant.OnCount(i));
   }
@@ -240,7 +240,7 @@ Result<std::vector<control::ActuatorResponse>> ActuatorResponses(
       control::EstimatorSpec spec;
       spec.model_file = settings.filter_model;
       auto file = BundleModelFile(task, settings, plant, i, options, spec, identify_s);
-      if (!file && options.identify_missing_models) return Error{file.error()};
+      if (!file && options.identify_missing_models) return Error{file.error(), file.code()};
       if (!file) {
         // No identified model and none to be made: the design rests on the unit's own lag.
         const double tau = plant.host().bundle(plant.bundle_index(i)).unit().time_constant();
@@ -251,7 +251,7 @@ Result<std::vector<control::ActuatorResponse>> ActuatorResponses(
         continue;
       }
       auto loaded = FilterModel::FromJson(*file);
-      if (!loaded) return Error{loaded.error()};
+      if (!loaded) return Error{loaded.error(), loaded.code()};
       model = std::move(loaded).value();
       IdentificationWarning(model, plant.bundle_name(i), warnings);
     }
@@ -582,19 +582,19 @@ Result<std::vector<JointDesignRecord>> DesignTaskLoops(const Task& task,
   }
   const ControllerSettings settings = EffectiveSettings(task, options);
   auto plant_or = Plant::Create(task, /*drawn=*/false);
-  if (!plant_or.ok()) return Error{plant_or.error()};
+  if (!plant_or.ok()) return Error{plant_or.error(), plant_or.code()};
   Plant& plant = **plant_or;
   plant.Reset(options.seed);
   double identify_s = 0;
   std::vector<std::string> warnings;
   auto channels = MakeChannels(task, settings, plant, options, where, identify_s, warnings);
-  if (!channels.ok()) return Error{channels.error()};
+  if (!channels.ok()) return Error{channels.error(), channels.code()};
   auto responses =
       ActuatorResponses(task, settings, plant, *channels, options, identify_s, warnings);
-  if (!responses) return Error{where + ".outer_loop: " + responses.error()};
+  if (!responses) return Error{where + ".outer_loop: " + responses.error(), responses.code()};
   auto loops = JointLoops::Create(task, plant, std::move(responses).value(), UnitForces(*channels),
                                   settings.dT);
-  if (!loops) return Error{where + ".outer_loop: " + loops.error()};
+  if (!loops) return Error{where + ".outer_loop: " + loops.error(), loops.code()};
   const double duration = options.duration ? *options.duration : task.duration;
   std::vector<JointDesignRecord> out;
   for (int j = 0; j < plant.num_joints(); ++j) {
@@ -611,7 +611,7 @@ Result<std::vector<JointDesignRecord>> DesignTaskLoops(const Task& task,
       if (std::find(done.begin(), done.end(), r[j]) != done.end()) continue;
       done.push_back(r[j]);
       auto rec = loops->Design(plant, j, r, step);
-      if (!rec) return Error{where + ": " + rec.error()};
+      if (!rec) return Error{where + ": " + rec.error(), rec.code()};
       out.push_back(std::move(rec).value());
     }
   }
@@ -646,7 +646,7 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
   const ControllerSettings settings = EffectiveSettings(task, options);
   const double duration = options.duration ? *options.duration : task.duration;
   if (!(duration > 0)) return Error{where + ": duration must be > 0 s"};
-  if (!(settings.dT > 0)) return Error{where + ": controller.dT must be > 0 s"};
+  RECRUIT_TRY(control::CheckDT(settings.dT, where + ": controller"));
   if (!(settings.lambda > 0 && settings.lambda <= 1)) {
     return Error{where + ": controller.lambda must be in (0, 1]"};
   }
@@ -654,7 +654,7 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
   const bool draws = std::any_of(observers.begin(), observers.end(),
                                  [](const StepObserver* o) { return o->Draws(); });
   auto plant_or = Plant::Create(task, /*drawn=*/draws);
-  if (!plant_or.ok()) return Error{plant_or.error()};
+  if (!plant_or.ok()) return Error{plant_or.error(), plant_or.code()};
   Plant& plant = **plant_or;
   plant.Reset(options.seed);
   double identify_s = 0;  // time spent identifying filter models, left out of wall_seconds
@@ -662,7 +662,7 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
   // fit), the identified models' quality, then the limits the run exceeded.
   std::vector<std::string> warnings = LoadWarnings(plant);
   auto channels_or = MakeChannels(task, settings, plant, options, where, identify_s, warnings);
-  if (!channels_or.ok()) return Error{channels_or.error()};
+  if (!channels_or.ok()) return Error{channels_or.error(), channels_or.code()};
   std::vector<Channel>& channels = *channels_or;
   const int nb = plant.num_bundles();
   AngleLoop angle_loop;
@@ -671,10 +671,10 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
   if (task.auto_loop) {
     auto responses =
         ActuatorResponses(task, settings, plant, channels, options, identify_s, warnings);
-    if (!responses) return Error{where + ".outer_loop: " + responses.error()};
+    if (!responses) return Error{where + ".outer_loop: " + responses.error(), responses.code()};
     auto loops = JointLoops::Create(task, plant, std::move(responses).value(), UnitForces(channels),
                                     settings.dT);
-    if (!loops) return Error{where + ".outer_loop: " + loops.error()};
+    if (!loops) return Error{where + ".outer_loop: " + loops.error(), loops.code()};
     joint_loops = std::move(loops).value();
   }
   // Joints after the first score against their own references (the first is `measured`).
@@ -716,7 +716,7 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
                                          plant, channels, t, settings.dT, options.control_hook,
                                          instant, on_before, force_ref, sample);
           !st.ok()) {
-        return Error{where + ": " + st.error()};
+        return Error{where + ": " + st.error(), st.code()};
       }
       sample.p_on = sample.bundles[0].p_on;
       sample.p_off = sample.bundles[0].p_off;
@@ -741,16 +741,17 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
       FillTelemetry(plant, r, y, draws, channels, sample);
       for (StepObserver* o : observers) {
         if (Status st = o->OnStep(plant.model(), plant.data(), sample); !st.ok()) {
-          return Error{st.error()};
+          return Error{st.error(), st.code()};
         }
       }
     }
-    if (Status st = plant.CheckFinite(); !st.ok()) return Error{where + ": " + st.error()};
+    if (Status st = plant.CheckFinite(); !st.ok())
+      return Error{where + ": " + st.error(), st.code()};
     progress.Update(step, num_steps, plant.time());
   }
   progress.Done(plant.time());
   for (StepObserver* o : observers) {
-    if (Status st = o->Finish(); !st.ok()) return Error{st.error()};
+    if (Status st = o->Finish(); !st.ok()) return Error{st.error(), st.code()};
   }
 
   RunSummary s;

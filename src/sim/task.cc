@@ -6,6 +6,7 @@
 #include <set>
 
 #include "common/atomic_file.h"
+#include "common/json_fields.h"
 #include "common/json_file.h"
 #include "common/short_text.h"
 
@@ -14,68 +15,10 @@ namespace {
 
 using nlohmann::json;
 namespace fs = std::filesystem;
-
-std::string Join(const std::set<std::string>& s) {
-  std::string out;
-  for (const auto& x : s) out += (out.empty() ? "" : ", ") + x;
-  return out;
-}
-
-Status CheckKeys(const json& j, const std::set<std::string>& allowed, const std::string& where) {
-  for (auto it = j.begin(); it != j.end(); ++it) {
-    if (!allowed.count(it.key())) {
-      return Error{where + ": unknown field '" + it.key() + "'; allowed: " + Join(allowed)};
-    }
-  }
-  return Status::Ok();
-}
-
-// Reads an optional number at j[key] into *out, checking lo <= x (lo_open: lo < x) and x <= hi.
-Status Number(const json& j, const std::string& key, const std::string& where, double* out,
-              bool required, double lo, double hi, bool lo_open, const std::string& allowed) {
-  if (!j.contains(key)) {
-    if (required) return Error{where + ": missing field '" + key + "' (" + allowed + ")"};
-    return Status::Ok();
-  }
-  const json& v = j.at(key);
-  if (!v.is_number()) {
-    return Error{where + "." + key + ": must be a number (" + allowed + "), got " + v.dump()};
-  }
-  const double x = v.get<double>();
-  if (!std::isfinite(x) || x < lo || (lo_open && x == lo) || x > hi) {
-    return Error{where + "." + key + ": " + v.dump() + " is out of range; allowed: " + allowed};
-  }
-  *out = x;
-  return Status::Ok();
-}
-
-Status String(const json& j, const std::string& key, const std::string& where, std::string* out,
-              bool required) {
-  if (!j.contains(key)) {
-    if (required) return Error{where + ": missing field '" + key + "' (a string)"};
-    return Status::Ok();
-  }
-  if (!j.at(key).is_string() || j.at(key).get<std::string>().empty()) {
-    return Error{where + "." + key + ": must be a non-empty string, got " + j.at(key).dump()};
-  }
-  *out = j.at(key).get<std::string>();
-  return Status::Ok();
-}
-
-Status Vec3(const json& j, const std::string& key, const std::string& where, Eigen::Vector3d* out) {
-  if (!j.contains(key)) return Status::Ok();
-  const json& v = j.at(key);
-  if (!v.is_array() || v.size() != 3) {
-    return Error{where + "." + key + ": must be an array of 3 numbers [x, y, z], got " + v.dump()};
-  }
-  for (int i = 0; i < 3; ++i) {
-    if (!v[i].is_number() || !std::isfinite(v[i].get<double>())) {
-      return Error{where + "." + key + ": must be an array of 3 finite numbers, got " + v.dump()};
-    }
-    (*out)[i] = v[i].get<double>();
-  }
-  return Status::Ok();
-}
+using json_fields::CheckKeys;
+using json_fields::Number;
+using json_fields::String;
+using json_fields::Vec3;
 
 std::string Resolve(const std::string& path, const std::string& source) {
   if (path.empty() || fs::path(path).is_absolute() || source.empty()) return path;
@@ -101,18 +44,12 @@ Result<Reference> ReadReference(const json& r, const std::string& where, Tracked
   json body = r;
   if (body.is_object()) body.erase("unit");
   auto ref = Reference::FromJson(body, where, scale);
-  if (!ref.ok()) return Error{ref.error()};
+  if (!ref.ok()) return Error{ref.error(), ref.code()};
   if (tracked == Tracked::kForce && ref->MinValue() < 0) {
     return Error{where + ": a force reference must be >= 0 N (a bundle can only pull)"};
   }
   return ref;
 }
-
-#define RECRUIT_TRY(expr)                   \
-  do {                                      \
-    Status _s = (expr);                     \
-    if (!_s.ok()) return Error{_s.error()}; \
-  } while (0)
 
 // The several-joint form: "joints": [{"joint", "reference"}, ...] and optional "bundles"; the
 // one-joint fields are not allowed beside it.
@@ -140,7 +77,7 @@ Status ReadJointsForm(const json& j, const std::string& file, Task& task) {
     }
     if (!js[i].contains("reference")) return Error{where + ": missing field 'reference'"};
     auto ref = ReadReference(js[i]["reference"], where + ".reference", Tracked::kAngle);
-    if (!ref.ok()) return Error{ref.error()};
+    if (!ref.ok()) return Error{ref.error(), ref.code()};
     d.reference = std::move(ref).value();
     task.joints.push_back(std::move(d));
   }
@@ -171,14 +108,14 @@ Status ReadJointsForm(const json& j, const std::string& file, Task& task) {
 
 Result<Task> Task::FromFile(const std::string& path) {
   auto text = ReadFile(path);
-  if (!text.ok()) return Error{"task file: " + text.error()};
+  if (!text.ok()) return Error{"task file: " + text.error(), text.code()};
   return FromJsonText(*text, path);
 }
 
 Result<Task> Task::FromJsonText(const std::string& text, const std::string& source) {
   const std::string file = source.empty() ? std::string("<task>") : source;
   auto parsed = ParseJsonText(text, file);  // depth, size, 1e999 and BOM checked
-  if (!parsed.ok()) return Error{parsed.error()};
+  if (!parsed.ok()) return Error{parsed.error(), parsed.code()};
   json j = std::move(parsed).value();
   if (!j.is_object()) return Error{file + ": the task must be a JSON object"};
   RECRUIT_TRY(
@@ -199,7 +136,8 @@ Result<Task> Task::FromJsonText(const std::string& text, const std::string& sour
   std::error_code ec;
   if (!fs::exists(task.model_path, ec)) {
     return Error{file + ".model: model file '" + ShortText(task.model_path, 120) +
-                 "' does not exist" + (ec ? " (" + ec.message() + ")" : "")};
+                     "' does not exist" + (ec ? " (" + ec.message() + ")" : ""),
+                 ec ? CodeOf(ec) : ErrorCode::kBadInput};
   }
   std::string tracked;
   RECRUIT_TRY(String(j, "tracked", file, &tracked, true));
@@ -233,7 +171,7 @@ Result<Task> Task::FromJsonText(const std::string& text, const std::string& sour
   if (!j.contains("joints")) {
     if (!j.contains("reference")) return Error{file + ": missing field 'reference'"};
     auto ref = ReadReference(j["reference"], file + ".reference", task.tracked);
-    if (!ref.ok()) return Error{ref.error()};
+    if (!ref.ok()) return Error{ref.error(), ref.code()};
     task.reference = std::move(ref).value();
   }
 
@@ -246,15 +184,15 @@ Result<Task> Task::FromJsonText(const std::string& text, const std::string& sour
     RECRUIT_TRY(String(c, "estimator", where, &task.controller.estimator, false));
     RECRUIT_TRY(String(c, "filter_model", where, &task.controller.filter_model, false));
     task.controller.filter_model = Resolve(task.controller.filter_model, source);
-    RECRUIT_TRY(Number(c, "dT", where, &task.controller.dT, false, 0, 1000, true,
-                       "seconds, 0 < dT <= 1000"));
+    RECRUIT_TRY(Number(c, "dT", where, &task.controller.dT, false, 0, control::kMaxDT, true,
+                       control::kDTAllowed));
     RECRUIT_TRY(
         Number(c, "lambda", where, &task.controller.lambda, false, 0, 1, true, "0 < lambda <= 1"));
   }
 
   if (j.contains("sensor")) {
     auto sensor = SensorParams::FromJson(j["sensor"], file + ".sensor");
-    if (!sensor.ok()) return Error{sensor.error()};
+    if (!sensor.ok()) return Error{sensor.error(), sensor.code()};
     task.sensor = *sensor;
   }
 

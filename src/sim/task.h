@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "common/result.h"
+#include "control/sampling_period.h"
 #include "sim/force_sensor.h"
 #include "sim/reference.h"
 
@@ -21,7 +22,7 @@ enum class Tracked { kForce, kAngle };
 struct ControllerSettings {
   std::string estimator = "output";  // "output", "kalman", ... (see docs/formats/task.md)
   std::string filter_model;          // filter model file for model-based estimators ("" = none)
-  double dT = 2.0;                   // s, sampling period of the broadcast controller
+  double dT = control::kDefaultDT;   // s, sampling period of the broadcast controller
   double lambda = 0.2;               // gain of the expectation law (the paper's lambda)
   // Kalman estimators: force measurement noise std, N (0 = the estimator's default: the model
   // file's R for kalman-augmented, one settled unit's force for kalman2).

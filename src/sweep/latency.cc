@@ -35,7 +35,7 @@ double DelayLoopGainForOvershoot(double overshoot) {
 
 Result<double> ForceLatency(const sim::Task& task) {
   auto model = LoadModel(task.model_path);
-  if (!model.ok()) return Error{model.error()};
+  if (!model.ok()) return Error{model.error(), model.code()};
   mjModel* m = model->get();
   if (task.timestep > 0) m->opt.timestep = task.timestep;
   const int act = mj_name2id(m, mjOBJ_ACTUATOR, task.agonist.c_str());

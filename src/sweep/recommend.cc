@@ -8,7 +8,7 @@
 
 namespace recruit::sweep {
 
-std::vector<Recommendation> Recommend(const std::vector<sim::CellStats>& cells) {
+std::vector<Recommendation> Recommend(const std::vector<sweep::CellStats>& cells) {
   std::vector<Recommendation> out;
   std::vector<std::tuple<int, std::string, double>> order;
   for (const auto& c : cells) {
@@ -16,7 +16,7 @@ std::vector<Recommendation> Recommend(const std::vector<sim::CellStats>& cells) 
     if (std::find(order.begin(), order.end(), key) == order.end()) order.push_back(key);
   }
   for (const auto& [plant, est, lambda] : order) {
-    std::vector<const sim::CellStats*> col;
+    std::vector<const sweep::CellStats*> col;
     for (const auto& c : cells) {
       if (c.plant == plant && c.estimator == est && c.lambda == lambda) col.push_back(&c);
     }
@@ -29,7 +29,7 @@ std::vector<Recommendation> Recommend(const std::vector<sim::CellStats>& cells) 
     r.critical_dT = std::nan("");
     for (size_t i = 0; i < col.size() && !r.found; ++i) {
       if (!col[i]->meets) continue;
-      const sim::CellStats& c = *col[i];
+      const sweep::CellStats& c = *col[i];
       r.found = true;
       r.dT = c.dT;
       r.margin = c.margin;
@@ -44,7 +44,7 @@ std::vector<Recommendation> Recommend(const std::vector<sim::CellStats>& cells) 
         r.critical_dT = c.dT;
         r.censored = true;
       } else {
-        const sim::CellStats& p = *col[i - 1];
+        const sweep::CellStats& p = *col[i - 1];
         const double f = (0 - p.margin) / (c.margin - p.margin);  // p.margin < 0 <= c.margin
         r.critical_dT = std::exp(std::log(p.dT) + f * (std::log(c.dT) - std::log(p.dT)));
       }

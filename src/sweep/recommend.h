@@ -8,7 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "sim/sweep.h"
+#include "sweep/grid.h"
+#include "sweep/table.h"
 
 namespace recruit::sweep {
 
@@ -28,7 +29,7 @@ struct Recommendation {
   bool censored = false;   // the shortest dT tried already meets: critical_dT <= dT
 };
 
-std::vector<Recommendation> Recommend(const std::vector<sim::CellStats>& cells);
+std::vector<Recommendation> Recommend(const std::vector<sweep::CellStats>& cells);
 
 struct Sensitivity {
   std::string estimator;

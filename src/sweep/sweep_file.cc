@@ -4,11 +4,14 @@
 
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <set>
 
 #include "common/atomic_file.h"
+#include "common/json_fields.h"
 #include "common/json_file.h"
 #include "common/short_text.h"
+#include "control/sampling_period.h"
 #include "sweep/sampling.h"
 
 namespace recruit::sweep {
@@ -16,6 +19,7 @@ namespace {
 
 using nlohmann::json;
 namespace fs = std::filesystem;
+using json_fields::CheckKeys;
 
 std::string Resolve(const std::string& path, const std::string& source) {
   if (path.empty() || fs::path(path).is_absolute() || source.empty()) return path;
@@ -92,17 +96,6 @@ Result<Values> ParseValues(const json& j, const std::string& where, bool need_st
   return v;
 }
 
-Status CheckKeys(const json& j, const std::set<std::string>& allowed, const std::string& where) {
-  for (auto it = j.begin(); it != j.end(); ++it) {
-    if (!allowed.count(it.key())) {
-      std::string list;
-      for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
-      return Error{where + ": unknown field '" + it.key() + "'; allowed: " + list};
-    }
-  }
-  return Status::Ok();
-}
-
 std::string FormatValue(double v, bool integer) {
   return integer ? fmt::format("{}", static_cast<long long>(std::llround(v)))
                  : fmt::format("{:.17g}", v);
@@ -123,20 +116,18 @@ double PlantAxis::FromUnit(double u) const {
 
 Result<SweepFile> SweepFile::FromFile(const std::string& path) {
   auto text = ReadFile(path);
-  if (!text.ok()) return Error{"sweep file: " + text.error()};
+  if (!text.ok()) return Error{"sweep file: " + text.error(), text.code()};
   return FromJsonText(*text, path);
 }
 
 Result<SweepFile> SweepFile::FromJsonText(const std::string& text, const std::string& source) {
   const std::string file = "sweep file '" + (source.empty() ? "<sweep>" : source) + "'";
   auto parsed = ParseJsonText(text, source.empty() ? "<sweep>" : source);
-  if (!parsed.ok()) return Error{parsed.error()};
+  if (!parsed.ok()) return Error{parsed.error(), parsed.code()};
   const json j = std::move(parsed).value();
   if (!j.is_object()) return Error{file + ": must be a JSON object"};
-  if (Status s =
-          CheckKeys(j, {"task", "duration", "controller", "plant", "criterion", "comment"}, file);
-      !s.ok())
-    return Error{s.error()};
+  RECRUIT_TRY(
+      CheckKeys(j, {"task", "duration", "controller", "plant", "criterion", "comment"}, file));
   SweepFile f;
   f.source = source;
   if (j.contains("task")) {
@@ -144,33 +135,30 @@ Result<SweepFile> SweepFile::FromJsonText(const std::string& text, const std::st
     f.task = Resolve(j["task"].get<std::string>(), source);
   }
   if (j.contains("duration")) {
-    const json& d = j["duration"];
-    if (!d.is_number() || !(d.get<double>() > 0) || d.get<double>() > 1e6) {
-      return Error{file + ".duration: " + ShortText(d.dump()) + "; allowed: seconds, 0 < d <= 1e6"};
-    }
-    f.duration = d.get<double>();
+    double d = 0;
+    RECRUIT_TRY(json_fields::Number(j, "duration", file, &d, true, 0, 1e6, true,
+                                    "seconds, 0 < duration <= 1e6"));
+    f.duration = d;
   }
   if (j.contains("controller")) {
     const json& c = j["controller"];
     const std::string where = file + ".controller";
     if (!c.is_object()) return Error{where + ": must be an object"};
-    if (Status s = CheckKeys(c, {"dT", "lambda", "estimator", "seeds", "base_seed"}, where);
-        !s.ok())
-      return Error{s.error()};
+    RECRUIT_TRY(CheckKeys(c, {"dT", "lambda", "estimator", "seeds", "base_seed"}, where));
     if (c.contains("dT")) {
       auto v = ParseValues(c["dT"], where + ".dT", true);
-      if (!v.ok()) return Error{v.error()};
+      if (!v.ok()) return Error{v.error(), v.code()};
       for (double x : v->values) {
-        if (!(x > 0 && x <= 1000)) {
-          return Error{fmt::format("{}.dT: value {:g} is out of range; allowed: 0 < dT <= 1000 s",
-                                   where, x)};
+        if (!control::ValidDT(x)) {
+          return Error{fmt::format("{}.dT: value {:g} is out of range; allowed: {}", where, x,
+                                   control::kDTAllowed)};
         }
       }
       f.dTs = v->values;
     }
     if (c.contains("lambda")) {
       auto v = ParseValues(c["lambda"], where + ".lambda", true);
-      if (!v.ok()) return Error{v.error()};
+      if (!v.ok()) return Error{v.error(), v.code()};
       for (double x : v->values) {
         if (!(x > 0 && x <= 1)) {
           return Error{fmt::format(
@@ -195,49 +183,33 @@ Result<SweepFile> SweepFile::FromJsonText(const std::string& text, const std::st
       }
     }
     if (c.contains("seeds")) {
-      const json& s = c["seeds"];
-      if (!s.is_number_integer() || s.get<long>() < 1 || s.get<long>() > 100000) {
-        return Error{where + ".seeds: " + ShortText(s.dump()) + "; allowed: 1..100000"};
-      }
-      f.seeds = s.get<int>();
+      std::int64_t seeds = 0;
+      RECRUIT_TRY(json_fields::Integer(c, "seeds", where, &seeds, true, 1, 100000, "1..100000"));
+      f.seeds = static_cast<int>(seeds);
     }
     if (c.contains("base_seed")) {
-      const json& s = c["base_seed"];
-      if (!s.is_number_unsigned()) {
-        return Error{where + ".base_seed: " + ShortText(s.dump()) +
-                     "; allowed: a whole number >= 0"};
-      }
-      f.base_seed = s.get<std::uint64_t>();
+      std::uint64_t seed = 0;
+      RECRUIT_TRY(json_fields::Unsigned(c, "base_seed", where, &seed, true));
+      f.base_seed = seed;
     }
   }
   if (j.contains("criterion")) {
     const json& c = j["criterion"];
     const std::string where = file + ".criterion";
     if (!c.is_object()) return Error{where + ": must be an object"};
-    if (Status s = CheckKeys(c, {"max_overshoot", "min_settled"}, where); !s.ok())
-      return Error{s.error()};
-    sim::TrackingCriterion crit;
-    if (c.contains("max_overshoot")) {
-      if (!c["max_overshoot"].is_number() || !(c["max_overshoot"].get<double>() >= 0)) {
-        return Error{where + ".max_overshoot: must be a number >= 0"};
-      }
-      crit.max_overshoot = c["max_overshoot"];
-    }
-    if (c.contains("min_settled")) {
-      const json& m = c["min_settled"];
-      if (!m.is_number() || !(m.get<double>() >= 0 && m.get<double>() <= 1)) {
-        return Error{where + ".min_settled: must be a number in [0, 1]"};
-      }
-      crit.min_settled = m;
-    }
+    RECRUIT_TRY(CheckKeys(c, {"max_overshoot", "min_settled"}, where));
+    sweep::TrackingCriterion crit;
+    RECRUIT_TRY(json_fields::Number(c, "max_overshoot", where, &crit.max_overshoot, false, 0,
+                                    std::numeric_limits<double>::max(), false, "a number >= 0"));
+    RECRUIT_TRY(json_fields::Number(c, "min_settled", where, &crit.min_settled, false, 0, 1, false,
+                                    "a number in [0, 1]"));
     f.criterion = crit;
   }
   if (j.contains("plant")) {
     const json& p = j["plant"];
     const std::string where = file + ".plant";
     if (!p.is_object()) return Error{where + ": must be an object"};
-    if (Status s = CheckKeys(p, {"sampling", "samples", "seed", "axes"}, where); !s.ok())
-      return Error{s.error()};
+    RECRUIT_TRY(CheckKeys(p, {"sampling", "samples", "seed", "axes"}, where));
     if (p.contains("sampling")) {
       const json& s = p["sampling"];
       if (s == "grid") {
@@ -252,16 +224,13 @@ Result<SweepFile> SweepFile::FromJsonText(const std::string& text, const std::st
       }
     }
     if (f.sampling != Sampling::kGrid) {
-      const json s = p.value("samples", json());
-      if (!s.is_number_integer() || s.get<long>() < 1 || s.get<long>() > 1000000) {
-        return Error{where + ".samples: " + ShortText(s.dump()) +
-                     "; a sample needs a whole number of points, 1..1000000"};
-      }
-      f.samples = s.get<int>();
-      if (p.contains("seed")) {
-        if (!p["seed"].is_number_unsigned()) return Error{where + ".seed: a whole number >= 0"};
-        f.sample_seed = p["seed"].get<std::uint64_t>();
-      }
+      std::int64_t samples = 0;
+      RECRUIT_TRY(json_fields::Integer(p, "samples", where, &samples, true, 1, 1000000,
+                                       "a sample needs a whole number of points, 1..1000000"));
+      f.samples = static_cast<int>(samples);
+      std::uint64_t seed = f.sample_seed;
+      RECRUIT_TRY(json_fields::Unsigned(p, "seed", where, &seed, false));
+      f.sample_seed = seed;
     }
     const json axes = p.value("axes", json::array());
     if (!axes.is_array()) return Error{where + ".axes: must be an array of axes"};
@@ -270,10 +239,8 @@ Result<SweepFile> SweepFile::FromJsonText(const std::string& text, const std::st
       const json& a = axes[i];
       std::string aw = fmt::format("{}.axes[{}]", where, i);
       if (!a.is_object()) return Error{aw + ": must be an object {name, path, values | range}"};
-      if (Status s =
-              CheckKeys(a, {"name", "path", "values", "range", "steps", "scale", "integer"}, aw);
-          !s.ok())
-        return Error{s.error()};
+      RECRUIT_TRY(
+          CheckKeys(a, {"name", "path", "values", "range", "steps", "scale", "integer"}, aw));
       PlantAxis ax;
       if (!a.contains("path") || !a["path"].is_string() || a["path"].get<std::string>().empty()) {
         return Error{aw +
@@ -309,12 +276,9 @@ Result<SweepFile> SweepFile::FromJsonText(const std::string& text, const std::st
       }
       if (!names.insert(ax.name).second) return Error{aw + ".name: repeated axis name"};
       if (!paths.insert(ax.path).second) return Error{aw + ".path: repeated path " + ax.path};
-      if (a.contains("integer")) {
-        if (!a["integer"].is_boolean()) return Error{aw + ".integer: must be true or false"};
-        ax.integer = a["integer"];
-      }
+      RECRUIT_TRY(json_fields::Boolean(a, "integer", aw, &ax.integer));
       auto v = ParseValues(a, aw, f.sampling == Sampling::kGrid);
-      if (!v.ok()) return Error{v.error()};
+      if (!v.ok()) return Error{v.error(), v.code()};
       ax.values = v->values;
       ax.lo = v->lo;
       ax.hi = v->hi;
@@ -333,9 +297,9 @@ Result<SweepFile> SweepFile::FromJsonText(const std::string& text, const std::st
   return f;
 }
 
-Result<std::vector<sim::PlantPoint>> PlantPoints(const SweepFile& f) {
-  std::vector<sim::PlantPoint> points;
-  if (f.axes.empty()) return std::vector<sim::PlantPoint>{sim::PlantPoint{}};
+Result<std::vector<sweep::PlantPoint>> PlantPoints(const SweepFile& f) {
+  std::vector<sweep::PlantPoint> points;
+  if (f.axes.empty()) return std::vector<sweep::PlantPoint>{sweep::PlantPoint{}};
   if (f.sampling == Sampling::kGrid) {
     size_t total = 1;
     for (const auto& a : f.axes) {
@@ -343,7 +307,7 @@ Result<std::vector<sim::PlantPoint>> PlantPoints(const SweepFile& f) {
       if (total > 10000000) return Error{"sweep file '" + f.source + "': the grid is too large"};
     }
     for (size_t i = 0; i < total; ++i) {
-      sim::PlantPoint p;
+      sweep::PlantPoint p;
       size_t rem = i;
       std::vector<size_t> idx(f.axes.size());
       for (size_t k = f.axes.size(); k-- > 0;) {  // last axis fastest
@@ -363,11 +327,11 @@ Result<std::vector<sim::PlantPoint>> PlantPoints(const SweepFile& f) {
     u = LatinHypercube(f.samples, dims, f.sample_seed);
   } else {
     auto s = Sobol(f.samples, dims, f.sample_seed);
-    if (!s.ok()) return Error{"sweep file '" + f.source + "': " + s.error()};
+    if (!s.ok()) return Error{"sweep file '" + f.source + "': " + s.error(), s.code()};
     u = std::move(s).value();
   }
   for (const auto& row : u) {
-    sim::PlantPoint p;
+    sweep::PlantPoint p;
     for (int k = 0; k < dims; ++k)
       p.values.emplace_back(f.axes[k].name, f.axes[k].FromUnit(row[k]));
     points.push_back(p);
@@ -428,7 +392,7 @@ Result<std::string> SetPluginConfig(const std::string& xml, const std::string& i
 
 Result<PlantInputs> ApplyPlantPoint(const std::string& task_text, const std::string& model_text,
                                     const std::vector<PlantAxis>& axes,
-                                    const sim::PlantPoint& point, const std::string& where) {
+                                    const sweep::PlantPoint& point, const std::string& where) {
   PlantInputs out;
   out.model_text = model_text;
   json doc;
@@ -444,7 +408,7 @@ Result<PlantInputs> ApplyPlantPoint(const std::string& task_text, const std::str
                                           FormatValue(v, a.integer));
     if (a.is_model()) {
       auto xml = SetPluginConfig(out.model_text, a.instance, a.key, FormatValue(v, a.integer));
-      if (!xml.ok()) return Error{label + ": " + xml.error()};
+      if (!xml.ok()) return Error{label + ": " + xml.error(), xml.code()};
       out.model_text = std::move(xml).value();
       out.model_edited = true;
       continue;

@@ -11,7 +11,8 @@
 #include <vector>
 
 #include "common/result.h"
-#include "sim/sweep.h"
+#include "sweep/grid.h"
+#include "sweep/table.h"
 
 namespace recruit::sweep {
 
@@ -40,7 +41,7 @@ struct SweepFile {
   std::vector<std::string> estimators;  // empty = not given
   std::optional<int> seeds;
   std::optional<std::uint64_t> base_seed;
-  std::optional<sim::TrackingCriterion> criterion;
+  std::optional<sweep::TrackingCriterion> criterion;
   std::vector<PlantAxis> axes;
   Sampling sampling = Sampling::kGrid;
   int samples = 0;  // lhs / sobol
@@ -52,7 +53,7 @@ struct SweepFile {
 
 // The plant points: the cartesian product of the axes (first axis outermost) or the sample.
 // No axes: one point with no values.
-Result<std::vector<sim::PlantPoint>> PlantPoints(const SweepFile& file);
+Result<std::vector<sweep::PlantPoint>> PlantPoints(const SweepFile& file);
 
 // One plant point applied to a task: the task document with the JSON-pointer axes set, and the
 // model text with the model axes set (model_edited false: the task's own model file is used).
@@ -64,7 +65,7 @@ struct PlantInputs {
 // `where` prefixes errors (the sweep file). Bad paths and values are errors naming the axis.
 Result<PlantInputs> ApplyPlantPoint(const std::string& task_text, const std::string& model_text,
                                     const std::vector<PlantAxis>& axes,
-                                    const sim::PlantPoint& point, const std::string& where);
+                                    const sweep::PlantPoint& point, const std::string& where);
 
 // Sets `key`'s value in the plugin instance `instance` of an MJCF text (adds the config line if
 // the key is not there).

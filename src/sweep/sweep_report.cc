@@ -356,7 +356,7 @@ Status WriteReport(const ReportInput& in, const std::string& out_dir,
     const int h = 120 + 260 * static_cast<int>(std::max<size_t>(1, fig.panels.size()));
     for (const auto fmt_ : {plot::Format::kPng, plot::Format::kSvg}) {
       auto bytes = render(fig, 900, h, fmt_);
-      if (!bytes.ok()) return Error{"report figure " + name + ": " + bytes.error()};
+      if (!bytes.ok()) return Error{"report figure " + name + ": " + bytes.error(), bytes.code()};
       const std::string file = name + (fmt_ == plot::Format::kPng ? ".png" : ".svg");
       if (Status s = WriteFileAtomically((dir / file).string(), *bytes); !s.ok()) return s;
       if (fmt_ == plot::Format::kPng) pngs[file] = *bytes;
@@ -368,7 +368,7 @@ Status WriteReport(const ReportInput& in, const std::string& out_dir,
     std::error_code ec;
     if (fs::exists(dir / "stability.png", ec)) {
       auto bytes = ReadFile((dir / "stability.png").string());
-      if (!bytes.ok()) return Error{"report figure stability: " + bytes.error()};
+      if (!bytes.ok()) return Error{"report figure stability: " + bytes.error(), bytes.code()};
       pngs["stability.png"] = std::move(bytes).value();
       with_map = true;
     }

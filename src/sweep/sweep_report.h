@@ -14,16 +14,17 @@
 #include "plot/figure.h"
 #include "plot/plot_run.h"
 #include "plot/render.h"
-#include "sim/sweep.h"
+#include "sweep/grid.h"
 #include "sweep/recommend.h"
+#include "sweep/table.h"
 
 namespace recruit::sweep {
 
 struct ReportInput {
   std::string title;        // the task's name
   std::string description;  // one line: what was swept
-  sim::TrackingCriterion criterion;
-  std::vector<sim::CellStats> cells;
+  sweep::TrackingCriterion criterion;
+  std::vector<sweep::CellStats> cells;
   // Per plant point: the agonist's force latency tau (s, sweep/latency.h; NaN = unknown). Empty:
   // no latency bound in the report.
   std::vector<double> latency;
@@ -46,7 +47,7 @@ using FigureRenderer =
 Status WriteReport(const ReportInput& in, const std::string& out_dir, const FigureRenderer& render);
 
 // What `recruit sweep` asks `recruit plot --stability-map` for: <out_dir>/stability.png from the
-// stability.dat that sim::WriteSweepReport wrote there (a panel of 460 x 420 px per estimator).
+// stability.dat that sweep::WriteTables wrote there (a panel of 460 x 420 px per estimator).
 plot::PlotOptions StabilityMapOptions(const std::string& out_dir, const std::string& title,
                                       int num_estimators);
 

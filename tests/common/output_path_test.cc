@@ -7,9 +7,11 @@
 #include <fstream>
 #include <vector>
 
+#include "common/atomic_file.h"
 #include "common/content_hash.h"
 #include "common/exit_codes.h"
 #include "common/file_lock.h"
+#include "common/json_file.h"
 #include "common/short_text.h"
 
 namespace recruit {
@@ -61,12 +63,32 @@ TEST(ShortText, LongValuesAndControlCharactersAreShortened) {
             "Could not convert: --dT = " + std::string(40, '9') + "... (45 characters)");
 }
 
-TEST(ExitCodes, IoWordingIsIoEverythingElseIsBadInput) {
-  EXPECT_EQ(exit_code::FromMessage("cannot open 'x': No such file or directory"), exit_code::kIo);
-  EXPECT_EQ(exit_code::FromMessage("cannot write 'x': the write failed (disk full?)"),
-            exit_code::kIo);
-  EXPECT_EQ(exit_code::FromMessage("task.json: controller.lambda 2: must be in (0, 1]"),
-            exit_code::kBadInput);
+TEST(ExitCodes, TheClassTravelsWithTheErrorNotItsWording) {
+  // A failed write is I/O (4) and a malformed JSON file bad input (3), read from their codes.
+  Status w = WriteFileAtomically("/proc/nonexistent/x.json", "{}");
+  ASSERT_FALSE(w.ok());
+  EXPECT_EQ(exit_code::Of(w.failure()), exit_code::kIo);
+  const std::string bad =
+      (fs::temp_directory_path() / ("recruit_bad_" + std::to_string(getpid()) + ".json")).string();
+  ASSERT_TRUE(WriteFileAtomically(bad, "{\"a\": ").ok());
+  auto j = LoadJsonFile(bad);
+  fs::remove(bad);
+  ASSERT_FALSE(j.ok());
+  EXPECT_EQ(exit_code::Of(j.failure()), exit_code::kBadInput);
+  // Wording decides nothing: "cannot open" in a bad-input message stays 3, any I/O message is 4.
+  EXPECT_EQ(exit_code::Of(Error{"cannot open: a field's value"}), exit_code::kBadInput);
+  EXPECT_EQ(exit_code::Of(IoError("the disk said no")), exit_code::kIo);
+  // Wrapping keeps the class.
+  Result<int> inner = IoError("x.csv: short read");
+  const Error outer = inner.failure().In("task.json: ");
+  EXPECT_EQ(outer.message, "task.json: x.csv: short read");
+  EXPECT_EQ(outer.code, ErrorCode::kIo);
+  EXPECT_EQ(exit_code::Of(ErrorCode::kUsage), exit_code::kUsage);
+  EXPECT_EQ(exit_code::Of(ErrorCode::kInternal), exit_code::kInternal);
+  // Failed filesystem calls: access, space, size and read-only are I/O; a missing path is not.
+  EXPECT_EQ(CodeOf(std::error_code(EACCES, std::generic_category())), ErrorCode::kIo);
+  EXPECT_EQ(CodeOf(std::error_code(ENOSPC, std::generic_category())), ErrorCode::kIo);
+  EXPECT_EQ(CodeOf(std::error_code(ENOENT, std::generic_category())), ErrorCode::kBadInput);
 }
 
 TEST(FileLock, ASecondLockOnTheSameFileFailsUntilTheFirstIsReleased) {

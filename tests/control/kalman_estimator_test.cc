@@ -173,11 +173,11 @@ TEST(KalmanAugmented, FactoryRejectsAModelForAnotherPeriodOrSize) {
 }
 
 TEST(ModelExport, FilterModelFileRoundTripsTheChain) {
-  TransientChain c = TransientChain::Uniform(8, 0.7);
+  identification::TransientChain c = identification::TransientChain::Uniform(8, 0.7);
   c.heat_advance << 1.0, 0.6, 0.4;
   c.force << 0.0, 0.05, 0.2, 0.35, 0.45, 0.42, 0.3, 0.12;
   c.switch_on[5] = 2;  // cool1 -> heat2
-  const FilterModel f = ToFilterModel(c, 60, 0.5, 0.01);
+  const FilterModel f = identification::ToFilterModel(c, 60, 0.5, 0.01);
   ASSERT_TRUE(f.Validate().ok()) << f.Validate().error();
   auto back = FilterModel::FromJsonValue(f.ToJson(), "round trip");
   ASSERT_TRUE(back.ok()) << back.error();

@@ -16,7 +16,7 @@
 #include "identification/excitation.h"
 #include "identification/transient_chain.h"
 
-namespace recruit::control {
+namespace recruit::identification {
 namespace {
 
 TransientChain KnownChain() {
@@ -152,9 +152,9 @@ TEST(Identification, RejectsTooShortLogsAndBadOptions) {
 }
 
 }  // namespace
-}  // namespace recruit::control
+}  // namespace recruit::identification
 
-namespace recruit::control {
+namespace recruit::identification {
 namespace {
 
 std::string TempPath(const std::string& name) {
@@ -219,4 +219,4 @@ TEST(Identification, BenchFitPredictsHeldOutForceBetterThanTheTwoStateModel) {
 }
 
 }  // namespace
-}  // namespace recruit::control
+}  // namespace recruit::identification

@@ -17,8 +17,10 @@
 #include "identification/model_export.h"
 #include "identification/transient_chain.h"
 
-namespace recruit::control {
+namespace recruit::identification {
 namespace {
+
+using namespace ::recruit::control;  // NOLINT: the controller side these tests check against
 
 // K = 3 (m = 8): cold, heat1..3, hot, cool1..3, with a fraction per state.
 TransientChain KnownChain() {
@@ -159,4 +161,4 @@ TEST(LengthModel, AFixedOutputModelIsInconsistentOnTheSameMovingTendon) {
 }
 
 }  // namespace
-}  // namespace recruit::control
+}  // namespace recruit::identification

@@ -13,8 +13,10 @@
 #include "common/mujoco_ptr.h"
 #include "control/on_count_estimator.h"
 
-namespace recruit::control {
+namespace recruit::identification {
 namespace {
+
+using namespace ::recruit::control;  // NOLINT: the controller side these tests check against
 
 // FNV-1a 64 of the text {"a":1}, by the published algorithm (offset 0xcbf29ce484222325, prime
 // 0x100000001b3), computed independently in Python.
@@ -75,4 +77,4 @@ TEST(PlantRecord, FactoryRefusesAModelOfAnotherPlantAndAcceptsOneWithoutARecord)
 }
 
 }  // namespace
-}  // namespace recruit::control
+}  // namespace recruit::identification

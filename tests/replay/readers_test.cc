@@ -79,8 +79,8 @@ TEST(BenchLogReaders, IdentifyReadsItAsASwitchingLog) {
   const std::string older = (dir / "recruit_readers_older.csv").string();
   std::ofstream(bench) << csv;
   std::ofstream(older) << OlderFormat(*log, "time,p_on,p_off,force");
-  auto a = control::SwitchingLog::FromCsv(bench, 60);
-  auto b = control::SwitchingLog::FromCsv(older, 60);
+  auto a = identification::SwitchingLog::FromCsv(bench, 60);
+  auto b = identification::SwitchingLog::FromCsv(older, 60);
   ASSERT_TRUE(a.ok()) << a.error();
   ASSERT_TRUE(b.ok()) << b.error();
   EXPECT_EQ(a->time, b->time);

@@ -15,13 +15,15 @@
 #include "sim/csv_writer.h"
 #include "sim/plant.h"
 #include "sim/run_task.h"
-#include "sim/sweep.h"
+#include "sweep/grid.h"
+#include "sweep/table.h"
 #include "tests/plugin/mujoco_util.h"
 
 namespace recruit::sim {
 namespace {
 
 namespace fs = std::filesystem;
+using namespace ::recruit::sweep;  // NOLINT: the sweep code under test (src/sweep)
 const std::string kRoot = RECRUIT_SOURCE_DIR;
 
 Task LoadTask(const std::string& name) {
@@ -153,7 +155,7 @@ TEST(ClosedLoop, RealSweepIsByteIdenticalOnOneAndTwoThreads) {
     ASSERT_TRUE(out.ok()) << out.error();
     EXPECT_EQ(out->executed, 6);
     const TrackingCriterion crit;
-    ASSERT_TRUE(WriteSweepReport(Aggregate(out->runs, crit), crit, dir.string(), "t").ok());
+    ASSERT_TRUE(WriteTables(Aggregate(out->runs, crit), crit, dir.string(), "t").ok());
     reports[threads - 1] = *ReadFile((dir / "table.csv").string()) +
                            *ReadFile((dir / "table.md").string()) +
                            *ReadFile((dir / "stability.dat").string());

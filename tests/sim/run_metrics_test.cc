@@ -15,12 +15,14 @@
 #include <utility>
 
 #include "sim/run_task.h"
-#include "sim/sweep.h"
+#include "sweep/grid.h"
+#include "sweep/table.h"
 
 namespace recruit::sim {
 namespace {
 
 namespace fs = std::filesystem;
+using namespace ::recruit::sweep;  // NOLINT: the sweep code under test (src/sweep)
 
 // The number of fields of an aggregate: the largest N for which T{x1, ..., xN} compiles.
 struct AnyValue {
@@ -168,7 +170,7 @@ TEST(RunMetricsTable, SweepTableHasEveryTabledMetricsMean) {
   const fs::path dir = fs::temp_directory_path() / "recruit_run_metrics_test";
   fs::remove_all(dir);
   fs::create_directories(dir);
-  ASSERT_TRUE(WriteSweepReport(Aggregate(runs, crit), crit, dir.string(), "metrics").ok());
+  ASSERT_TRUE(WriteTables(Aggregate(runs, crit), crit, dir.string(), "metrics").ok());
   std::ifstream in(dir / "table.csv");
   std::string head, row;
   std::getline(in, head);

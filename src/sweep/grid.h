@@ -7,7 +7,6 @@
 // same.
 #pragma once
 
-#include <array>
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -18,7 +17,7 @@
 #include "sim/run_metrics.h"
 #include "sim/run_task.h"
 
-namespace recruit::sim {
+namespace recruit::sweep {
 
 // One point of the plant axes (hardware and sensor parameters set through the task or its model,
 // src/sweep/sweep_file.h): (axis name, value) in axis order. No values: the task as it is.
@@ -56,7 +55,7 @@ struct SweepRun {
 
 // The run options of one grid point: its estimator, dT, lambda and seed, the spec's duration and
 // filter model (what `recruit sweep` and the Python `sweep` run each point with).
-RunOptions RunOptionsFor(const SweepRun& run, const SweepSpec& spec);
+sim::RunOptions RunOptionsFor(const SweepRun& run, const SweepSpec& spec);
 
 Result<std::vector<SweepRun>> ExpandGrid(const SweepSpec& spec);
 
@@ -70,12 +69,12 @@ Result<std::pair<int, int>> ParseShard(const std::string& text);
 std::string SweepId(const std::vector<SweepRun>& grid);
 
 // What the sweep runs for one grid point (RunTask in production, a fake in tests).
-using SweepRunFn = std::function<Result<RunSummary>(const SweepRun&)>;
+using SweepRunFn = std::function<Result<sim::RunSummary>(const SweepRun&)>;
 
 struct SweepOutcome {
-  std::vector<RunSummary> runs;  // in grid order
-  int executed = 0;              // runs made now
-  int reused = 0;                // runs read back from <out>/runs
+  std::vector<sim::RunSummary> runs;  // in grid order
+  int executed = 0;                   // runs made now
+  int reused = 0;                     // runs read back from <out>/runs
 };
 
 // Runs every grid point not yet recorded under `out_dir`/runs on `threads` threads (0 = all
@@ -85,54 +84,7 @@ Result<SweepOutcome> RunSweep(const std::vector<SweepRun>& grid, const std::stri
                               const SweepRunFn& run, int threads,
                               const std::function<void(int, int)>& progress = {});
 
-// A stated tracking criterion for one grid cell (all seeds of one dT, lambda, estimator).
-struct TrackingCriterion {
-  double max_overshoot = 0.10;  // mean step overshoot, fraction of the step
-  double min_settled = 0.90;    // fraction of steps that settle within the 10 % band
-};
-
-// One grid cell aggregated over seeds.
-struct CellStats {
-  int plant = 0;
-  std::vector<std::pair<std::string, double>> plant_values;
-  double dT = 0, lambda = 0;
-  std::string estimator;
-  int seeds = 0;
-  // Per field of kMetricFields (sim/run_metrics.h), over seeds: the mean (of the finite values
-  // for a field that may be NaN; NaN if none is) and the sample standard deviation.
-  std::array<double, kMetricCount> mean{}, sd{};
-  double Mean(double RunMetrics::*field) const { return mean.at(MetricIndex(field)); }
-  double Sd(double RunMetrics::*field) const { return sd.at(MetricIndex(field)); }
-  bool meets = false;
-  double margin = 0;  // min(max_overshoot - overshoot, settled - min_settled); >= 0 iff meets
-  // Over seeds: each seed's own margin (same formula on its run alone), how many meet, and the
-  // standard error of their mean (the spread the confidence in the report comes from).
-  int seeds_meeting = 0;
-  double margin_se = 0;
-};
-
-// Cells in grid order; runs are told apart by (dT, lambda, estimator).
-std::vector<CellStats> Aggregate(const std::vector<RunSummary>& runs,
-                                 const TrackingCriterion& criterion);
-// The same with plant points: runs[i] was made for grid[i].
-std::vector<CellStats> Aggregate(const std::vector<SweepRun>& grid,
-                                 const std::vector<RunSummary>& runs,
-                                 const TrackingCriterion& criterion);
-
-// The columns of table.csv and of the Python aggregate, plant axes left out: dT, lambda,
-// estimator, seeds, the metric columns (CellMetricColumns()), meets_criterion, margin.
-std::vector<std::string> CellColumns();
-// A cell's values of the metric columns, in their order.
-std::vector<double> CellMetricValues(const CellStats& c);
-
-// Writes table.csv, table.md (with a column per plant axis when there are plant points),
-// and, without plant axes, stability.dat (the map's data: `recruit sweep` draws stability.png from
-// it with the plot module, sweep::StabilityMapOptions) into `out_dir`. The files depend only on
-// the runs' results. Any failed write (full disk) is an error.
-Status WriteSweepReport(const std::vector<CellStats>& cells, const TrackingCriterion& criterion,
-                        const std::string& out_dir, const std::string& title);
-
 // RunSummary <-> JSON for the per-run record files.
-Result<RunSummary> RunSummaryFromJson(const nlohmann::json& j);
+Result<sim::RunSummary> RunSummaryFromJson(const nlohmann::json& j);
 
-}  // namespace recruit::sim
+}  // namespace recruit::sweep

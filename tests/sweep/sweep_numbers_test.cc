@@ -15,13 +15,15 @@
 #include "common/atomic_file.h"
 #include "plot/plot_run.h"
 #include "plot/render.h"
-#include "sim/sweep.h"
+#include "sweep/grid.h"
 #include "sweep/sweep_report.h"
+#include "sweep/table.h"
 
-namespace recruit::sim {
+namespace recruit::sweep {
 namespace {
 
 namespace fs = std::filesystem;
+using namespace ::recruit::sim;  // NOLINT: tasks and runs the sweeps are made of
 
 fs::path FreshDir(const std::string& name) {
   const fs::path dir = fs::temp_directory_path() / ("recruit_sweep_numbers_" + name);
@@ -111,7 +113,7 @@ TEST(SweepNumbers, TableCsvReadsBackAsTheExactDoubles) {
   };
   cells[1].plant = 1;
   const fs::path dir = FreshDir("csv");
-  ASSERT_TRUE(WriteSweepReport(cells, TrackingCriterion{}, dir.string(), "numbers").ok());
+  ASSERT_TRUE(WriteTables(cells, TrackingCriterion{}, dir.string(), "numbers").ok());
   std::stringstream csv(*ReadFile((dir / "table.csv").string()));
   std::string line;
   std::getline(csv, line);
@@ -191,7 +193,7 @@ std::vector<CellStats> TwoCells(std::vector<std::pair<std::string, double>> plan
 TEST(SweepReportLinks, ReportLinksAndEmbedsTheStabilityMap) {
   const std::vector<CellStats> cells = TwoCells({});
   const fs::path dir = FreshDir("map");
-  ASSERT_TRUE(WriteSweepReport(cells, TrackingCriterion{}, dir.string(), "numbers").ok());
+  ASSERT_TRUE(WriteTables(cells, TrackingCriterion{}, dir.string(), "numbers").ok());
   ASSERT_TRUE(plot::RunPlot(sweep::StabilityMapOptions(dir.string(), "numbers", 1)).ok());
   const sweep::ReportInput in{"numbers", "a test", TrackingCriterion{}, cells, {}};
   ASSERT_TRUE(sweep::WriteReport(in, dir.string(), plot::RenderFigure).ok());
@@ -224,4 +226,4 @@ TEST(SweepReportLinks, NoStabilityMapNoLink) {
 }
 
 }  // namespace
-}  // namespace recruit::sim
+}  // namespace recruit::sweep

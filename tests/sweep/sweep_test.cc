@@ -3,8 +3,6 @@
 // files (plant axes, samples), shards, and the sensitivities of a synthetic plant whose critical
 // dT is known in closed form.
 // closed_loop_test.cc repeats the thread-count check with real closed-loop runs.
-#include "sim/sweep.h"
-
 #include <gtest/gtest.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
@@ -22,16 +20,19 @@
 #include "plot/plot_run.h"
 #include "plot/render.h"
 #include "sim/task.h"
+#include "sweep/grid.h"
 #include "sweep/latency.h"
 #include "sweep/recommend.h"
 #include "sweep/sampling.h"
 #include "sweep/sweep_file.h"
 #include "sweep/sweep_report.h"
+#include "sweep/table.h"
 
-namespace recruit::sim {
+namespace recruit::sweep {
 namespace {
 
 namespace fs = std::filesystem;
+using namespace ::recruit::sim;  // NOLINT: tasks and runs the sweeps are made of
 
 fs::path TempDir(const std::string& name) {
   const fs::path p = fs::temp_directory_path() / ("recruit_sweep_test_" + name);
@@ -102,7 +103,7 @@ std::string RunAndReport(const fs::path& dir, int threads) {
   auto out = RunSweep(*grid, dir.string(), FakeRun, threads);
   EXPECT_TRUE(out.ok()) << out.error();
   const TrackingCriterion crit;
-  EXPECT_TRUE(WriteSweepReport(Aggregate(out->runs, crit), crit, dir.string(), "fake").ok());
+  EXPECT_TRUE(WriteTables(Aggregate(out->runs, crit), crit, dir.string(), "fake").ok());
   return *ReadFile((dir / "table.csv").string()) + *ReadFile((dir / "table.md").string());
 }
 
@@ -155,8 +156,8 @@ TEST(Sweep, InterruptedSweepResumesWithoutRedoingFinishedRuns) {
   const auto clean = TempDir("resume_clean");
   auto full = RunSweep(*grid, clean.string(), FakeRun, 2);
   ASSERT_TRUE(full.ok());
-  ASSERT_TRUE(WriteSweepReport(Aggregate(second->runs, crit), crit, dir.string(), "x").ok());
-  ASSERT_TRUE(WriteSweepReport(Aggregate(full->runs, crit), crit, clean.string(), "x").ok());
+  ASSERT_TRUE(WriteTables(Aggregate(second->runs, crit), crit, dir.string(), "x").ok());
+  ASSERT_TRUE(WriteTables(Aggregate(full->runs, crit), crit, clean.string(), "x").ok());
   EXPECT_EQ(*ReadFile((dir / "table.csv").string()), *ReadFile((clean / "table.csv").string()));
 
   // A third attempt makes nothing.
@@ -207,7 +208,7 @@ TEST(Sweep, ShortestDtIsTheShortestThatMeetsTheCriterion) {
       EXPECT_TRUE(c.meets);
     }
   }
-  ASSERT_TRUE(WriteSweepReport(cells, crit, dir.string(), "fake").ok());
+  ASSERT_TRUE(WriteTables(cells, crit, dir.string(), "fake").ok());
   const std::string md = *ReadFile((dir / "table.md").string());
   EXPECT_NE(md.find("| output | 0.1 | 2 |"), std::string::npos) << md;
   EXPECT_NE(md.find("| kalman-augmented | 0.1 | 0.25 |"), std::string::npos) << md;
@@ -245,7 +246,7 @@ TEST(Sweep, AReportOnAFullDiskFails) {
   const plot::PlotOptions map = sweep::StabilityMapOptions(dir.string(), "full", 2);
   // First with room, to size the files: the limit lets every text file through and stops the
   // image, so this checks the image's failed write is seen (not only the tables').
-  ASSERT_TRUE(WriteSweepReport(cells, crit, dir.string(), "full").ok());
+  ASSERT_TRUE(WriteTables(cells, crit, dir.string(), "full").ok());
   ASSERT_TRUE(plot::RunPlot(map).ok());
   std::uintmax_t text = 0;
   for (const char* f : {"table.csv", "table.md", "stability.dat"}) {
@@ -259,8 +260,7 @@ TEST(Sweep, AReportOnAFullDiskFails) {
     std::signal(SIGXFSZ, SIG_IGN);
     rlimit lim{text + 100, text + 100};
     ::setrlimit(RLIMIT_FSIZE, &lim);
-    const bool ok =
-        WriteSweepReport(cells, crit, dir.string(), "full").ok() && plot::RunPlot(map).ok();
+    const bool ok = WriteTables(cells, crit, dir.string(), "full").ok() && plot::RunPlot(map).ok();
     ::_exit(ok ? 1 : 0);
   }
   int status = 0;
@@ -283,7 +283,7 @@ TEST(Sweep, TheStabilityMapIsDrawnWithoutGnuplot) {
   ASSERT_TRUE(out.ok());
   const TrackingCriterion crit;
   const std::string title = "it's'; system('x";
-  ASSERT_TRUE(WriteSweepReport(Aggregate(out->runs, crit), crit, dir.string(), title).ok());
+  ASSERT_TRUE(WriteTables(Aggregate(out->runs, crit), crit, dir.string(), title).ok());
   EXPECT_FALSE(fs::exists(dir / "stability.gp"));
   auto written = plot::RunPlot(sweep::StabilityMapOptions(dir.string(), title, 2));
   ASSERT_TRUE(written.ok()) << written.error();
@@ -564,9 +564,8 @@ TEST(SweepShard, ShardsPartitionTheGridAndMergeToTheUnshardedTable) {
   const TrackingCriterion crit;
   const auto merged_dir = TempDir("merged");
   fs::create_directories(merged_dir);
-  ASSERT_TRUE(
-      WriteSweepReport(Aggregate(*grid, merged, crit), crit, merged_dir.string(), "x").ok());
-  ASSERT_TRUE(WriteSweepReport(Aggregate(*grid, all->runs, crit), crit, whole.string(), "x").ok());
+  ASSERT_TRUE(WriteTables(Aggregate(*grid, merged, crit), crit, merged_dir.string(), "x").ok());
+  ASSERT_TRUE(WriteTables(Aggregate(*grid, all->runs, crit), crit, whole.string(), "x").ok());
   EXPECT_EQ(*ReadFile((merged_dir / "table.csv").string()),
             *ReadFile((whole / "table.csv").string()));
   EXPECT_NE(ReadFile((whole / "table.csv").string())->find("plant,N,dT"), std::string::npos);
@@ -667,4 +666,4 @@ TEST(SweepSensitivity, SyntheticPlantGivesItsClosedFormElasticities) {
 }
 
 }  // namespace
-}  // namespace recruit::sim
+}  // namespace recruit::sweep

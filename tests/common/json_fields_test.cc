@@ -1,0 +1,80 @@
+#include "common/json_fields.h"
+
+#include <gtest/gtest.h>
+
+#include <limits>
+
+namespace recruit::json_fields {
+namespace {
+
+using nlohmann::json;
+
+TEST(JsonFields, NumbersAreCheckedAgainstTheirRangeAndNamed) {
+  const json j = json::parse(R"({"dT": 0.5, "zero": 0, "text": "x", "big": 1e308})");
+  double v = -1;
+  ASSERT_TRUE(Number(j, "dT", "t.json", &v, true, 0, 1000, true, "0 < dT <= 1000").ok());
+  EXPECT_EQ(v, 0.5);
+  // lo_open: the bound itself is refused; closed: accepted.
+  Status open = Number(j, "zero", "t.json", &v, true, 0, 1, true, "0 < x <= 1");
+  ASSERT_FALSE(open.ok());
+  EXPECT_EQ(open.error(), "t.json.zero: 0 is out of range; allowed: 0 < x <= 1");
+  EXPECT_TRUE(Number(j, "zero", "t.json", &v, true, 0, 1, false, "0 <= x <= 1").ok());
+  EXPECT_FALSE(Number(j, "big", "t.json", &v, true, 0, 1e300, false, "").ok());
+  Status text = Number(j, "text", "t.json", &v, true, 0, 1, false, "a fraction");
+  EXPECT_EQ(text.error(), "t.json.text: must be a number (a fraction), got \"x\"");
+  EXPECT_EQ(text.code(), ErrorCode::kBadInput);
+  // Missing: an error when required, else *out unchanged.
+  v = 7;
+  EXPECT_TRUE(Number(j, "absent", "t.json", &v, false, 0, 1, false, "").ok());
+  EXPECT_EQ(v, 7);
+  EXPECT_EQ(Number(j, "absent", "t.json", &v, true, 0, 1, false, "0..1").error(),
+            "t.json: missing field 'absent' (0..1)");
+}
+
+TEST(JsonFields, IntegersRefuseFractionsAndValuesOutsideTheRange) {
+  const json j = json::parse(R"({"a": 3, "b": 2.5, "c": 0, "d": 18446744073709551615, "e": -1})");
+  std::int64_t n = 0;
+  EXPECT_TRUE(Integer(j, "a", "w", &n, true, 1, 10, "1..10").ok());
+  EXPECT_EQ(n, 3);
+  EXPECT_EQ(Integer(j, "b", "w", &n, true, 1, 10, "1..10").error(), "w.b: 2.5; allowed: 1..10");
+  EXPECT_FALSE(Integer(j, "c", "w", &n, true, 1, 10, "1..10").ok());
+  EXPECT_FALSE(Integer(j, "d", "w", &n, true, 1, 10, "1..10").ok());  // not wrapped to -1
+  std::uint64_t u = 0;
+  EXPECT_TRUE(Unsigned(j, "d", "w", &u, true).ok());
+  EXPECT_EQ(u, std::numeric_limits<std::uint64_t>::max());
+  EXPECT_FALSE(Unsigned(j, "e", "w", &u, true).ok());
+}
+
+TEST(JsonFields, UnknownKeysAreNamedWithTheAllowedOnes) {
+  const json j = json::parse(R"({"kp": 1, "colour": 2})");
+  Status s = CheckKeys(j, {"kp", "ki"}, "t.json.outer_loop");
+  EXPECT_EQ(s.error(), "t.json.outer_loop: unknown field 'colour'; allowed: ki, kp");
+  EXPECT_TRUE(CheckKeys(j, {"kp", "colour"}, "w").ok());
+}
+
+TEST(JsonFields, StringsBooleansAndVectors) {
+  const json j = json::parse(R"({"s": "ok", "e": "", "b": true, "v": [1, 2, 3], "w": [1, 2]})");
+  std::string s;
+  EXPECT_TRUE(String(j, "s", "w", &s, true).ok());
+  EXPECT_EQ(s, "ok");
+  EXPECT_FALSE(String(j, "e", "w", &s, true).ok());
+  bool b = false;
+  EXPECT_TRUE(Boolean(j, "b", "w", &b).ok());
+  EXPECT_TRUE(b);
+  EXPECT_FALSE(Boolean(j, "s", "w", &b).ok());
+  Eigen::Vector3d v = Eigen::Vector3d::Zero();
+  EXPECT_TRUE(Vec3(j, "v", "w", &v).ok());
+  EXPECT_EQ(v, Eigen::Vector3d(1, 2, 3));
+  EXPECT_FALSE(Vec3(j, "w", "w", &v).ok());
+}
+
+TEST(JsonFields, LongValuesAreShortenedInMessages) {
+  const json j = {{"x", std::string(5000, 'a')}};
+  double v = 0;
+  Status s = Number(j, "x", "w", &v, true, 0, 1, false, "0..1");
+  ASSERT_FALSE(s.ok());
+  EXPECT_LT(s.error().size(), 120u) << s.error();
+}
+
+}  // namespace
+}  // namespace recruit::json_fields
