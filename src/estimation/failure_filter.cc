@@ -169,7 +169,7 @@ void FailureKalmanFilter::Update(double y) {
     const double e = nu / std::sqrt(s);
     g_low_ = std::max(0.0, g_low_ - e - params_.cusum_drift);
     g_high_ = std::max(0.0, g_high_ + e - params_.cusum_drift);
-    if (g_low_ > params_.cusum_threshold) declared_to = m_;  // force short: open
+    if (g_low_ > params_.cusum_threshold) declared_to = m_;       // force short: open
     if (g_high_ > params_.cusum_threshold) declared_to = m_ + 1;  // force over: stuck
   }
   if (declared_to < 0 && !augmented_) {
@@ -204,8 +204,8 @@ void FailureKalmanFilter::Update(double y) {
 
 void FailureKalmanFilter::FillAugmentedA(double p_on, double p_off) {
   A_.setIdentity();
-  A_.topLeftCorner(m_ + 2, m_ + 2) = AugmentedTransition(
-      model_.broadcast, p_on, p_off, params_.open_hazard, params_.stuck_hazard);
+  A_.topLeftCorner(m_ + 2, m_ + 2) =
+      AugmentedTransition(model_.broadcast, p_on, p_off, params_.open_hazard, params_.stuck_hazard);
 }
 
 void FailureKalmanFilter::PredictBroadcast(double p_on, double p_off) {

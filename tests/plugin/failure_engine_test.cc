@@ -68,10 +68,10 @@ TEST(EngineFailures, SensorReportsWorkingOpenAndStuckCounts) {
 }
 
 TEST(EngineFailures, CopyAndResetStayExactWithHazardsAndFatigue) {
-  ModelPtr m = MustLoad(FailingBench(ConfigXml("open_rate", "300") + ConfigXml("stuck_rate", "100") +
-                                     ConfigXml("open_per_cycle", "0.01") +
-                                     ConfigXml("fatigue_loss", "0.2") +
-                                     ConfigXml("fatigue_cycles", "3")));
+  ModelPtr m =
+      MustLoad(FailingBench(ConfigXml("open_rate", "300") + ConfigXml("stuck_rate", "100") +
+                            ConfigXml("open_per_cycle", "0.01") + ConfigXml("fatigue_loss", "0.2") +
+                            ConfigXml("fatigue_cycles", "3")));
   ASSERT_NE(m, nullptr);
   DataPtr a(mj_makeData(m.get()));
   const std::vector<double> initial = PluginState(m.get(), a.get());
