@@ -30,9 +30,9 @@ FailureOnCountEstimator::FailureOnCountEstimator(FilterModel model, FailureKalma
       output_(std::move(output)),
       relative_noise_(relative_noise) {
   const int m = model_.num_states();
-  on_mask_ = Eigen::VectorXd::Zero(m + 2);
+  on_mask_ = Eigen::VectorXd::Zero(3 * m);
   for (int i = 0; i < m; ++i) on_mask_[i] = model_.broadcast.is_on[i] ? 1.0 : 0.0;
-  on_mask_[m + 1] = 1;  // stuck units are heated
+  on_mask_.tail(m).setOnes();  // stuck units are heated
   on_mask_w_ = on_mask_.head(m);
   h_ = model_.H;
   r_ = model_.R;
@@ -60,15 +60,15 @@ double FailureOnCountEstimator::EstimatedOnVariance() const {
 
 std::vector<std::string> FailureOnCountEstimator::StateNames() const {
   std::vector<std::string> n = model_.state_names;
-  n.push_back("open");
-  n.push_back("stuck");
+  for (const std::string& s : model_.state_names) n.push_back("open:" + s);
+  for (const std::string& s : model_.state_names) n.push_back("stuck:" + s);
   return n;
 }
 
 std::vector<bool> FailureOnCountEstimator::OnStates() const {
   std::vector<bool> on = model_.broadcast.is_on;
-  on.push_back(false);
-  on.push_back(true);
+  on.insert(on.end(), model_.num_states(), false);
+  on.insert(on.end(), model_.num_states(), true);
   return on;
 }
 
@@ -95,9 +95,13 @@ void FailureOnCountEstimator::Observe(double measured_force, double tendon_lengt
       h_ = model_.H;
     }
     const int m = model_.num_states();
-    const double predicted = filter_.augmented()
-                                 ? h_.row(0).dot(filter_.estimate().head(m))
-                                 : h_.row(0).dot(filter_.working_filter().estimate());
+    double predicted;
+    if (filter_.augmented()) {
+      const Eigen::VectorXd& e = filter_.estimate();
+      predicted = h_.row(0).dot(e.head(m) + e.segment(m, m) + e.tail(m));
+    } else {
+      predicted = h_.row(0).dot(filter_.working_filter().estimate());
+    }
     r_(0, 0) = model_.R(0, 0) + relative_noise_ * relative_noise_ * predicted * predicted;
     filter_.SetOutput(h_, r_);
   }

@@ -26,7 +26,7 @@ class FailureOnCountEstimator final : public OnCountEstimator {
   void Broadcasted(const Broadcast& b) override { filter_.PredictBroadcast(b.p_on, b.p_off); }
   double EstimatedOn() const override;
   double EstimatedOnVariance() const override;
-  // [model states; open; stuck].
+  // [model states; open: model states; stuck: model states].
   Eigen::VectorXd StateEstimate() const override { return filter_.estimate(); }
   std::vector<std::string> StateNames() const override;
   std::vector<bool> OnStates() const override;
@@ -41,7 +41,7 @@ class FailureOnCountEstimator final : public OnCountEstimator {
 
   FilterModel model_;
   FailureKalmanFilter filter_;
-  Eigen::VectorXd on_mask_;    // m + 2: the heater-on states and "stuck"
+  Eigen::VectorXd on_mask_;    // 3m: the working heater-on states and every stuck state
   Eigen::VectorXd on_mask_w_;  // its first m entries (the working states)
   std::optional<UnitForceMap> output_;
   double relative_noise_ = 0;

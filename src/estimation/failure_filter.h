@@ -1,33 +1,51 @@
 // The population Kalman filter with absorbing failed states (docs/failures.md).
 //
-// The unit chain (m working states, the paper's filter) is augmented with two absorbing states,
-// "open" (never heats: the force of a cold off unit) and "stuck" (always heated: the force of a
-// settled on unit), and a force scale c of the working units (functional fatigue):
-//   X = [x_w (m); n_open; n_stuck],  y = c H_w x_w + h_cold n_open + h_hot n_stuck + v.
-// Over one control period a working unit in state j fails open with q_o,j, stuck with q_s,j
-// (prior hazards, heated states only), else moves by the broadcast A_w:
-//   A = [[A_w D, 0, 0], [q_o^T, 1, 0], [q_s^T, 0, 1]],  D = diag(1 - q_o,j - q_s,j),
-// column-stochastic, so the paper's Qz(X) = diag(A X) - A diag(X) A^T holds as it is.
+// The unit chain (m working states, the paper's filter) is augmented with two absorbing classes
+// of m states each: "open" units (never heated again) and "stuck" units (heated for good). A
+// failed unit keeps its thermal transient but ignores broadcasts, so both classes evolve by the
+// chain's interior A_w(0, 0); a unit failing open from a heated state j enters the open class at
+// the cooling state of its temperature (off_target[j]), one failing stuck from an unheated state
+// enters the stuck class at the first heating state (on_target[j]). With a force scale c of the
+// working units (functional fatigue) the state and output are
+//   X = [x_w; x_open; x_stuck] (3m),  y = c H_w x_w + H_w x_open + H_w x_stuck + v.
+// Over one control period a working unit in heated state j fails open with q_o, stuck with q_s
+// (prior hazards), else moves by the broadcast A_w(p_on, p_off):
+//   A = [[A_w D, 0, 0], [q_o F_o, A_w(0,0), 0], [q_s F_s, 0, A_w(0,0)]],
+// D = diag(1 - q_o,j - q_s,j), F_o / F_s the entry maps above; A is column-stochastic, so the
+// paper's Qz(X) = diag(A X) - A diag(X) A^T holds as it is.
 //
 // Abrupt failures (a broken lead, a burnt driver) are far likelier at once than the prior hazard
 // says; a two-sided CUSUM on the normalised innovations e = (y - y^) / sqrt(S) declares one
-// (force persistently below the prediction: open; above: stuck). A declaration adds, before the
-// update at that instant, the Qz of one step of the absorbing chain with the jump hazard q_J
-// (into open, or stuck) to the predicted covariance; the mean is unchanged and the measurements
-// then place the failed units.
+// (force persistently below the prediction: open; above: stuck). A declaration goes back to the
+// prior at the CUSUM's onset (the instant its statistic last left 0, at most kHistory instants
+// back), adds there the covariance of a jump into the failed class: a common cause taking a
+// fraction f of the working units in proportion to each state's count, sd_f^2 v v^T with
+// v = sum_j x_j (e_fail(j) - e_j), plus the Qz of one step with independent failures of
+// probability q_J; the mean is unchanged. The measurements and broadcasts since the onset are
+// replayed, and place the failed units.
 //
 // Until the first declaration, with zero prior hazards and no fatigue estimate, the failed
-// states hold 0 exactly and the filter is the paper's filter (PopulationKalmanFilter) on x_w,
-// run by the same code: bit-identical. From then on the augmented (m + 2) filter runs dense.
+// classes hold 0 exactly and the filter is the paper's filter (PopulationKalmanFilter) on x_w,
+// run by the same code: bit-identical. From then on the augmented (3m + 1) filter runs dense.
 #pragma once
 
 #include <Eigen/Dense>
+#include <deque>
 
 #include "common/result.h"
 #include "estimation/filter_model.h"
 #include "estimation/population_kalman_filter.h"
 
 namespace recruit {
+
+// The augmented chain's A (3m x 3m, classes working, open, stuck) for a broadcast: heated working
+// states fail open with q_open and stuck with q_stuck per period; failed classes absorb and
+// follow the chain's interior.
+Eigen::MatrixXd AugmentedTransition(const BroadcastTransitionModel& chain, double p_on,
+                                    double p_off, double q_open, double q_stuck);
+// The state a working unit in state j enters when it fails open / stuck (within its class).
+int OpenEntry(const BroadcastTransitionModel& chain, int j);
+int StuckEntry(const BroadcastTransitionModel& chain, int j);
 
 struct FailureFilterParams {
   // Prior probabilities, per control period, that a working unit in a heated state fails open or
@@ -37,18 +55,16 @@ struct FailureFilterParams {
   bool detect = true;
   double cusum_drift = 1.0;
   double cusum_threshold = 8;
-  // Hazard of the covariance jump at a declaration (per working unit).
-  double jump_hazard = 0.2;
+  // The covariance jump at a declaration: a common cause that takes a fraction f of the working
+  // units in proportion to each state's count (std of f), plus independent failures with
+  // probability jump_hazard per working unit.
+  double jump_fraction_std = 0.3;
+  double jump_hazard = 0.005;
   // Random-walk variance of the working units' force scale per control period; 0 = c fixed at 1.
   double scale_variance = 0;
 
   Status Validate() const;
 };
-
-// The augmented chain's A ((m + 2) x (m + 2)) for a broadcast: heated working states fail open
-// with q_open and stuck with q_stuck per period, the failed states absorb.
-Eigen::MatrixXd AugmentedTransition(const BroadcastTransitionModel& chain, double p_on,
-                                    double p_off, double q_open, double q_stuck);
 
 class FailureKalmanFilter {
  public:
@@ -65,12 +81,12 @@ class FailureKalmanFilter {
   void PredictBroadcast(double p_on, double p_off);
 
   int num_working_states() const { return m_; }
-  // The augmented estimate [x_w; open; stuck] (m + 2) and its covariance, and the fatigue scale.
+  // The augmented estimate [x_w; x_open; x_stuck] (3m) and its covariance.
   const Eigen::VectorXd& estimate() const;
   const Eigen::MatrixXd& covariance() const;
-  double force_scale() const { return augmented_ ? x_[m_ + 2] : 1.0; }
-  double open() const { return estimate()[m_]; }
-  double stuck() const { return estimate()[m_ + 1]; }
+  double force_scale() const { return augmented_ ? x_[3 * m_] : 1.0; }
+  double open() const { return augmented_ ? x_.segment(m_, m_).sum() : 0.0; }
+  double stuck() const { return augmented_ ? x_.segment(2 * m_, m_).sum() : 0.0; }
   double working() const { return N_ - open() - stuck(); }
   // Var(working) = Var(open + stuck).
   double working_variance() const;
@@ -87,11 +103,18 @@ class FailureKalmanFilter {
                       PopulationKalmanFilter inner);
   // Copies the working filter's belief into the augmented state.
   void Augment();
-  // The augmented A for a broadcast ((m + 3) x (m + 3) with the scale row: identity there).
-  void FillAugmentedA(double p_on, double p_off);
-  // Qz of one step of the absorbing chain with hazard q from every working state into state
-  // `to` (m: open, m + 1: stuck) at X.
-  Eigen::MatrixXd JumpQz(const Eigen::VectorXd& x, double q, int to) const;
+  // The state a working unit in state j enters when it fails into class `to` (1 open, 2 stuck).
+  int FailEntry(int j, int to) const;
+  // Qz of one step with independent failures of probability q from every working state into
+  // class `to` at a feasible X (3m entries).
+  Eigen::MatrixXd JumpQz(const Eigen::VectorXd& xq, double q, int to) const;
+  // The covariance added at a declared failure into class `to`.
+  Eigen::MatrixXd JumpCovariance(int to) const;
+  // The augmented output row [c H, H, H, dy/dc] for the working-state row H.
+  Eigen::RowVectorXd OutputRow(const Eigen::MatrixXd& H) const;
+  double Predicted(const Eigen::MatrixXd& H) const;
+  void UpdateCore(double y, const Eigen::MatrixXd& H, double R);
+  void PredictCore(double p_on, double p_off);
 
   FilterModel model_;
   CovarianceMode mode_;
@@ -99,9 +122,8 @@ class FailureKalmanFilter {
   PopulationKalmanFilter inner_;
   int m_ = 0;
   double N_ = 0;
-  int cold_ = 0, hot_ = 0;  // working states whose force an open / stuck unit has
   bool augmented_ = false;
-  Eigen::VectorXd x_;  // m + 3: [x_w; open; stuck; c]
+  Eigen::VectorXd x_;  // 3m + 1: [x_w; x_open; x_stuck; c]
   Eigen::MatrixXd P_, A_;
   Eigen::MatrixXd H_, R_;  // the working states' output (1 x m), noise
   mutable Eigen::VectorXd view_x_;
@@ -109,6 +131,16 @@ class FailureKalmanFilter {
   double g_low_ = 0, g_high_ = 0;  // CUSUM statistics
   int declarations_ = 0;
   bool declared_last_ = false;
+  // One control instant as the filter saw it: the prior (augmented form), the measurement and
+  // its output model, the broadcast that followed. A declaration replays from the onset.
+  struct History {
+    Eigen::VectorXd x;
+    Eigen::MatrixXd P, H;
+    double R = 0, y = 0, p_on = 0, p_off = 0;
+  };
+  static constexpr int kHistory = 40;
+  std::deque<History> history_;
+  int onset_low_ = 0, onset_high_ = 0;  // instants since each CUSUM statistic left 0
 };
 
 }  // namespace recruit
