@@ -23,7 +23,7 @@ using recruit::control::EstimatorSpec;
 namespace {
 
 // The estimator's detection settings can be varied: FAILURE_JUMP_STD, FAILURE_JUMP_HAZARD,
-// FAILURE_CUSUM_H, FAILURE_CUSUM_K (defaults: FailureFilterParams).
+// FAILURE_CUSUM_H, FAILURE_CUSUM_K, FAILURE_SETTLE_HAZARD (defaults: FailureFilterParams).
 EstimatorSpec Failures() {
   EstimatorSpec s = *EstimatorSpec::Parse("kalman-failures");
   auto env = [](const char* name, double& v) {
@@ -33,6 +33,7 @@ EstimatorSpec Failures() {
   env("FAILURE_JUMP_HAZARD", s.failure.jump_hazard);
   env("FAILURE_CUSUM_H", s.failure.cusum_threshold);
   env("FAILURE_CUSUM_K", s.failure.cusum_drift);
+  env("FAILURE_SETTLE_HAZARD", s.failure.settle_hazard);
   return s;
 }
 

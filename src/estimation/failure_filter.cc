@@ -53,6 +53,10 @@ Status FailureFilterParams::Validate() const {
     return Error{"failure filter: jump_hazard = " + std::to_string(jump_hazard) +
                  " must be in [0, 1]"};
   }
+  if (!(settle_hazard >= 0 && settle_hazard <= 1)) {
+    return Error{"failure filter: settle_hazard = " + std::to_string(settle_hazard) +
+                 " must be in [0, 1]"};
+  }
   if (!(std::isfinite(jump_fraction_std) && jump_fraction_std >= 0)) {
     return Error{"failure filter: jump_fraction_std = " + std::to_string(jump_fraction_std) +
                  " must be finite and >= 0"};
@@ -97,6 +101,7 @@ void FailureKalmanFilter::Reset() {
   g_low_ = g_high_ = 0;
   declarations_ = 0;
   declared_last_ = false;
+  declared_class_[1] = declared_class_[2] = false;
   if (params_.open_hazard > 0 || params_.stuck_hazard > 0 || params_.scale_variance > 0) Augment();
 }
 
@@ -254,6 +259,7 @@ void FailureKalmanFilter::Update(double y) {
   onset_low_ = onset_high_ = 0;
   ++declarations_;
   declared_last_ = true;
+  declared_class_[declared_to] = true;
   augmented_ = true;
   const int first = static_cast<int>(history_.size()) - 1 - back;
   x_ = history_[first].x;
@@ -291,6 +297,12 @@ void FailureKalmanFilter::PredictCore(double p_on, double p_off) {
   }
   if (model_.G.cols() > 0) Q.topLeftCorner(m_, m_) += model_.ProcessNoise();
   Q(n, n) = params_.scale_variance;
+  if (params_.settle_hazard > 0) {
+    const Eigen::VectorXd xq = ProjectOntoSimplex(x_.head(n), N_);
+    for (int to : {1, 2}) {
+      if (declared_class_[to]) Q.topLeftCorner(n, n) += JumpQz(xq, params_.settle_hazard, to);
+    }
+  }
   P_ = A_ * P_ * A_.transpose() + Q;
   x_ = A_ * x_;
 }

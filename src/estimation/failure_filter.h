@@ -22,7 +22,9 @@
 // fraction f of the working units in proportion to each state's count, sd_f^2 v v^T with
 // v = sum_j x_j (e_fail(j) - e_j), plus the Qz of one step with independent failures of
 // probability q_J; the mean is unchanged. The measurements and broadcasts since the onset are
-// replayed, and place the failed units.
+// replayed, and place the failed units. From then on every prediction adds the Qz of
+// independent failures into the declared class with probability q_S (mean unchanged), so that
+// units lost while off are found when the controller fails to recruit them.
 //
 // Until the first declaration, with zero prior hazards and no fatigue estimate, the failed
 // classes hold 0 exactly and the filter is the paper's filter (PopulationKalmanFilter) on x_w,
@@ -60,6 +62,10 @@ struct FailureFilterParams {
   // probability jump_hazard per working unit.
   double jump_fraction_std = 0.3;
   double jump_hazard = 0.005;
+  // After a declaration into a class, every prediction adds the Qz of independent failures into
+  // it with this probability (the mean is not moved): the count of failed units stays free to
+  // follow what later broadcasts reveal (units lost while off show only when recruited).
+  double settle_hazard = 0.05;
   // Random-walk variance of the working units' force scale per control period; 0 = c fixed at 1.
   double scale_variance = 0;
 
@@ -128,7 +134,8 @@ class FailureKalmanFilter {
   Eigen::MatrixXd H_, R_;  // the working states' output (1 x m), noise
   mutable Eigen::VectorXd view_x_;
   mutable Eigen::MatrixXd view_P_;
-  double g_low_ = 0, g_high_ = 0;  // CUSUM statistics
+  double g_low_ = 0, g_high_ = 0;                   // CUSUM statistics
+  bool declared_class_[3] = {false, false, false};  // classes declared since Reset
   int declarations_ = 0;
   bool declared_last_ = false;
   // One control instant as the filter saw it: the prior (augmented form), the measurement and
