@@ -44,11 +44,17 @@ void StoreRng(const Rng& rng, double* halves) {
   }
 }
 
-// Binomial(n, p) by inversion from one uniform: failures are rare (p n << 1), so the loop
-// rarely goes past k = 0.
+// Binomial(n, p): by inversion from one uniform when n p is small (failures are rare, so the
+// loop rarely goes past k = 0), else one Bernoulli draw per unit (where (1 - p)^n would
+// underflow).
 int Binomial(Rng& rng, int n, double p) {
   if (n <= 0 || !(p > 0)) return 0;
   if (p >= 1) return n;
+  if (n * p > 10) {
+    int k = 0;
+    for (int i = 0; i < n; ++i) k += rng.Uniform() < p ? 1 : 0;
+    return k;
+  }
   const double u = rng.Uniform();
   double pmf = std::pow(1 - p, n), cdf = pmf;
   int k = 0;

@@ -118,6 +118,23 @@ TEST(Failures, HeatedHazardGivesBinomialCountsSplitByRate) {
   EXPECT_EQ(off_failed, 0);
 }
 
+// The same law where n p is large (one Bernoulli draw per unit instead of the inversion).
+TEST(Failures, HeatedHazardIsRightForLargeCohortsAndRates) {
+  const int units = 200, seeds = 30;
+  const SmaBundle b = Make("units=200 open_rate=3600", 0.1);  // 1 per second heated
+  const double x = b.config().unit.prestretch;
+  long failed = 0;
+  for (int seed = 0; seed < seeds; ++seed) {
+    std::vector<double> s(b.state_size());
+    b.Reset(s.data(), 300 + seed, x);
+    ASSERT_TRUE(b.Broadcast(s.data(), 1, 0, x).ok());
+    for (int step = 0; step < 10; ++step) b.Advance(s.data(), x, 0.1);
+    failed += b.Failures(s.data()).open;
+  }
+  const double n = double(units) * seeds, p = -std::expm1(-1.0);
+  EXPECT_NEAR(failed, n * p, Band(n, p));
+}
+
 // Hazard per cycle: after K on/off cycles a unit has failed with p = 1 - (1 - q)^K.
 TEST(Failures, CycleHazardGivesBinomialCounts) {
   const int units = 50, seeds = 40, K = 10;
