@@ -23,7 +23,8 @@ using recruit::control::EstimatorSpec;
 namespace {
 
 // The estimator's detection settings can be varied: FAILURE_JUMP_STD, FAILURE_JUMP_HAZARD,
-// FAILURE_CUSUM_H, FAILURE_CUSUM_K, FAILURE_SETTLE_HAZARD (defaults: FailureFilterParams).
+// FAILURE_CUSUM_H, FAILURE_CUSUM_K, FAILURE_SETTLE_HAZARD, FAILURE_OPEN_HAZARD (defaults:
+// FailureFilterParams).
 EstimatorSpec Failures() {
   EstimatorSpec s = *EstimatorSpec::Parse("kalman-failures");
   auto env = [](const char* name, double& v) {
@@ -34,6 +35,7 @@ EstimatorSpec Failures() {
   env("FAILURE_CUSUM_H", s.failure.cusum_threshold);
   env("FAILURE_CUSUM_K", s.failure.cusum_drift);
   env("FAILURE_SETTLE_HAZARD", s.failure.settle_hazard);
+  env("FAILURE_OPEN_HAZARD", s.failure.open_hazard);
   return s;
 }
 
@@ -72,7 +74,7 @@ int main(int argc, char** argv) {
               first + seeds - 1);
 
   // detect
-  std::vector<double> found, nees_loss, quiet_nees;
+  std::vector<double> found, nees_loss, quiet_nees, quiet_working;
   int within10 = 0, never = 0;
   long quiet_instants = 0, false_alarms = 0;
   for (int s = first; s < first + seeds; ++s) {
@@ -90,6 +92,9 @@ int main(int argc, char** argv) {
     fl::Spec quiet{"", Failures(), 0.5, 0.2, static_cast<std::uint64_t>(s), 500, Steps};
     const auto q = MustRun(quiet);
     false_alarms += fl::DeclarationsBefore(q, 1e9);
+    double worst = 0;
+    for (const auto& r : q) worst = std::max(worst, std::abs(r.est_working - r.working));
+    quiet_working.push_back(worst);
     quiet_instants += static_cast<long>(q.size());
     quiet_nees.push_back(fl::MeanNees(q));
   }
@@ -101,6 +106,7 @@ int main(int argc, char** argv) {
   std::printf("  declared failures: %ld in %ld control instants (%.2g per instant)\n", false_alarms,
               quiet_instants, double(false_alarms) / quiet_instants);
   Report("mean on-count NEES per run", quiet_nees);
+  Report("largest |working est - 60| per run", quiet_working);
 
   // track
   struct Case {
