@@ -44,6 +44,44 @@ void StoreRng(const Rng& rng, double* halves) {
   }
 }
 
+// Binomial(n, p): by inversion from one uniform when n p is small (failures are rare, so the
+// loop rarely goes past k = 0), else one Bernoulli draw per unit (where (1 - p)^n would
+// underflow).
+int Binomial(Rng& rng, int n, double p) {
+  if (n <= 0 || !(p > 0)) return 0;
+  if (p >= 1) return n;
+  if (n * p > 10) {
+    int k = 0;
+    for (int i = 0; i < n; ++i) k += rng.Uniform() < p ? 1 : 0;
+    return k;
+  }
+  const double u = rng.Uniform();
+  double pmf = std::pow(1 - p, n), cdf = pmf;
+  int k = 0;
+  while (u >= cdf && k < n) {
+    pmf *= (n - k) / (k + 1.0) * (p / (1 - p));
+    ++k;
+    cdf += pmf;
+  }
+  return k;
+}
+
+// Picks `want` of the units i < n with eligible(i) true (there are `pool`), uniformly, in unit
+// order (selection sampling, Knuth's Algorithm S): one draw per eligible unit until done.
+template <class Eligible>
+void PickUnits(Rng& rng, int n, int pool, int want, Eligible eligible, std::vector<int>* out) {
+  for (int i = 0; i < n && want > 0; ++i) {
+    if (!eligible(i)) continue;
+    if (rng.Uniform() * pool < want) {
+      out->push_back(i);
+      --want;
+    }
+    --pool;
+  }
+}
+
+constexpr std::uint64_t kFailureStream = 0xFA11ED;  // sub-stream index of the failure draws
+
 }  // namespace
 
 SmaBundle::SmaBundle(BundleConfig c, UnitModel u, double dt)
@@ -52,6 +90,8 @@ SmaBundle::SmaBundle(BundleConfig c, UnitModel u, double dt)
       limits_(UnitLimits::ForWire(config_.unit.wire_diameter)),
       dt_(dt),
       decay_(unit_.DecayFactor(dt)) {
+  failures_ = config_.failure.given;
+  fatigue_ = failures_ && config_.failure.fatigue_loss > 0;
   if (config_.update_period > 0) {
     // The pending time reaches about a whole number of steps >= update_period.
     period_ = dt_ * std::max(1.0, std::round(config_.update_period / dt_));
@@ -80,12 +120,23 @@ void SmaBundle::Reset(double* s, std::uint64_t seed, double stretch) const {
   Field(s, kHeatScale)[0] = rest.heat_scale;
   Field(s, kCoolScale)[0] = rest.cool_scale;
   // Unit index block is already 0: every unit in cohort 0.
+  if (failures_) StoreRng(Rng(Rng::DeriveSeed(seed, kFailureStream)), Fail(s) + kFailRngSlot);
+  // Modes and damage are 0: every unit working and fresh.
 }
 
 bool SmaBundle::Initialized(const double* s) { return s[kMagicSlot] == kMagic; }
 
 void SmaBundle::CopyCohort(double* s, int from, int to) const {
   for (int f = 0; f < kFields; ++f) Field(s, f)[to] = Field(s, f)[from];
+  if (failures_) {
+    Mode(s)[to] = Mode(s)[from];
+    Damage(s)[to] = Damage(s)[from];
+  }
+}
+
+double SmaBundle::ForceScale(double damage) const {
+  const FailureConfig& f = config_.failure;
+  return 1 - f.fatigue_loss * -std::expm1(-damage / f.fatigue_cycles);
 }
 
 Status SmaBundle::Broadcast(double* s, double p_on, double p_off, double stretch) const {
@@ -105,6 +156,9 @@ Status SmaBundle::Broadcast(double* s, double p_on, double p_off, double stretch
   for (int i = 0; i < config_.units; ++i) {
     const int from = static_cast<int>(idx[i]);
     const double u = rng.Uniform();
+    // A failed unit draws like the others (the working units' draws do not depend on which
+    // units failed) but does not switch.
+    if (failures_ && Mode(s)[from] != kModeWorking) continue;
     if (u < (on[from] != 0 ? p_off : p_on)) {
       flip[i] = 1;
       ++flips[from];
@@ -117,14 +171,25 @@ Status SmaBundle::Broadcast(double* s, double p_on, double p_off, double stretch
   int k = k0;
   for (int j = 0; j < k0; ++j) {
     if (flips[j] == 0) continue;
+    // Fatigue: a heating cycle ends (on -> off); it adds the fraction transformed times the
+    // stress ratio to the power m (docs/failures.md).
+    double damage = 0;
+    if (fatigue_ && on[j] != 0) {
+      const FailureConfig& fc = config_.failure;
+      const double xi = Field(s, kXi)[j];
+      const double stress = unit_.WireStress(ForceScale(Damage(s)[j]) * unit_.Tension(xi, stretch));
+      damage = (1 - xi) * std::pow(stress / fc.fatigue_stress, fc.fatigue_exponent);
+    }
     if (flips[j] == static_cast<int>(count[j])) {
       on[j] = on[j] != 0 ? 0 : 1;
+      if (fatigue_) Damage(s)[j] += damage;
       target[j] = j;
       continue;
     }
     CopyCohort(s, j, k);
     count[k] = flips[j];
     on[k] = on[j] != 0 ? 0 : 1;
+    if (fatigue_) Damage(s)[k] += damage;
     count[j] -= flips[j];
     target[j] = k++;
   }
@@ -132,6 +197,7 @@ Status SmaBundle::Broadcast(double* s, double p_on, double p_off, double stretch
     if (flip[i]) idx[i] = target[static_cast<int>(idx[i])];
   }
   s[kCohortCountSlot] = k;
+  if (failures_) CycleFailures(s, flip, stretch);
   return Status::Ok();
 }
 
@@ -139,10 +205,110 @@ void SmaBundle::Advance(double* s, double stretch, double dt) const {
   DropKept(s);
   if (config_.update_period <= 0) {
     Integrate(s, stretch, dt);
-    return;
+  } else {
+    s[kPendingSlot] += dt;
+    if (s[kPendingSlot] >= config_.update_period - 0.5 * dt) Flush(s, stretch);
   }
-  s[kPendingSlot] += dt;
-  if (s[kPendingSlot] >= config_.update_period - 0.5 * dt) Flush(s, stretch);
+  if (failures_) StepFailures(s, stretch, dt);
+}
+
+void SmaBundle::FailUnits(double* s, const std::vector<int>& units, int mode) const {
+  if (units.empty()) return;
+  const int k0 = NumCohorts(s);
+  double* idx = UnitIndex(s);
+  double* count = Field(s, kCount);
+  double* on = Field(s, kOn);
+  std::vector<int> moving(k0, 0), target(k0, -1);
+  for (int i : units) ++moving[static_cast<int>(idx[i])];
+  int k = k0;
+  for (int j = 0; j < k0; ++j) {
+    if (moving[j] == 0) continue;
+    int t = j;
+    if (moving[j] != static_cast<int>(count[j])) {
+      t = k++;
+      CopyCohort(s, j, t);
+      count[t] = moving[j];
+      count[j] -= moving[j];
+    }
+    on[t] = mode == kModeStuck ? 1 : 0;  // open: never heats; stuck: heated for good
+    Mode(s)[t] = mode;
+    target[j] = t;
+  }
+  for (int i : units) idx[i] = target[static_cast<int>(idx[i])];
+  s[kCohortCountSlot] = k;
+}
+
+void SmaBundle::CycleFailures(double* s, const std::vector<char>& flip, double stretch) const {
+  const FailureConfig& fc = config_.failure;
+  if (!(fc.open_per_cycle > 0 || fc.stuck_per_cycle > 0)) return;
+  double* f = Fail(s);
+  Rng rng = LoadRng(f + kFailRngSlot);
+  const double* idx = UnitIndex(s);
+  std::vector<int> open, stuck;
+  for (int i = 0; i < config_.units; ++i) {
+    const int j = static_cast<int>(idx[i]);
+    // A cycle starts when a working unit switches on.
+    if (!flip[i] || Field(s, kOn)[j] == 0 || Mode(s)[j] != kModeWorking) continue;
+    const double u = rng.Uniform();
+    if (u < fc.open_per_cycle) {
+      open.push_back(i);
+    } else if (u < fc.open_per_cycle + fc.stuck_per_cycle) {
+      stuck.push_back(i);
+    }
+  }
+  StoreRng(rng, f + kFailRngSlot);
+  FailUnits(s, open, kModeOpen);
+  FailUnits(s, stuck, kModeStuck);
+}
+
+void SmaBundle::StepFailures(double* s, double stretch, double dt) const {
+  const FailureConfig& fc = config_.failure;
+  double* f = Fail(s);
+  f[kFailTimeSlot] += dt;
+  const int n_events = static_cast<int>(fc.schedule.size());
+  const bool due =
+      f[kFailNextSlot] < n_events &&
+      fc.schedule[static_cast<int>(f[kFailNextSlot])].time <= f[kFailTimeSlot] + 0.5 * dt;
+  const double rate = (fc.open_rate + fc.stuck_rate) / 3600.0;  // per second heated
+  if (!due && !(rate > 0)) return;
+  Rng rng = LoadRng(f + kFailRngSlot);
+  const double* idx = UnitIndex(s);
+  const double* count = Field(s, kCount);
+  const double* on = Field(s, kOn);
+  std::vector<int> open, stuck, picked;
+  if (rate > 0) {
+    const double p = -std::expm1(-rate * dt);
+    const int k = NumCohorts(s);
+    for (int j = 0; j < k; ++j) {
+      if (Mode(s)[j] != kModeWorking || on[j] == 0) continue;
+      const int n = static_cast<int>(count[j]);
+      const int failing = Binomial(rng, n, p);
+      if (failing == 0) continue;
+      picked.clear();
+      PickUnits(
+          rng, config_.units, n, failing, [&](int i) { return idx[i] == j; }, &picked);
+      for (int i : picked) {
+        (rng.Uniform() * (fc.open_rate + fc.stuck_rate) < fc.open_rate ? open : stuck).push_back(i);
+      }
+    }
+  }
+  const bool any = !open.empty() || !stuck.empty() || due;
+  if (any && s[kPendingSlot] > 0) Flush(s, stretch);  // the old states ran until now
+  FailUnits(s, open, kModeOpen);
+  FailUnits(s, stuck, kModeStuck);
+  while (f[kFailNextSlot] < n_events) {
+    const FailureConfig::Event& e = fc.schedule[static_cast<int>(f[kFailNextSlot])];
+    if (!(e.time <= f[kFailTimeSlot] + 0.5 * dt)) break;
+    f[kFailNextSlot] += 1;
+    const int working = Failures(s).working;
+    picked.clear();
+    const double* ix = UnitIndex(s);
+    PickUnits(
+        rng, config_.units, working, std::min(e.count, working),
+        [&](int i) { return Mode(s)[static_cast<int>(ix[i])] == kModeWorking; }, &picked);
+    FailUnits(s, picked, e.stuck ? kModeStuck : kModeOpen);
+  }
+  StoreRng(rng, f + kFailRngSlot);
 }
 
 void SmaBundle::Flush(double* s, double stretch) const {
@@ -214,10 +380,14 @@ void SmaBundle::Merge(double* s) const {
   int rep = sorted[0];
   for (int j = 1; j < k; ++j) {
     const int r = rep, c = sorted[j];
-    const bool same = on[r] == on[c] && std::abs(temp[r] - temp[c]) <= config_.merge_temperature &&
-                      std::abs(f[kXi][r] - f[kXi][c]) <= config_.merge_xi &&
-                      std::abs(f[kHeatScale][r] - f[kHeatScale][c]) <= config_.merge_xi &&
-                      std::abs(f[kCoolScale][r] - f[kCoolScale][c]) <= config_.merge_xi;
+    const bool same =
+        on[r] == on[c] && std::abs(temp[r] - temp[c]) <= config_.merge_temperature &&
+        std::abs(f[kXi][r] - f[kXi][c]) <= config_.merge_xi &&
+        std::abs(f[kHeatScale][r] - f[kHeatScale][c]) <= config_.merge_xi &&
+        std::abs(f[kCoolScale][r] - f[kCoolScale][c]) <= config_.merge_xi &&
+        (!failures_ ||
+         (Mode(s)[r] == Mode(s)[c] &&
+          std::abs(ForceScale(Damage(s)[r]) - ForceScale(Damage(s)[c])) <= config_.merge_xi));
     if (!same) {
       rep = c;
       continue;
@@ -227,6 +397,7 @@ void SmaBundle::Merge(double* s) const {
     for (int i : {kTemp, kXi, kTeff, kHeatScale, kCoolScale}) {
       f[i][r] = (f[i][r] * count[r] + f[i][c] * count[c]) / n;
     }
+    if (fatigue_) Damage(s)[r] = (Damage(s)[r] * count[r] + Damage(s)[c] * count[c]) / n;
     count[r] = n;
     count[c] = 0;
     forward[c] = rep;
@@ -258,7 +429,38 @@ void SmaBundle::Compact(double* s, const int* forward, int* remap) const {
 }
 
 double SmaBundle::Tension(const double* s, double stretch) const {
-  return unit_.SumTension(Field(s, kCount), Field(s, kXi), NumCohorts(s), stretch);
+  const double* w = fatigue_ ? TensionWeights(s) : Field(s, kCount);
+  return unit_.SumTension(w, Field(s, kXi), NumCohorts(s), stretch);
+}
+
+const double* SmaBundle::TensionWeights(const double* s) const {
+  static thread_local std::vector<double> w;
+  const int k = NumCohorts(s);
+  w.resize(k);
+  for (int j = 0; j < k; ++j) w[j] = Field(s, kCount)[j] * ForceScale(Damage(s)[j]);
+  return w.data();
+}
+
+SmaBundle::FailureCounts SmaBundle::Failures(const double* s) const {
+  FailureCounts c;
+  if (!failures_) {
+    c.working = config_.units;
+    return c;
+  }
+  for (int j = 0; j < NumCohorts(s); ++j) {
+    const int n = static_cast<int>(Field(s, kCount)[j]);
+    const double mode = Mode(s)[j];
+    (mode == kModeOpen ? c.open : mode == kModeStuck ? c.stuck : c.working) += n;
+  }
+  return c;
+}
+
+int SmaBundle::UnitFailure(const double* s, int i) const {
+  return failures_ ? static_cast<int>(Mode(s)[UnitCohort(s, i)]) : kModeWorking;
+}
+
+double SmaBundle::UnitForceScale(const double* s, int i) const {
+  return fatigue_ ? ForceScale(Damage(s)[UnitCohort(s, i)]) : 1.0;
 }
 
 double SmaBundle::CountWeightedSum(const double* s, int f) const {
@@ -274,6 +476,7 @@ SmaBundle::Summary SmaBundle::Summarize(const double* s, double stretch) const {
   const double* v[3] = {Field(s, kOn), Field(s, kTemp), Field(s, kXi)};
   double sum[4];
   unit_.Observe(Field(s, kCount), v, k, stretch, false, sum);
+  if (fatigue_) sum[3] = unit_.SumTension(TensionWeights(s), Field(s, kXi), k, stretch);
   return FromSums(sum, k);
 }
 
@@ -291,6 +494,8 @@ SmaBundle::Telemetry SmaBundle::Observe(const double* s, double stretch) const {
   const double* v[3] = {Field(s, kOn), Field(s, kTemp), Field(s, kXi)};
   double sum[5];
   unit_.Observe(Field(s, kCount), v, k, stretch, true, sum);
+  // With fatigue the peak stays that of a fresh wire at the cohort's xi (an upper bound).
+  if (fatigue_) sum[3] = unit_.SumTension(TensionWeights(s), Field(s, kXi), k, stretch);
   Telemetry r;
   static_cast<Summary&>(r) = FromSums(sum, k);
   r.max_temperature = MaxTemperature(s);

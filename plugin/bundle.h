@@ -21,9 +21,14 @@ class SmaBundle {
   // dt: the step it will usually advance by (its exp(-dt/tau) is precomputed).
   static Result<SmaBundle> Create(const BundleConfig& config, double dt);
 
-  // Doubles of state needed for `units` units.
+  // Doubles of state needed for `units` units without failures; with a failure block
+  // (config().failure.given), FailureBlockSize(units) more after them.
   static int StateSize(int units) { return kHeader + (kFields + 1) * units; }
-  int state_size() const { return StateSize(config_.units); }
+  static int FailureBlockSize(int units) { return kFailHeader + 2 * units; }
+  int state_size() const {
+    return StateSize(config_.units) + (failures_ ? FailureBlockSize(config_.units) : 0);
+  }
+  bool has_failures() const { return failures_; }
 
   const BundleConfig& config() const { return config_; }
   const UnitModel& unit() const { return unit_; }
@@ -52,6 +57,17 @@ class SmaBundle {
   double ActDot(const double* s) const { return 0; }
 
   int OnCount(const double* s) const;
+  // Units by failure state (all working without a failure block). Stuck units are heated and
+  // count as on in OnCount; open ones never heat.
+  struct FailureCounts {
+    int working = 0, open = 0, stuck = 0;
+  };
+  FailureCounts Failures(const double* s) const;
+  // Unit i's failure state: 0 working, 1 open, 2 stuck; its fatigue force scale (1 = fresh).
+  int UnitFailure(const double* s, int i) const;
+  double UnitForceScale(const double* s, int i) const;
+  // The fatigue law (FailureConfig): force scale after damage D (reference cycles).
+  double ForceScale(double damage) const;
   // OnCount, Tension, MeanTemperature and MeanXi (the plugin's sensor) in one pass, with the
   // same values.
   struct Summary {
@@ -115,7 +131,27 @@ class SmaBundle {
   static constexpr int kCount = 0, kOn = 1, kTemp = 2, kXi = 3, kTeff = 4, kHeatScale = 5,
                        kCoolScale = 6;
   static constexpr int kMergeEvery = 8;  // steps between merge passes
-
+  // The failure block (after the unit index): the failure stream's 8 halves, time since reset
+  // (s), the next scheduled event, 6 reserved; then per cohort the failure mode (0 working,
+  // 1 open, 2 stuck) and the fatigue damage D.
+  static constexpr int kFailHeader = 16;
+  static constexpr int kFailRngSlot = 0, kFailTimeSlot = 8, kFailNextSlot = 9;
+  static constexpr int kModeWorking = 0, kModeOpen = 1, kModeStuck = 2;
+  double* Fail(double* s) const { return s + StateSize(config_.units); }
+  const double* Fail(const double* s) const { return s + StateSize(config_.units); }
+  double* Mode(double* s) const { return Fail(s) + kFailHeader; }
+  const double* Mode(const double* s) const { return Fail(s) + kFailHeader; }
+  double* Damage(double* s) const { return Mode(s) + config_.units; }
+  const double* Damage(const double* s) const { return Mode(s) + config_.units; }
+  // Moves `units` (working units) to failure `mode`: a cohort whose units all fail changes in
+  // place, else its failing units get a new cohort (so cohorts never exceed N).
+  void FailUnits(double* s, const std::vector<int>& units, int mode) const;
+  // Hazards per hour heated and the schedule, for a step of dt that has just been integrated.
+  void StepFailures(double* s, double stretch, double dt) const;
+  // Per-cycle hazards of the units that a broadcast switched on (flip[i] and now on).
+  void CycleFailures(double* s, const std::vector<char>& flip, double stretch) const;
+  // count * force scale per cohort (fatigue), in a scratch array; null without fatigue.
+  const double* TensionWeights(const double* s) const;
   SmaBundle(BundleConfig c, UnitModel u, double dt);
   double* Field(double* s, int f) const { return s + kHeader + f * config_.units; }
   const double* Field(const double* s, int f) const { return s + kHeader + f * config_.units; }
@@ -140,6 +176,7 @@ class SmaBundle {
   UnitModel unit_;
   UnitLimits limits_;
   double dt_ = 0, decay_ = 1, period_ = 0, decay_period_ = 1;
+  bool failures_ = false, fatigue_ = false;
 };
 
 }  // namespace recruit::sma

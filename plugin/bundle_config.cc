@@ -1,5 +1,6 @@
 #include "plugin/bundle_config.h"
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -62,6 +63,21 @@ const std::vector<Key>& NumericKeys() {
        [](BundleConfig& c, double v) { c.merge_temperature = v; }},
       {"merge_xi", 0, 0.1, false, "", [](BundleConfig& c, double v) { c.merge_xi = v; }},
       {"update_period", 0, 1, false, "s", [](BundleConfig& c, double v) { c.update_period = v; }},
+#define FAILURE_FIELD(f)          \
+  [](BundleConfig& c, double v) { \
+    c.failure.f = v;              \
+    c.failure.given = true;       \
+  }
+      {"open_rate", 0, 3600, false, "per hour heated", FAILURE_FIELD(open_rate)},
+      {"stuck_rate", 0, 3600, false, "per hour heated", FAILURE_FIELD(stuck_rate)},
+      {"open_per_cycle", 0, 1, false, "per cycle", FAILURE_FIELD(open_per_cycle)},
+      {"stuck_per_cycle", 0, 1, false, "per cycle", FAILURE_FIELD(stuck_per_cycle)},
+      // A unit keeps at least 10 % of its force: beyond that it is a failure, not fatigue.
+      {"fatigue_loss", 0, 0.9, false, "", FAILURE_FIELD(fatigue_loss)},
+      {"fatigue_cycles", 0, 1e9, true, "cycles", FAILURE_FIELD(fatigue_cycles)},
+      {"fatigue_stress", 0, 2e9, true, "Pa", FAILURE_FIELD(fatigue_stress)},
+      {"fatigue_exponent", 0, 10, false, "", FAILURE_FIELD(fatigue_exponent)},
+#undef FAILURE_FIELD
   };
   return keys;
 }
@@ -158,12 +174,65 @@ Status CheckDomain(const BundleConfig& c, const std::map<std::string, std::strin
   return Status::Ok();
 }
 
+// Failure settings that cannot happen together: exclusive outcomes of one cycle whose
+// probabilities add past 1, more scheduled failures than units.
+Status CheckFailures(const BundleConfig& c, const std::map<std::string, std::string>& given,
+                     const std::string& where) {
+  const FailureConfig& f = c.failure;
+  if (f.open_per_cycle + f.stuck_per_cycle > 1) {
+    return Error{where + Given(given, {"open_per_cycle", "stuck_per_cycle"}) +
+                 ": a cycle's failure probabilities add to " +
+                 GText(f.open_per_cycle + f.stuck_per_cycle) +
+                 ", more than 1 (one cycle fails a unit open or stuck, not both)"};
+  }
+  long scheduled = 0;
+  for (const auto& e : f.schedule) scheduled += e.count;
+  if (scheduled > c.units) {
+    return Error{where + Given(given, {"failures", "units"}) + ": the schedule fails " +
+                 std::to_string(scheduled) + " units of a bundle of " + std::to_string(c.units) +
+                 " (at most units)"};
+  }
+  return Status::Ok();
+}
+
 }  // namespace
 
 std::vector<std::string> BundleConfig::Keys() {
   std::vector<std::string> k = {"law"};
   for (const Key& key : NumericKeys()) k.push_back(key.name);
+  k.push_back("failures");
   return k;
+}
+
+Result<std::vector<FailureConfig::Event>> FailureConfig::ParseSchedule(const std::string& text) {
+  std::vector<Event> events;
+  std::stringstream in(text);
+  std::string item;
+  const std::string allowed =
+      ": must be time:count:mode[,...] with time in [0, 1e9] s, count a whole number >= 1 and "
+      "mode open or stuck, e.g. 30:6:open,60:2:stuck";
+  while (std::getline(in, item, ',')) {
+    const auto a = item.find(':'), b = item.rfind(':');
+    if (a == std::string::npos || a == b) return Error{"'" + ShortText(item) + "'" + allowed};
+    const std::string t = item.substr(0, a), n = item.substr(a + 1, b - a - 1),
+                      mode = item.substr(b + 1);
+    char* end = nullptr;
+    errno = 0;
+    const double time = std::strtod(t.c_str(), &end);
+    const bool time_ok = end != t.c_str() && *end == '\0' && errno == 0 && time >= 0 && time <= 1e9;
+    end = nullptr;
+    const double count = std::strtod(n.c_str(), &end);
+    const bool count_ok = end != n.c_str() && *end == '\0' && count >= 1 && count <= 1e6 &&
+                          count == std::floor(count);
+    if (!time_ok || !count_ok || (mode != "open" && mode != "stuck")) {
+      return Error{"'" + ShortText(item) + "'" + allowed};
+    }
+    events.push_back({time, static_cast<int>(count), mode == "stuck"});
+  }
+  if (events.empty()) return Error{"no event" + allowed};
+  std::stable_sort(events.begin(), events.end(),
+                   [](const Event& x, const Event& y) { return x.time < y.time; });
+  return events;
 }
 
 Result<BundleConfig> BundleConfig::FromText(const std::string& actuator, const std::string& text) {
@@ -207,6 +276,14 @@ Result<BundleConfig> BundleConfig::FromPairs(
       }
       continue;
     }
+    if (key == "failures") {
+      auto events = FailureConfig::ParseSchedule(value);
+      if (!events.ok())
+        return Error{where + "failures=" + ShortText(value) + " is invalid: " + events.error()};
+      c.failure.schedule = std::move(events).value();
+      c.failure.given = true;
+      continue;
+    }
     const Key* spec = nullptr;
     for (const Key& k : NumericKeys()) {
       if (key == k.name) spec = &k;
@@ -246,6 +323,7 @@ Result<BundleConfig> BundleConfig::FromPairs(
     }
     c.unit.prestretch = prestrain * c.unit.wire_length * c.unit.series;  // whole unit
   }
+  if (Status f = CheckFailures(c, given, where); !f.ok()) return Error{f.error()};
   auto check = UnitModel::Create(c.unit);
   if (!check.ok()) return Error{where + check.error(), check.code()};
   Status domain = CheckDomain(c, given, where);

@@ -12,6 +12,39 @@
 
 namespace recruit::sma {
 
+// Unit failures and functional fatigue (plugin/README.md "Failures"; docs/failures.md). Off
+// unless a failure key is given: then the bundle's block has a failure block and its sensor
+// reports the working, open and stuck counts.
+struct FailureConfig {
+  bool given = false;  // a failure key was given (even 0): the failure block exists
+  // Hazards per hour heated (a unit whose heater is on, stuck units excepted) and per
+  // transformation cycle (a working unit switched on), into "open" (never heats again) and
+  // "stuck" (heated for good).
+  double open_rate = 0, stuck_rate = 0;            // 1/h heated
+  double open_per_cycle = 0, stuck_per_cycle = 0;  // probability per cycle
+  // Scheduled failures: at `time` (s since reset), `count` working units (chosen uniformly by
+  // the failure stream) fail open or stuck.
+  struct Event {
+    double time = 0;
+    int count = 0;
+    bool stuck = false;
+  };
+  std::vector<Event> schedule;  // in time order
+  // Functional fatigue: a unit's force and recoverable strain scale by
+  // s(D) = 1 - fatigue_loss (1 - exp(-D / fatigue_cycles)), D the damage in reference cycles:
+  // each heating cycle adds (1 - xi at switch-off) (stress / fatigue_stress)^fatigue_exponent.
+  double fatigue_loss = 0;        // asymptotic fraction lost; 0 = no fatigue
+  double fatigue_cycles = 100;    // shakedown constant N_p (reference cycles)
+  double fatigue_stress = 172e6;  // reference wire stress (Pa)
+  double fatigue_exponent = 1.5;  // stress exponent m
+
+  bool any_hazard() const {
+    return open_rate > 0 || stuck_rate > 0 || open_per_cycle > 0 || stuck_per_cycle > 0;
+  }
+  // Parses "t:count:open|stuck[,t:count:mode...]" (times in s, in any order; sorted).
+  static Result<std::vector<Event>> ParseSchedule(const std::string& text);
+};
+
 struct BundleConfig {
   std::string actuator;  // actuator name in the model
   int units = 60;        // N, units in the bundle
@@ -31,6 +64,7 @@ struct BundleConfig {
   // every step; 0 = every step. For long sweeps: the thermal time constant is about 1 s, so a
   // few ms keeps the force within a fraction of a percent at a fraction of the cost.
   double update_period = 0;
+  FailureConfig failure;
 
   // Parses key/value pairs; an empty value keeps the default (MuJoCo gives "" for a declared key
   // that MJCF did not set). Errors start with `where` and name the key and value.

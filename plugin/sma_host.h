@@ -64,6 +64,10 @@ class SmaHost {
 
   // Ground truth and telemetry.
   int OnCount(const mjData* d, int b) const { return bundle(b).OnCount(State(d, b)); }
+  // Working, open and stuck units of bundle b (all working without failure keys).
+  SmaBundle::FailureCounts Failures(const mjData* d, int b) const {
+    return bundle(b).Failures(State(d, b));
+  }
   double Force(const mjData* d, int b) const;  // bundle tension (N) at the current tendon length
   // OnCount, Force, MeanTemperature, MeanXi, and the peak-relevant MaxTemperature and
   // MaxWireStress (SmaBundle) of bundle b in one pass, each bit for bit the same value: for run

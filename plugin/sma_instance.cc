@@ -308,6 +308,11 @@ int SmaInstance::StateSize(const mjModel* m, int instance) {
   return p.ok() ? (*p)->state_size_ : 0;
 }
 
+int SmaInstance::SensorValues(const mjModel* m, int instance) {
+  auto p = Build(m, instance, false);
+  return p.ok() ? (*p)->sensor_values() : kSensorValues;
+}
+
 void SmaInstance::Reset(const mjModel* m, double* block) const {
   for (const SmaActuator& a : actuators_) {
     double* slots = block + a.offset;
@@ -364,10 +369,17 @@ void SmaInstance::Sensor(const mjModel* m, mjData* d) const {
       const double stretch = Stretch(k, Length(m, d, act.actuator));
       // Keeps the tension for the actuator's force, computed later in the same mj_forward.
       const SmaBundle::Summary sum = act.model.SummarizeAndKeep(s, stretch);
-      out[kSensorValues * k + 0] = sum.on_count;
-      out[kSensorValues * k + 1] = sum.tension;
-      out[kSensorValues * k + 2] = sum.mean_temperature;
-      out[kSensorValues * k + 3] = sum.mean_xi;
+      const int stride = sensor_values();
+      out[stride * k + 0] = sum.on_count;
+      out[stride * k + 1] = sum.tension;
+      out[stride * k + 2] = sum.mean_temperature;
+      out[stride * k + 3] = sum.mean_xi;
+      if (stride == kFailureSensorValues) {
+        const SmaBundle::FailureCounts f = act.model.Failures(s);
+        out[stride * k + 4] = f.working;
+        out[stride * k + 5] = f.open;
+        out[stride * k + 6] = f.stuck;
+      }
     }
   }
 }

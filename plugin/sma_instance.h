@@ -29,6 +29,8 @@ inline constexpr const char* kBroadcastPeriodKey = "broadcast_period";
 
 // Values a recruit.sma sensor reports per bundle, in this order.
 inline constexpr int kSensorValues = 4;  // on count, tension (N), mean T (C), mean xi
+// With failure keys in the config: kSensorValues, then working, open and stuck counts.
+inline constexpr int kFailureSensorValues = 7;
 
 struct SmaActuator {
   int actuator = -1;  // actuator id
@@ -83,6 +85,12 @@ class SmaInstance {
   // Called by the compiler before the actuators' transmissions are filled in: reads only the
   // config and which actuators use the instance.
   static int StateSize(const mjModel* m, int instance);
+  // Values a sensor on the instance reports per bundle (kSensorValues, or kFailureSensorValues
+  // when its config gives a failure key); kSensorValues for an invalid config.
+  static int SensorValues(const mjModel* m, int instance);
+  int sensor_values() const {
+    return actuators_.front().model.has_failures() ? kFailureSensorValues : kSensorValues;
+  }
 
   int instance() const { return instance_; }
   const std::vector<SmaActuator>& actuators() const { return actuators_; }
@@ -105,7 +113,7 @@ class SmaInstance {
   // which takes it (SmaBundle::SummarizeAndKeep, TakeTension).
   void Compute(const mjModel* m, mjData* d) const;  // actuator_force = -tension
   void Advance(const mjModel* m, mjData* d) const;  // ctrl broadcasts, then one timestep
-  void Sensor(const mjModel* m, mjData* d) const;   // kSensorValues per actuator
+  void Sensor(const mjModel* m, mjData* d) const;   // sensor_values() per actuator
 
   // Unit extension (m) of actuator k at actuator length `length` (gear x tendon length).
   double Stretch(int k, double length) const {

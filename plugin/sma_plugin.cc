@@ -28,7 +28,7 @@ int NState(const mjModel* m, int instance) { return SmaInstance::StateSize(m, in
 int NSensorData(const mjModel* m, int instance, int sensor_id) {
   int n = 0;
   for (int a = 0; a < m->nactuator; ++a) n += m->actuator_plugin[a] == instance ? 1 : 0;
-  return kSensorValues * (n > 0 ? n : 1);
+  return SmaInstance::SensorValues(m, instance) * (n > 0 ? n : 1);
 }
 
 int Init(const mjModel* m, mjData* d, int instance) {

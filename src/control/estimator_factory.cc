@@ -9,6 +9,7 @@
 
 #include "common/atomic_file.h"
 #include "common/data_path.h"
+#include "control/failure_estimator.h"
 #include "control/kalman_estimator.h"
 #include "control/model_plant.h"
 #include "control/on_count_estimator.h"
@@ -60,7 +61,9 @@ const char* EstimatorKindName(EstimatorKind kind) {
 Result<EstimatorSpec> EstimatorSpec::Parse(const std::string& kind, const std::string& covariance,
                                            const std::string& model_file, int num_states,
                                            double force_noise_std) {
-  auto k = ParseEstimatorKind(kind);
+  // "kalman-failures": the augmented kind with failed states (EstimatorSpec::failures).
+  const bool failures = kind == "kalman-failures";
+  auto k = ParseEstimatorKind(failures ? "kalman-augmented" : kind);
   if (!k) return Error{k.error(), k.code()};
   auto c = ParseCovarianceMode(covariance);
   if (!c) {
@@ -82,6 +85,7 @@ Result<EstimatorSpec> EstimatorSpec::Parse(const std::string& kind, const std::s
   s.model_file = model_file;
   s.num_states = num_states;
   s.force_noise_std = force_noise_std;
+  s.failures = failures;
   return s;
 }
 
@@ -273,6 +277,12 @@ Result<std::unique_ptr<OnCountEstimator>> MakeEstimator(const EstimatorSpec& spe
     return Error{"estimator: sensor_variance must be finite and >= 0 N^2"};
   }
   model.R(0, 0) += spec.sensor_variance;
+  if (spec.failures) {
+    auto est = FailureOnCountEstimator::Create(model, mode, spec.failure, std::move(output),
+                                               relative_noise);
+    if (!est) return Error{"estimator: " + est.error()};
+    return std::unique_ptr<OnCountEstimator>(std::move(est).value());
+  }
   auto est = KalmanOnCountEstimator::Create(model, mode, std::move(output), relative_noise);
   if (!est) return Error{"estimator: " + est.error(), est.code()};
   return std::unique_ptr<OnCountEstimator>(std::move(est).value());

@@ -12,21 +12,34 @@
 //   "kalman-augmented"  population Kalman filter on the identified transient model
 //                       (models/identified/, `recruit identify`); "on" = the states whose heater
 //                       is on (heating chain and hot settled state)
+//   "kalman-failures"   kalman-augmented with absorbing open/stuck states and declared failures
+//                       (estimation/failure_filter.h): also estimates the working units
 #pragma once
 
 #include <Eigen/Core>
 #include <limits>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "common/result.h"
 #include "control/broadcast.h"
 #include "control/unit_force_map.h"
+#include "estimation/failure_filter.h"
 #include "estimation/population_kalman_filter.h"
 
 namespace recruit::control {
+
+// What a failure-aware estimator knows of a bundle's failed units (docs/failures.md).
+struct FailureEstimate {
+  double working = 0, open = 0, stuck = 0;  // units (estimates; they add to N)
+  double working_variance = 0;              // units^2
+  int declarations = 0;                     // failures declared since Reset
+  bool declared = false;                    // the last Observe declared one
+  double force_scale = 1;                   // working units' fatigue force scale
+};
 
 class OnCountEstimator {
  public:
@@ -51,6 +64,8 @@ class OnCountEstimator {
   virtual std::vector<std::string> StateNames() const = 0;
   // Which model states count as "on" (heater on); same length as StateNames().
   virtual std::vector<bool> OnStates() const = 0;
+  // The failed units' estimate; none from estimators that assume every unit works.
+  virtual std::optional<FailureEstimate> Failures() const { return std::nullopt; }
 };
 
 // The estimator kinds, named "output", "kalman2", "kalman-augmented" in task files, sweeps and
@@ -74,6 +89,10 @@ struct EstimatorSpec {
   // Variance of the load cell's reading (noise and quantisation), N^2, added to the model's R
   // (which is what the unit population and the model's error add, from identification).
   double sensor_variance = 0;
+  // kalman-augmented with absorbing failed states (FailureKalmanFilter): the kind name
+  // "kalman-failures" sets it; `failure` holds the filter's detection settings.
+  bool failures = false;
+  FailureFilterParams failure;
   // kalman-augmented: the plant the model will run on (control/plant_record.h, PlantRecord);
   // null = unchecked. A model file recording another plant is refused (CheckModelPlant).
   nlohmann::json plant;

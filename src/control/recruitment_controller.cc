@@ -1,5 +1,6 @@
 #include "control/recruitment_controller.h"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -51,6 +52,8 @@ void RecruitmentController::Reset() {
   unit_force_ = params_.unit_force;
   estimated_on_ = estimator_->EstimatedOn();
   estimated_on_variance_ = estimator_->EstimatedOnVariance();
+  estimated_working_ = params_.num_units;
+  saturation_ = 0;
   last_ = Broadcast{};
 }
 
@@ -68,9 +71,24 @@ Broadcast RecruitmentController::Step(double reference_force, double measured_fo
                                : (reference_force > 0 ? params_.num_units : 0.0);
   estimated_on_ = estimator_->EstimatedOn();
   estimated_on_variance_ = estimator_->EstimatedOnVariance();
-  last_ = ExpectationLaw(target_on_, estimated_on_, params_.num_units, params_.lambda);
+  if (const auto f = estimator_->Failures()) {
+    last_ = FailureAwareLaw(*f);
+  } else {
+    last_ = ExpectationLaw(target_on_, estimated_on_, params_.num_units, params_.lambda);
+  }
   estimator_->Broadcasted(last_);
   return last_;
+}
+
+Broadcast RecruitmentController::FailureAwareLaw(const FailureEstimate& f) {
+  const double n = params_.num_units;
+  const double stuck = std::clamp(f.stuck, 0.0, n);
+  const double working = std::clamp(f.working, 0.0, n - stuck);
+  estimated_working_ = working;
+  // The working units must make up what the stuck ones do not.
+  const double target = target_on_ - stuck;
+  saturation_ = target > working ? 1 : (target < 0 ? -1 : 0);
+  return ExpectationLaw(target, estimated_on_ - stuck, working, params_.lambda);
 }
 
 }  // namespace recruit::control

@@ -54,6 +54,13 @@ class RecruitmentController {
   // Settled force of one on unit at `tendon_length` (N): what Step would target with.
   double OnUnitForce(double tendon_length) const;
   double estimated_on() const { return estimated_on_; }
+  // With a failure-aware estimator (OnCountEstimator::Failures): the law acts on the estimated
+  // working units only (stuck ones are on for good and count towards the target, open ones never
+  // switch). saturation() at the last Step: +1 when the reference needs more than every working
+  // unit (the target is clamped to them: the law asks for all and winds nothing up), -1 when the
+  // stuck units alone exceed it, 0 otherwise (and always 0 without failures).
+  int saturation() const { return saturation_; }
+  double estimated_working() const { return estimated_working_; }
   double estimated_on_variance() const { return estimated_on_variance_; }
   const Broadcast& last_broadcast() const { return last_; }
 
@@ -62,6 +69,9 @@ class RecruitmentController {
                         std::optional<UnitForceMap> on_force)
       : params_(params), estimator_(std::move(est)), on_force_(std::move(on_force)) {}
 
+  // The expectation law on the working units (a failure-aware estimator).
+  Broadcast FailureAwareLaw(const FailureEstimate& f);
+
   ControllerParams params_;
   std::unique_ptr<OnCountEstimator> estimator_;
   std::optional<UnitForceMap> on_force_;  // one state: the settled on unit
@@ -69,6 +79,8 @@ class RecruitmentController {
   double target_on_ = 0;
   double estimated_on_ = 0;
   double estimated_on_variance_ = 0;
+  double estimated_working_ = 0;
+  int saturation_ = 0;
   Broadcast last_;
 };
 

@@ -1,0 +1,162 @@
+// The failure figures of docs/failures.md, over seeds the tests do not use (they use 1-3):
+//   build/bench/failures/failure_measure [first_seed=100] [seeds=40]
+// On the isometric bench (60 units, dT 0.5 s, lambda 0.2), "kalman-failures" estimator:
+//   detect   10 % of the units fail open at 60 s (15 N held): control instants until the working
+//            estimate is within 2 units of the truth; mean on-count NEES per run
+//   quiet    no failure, 500 s of changing references: declared failures (false alarms) per
+//            control instant; mean NEES per run
+//   track    10 % and 30 % open, or 10 % stuck, at 60 s: mean |error| 20-40 s after the loss
+//            against the same seed without failures
+//   reach    30 % open at 60 s and a reference out of reach (22 N) from 70 s to 130 s, back to
+//            15 N after: saturated instants, and |error| 20-40 s after the reference returns
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#include "tests/control/failure_loop.h"
+
+namespace fl = recruit::control::failure_loop;
+using recruit::control::EstimatorSpec;
+
+namespace {
+
+// The estimator's detection settings can be varied: FAILURE_JUMP_STD, FAILURE_JUMP_HAZARD,
+// FAILURE_CUSUM_H, FAILURE_CUSUM_K, FAILURE_SETTLE_HAZARD, FAILURE_OPEN_HAZARD (defaults:
+// FailureFilterParams).
+EstimatorSpec Failures() {
+  EstimatorSpec s = *EstimatorSpec::Parse("kalman-failures");
+  auto env = [](const char* name, double& v) {
+    if (const char* e = std::getenv(name)) v = std::atof(e);
+  };
+  env("FAILURE_JUMP_STD", s.failure.jump_fraction_std);
+  env("FAILURE_JUMP_HAZARD", s.failure.jump_hazard);
+  env("FAILURE_CUSUM_H", s.failure.cusum_threshold);
+  env("FAILURE_CUSUM_K", s.failure.cusum_drift);
+  env("FAILURE_SETTLE_HAZARD", s.failure.settle_hazard);
+  env("FAILURE_OPEN_HAZARD", s.failure.open_hazard);
+  return s;
+}
+
+std::vector<fl::Instant> MustRun(fl::Spec s) {
+  auto r = fl::Run(s);
+  if (!r) {
+    std::fprintf(stderr, "%s\n", r.error().c_str());
+    std::exit(1);
+  }
+  return *r;
+}
+
+double Quantile(std::vector<double> v, double q) {
+  if (v.empty()) return NAN;
+  std::sort(v.begin(), v.end());
+  return v[static_cast<size_t>(q * (v.size() - 1) + 0.5)];
+}
+
+void Report(const char* what, const std::vector<double>& v) {
+  std::printf("  %-44s median %7.3f  p10 %7.3f  p90 %7.3f  min %7.3f  max %7.3f  (n %zu)\n", what,
+              Quantile(v, 0.5), Quantile(v, 0.1), Quantile(v, 0.9), Quantile(v, 0), Quantile(v, 1),
+              v.size());
+}
+
+double Steps(double t) {  // 10, 20, 5, 15 N, every 25 s
+  static const double level[] = {10, 20, 5, 15};
+  return level[static_cast<int>(t / 25) % 4];
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const int first = argc > 1 ? std::atoi(argv[1]) : 100;
+  const int seeds = argc > 2 ? std::atoi(argv[2]) : 40;
+  std::printf("seeds %d..%d, isometric bench, dT 0.5 s, lambda 0.2, kalman-failures\n", first,
+              first + seeds - 1);
+
+  // detect
+  std::vector<double> found, nees_loss, quiet_nees, quiet_working;
+  int within10 = 0, never = 0;
+  long quiet_instants = 0, false_alarms = 0;
+  for (int s = first; s < first + seeds; ++s) {
+    fl::Spec spec{
+        "failures=60:6:open",       Failures(), 0.5, 0.2, static_cast<std::uint64_t>(s), 100,
+        [](double) { return 15.0; }};
+    const auto run = MustRun(spec);
+    const int k = fl::InstantsToFind(run, 60);
+    found.push_back(k);
+    within10 += k >= 0 && k <= 10;
+    never += k < 0;
+    nees_loss.push_back(fl::MeanNees(run));
+    false_alarms += fl::DeclarationsBefore(run, 60);
+    quiet_instants += 120;
+    fl::Spec quiet{"", Failures(), 0.5, 0.2, static_cast<std::uint64_t>(s), 500, Steps};
+    const auto q = MustRun(quiet);
+    false_alarms += fl::DeclarationsBefore(q, 1e9);
+    double worst = 0;
+    for (const auto& r : q) worst = std::max(worst, std::abs(r.est_working - r.working));
+    quiet_working.push_back(worst);
+    quiet_instants += static_cast<long>(q.size());
+    quiet_nees.push_back(fl::MeanNees(q));
+  }
+  std::printf("detect: 6 of 60 units open at 60 s, 15 N\n");
+  Report("instants to |working est - true| <= 2", found);
+  std::printf("  within 10 instants: %d of %d runs (never: %d)\n", within10, seeds, never);
+  Report("mean on-count NEES per run", nees_loss);
+  std::printf("quiet: no failure (500 s of 10/20/5/15 N steps, and the first 60 s above)\n");
+  std::printf("  declared failures: %ld in %ld control instants (%.2g per instant)\n", false_alarms,
+              quiet_instants, double(false_alarms) / quiet_instants);
+  Report("mean on-count NEES per run", quiet_nees);
+  Report("largest |working est - 60| per run", quiet_working);
+
+  // track
+  struct Case {
+    const char* name;
+    const char* config;
+  };
+  for (const Case& c :
+       {Case{"10 % open", "failures=60:6:open"}, Case{"30 % open", "failures=60:18:open"},
+        Case{"10 % stuck", "failures=60:6:stuck"}}) {
+    std::vector<double> after, base, ratio, aug_after, nees;
+    for (int s = first; s < first + seeds; ++s) {
+      auto ref = [](double) { return 15.0; };
+      const auto f =
+          MustRun({c.config, Failures(), 0.5, 0.2, static_cast<std::uint64_t>(s), 100, ref});
+      const auto n = MustRun({"", Failures(), 0.5, 0.2, static_cast<std::uint64_t>(s), 100, ref});
+      const auto a = MustRun({c.config, *EstimatorSpec::Parse("kalman-augmented"), 0.5, 0.2,
+                              static_cast<std::uint64_t>(s), 100, ref});
+      after.push_back(fl::MeanError(f, 80, 100));
+      base.push_back(fl::MeanError(n, 80, 100));
+      aug_after.push_back(fl::MeanError(a, 80, 100));
+      nees.push_back(fl::MeanNees(f));
+    }
+    std::printf("track: %s at 60 s, 15 N (mean |error| over 80-100 s, N)\n", c.name);
+    Report("kalman-failures, with the loss", after);
+    Report("kalman-failures, same seeds, no loss", base);
+    Report("kalman-augmented (unaware), with the loss", aug_after);
+    Report("mean on-count NEES per run (kalman-failures)", nees);
+  }
+
+  // reach
+  std::vector<double> saturated, recovered, base_rec, nees_reach;
+  for (int s = first; s < first + seeds; ++s) {
+    auto ref = [](double t) { return t >= 70 && t < 130 ? 22.0 : 15.0; };
+    const auto f = MustRun(
+        {"failures=60:18:open", Failures(), 0.5, 0.2, static_cast<std::uint64_t>(s), 180, ref});
+    const auto n = MustRun({"", Failures(), 0.5, 0.2, static_cast<std::uint64_t>(s), 180,
+                            [](double) { return 15.0; }});
+    int sat = 0, total = 0;
+    for (const auto& r : f) {
+      if (r.t >= 80 && r.t < 130) sat += r.saturation == 1, ++total;
+    }
+    saturated.push_back(double(sat) / total);
+    recovered.push_back(fl::MeanError(f, 150, 170));
+    base_rec.push_back(fl::MeanError(n, 150, 170));
+    nees_reach.push_back(fl::MeanNees(f));
+  }
+  std::printf("reach: 30 %% open at 60 s; 22 N (beyond 42 units) 70-130 s, then 15 N\n");
+  Report("fraction of 80-130 s flagged saturated", saturated);
+  Report("mean |error| 150-170 s, N", recovered);
+  Report("same seeds, no loss, 15 N throughout", base_rec);
+  Report("mean on-count NEES per run", nees_reach);
+  return 0;
+}

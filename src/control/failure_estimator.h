@@ -1,0 +1,51 @@
+// The failure-aware Kalman on-count estimator ("kalman-failures"): KalmanOnCountEstimator's
+// observation model (length-aware H, R growing with the force) on the filter with absorbing
+// open/stuck states (estimation/failure_filter.h). The on count is the heated units: working
+// units in heater-on states plus the stuck ones. Until a failure is declared its estimates are
+// those of "kalman-augmented", bit for bit.
+#pragma once
+
+#include <memory>
+#include <optional>
+
+#include "control/on_count_estimator.h"
+#include "estimation/failure_filter.h"
+#include "estimation/filter_model.h"
+
+namespace recruit::control {
+
+class FailureOnCountEstimator final : public OnCountEstimator {
+ public:
+  static Result<std::unique_ptr<FailureOnCountEstimator>> Create(
+      const FilterModel& model, CovarianceMode mode, const FailureFilterParams& params,
+      std::optional<UnitForceMap> output = std::nullopt, double relative_noise = 0);
+
+  void Reset() override { filter_.Reset(); }
+  using OnCountEstimator::Observe;
+  void Observe(double measured_force, double tendon_length) override;
+  void Broadcasted(const Broadcast& b) override { filter_.PredictBroadcast(b.p_on, b.p_off); }
+  double EstimatedOn() const override;
+  double EstimatedOnVariance() const override;
+  // [model states; open: model states; stuck: model states].
+  Eigen::VectorXd StateEstimate() const override { return filter_.estimate(); }
+  std::vector<std::string> StateNames() const override;
+  std::vector<bool> OnStates() const override;
+  std::optional<FailureEstimate> Failures() const override;
+
+  const FilterModel& model() const { return model_; }
+  const FailureKalmanFilter& filter() const { return filter_; }
+
+ private:
+  FailureOnCountEstimator(FilterModel model, FailureKalmanFilter filter,
+                          std::optional<UnitForceMap> output, double relative_noise);
+
+  FilterModel model_;
+  FailureKalmanFilter filter_;
+  Eigen::VectorXd on_mask_;    // 3m: the working heater-on states and every stuck state
+  Eigen::VectorXd on_mask_w_;  // its first m entries (the working states)
+  std::optional<UnitForceMap> output_;
+  double relative_noise_ = 0;
+  Eigen::MatrixXd h_, r_;
+};
+
+}  // namespace recruit::control
