@@ -16,5 +16,6 @@ void AddPlotCommand(CLI::App& app, int& exit_code);      // plot_command.cc
 void AddTuneLoopCommand(CLI::App& app, int& exit_code);  // tune_loop_command.cc
 void AddAttachCommand(CLI::App& app, int& exit_code);    // attach_command.cc
 void AddExportCommand(CLI::App& app, int& exit_code);    // export_command.cc
+void AddSilCommand(CLI::App& app, int& exit_code);       // sil_command.cc
 
 }  // namespace recruit::cli

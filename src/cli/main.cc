@@ -73,7 +73,7 @@ int main(int argc, char** argv) {
                   {"simulate", cli::AddSimulateCommand},  {"sweep", cli::AddSweepCommand},
                   {"render", cli::AddRenderCommand},      {"plot", cli::AddPlotCommand},
                   {"tune-loop", cli::AddTuneLoopCommand}, {"attach", cli::AddAttachCommand},
-                  {"export", cli::AddExportCommand}};
+                  {"export", cli::AddExportCommand},      {"sil", cli::AddSilCommand}};
   const std::string first = argc > 1 ? argv[1] : "";
   bool named = false;
   for (const auto& c : commands) named |= first == c.name;
