@@ -36,6 +36,7 @@ SilHook::SilHook(Transport& transport, const SilOptions& options, double dT)
 }
 
 Status SilHook::Connect(int bundles) {
+  bundles_ = bundles;
   const Clock::time_point until = Clock::now() + Seconds(options_.connect_timeout);
   for (;;) {
     std::optional<Frame> f = transport_.Receive(until, counters_.refused);
@@ -136,9 +137,10 @@ Status SilHook::OnInstant(sim::ControlInstant& c) {
 }
 
 void SilHook::Finish() {
-  if (connected_) {
-    const int n = static_cast<int>(last_.p_on.size());
-    (void)transport_.Send(EncodeEnd(n, static_cast<std::uint32_t>(counters_.instants)));
+  // Also after a refused hello, so that the controller does not wait for measurements; with no
+  // controller known (UDP) the send fails, which is fine.
+  if (bundles_ > 0) {
+    (void)transport_.Send(EncodeEnd(bundles_, static_cast<std::uint32_t>(counters_.instants)));
   }
 }
 

@@ -38,7 +38,7 @@ class SilHook : public sim::ControlInstantHook {
   SilHook(Transport& transport, const SilOptions& options, double dT);
   bool Replaces() const override { return true; }
   Status OnInstant(sim::ControlInstant& instant) override;
-  // Tells the controller the run is over (the end frame).
+  // Tells the controller the run is over (the end frame), also when it ended in an error.
   void Finish();
 
   const SilCounters& counters() const { return counters_; }
@@ -57,6 +57,7 @@ class SilHook : public sim::ControlInstantHook {
   double dT_, deadline_;
   SilCounters counters_;
   bool connected_ = false, timed_out_ = false;
+  int bundles_ = 0;  // known once the first instant is reached
   Clock::time_point start_, last_heard_;
   std::vector<bool> applied_;  // per instant
   Command last_;               // held on loss; before the first: p_on = p_off = 0
