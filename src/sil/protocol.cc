@@ -76,7 +76,7 @@ const char* ToString(ParseError e) {
     case ParseError::kBadCrc:
       return "bad CRC";
     case ParseError::kBadValue:
-      return "probability outside [0, 1]";
+      return "value out of range (a probability outside [0, 1], a hello's sequence not 0)";
   }
   return "?";
 }
@@ -148,6 +148,7 @@ ParseError ParseFrame(const std::uint8_t* data, std::size_t size, Frame& out) {
   f.sequence = GetU32(data + 3);
   const std::uint8_t* p = data + kHeaderSize;
   if (f.type == FrameType::kHello) {
+    if (f.sequence != 0) return ParseError::kBadValue;
     f.dT = GetDouble(p);
   } else if (f.type == FrameType::kMeasurement) {
     Measurement& m = f.measurement;

@@ -74,7 +74,8 @@ std::vector<std::uint8_t> EncodeMeasurement(const Measurement& m);
 std::vector<std::uint8_t> EncodeCommand(const Command& c);
 
 // Parses exactly one frame from `size` bytes (a datagram, or a candidate cut from a stream). A
-// command's p_on and p_off must lie in [0, 1]; any other value is taken as sent.
+// command's p_on and p_off must lie in [0, 1] and a hello's sequence be 0; any other value is
+// taken as sent.
 ParseError ParseFrame(const std::uint8_t* data, std::size_t size, Frame& out);
 
 // Frames out of a byte stream (the pseudo-terminal): bytes are appended as they arrive; Next()

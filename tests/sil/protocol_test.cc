@@ -141,6 +141,10 @@ TEST(SilProtocol, BadHeaderFieldsAndProbabilitiesAreRefused) {
   EXPECT_EQ(ParseFrame(b.data(), b.size(), f), ParseError::kBadBundles);
   b[2] = kMaxBundles + 1;
   EXPECT_EQ(ParseFrame(b.data(), b.size(), f), ParseError::kBadBundles);
+  b = EncodeHello(2, 1.0);
+  b[3] = 1;  // a hello's sequence is 0
+  b = reseal(b);
+  EXPECT_EQ(ParseFrame(b.data(), b.size(), f), ParseError::kBadValue);
   for (double bad : {-1e-300, 1.0000000000000002, std::numeric_limits<double>::quiet_NaN(),
                      std::numeric_limits<double>::infinity()}) {
     Command c = SampleCommand(3);
