@@ -44,7 +44,9 @@ void PrintCounters(const sil::SilCounters& c) {
             << " late, " << c.replayed << " replayed, " << c.unexpected << " unexpected, "
             << c.refused.malformed << " malformed, " << c.refused.truncated << " truncated, "
             << c.refused.oversized << " oversized, " << c.refused.foreign << " foreign, "
-            << c.refused.junk_bytes << " junk bytes; " << c.overruns << " overruns\n";
+            << c.refused.junk_bytes << " junk bytes; " << c.overruns << " overruns; answer "
+            << "latency mean " << (c.applied > 0 ? 1e3 * c.latency_sum / c.applied : 0.0)
+            << " ms, max " << 1e3 * c.latency_max << " ms\n";
 }
 
 int RunSil(const SilArgs& a) {

@@ -1,5 +1,6 @@
 #include "sil/sil_hook.h"
 
+#include <algorithm>
 #include <cmath>
 #include <thread>
 
@@ -24,7 +25,9 @@ nlohmann::json SilCounters::ToJson() const {
           {"oversized", refused.oversized},
           {"foreign", refused.foreign},
           {"junk_bytes", refused.junk_bytes},
-          {"overruns", overruns}};
+          {"overruns", overruns},
+          {"latency_mean_ms", applied > 0 ? 1e3 * latency_sum / applied : 0.0},
+          {"latency_max_ms", 1e3 * latency_max}};
 }
 
 SilHook::SilHook(Transport& transport, const SilOptions& options, double dT)
@@ -117,6 +120,7 @@ Status SilHook::OnInstant(sim::ControlInstant& c) {
   m.angular_velocity = c.angular_velocity;
   m.force = c.sensed_force;
   m.length = c.tendon_length;
+  const Clock::time_point sent = Clock::now();
   if (Status s = transport_.Send(EncodeMeasurement(m)); !s.ok()) return s;
   ++counters_.instants;
   applied_.push_back(false);
@@ -124,6 +128,9 @@ Status SilHook::OnInstant(sim::ControlInstant& c) {
     last_ = std::move(*cmd);
     applied_[k] = true;
     ++counters_.applied;
+    const double latency = std::chrono::duration<double>(Clock::now() - sent).count();
+    counters_.latency_sum += latency;
+    counters_.latency_max = std::max(counters_.latency_max, latency);
   } else {
     ++counters_.lost;
     if (Clock::now() - last_heard_ > Seconds(options_.connect_timeout)) {

@@ -28,6 +28,7 @@ struct SilCounters {
   long unexpected = 0;  // valid frames out of place: a future instant, another bundle count, a
                         // frame type the controller does not send (dropped)
   long overruns = 0;    // instants the plant reached after their wall-clock time (paced runs)
+  double latency_sum = 0, latency_max = 0;  // wall s from a measurement to its applied answer
   Refused refused;
   nlohmann::json ToJson() const;
 };

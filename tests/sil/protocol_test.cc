@@ -47,6 +47,26 @@ TEST(SilProtocol, Crc16HasTheCcittFalseCheckValue) {
 TEST(SilProtocol, EncodesTheDocumentedExampleFrames) {
   EXPECT_EQ(Hex(EncodeHello(2, 1.0)), "5A 48 02 00 00 00 00 00 00 00 00 00 00 F0 3F B3 DE");
   EXPECT_EQ(Hex(EncodeEnd(1, 40)), "5A 45 01 28 00 00 00 DA D9");
+  Measurement m;
+  m.sequence = 3;
+  m.time = 3.0;
+  m.reference = 2.0;
+  m.force = {1.875};
+  m.length = {0.03125};
+  EXPECT_EQ(Hex(EncodeMeasurement(m)),
+            "5A 4D 01 03 00 00 00 00 00 00 00 00 00 08 40 00 00 00 00 00 00 00 40 00 00 00 00 00 "
+            "00 00 00 00 00 00 00 00 00 00 00 00 00 00 00 00 00 FE 3F 00 00 00 00 00 00 A0 3F A2 "
+            "CA");
+  Command c;
+  c.sequence = 3;
+  c.force_reference = {2.0};
+  c.p_on = {0.25};
+  c.p_off = {0.0};
+  c.estimated_on = {10.0};
+  c.variance = {0.5};
+  EXPECT_EQ(Hex(EncodeCommand(c)),
+            "5A 43 01 03 00 00 00 00 00 00 00 00 00 00 40 00 00 00 00 00 00 D0 3F 00 00 00 00 00 "
+            "00 00 00 00 00 00 00 00 00 24 40 00 00 00 00 00 00 E0 3F BF E3");
 }
 
 TEST(SilProtocol, FramesRoundTripBitExactly) {

@@ -190,7 +190,7 @@ TEST(Sil, ForceTaskOverUdpEqualsSimulate) {
 // A skipped answer and a late one: both instants lost (the plant held the previous command),
 // the late answer counted and dropped.
 TEST(Sil, LostAndLateAnswersAreCountedAndHeld) {
-  const SilRun r = RunSil("arm_reach_hold", kArm + " --speed max --deadline 0.2", "udp",
+  const SilRun r = RunSil("arm_reach_hold", kArm + " --speed max --deadline 1", "udp",
                           "--skip 3 --late 7", "udp_lost", 1);
   ASSERT_EQ(r.plant_rc, 0) << r.log;
   const nlohmann::json& s = r.summary["sil"];
