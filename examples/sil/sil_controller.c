@@ -12,8 +12,8 @@
  * --late K (K's answer sent after the next measurement), --corrupt K (a copy with one bit
  * flipped first), --truncate K (a copy cut short first), --oversize K (a copy with bytes
  * appended first), --replay K (the answer sent twice), --junk K (random bytes first).
- * Exit: 0 after the end frame, 1 on bad arguments or a failed link, 3 when the plant is silent
- * for --timeout seconds (default 15). */
+ * Exit: 0 after the end frame, 1 on bad arguments or a failed link, 2 when the plant closed the
+ * pseudo-terminal without one, 3 when the plant is silent for --timeout seconds (default 15). */
 #define _DEFAULT_SOURCE
 #include <arpa/inet.h>
 #include <fcntl.h>
@@ -41,7 +41,8 @@ static uint16_t crc16(const uint8_t *d, size_t n) { /* CRC-16/CCITT-FALSE */
   int b;
   for (i = 0; i < n; ++i) {
     crc ^= (uint16_t)(d[i] << 8);
-    for (b = 0; b < 8; ++b) crc = (crc & 0x8000) ? (uint16_t)((crc << 1) ^ 0x1021) : (uint16_t)(crc << 1);
+    for (b = 0; b < 8; ++b)
+      crc = (crc & 0x8000) ? (uint16_t)((crc << 1) ^ 0x1021) : (uint16_t)(crc << 1);
   }
   return crc;
 }
@@ -84,11 +85,20 @@ static size_t frame_size(const uint8_t *p) {
   size_t values;
   if (p[0] != SYNC || p[2] < 1 || p[2] > 8) return 0;
   switch (p[1]) {
-    case 'H': values = 1; break;
-    case 'E': values = 0; break;
-    case 'M': values = 4 + 2 * (size_t)p[2]; break;
-    case 'C': values = 5 * (size_t)p[2]; break;
-    default: return 0;
+    case 'H':
+      values = 1;
+      break;
+    case 'E':
+      values = 0;
+      break;
+    case 'M':
+      values = 4 + 2 * (size_t)p[2];
+      break;
+    case 'C':
+      values = 5 * (size_t)p[2];
+      break;
+    default:
+      return 0;
   }
   return HEADER + 8 * values + 2;
 }
@@ -126,10 +136,16 @@ static size_t receive(uint8_t *f, int timeout_ms) {
       size_t s = 0;
       while (s < rx_len) {
         size_t want;
-        if (rx[s] != SYNC) { ++s; continue; }
+        if (rx[s] != SYNC) {
+          ++s;
+          continue;
+        }
         if (rx_len - s < 3) break;
         want = frame_size(rx + s);
-        if (want == 0) { ++s; continue; }
+        if (want == 0) {
+          ++s;
+          continue;
+        }
         if (rx_len - s < want) break;
         if (valid(rx + s, want)) {
           memcpy(f, rx + s, want);
@@ -148,7 +164,11 @@ static size_t receive(uint8_t *f, int timeout_ms) {
     if (poll(&p, 1, timeout_ms) <= 0) return 0;
     if (is_pty) {
       n = read(fd, rx + rx_len, sizeof rx - rx_len);
-      if (n > 0) rx_len += (size_t)n;
+      if (n <= 0) { /* the plant closed the pseudo-terminal (EIO or end of file) */
+        fprintf(stderr, "sil_controller: the link was closed\n");
+        exit(2);
+      }
+      rx_len += (size_t)n;
     } else {
       n = recv(fd, f, MAX_FRAME, 0);
       if (n > 0 && valid(f, (size_t)n)) return (size_t)n;
@@ -193,20 +213,37 @@ int main(int argc, char **argv) {
   int i;
   for (i = 1; i + 1 < argc; i += 2) {
     const char *k = argv[i], *v = argv[i + 1];
-    if (!strcmp(k, "--udp")) open_udp(v);
-    else if (!strcmp(k, "--pty")) open_pty(v);
-    else if (!strcmp(k, "--dT")) dT = atof(v);
-    else if (!strcmp(k, "--timeout")) timeout = atof(v);
-    else if (!strcmp(k, "--skip")) skip = atol(v);
-    else if (!strcmp(k, "--late")) late = atol(v);
-    else if (!strcmp(k, "--corrupt")) corrupt = atol(v);
-    else if (!strcmp(k, "--truncate")) truncate_at = atol(v);
-    else if (!strcmp(k, "--oversize")) oversize = atol(v);
-    else if (!strcmp(k, "--replay")) replay = atol(v);
-    else if (!strcmp(k, "--junk")) junk = atol(v);
-    else { fprintf(stderr, "sil_controller: unknown option %s\n", k); return 1; }
+    if (!strcmp(k, "--udp"))
+      open_udp(v);
+    else if (!strcmp(k, "--pty"))
+      open_pty(v);
+    else if (!strcmp(k, "--dT"))
+      dT = atof(v);
+    else if (!strcmp(k, "--timeout"))
+      timeout = atof(v);
+    else if (!strcmp(k, "--skip"))
+      skip = atol(v);
+    else if (!strcmp(k, "--late"))
+      late = atol(v);
+    else if (!strcmp(k, "--corrupt"))
+      corrupt = atol(v);
+    else if (!strcmp(k, "--truncate"))
+      truncate_at = atol(v);
+    else if (!strcmp(k, "--oversize"))
+      oversize = atol(v);
+    else if (!strcmp(k, "--replay"))
+      replay = atol(v);
+    else if (!strcmp(k, "--junk"))
+      junk = atol(v);
+    else {
+      fprintf(stderr, "sil_controller: unknown option %s\n", k);
+      return 1;
+    }
   }
-  if (fd < 0) { fprintf(stderr, "sil_controller: give --udp HOST:PORT or --pty PATH\n"); return 1; }
+  if (fd < 0) {
+    fprintf(stderr, "sil_controller: give --udp HOST:PORT or --pty PATH\n");
+    return 1;
+  }
   recruit_init(&ctl);
   send_bytes(f, seal(f, put_double(f, header(f, 'H', 0), dT)));
   for (;;) {
@@ -215,7 +252,10 @@ int main(int argc, char **argv) {
     uint8_t c[MAX_FRAME + 16];
     size_t n = receive(f, (int)(timeout * 1000)), at;
     uint32_t k;
-    if (n == 0) { fprintf(stderr, "sil_controller: the plant is silent\n"); return 3; }
+    if (n == 0) {
+      fprintf(stderr, "sil_controller: the plant is silent\n");
+      return 3;
+    }
     if (f[1] == 'E') return 0;
     if (f[1] != 'M') continue;
     k = (uint32_t)f[3] | (uint32_t)f[4] << 8 | (uint32_t)f[5] << 16 | (uint32_t)f[6] << 24;
@@ -236,14 +276,32 @@ int main(int argc, char **argv) {
       at = put_double(c, at, out.variance[i]);
     }
     n = seal(c, at);
-    if ((long)k == junk) { uint8_t j[23]; for (i = 0; i < 23; ++i) j[i] = (uint8_t)(37 * i + 11); send_bytes(j, 23); }
-    if ((long)k == corrupt) { c[HEADER + 3] ^= 0x10; send_bytes(c, n); c[HEADER + 3] ^= 0x10; }
+    if ((long)k == junk) {
+      uint8_t j[23];
+      for (i = 0; i < 23; ++i) j[i] = (uint8_t)(37 * i + 11);
+      send_bytes(j, 23);
+    }
+    if ((long)k == corrupt) {
+      c[HEADER + 3] ^= 0x10;
+      send_bytes(c, n);
+      c[HEADER + 3] ^= 0x10;
+    }
     if ((long)k == truncate_at) send_bytes(c, n - 5);
-    if ((long)k == oversize) { memset(c + n, 0, 16); send_bytes(c, n + 16); }
+    if ((long)k == oversize) {
+      memset(c + n, 0, 16);
+      send_bytes(c, n + 16);
+    }
     if ((long)k == skip) continue;
-    if ((long)k == late) { memcpy(held, c, n); held_n = n; continue; }
+    if ((long)k == late) {
+      memcpy(held, c, n);
+      held_n = n;
+      continue;
+    }
     send_bytes(c, n);
-    if (held_n > 0) { send_bytes(held, held_n); held_n = 0; }
+    if (held_n > 0) {
+      send_bytes(held, held_n);
+      held_n = 0;
+    }
     if ((long)k == replay) send_bytes(c, n);
   }
 }

@@ -10,6 +10,7 @@
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
+#include <thread>
 
 #include "sil/transport.h"
 
@@ -21,6 +22,10 @@ class PtyTransport : public Transport {
   PtyTransport(int master, int slave, std::string path, std::string link)
       : master_(master), slave_(slave), path_(std::move(path)), link_(std::move(link)) {}
   ~PtyTransport() override {
+    // Closing the master hangs the slave up, which may discard what the controller has not read
+    // yet (the end frame): give it a moment.
+    ::tcdrain(master_);
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
     if (!link_.empty()) {
       std::error_code ec;
       std::filesystem::remove(link_, ec);

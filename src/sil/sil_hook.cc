@@ -2,10 +2,18 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <string>
 #include <thread>
 
 namespace recruit::sil {
 namespace {
+
+std::string Text(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%g", v);
+  return b;
+}
 
 Clock::duration Seconds(double s) {
   return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s));
@@ -45,8 +53,8 @@ Status SilHook::Connect(int bundles) {
     std::optional<Frame> f = transport_.Receive(until, counters_.refused);
     if (!f) {
       timed_out_ = true;
-      return Error{"no controller connected within " + std::to_string(options_.connect_timeout) +
-                   " s on " + transport_.Describe()};
+      return Error{"no controller connected within " + Text(options_.connect_timeout) + " s on " +
+                   transport_.Describe()};
     }
     if (f->type != FrameType::kHello) {
       ++counters_.unexpected;
@@ -59,8 +67,8 @@ Status SilHook::Connect(int bundles) {
     }
     // The controller's period must be the plant's: its model and gains were made for it.
     if (f->dT != 0 && !(std::abs(f->dT - dT_) <= 1e-9 * dT_)) {
-      return Error{"the controller's dT is " + std::to_string(f->dT) + " s, the run's " +
-                   std::to_string(dT_) + " s: export with the same --dT"};
+      return Error{"the controller's dT is " + Text(f->dT) + " s, the run's " + Text(dT_) +
+                   " s: export with the same --dT"};
     }
     connected_ = true;
     last_.force_reference.assign(bundles, 0.0);
@@ -135,8 +143,8 @@ Status SilHook::OnInstant(sim::ControlInstant& c) {
     ++counters_.lost;
     if (Clock::now() - last_heard_ > Seconds(options_.connect_timeout)) {
       timed_out_ = true;
-      return Error{"the controller fell silent for more than " +
-                   std::to_string(options_.connect_timeout) + " s on " + transport_.Describe()};
+      return Error{"the controller fell silent for more than " + Text(options_.connect_timeout) +
+                   " s on " + transport_.Describe()};
     }
   }
   Hold(c);

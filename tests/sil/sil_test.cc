@@ -210,6 +210,7 @@ TEST(Sil, PtyRunEqualsSimulate) {
                           "--corrupt 3 --replay 6 --junk 7", "pty", 1);
   ASSERT_EQ(r.plant_rc, 0) << r.log;
   ExpectSameMetrics(ref, r.summary, "arm_reach_hold over a pty");
+  EXPECT_EQ(r.controller_rc, 0) << "the controller read the end frame";
   const nlohmann::json& s = r.summary["sil"];
   EXPECT_EQ(s["lost"], 0);
   EXPECT_EQ(s["replayed"], 1);
