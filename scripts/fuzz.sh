@@ -7,6 +7,7 @@
 # build-asan/artifacts/.
 # Usage:
 #   scripts/fuzz.sh [target...]     targets: task filter_model filter_log bundle_config mjcf_config
+#                                   sil_packet
 #                                   (default: all)
 # Environment: FUZZ_SECONDS per target (default 30), FUZZ_SEED (default 1), BUILD_DIR (default
 # build-asan), JOBS (default: nproc). Reproduce a crash: build-asan/tests/fuzz/fuzz_<target> FILE.
@@ -19,7 +20,7 @@ JOBS=${JOBS:-$(nproc)}
 FUZZ_SECONDS=${FUZZ_SECONDS:-30}
 FUZZ_SEED=${FUZZ_SEED:-1}
 TARGETS=("$@")
-if [ ${#TARGETS[@]} -eq 0 ]; then TARGETS=(task filter_model filter_log bundle_config mjcf_config); fi
+if [ ${#TARGETS[@]} -eq 0 ]; then TARGETS=(task filter_model filter_log bundle_config mjcf_config sil_packet); fi
 
 export BUILD_DIR JOBS
 if ! "${CXX:-clang++}" --version | grep -q clang; then

@@ -17,5 +17,6 @@ void AddTuneLoopCommand(CLI::App& app, int& exit_code);  // tune_loop_command.cc
 void AddAttachCommand(CLI::App& app, int& exit_code);    // attach_command.cc
 void AddExportCommand(CLI::App& app, int& exit_code);    // export_command.cc
 void AddReplayCommand(CLI::App& app, int& exit_code);    // replay_command.cc
+void AddSilCommand(CLI::App& app, int& exit_code);       // sil_command.cc
 
 }  // namespace recruit::cli

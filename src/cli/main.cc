@@ -48,12 +48,17 @@ int main(int argc, char** argv) {
   const struct {
     const char* name;
     void (*add)(CLI::App&, int&);
-  } commands[] = {{"filter", cli::AddFilterCommand},      {"identify", cli::AddIdentifyCommand},
-                  {"simulate", cli::AddSimulateCommand},  {"sweep", cli::AddSweepCommand},
-                  {"render", cli::AddRenderCommand},      {"plot", cli::AddPlotCommand},
-                  {"tune-loop", cli::AddTuneLoopCommand}, {"attach", cli::AddAttachCommand},
+  } commands[] = {{"filter", cli::AddFilterCommand},
+                  {"identify", cli::AddIdentifyCommand},
+                  {"simulate", cli::AddSimulateCommand},
+                  {"sweep", cli::AddSweepCommand},
+                  {"render", cli::AddRenderCommand},
+                  {"plot", cli::AddPlotCommand},
+                  {"tune-loop", cli::AddTuneLoopCommand},
+                  {"attach", cli::AddAttachCommand},
                   {"export", cli::AddExportCommand},
-                  {"replay", cli::AddReplayCommand}};
+                  {"replay", cli::AddReplayCommand},
+                  {"sil", cli::AddSilCommand}};
   const std::string first = argc > 1 ? argv[1] : "";
   bool named = false;
   for (const auto& c : commands) named |= first == c.name;

@@ -11,6 +11,7 @@ constexpr int kUsage = 2;     // bad option or option value (CLI11 errors too), 
 constexpr int kBadInput = 3;  // an input file's content is invalid (task, model, log, MJCF, ...)
 constexpr int kIo = 4;        // a file cannot be read or written (permissions, full disk, ...)
 constexpr int kInternal = 5;  // a bug: an unexpected exception; please report it
+constexpr int kNoController = 6;  // recruit sil: the controller never connected, or fell silent
 
 inline int Of(ErrorCode code) {
   switch (code) {

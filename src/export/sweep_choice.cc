@@ -7,8 +7,8 @@
 #include <vector>
 
 #include "common/atomic_file.h"
-#include "sweep/table.h"
 #include "sweep/recommend.h"
+#include "sweep/table.h"
 
 namespace recruit::exporter {
 namespace {

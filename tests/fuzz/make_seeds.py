@@ -103,3 +103,36 @@ write("mjcf_config", "bad_period.txt", lines({36: "soon"}))
 write("mjcf_config", "huge_seed.txt", lines({35: "18446744073709551616"}))
 write("mjcf_config", "xml_chars.txt", lines({0: "<&\"'>", 1: "6\x01"}))
 write("mjcf_config", "many_units.txt", lines({1: "100000"}))
+
+
+# --- sil_packet: frames of docs/sil.md (byte 0 also sets the stream's piece size) ---
+import struct
+
+
+def crc16(data):
+    c = 0xFFFF
+    for x in data:
+        c ^= x << 8
+        for _ in range(8):
+            c = ((c << 1) ^ 0x1021) & 0xFFFF if c & 0x8000 else (c << 1) & 0xFFFF
+    return c
+
+
+def frame(kind, n, seq, values):
+    body = bytes([0x5A, ord(kind), n]) + struct.pack("<I", seq) + struct.pack("<%dd" % len(values), *values)
+    return body + struct.pack("<H", crc16(body))
+
+
+hello = frame("H", 2, 0, [1.0])
+meas = frame("M", 2, 7, [7.0, 0.5, 0.4, -0.01, 3.2, 2.9, 0.031, 0.029])
+cmd = frame("C", 2, 7, [3.0, 0.2, 0.0, 11.5, 0.8, 1.0, 0.0, 0.05, 2.0, float("nan")])
+end = frame("E", 1, 40, [])
+write("sil_packet", "hello", hello)
+write("sil_packet", "measurement", meas)
+write("sil_packet", "command", cmd)
+write("sil_packet", "end", end)
+write("sil_packet", "bad_crc", cmd[:-1] + bytes([cmd[-1] ^ 1]))
+write("sil_packet", "truncated", cmd[:-3])
+write("sil_packet", "p_above_one", frame("C", 1, 3, [1.0, 1.5, 0.0, 1.0, 0.1]))
+write("sil_packet", "eight_bundles", frame("C", 8, 9, [0.5] * 40))
+write("sil_packet", "stream", bytes([0x5A, 0x13]) + hello + meas + b"\x5a\x43" + cmd + cmd[:10] + end)
