@@ -51,7 +51,8 @@ int main(int argc, char** argv) {
   } commands[] = {{"filter", cli::AddFilterCommand},      {"identify", cli::AddIdentifyCommand},
                   {"simulate", cli::AddSimulateCommand},  {"sweep", cli::AddSweepCommand},
                   {"render", cli::AddRenderCommand},      {"plot", cli::AddPlotCommand},
-                  {"tune-loop", cli::AddTuneLoopCommand}, {"attach", cli::AddAttachCommand}};
+                  {"tune-loop", cli::AddTuneLoopCommand}, {"attach", cli::AddAttachCommand},
+                  {"tune", cli::AddTuneCommand}};
   const std::string first = argc > 1 ? argv[1] : "";
   bool named = false;
   for (const auto& c : commands) named |= first == c.name;

@@ -226,6 +226,11 @@ Result<PreparedSweep> Prepare(const SweepDefinition& d) {
   return p;
 }
 
+std::string InputHash(const PreparedSweep& p, const SweepRun& run) {
+  std::map<std::string, std::string> contents;
+  return RunInputHash(p.plant.at(run.plant), p.spec, run, contents);
+}
+
 Result<FileLock> OpenOutput(const PreparedSweep& p, const SweepDefinition& d) {
   // The outputs must not replace the inputs (a task file kept in the output folder).
   for (const char* name :

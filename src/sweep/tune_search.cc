@@ -154,6 +154,15 @@ std::vector<Request> NextBatch(const Tallies& t, const TuneSettings& s, const Dt
   if (!w.found) return out;
   if (!w.lower.resolved) out.push_back({(w.lower.fails + w.lower.meets) / 2, s.initial_seeds});
   if (!w.upper.resolved) out.push_back({(w.upper.meets + w.upper.fails + 1) / 2, s.initial_seeds});
+  if (!out.empty()) return out;
+  // Edges known: try the window's middle (in log dT) if no period there was, so the
+  // recommendation has room on both sides.
+  const double lo = w.lower.censored ? 0 : 0.5 * (w.lower.meets + w.lower.fails);
+  const double hi = w.upper.censored ? n - 1 : 0.5 * (w.upper.meets + w.upper.fails);
+  const int mid = static_cast<int>(std::floor(0.5 * (lo + hi)));
+  if (mid > w.lower.meets && mid < w.upper.meets && !t.count(mid)) {
+    out.push_back({mid, s.initial_seeds});
+  }
   return out;
 }
 

@@ -10,7 +10,8 @@
 // periods spread over the lattice, decides them, then bisects (in lattice index, i.e. log dT)
 // between the meeting periods at the window's ends and the failing ones beyond, until each edge
 // lies between lattice neighbours (known to the factor q) or the window reaches the lattice's end
-// (a censored edge).
+// (a censored edge). Last, the lattice period in the window's middle is tried, so the recommended
+// period (the meeting one farthest from both edges) has room on both sides.
 #pragma once
 
 #include <map>
@@ -91,7 +92,7 @@ struct Request {
 };
 
 // What to run next; empty when the search is done: every period tried decided (or marginal),
-// both edges resolved, or no period meets.
+// both edges resolved and the window's middle tried, or no period meets.
 std::vector<Request> NextBatch(const Tallies& t, const TuneSettings& s, const DtLattice& lattice);
 
 }  // namespace recruit::sweep

@@ -52,6 +52,8 @@ TEST(TuneSearch, CellsAreJudgedByTheWilsonBounds) {
 struct OracleResult {
   double hit_rate = 0, runs = 0, grid_runs = 0;
   int censored_lower = 0, censored_upper = 0;
+  int recommended_inside = 0;  // repetitions whose recommended dT lies in the true window
+  int roomy = 0;               // ... and a factor >= 2 from both true edges (or the range's ends)
 };
 
 // Runs the search `reps` times against p(dT); an edge counts as found when its estimate is within
@@ -82,6 +84,12 @@ OracleResult RunOracle(const std::function<double(double)>& p, double lo_true, d
       return std::abs(std::log(EdgeEstimate(e, lattice) / truth)) <= std::log1p(s.tolerance);
     };
     if (w.found && near(w.lower, lo_true, true) && near(w.upper, hi_true, false)) ++hits;
+    if (w.found) {
+      const double rec = lattice.dT(w.recommended);
+      r.recommended_inside += rec >= lo_true && rec <= hi_true;
+      r.roomy +=
+          std::min(rec / std::max(lo_true, s.dT_min), std::min(hi_true, s.dT_max) / rec) >= 2.0;
+    }
     r.censored_lower += w.lower.censored;
     r.censored_upper += w.upper.censored;
     r.runs += runs;
@@ -99,6 +107,11 @@ TEST(TuneSearch, FindsASharpWindowWithinToleranceAndFewerRuns) {
   const OracleResult r = RunOracle(p, 0.13, 0.95, 300, 7);
   EXPECT_GE(r.hit_rate, 0.95);
   EXPECT_GE(r.grid_runs / r.runs, 5.0) << r.runs << " runs against " << r.grid_runs;
+  // The window spans a factor 7.3 (2.7 from its middle to each edge): the recommendation keeps
+  // a factor >= 2 from both edges in >= 95 % of repetitions.
+  EXPECT_EQ(r.recommended_inside, 300);
+  EXPECT_GE(r.roomy, 285);
+  std::printf("recommended dT a factor >= 2 from both edges in %d of 300\n", r.roomy);
   RecordProperty("runs", std::to_string(r.runs));
   RecordProperty("grid_runs", std::to_string(r.grid_runs));
   std::printf("sharp window: hit rate %.3f, %.1f runs against %.1f on the grid (%.1fx)\n",
