@@ -132,6 +132,37 @@ double EdgeEstimate(const Edge& e, const DtLattice& lattice) {
   return std::sqrt(lattice.dT(e.meets) * lattice.dT(e.fails));
 }
 
+namespace {
+
+// No period meets yet: look between the most promising period (the largest fraction meeting
+// among those whose Wilson upper bound still reaches the level) and its tried neighbours, until
+// they are lattice neighbours. Nothing when every period tried fails outright.
+std::vector<Request> Explore(const Tallies& t, const TuneSettings& s) {
+  const double z = NormalQuantile(s.confidence);
+  auto best = t.end();
+  double best_fraction = -1;
+  for (auto it = t.begin(); it != t.end(); ++it) {
+    const Tally& c = it->second;
+    const double f = static_cast<double>(c.meeting) / std::max(1, c.seeds);
+    if (WilsonInterval(c.meeting, c.seeds, z).hi >= s.level && f > best_fraction) {
+      best_fraction = f;
+      best = it;
+    }
+  }
+  std::vector<Request> out;
+  if (best == t.end()) return out;
+  const int k = best->first;
+  if (best != t.begin() && k - std::prev(best)->first > 1) {
+    out.push_back({(std::prev(best)->first + k) / 2, s.initial_seeds});
+  }
+  if (std::next(best) != t.end() && std::next(best)->first - k > 1) {
+    out.push_back({(k + std::next(best)->first + 1) / 2, s.initial_seeds});
+  }
+  return out;
+}
+
+}  // namespace
+
 std::vector<Request> NextBatch(const Tallies& t, const TuneSettings& s, const DtLattice& lattice) {
   std::vector<Request> out;
   const int n = lattice.size();
@@ -151,7 +182,7 @@ std::vector<Request> NextBatch(const Tallies& t, const TuneSettings& s, const Dt
   }
   if (!out.empty()) return out;
   const Window w = FindWindow(t, s, lattice);
-  if (!w.found) return out;
+  if (!w.found) return Explore(t, s);
   if (!w.lower.resolved) out.push_back({(w.lower.fails + w.lower.meets) / 2, s.initial_seeds});
   if (!w.upper.resolved) out.push_back({(w.upper.meets + w.upper.fails + 1) / 2, s.initial_seeds});
   if (!out.empty()) return out;

@@ -92,7 +92,8 @@ struct Request {
 };
 
 // What to run next; empty when the search is done: every period tried decided (or marginal),
-// both edges resolved and the window's middle tried, or no period meets.
+// both edges resolved and the window's middle tried; or no period meets and none is left to try
+// next to the most promising marginal one (the periods between it and its tried neighbours).
 std::vector<Request> NextBatch(const Tallies& t, const TuneSettings& s, const DtLattice& lattice);
 
 }  // namespace recruit::sweep

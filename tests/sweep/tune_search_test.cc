@@ -152,6 +152,32 @@ TEST(TuneSearch, SaysAnEdgeBeyondTheRangeIsCensored) {
   EXPECT_GE(r.hit_rate, 0.95);
 }
 
+TEST(TuneSearch, LooksBetweenMarginalPeriodsWhenNoneMeets) {
+  // The start points decided, none meeting; two marginal (0.5 s: 56/64, 0.97 s: 55/64, as the
+  // output estimator on the isometric bench): the search tries between the better one and its
+  // neighbours, then stops once they are lattice neighbours.
+  TuneSettings s;
+  const DtLattice lattice(s);
+  Tallies t;
+  const std::vector<Request> start = NextBatch(t, s, lattice);
+  ASSERT_EQ(start.size(), 7u);
+  for (const Request& q : start) t[q.index] = {q.seeds, 0};
+  const int a = start[3].index, b = start[4].index;  // 0.5 and 0.97 s
+  t[a] = {64, 56};
+  t[b] = {64, 55};
+  ASSERT_EQ(Judge(t[a], s), Verdict::kMarginal);
+  const std::vector<Request> next = NextBatch(t, s, lattice);
+  ASSERT_EQ(next.size(), 2u);
+  EXPECT_EQ(next[0].index, (start[2].index + a) / 2);
+  EXPECT_EQ(next[1].index, (a + b + 1) / 2);
+  // Neighbours all tried and failing: done, no window.
+  for (int k = start[2].index; k <= b; ++k) {
+    if (!t.count(k)) t[k] = {4, 0};
+  }
+  EXPECT_TRUE(NextBatch(t, s, lattice).empty());
+  EXPECT_FALSE(FindWindow(t, s, lattice).found);
+}
+
 TEST(TuneSearch, NothingMeetsEndsWithNoWindow) {
   TuneSettings s;
   const DtLattice lattice(s);
