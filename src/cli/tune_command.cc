@@ -21,6 +21,7 @@ struct TuneArgs {
   sweep::TuneDefinition def;
   std::vector<double> range{0.0625, 4};
   double max_step_overshoot = -1;  // < 0: no limit on the worst step
+  double quantum = -1;             // < 0: the physics timestep
   int threads = 0;
   bool progress = false;
 };
@@ -32,6 +33,7 @@ int RunTuneCommand(TuneArgs& a) {
   d.settings.dT_min = a.range[0];
   d.settings.dT_max = a.range[1];
   if (a.max_step_overshoot >= 0) d.criterion.max_step_overshoot = a.max_step_overshoot;
+  if (a.quantum >= 0) d.settings.dT_quantum = a.quantum;
   if (std::string why = sweep::CheckTuneSettings(d.settings); !why.empty()) {
     return Fail(cmd, why, exit_code::kUsage);
   }
@@ -43,6 +45,7 @@ int RunTuneCommand(TuneArgs& a) {
   auto prep = sweep::Prepare(d.sweep);
   if (!prep.ok()) return Fail(cmd, prep.failure());
   d.criterion.tracking = prep->criterion;  // options over the sweep file's criterion
+  if (a.quantum < 0) d.settings.dT_quantum = sweep::PhysicsTimestep(*prep);
   const bool tty = ::isatty(STDERR_FILENO);
   std::mutex mu;
   auto t0 = std::chrono::steady_clock::now();
@@ -138,6 +141,10 @@ void AddTuneCommand(CLI::App& app, int& exit_code) {
       ->expected(2)
       ->check(SamplingPeriod())
       ->capture_default_str();
+  cmd->add_option("--dT-quantum", args->quantum,
+                  "Periods tried are whole multiples of this, s (0: any) [default: the physics "
+                  "timestep; kalman-augmented identifies models only for its multiples]")
+      ->check(NonNegative());
   cmd->add_option("--tolerance", s.tolerance, "Edges known to a factor 1 + this, [0.01, 1]")
       ->capture_default_str();
   cmd->add_option("--level", s.level,

@@ -9,6 +9,7 @@
 #include <tuple>
 
 #include "common/atomic_file.h"
+#include "common/mujoco_load.h"
 #include "common/rng.h"
 
 namespace recruit::sweep {
@@ -105,6 +106,12 @@ DtRow SummarizeDt(double dT, const std::vector<sim::RunSummary>& runs, const Tun
   row.estimator_rmse = rmse / n;
   row.mean_nees = nees_n ? nees / nees_n : std::nan("");
   return row;
+}
+
+double PhysicsTimestep(const PreparedSweep& p) {
+  if (p.task.timestep > 0) return p.task.timestep;
+  auto m = LoadModel(p.task.model_path);
+  return m.ok() ? (*m)->opt.timestep : 0;
 }
 
 Result<TuneOutcome> Tune(const PreparedSweep& p, const TuneDefinition& d, int threads,

@@ -80,6 +80,10 @@ struct TuneHooks {
   std::function<void(int done, int total)> progress;  // after each run (serialised)
 };
 
+// The physics timestep of the task's runs (the task's override, else its model's; 0 when the
+// model does not load): the tune's default dT quantum.
+double PhysicsTimestep(const PreparedSweep& p);
+
 // Runs the search into `d.sweep.out` (locked while it runs). `p` from Prepare(d.sweep).
 Result<TuneOutcome> Tune(const PreparedSweep& p, const TuneDefinition& d, int threads,
                          const TuneHooks& hooks);

@@ -19,6 +19,9 @@ std::string CheckTuneSettings(const TuneSettings& s) {
     return fmt::format("--confidence {}: must be in [0.5, 1)", s.confidence);
   }
   if (s.initial_points < 2) return "--initial-points must be >= 2";
+  if (!(s.dT_quantum >= 0) || s.dT_quantum > s.dT_min) {
+    return fmt::format("dT quantum {}: must be in [0, --dT-range min {}]", s.dT_quantum, s.dT_min);
+  }
   if (s.initial_seeds < 1 || s.max_seeds < s.initial_seeds) {
     return fmt::format("--seeds {} / --max-seeds {}: need 1 <= seeds <= max-seeds", s.initial_seeds,
                        s.max_seeds);
@@ -56,9 +59,17 @@ DtLattice::DtLattice(const TuneSettings& s) {
   const double span = std::log(s.dT_max / s.dT_min);
   const int steps = std::max(1, static_cast<int>(std::ceil(span / std::log1p(s.tolerance) - 1e-9)));
   q_ = std::exp(span / steps);
+  auto quantize = [&s](double x) {
+    if (!(s.dT_quantum > 0)) return x;
+    const double m = std::max(1.0, std::round(x / s.dT_quantum));
+    return ThreeDigits(m * s.dT_quantum);  // the multiple, without binary residue
+  };
   for (int k = 0; k <= steps; ++k) {
-    const double x = k == steps ? s.dT_max : ThreeDigits(s.dT_min * std::exp(span * k / steps));
-    if (dts_.empty() || x > dts_.back()) dts_.push_back(k == 0 ? s.dT_min : x);
+    double x = k == 0       ? s.dT_min
+               : k == steps ? s.dT_max
+                            : ThreeDigits(s.dT_min * std::exp(span * k / steps));
+    x = quantize(x);
+    if (dts_.empty() || x > dts_.back()) dts_.push_back(x);
   }
 }
 

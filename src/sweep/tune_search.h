@@ -28,6 +28,9 @@ struct TuneSettings {
   int initial_points = 7;              // periods spread over the range to start from
   int initial_seeds = 4;               // seeds of a new period; doubled while open
   int max_seeds = 64;
+  // Lattice periods are whole multiples of this (s; 0: none), e.g. the physics timestep: a
+  // filter model is identified only for whole multiples of the model's timestep.
+  double dT_quantum = 0;
 };
 
 // Checks the settings; "" when valid, else what is wrong (option names as `recruit tune` has them).
@@ -42,7 +45,8 @@ Interval WilsonInterval(int k, int n, double z);
 double NormalQuantile(double confidence);
 
 // The dT lattice: dT_k = dT_min q^k, k = 0 .. size-1, dT_{size-1} = dT_max, each rounded to three
-// significant digits (a period a lab can set; records are keyed by it).
+// significant digits (a period a lab can set; records are keyed by it) and then to a whole
+// multiple of dT_quantum (periods that round to the same value are kept once).
 class DtLattice {
  public:
   explicit DtLattice(const TuneSettings& s);

@@ -41,6 +41,18 @@ TEST(TuneLattice, SpansTheRangeWithinTheTolerance) {
   }
 }
 
+TEST(TuneLattice, PeriodsAreWholeMultiplesOfTheQuantum) {
+  TuneSettings s;
+  s.dT_quantum = 0.002;  // the isometric bench's timestep
+  const DtLattice l(s);
+  EXPECT_GT(l.size(), 40);
+  for (int k = 0; k < l.size(); ++k) {
+    const double m = l.dT(k) / s.dT_quantum;
+    EXPECT_NEAR(m, std::round(m), 1e-9) << l.dT(k);
+    if (k > 0) EXPECT_GT(l.dT(k), l.dT(k - 1));
+  }
+}
+
 TEST(TuneSearch, CellsAreJudgedByTheWilsonBounds) {
   TuneSettings s;                                  // level 0.8, 95 %
   EXPECT_EQ(Judge({16, 16}, s), Verdict::kMeets);  // 16 / (16 + 3.84) = 0.806
