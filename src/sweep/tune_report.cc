@@ -4,6 +4,7 @@
 // percentile and worst step, the datasheet limits and the estimator's quality.
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 
@@ -38,14 +39,16 @@ std::string EdgeText(const TuneColumn& c, const TuneSettings& s, bool lower,
   if (!c.window.found) return "-";
   const Edge& e = lower ? c.window.lower : c.window.upper;
   if (e.censored) {
-    return lower ? fmt::format(
-                       "< {} (censored: below the shortest dT tried; extend the range, "
-                       "e.g. --dT-range {:g},{:g})",
-                       s.dT_min, s.dT_min / 4, s.dT_max)
-                 : fmt::format(
-                       "> {} (censored: above the longest dT tried; extend the range, "
-                       "e.g. --dT-range {:g},{:g})",
-                       s.dT_max, s.dT_min, s.dT_max * 4);
+    const double first = lattice.dT(0), last = lattice.dT(lattice.size() - 1);
+    if (lower) {
+      return fmt::format(
+          "< {} (censored: below the shortest dT tried; extend the range, e.g. --dT-range "
+          "{:g},{:g})",
+          first, std::max(s.dT_min / 4, s.dT_quantum), s.dT_max);
+    }
+    return fmt::format(
+        "> {} (censored: above the longest dT tried; extend the range, e.g. --dT-range {:g},{:g})",
+        last, s.dT_min, s.dT_max * 4);
   }
   return fmt::format("{:.3g} (fails at {}, meets at {})", lower ? c.lower_edge : c.upper_edge,
                      lattice.dT(e.fails), lattice.dT(e.meets));
