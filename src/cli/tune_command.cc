@@ -9,6 +9,7 @@
 #include <iostream>
 #include <limits>
 #include <mutex>
+#include <tuple>
 
 #include "cli/commands.h"
 #include "cli/errors.h"
@@ -24,6 +25,7 @@ struct TuneArgs {
   double quantum = -1;             // < 0: the physics timestep
   int threads = 0;
   bool progress = false;
+  std::string shard;  // "K/N"
 };
 
 int RunTuneCommand(TuneArgs& a) {
@@ -34,6 +36,11 @@ int RunTuneCommand(TuneArgs& a) {
   d.settings.dT_max = a.range[1];
   if (a.max_step_overshoot >= 0) d.criterion.max_step_overshoot = a.max_step_overshoot;
   if (a.quantum >= 0) d.settings.dT_quantum = a.quantum;
+  if (!a.shard.empty()) {
+    auto s = sweep::ParseShard(a.shard);
+    if (!s.ok()) return Fail(cmd, s.error(), exit_code::kUsage);
+    std::tie(d.shard_k, d.shard_n) = *s;
+  }
   if (std::string why = sweep::CheckTuneSettings(d.settings); !why.empty()) {
     return Fail(cmd, why, exit_code::kUsage);
   }
@@ -162,6 +169,10 @@ void AddTuneCommand(CLI::App& app, int& exit_code) {
   cmd->add_option("--threads", args->threads, "Worker threads, 0..4096 (0 = all cores)")
       ->check(CLI::Range(0, 4096))
       ->capture_default_str();
+  cmd->add_option("--shard", args->shard,
+                  "Run only shard K of N (K/N): the searches (plant point x lambda x estimator) "
+                  "with index % N == K-1; copy the shards' runs/ into one folder and tune there "
+                  "to report them all (every run reused)");
   cmd->add_flag("--progress", args->progress, "Show progress even when stderr is not a terminal");
   cmd->callback([args, &exit_code] { exit_code = RunTuneCommand(*args); });
 }

@@ -124,10 +124,16 @@ Result<TuneOutcome> Tune(const PreparedSweep& p, const TuneDefinition& d, int th
   if (!lock.ok()) return lock.failure();
 
   std::vector<Column> columns;
+  if (d.shard_n < 1 || d.shard_k < 1 || d.shard_k > d.shard_n) {
+    return Error{"tune: bad shard", ErrorCode::kUsage};
+  }
+  int search = 0;  // index of a search in plant point x lambda x estimator order
   for (size_t pl = 0; pl < p.plant.size(); ++pl) {
     for (double lambda : p.spec.lambdas) {
       for (const auto& est : p.spec.estimators) {
-        columns.push_back({static_cast<int>(pl), est, lambda, {}});
+        if (search++ % d.shard_n == d.shard_k - 1) {
+          columns.push_back({static_cast<int>(pl), est, lambda, {}});
+        }
       }
     }
   }

@@ -65,6 +65,10 @@ struct TuneDefinition {
   SweepDefinition sweep;  // task or sweep file, lambdas, estimators, seeds' base, duration, out
   TuneSettings settings;
   TuneCriterion criterion;  // its tracking part replaces sweep.criterion
+  // Shard k of n (1 <= k <= n): only the searches (plant point x lambda x estimator, in that
+  // order) whose index i has i % n == k - 1. The shards' runs/ copied into one folder and the
+  // tune run there unsharded reuse them all and report every search.
+  int shard_k = 1, shard_n = 1;
 };
 
 struct TuneOutcome {
