@@ -11,6 +11,7 @@
 #include <mutex>
 #include <tuple>
 
+#include "cli/command_modules.h"
 #include "cli/commands.h"
 #include "cli/errors.h"
 #include "sweep/tune.h"
@@ -27,6 +28,20 @@ struct TuneArgs {
   bool progress = false;
   std::string shard;  // "K/N"
 };
+
+// The figure's drawing through the plot module (cairo), opened on first use.
+sweep::FigureRenderer PlotModuleFigure() {
+  return [](const plot::Figure& fig, int w, int h, plot::Format f) -> Result<std::string> {
+    std::string error;
+    const PlotModule* plot = OpenPlotModule(&error);
+    if (!plot) return IoError(error);
+    std::string bytes;
+    Error why;
+    plot->figure(&fig, w, h, f, &bytes, &why);
+    if (!why.message.empty()) return why;
+    return bytes;
+  };
+}
 
 int RunTuneCommand(TuneArgs& a) {
   const std::string cmd = "tune";
@@ -73,7 +88,9 @@ int RunTuneCommand(TuneArgs& a) {
   };
   auto out = sweep::Tune(*prep, d, a.threads, hooks);
   if (!out.ok()) return Fail(cmd, out.failure());
-  if (Status s = sweep::WriteTuneReport(*prep, d, *out); !s.ok()) return Fail(cmd, s.failure());
+  if (Status s = sweep::WriteTuneReport(*prep, d, *out, PlotModuleFigure()); !s.ok()) {
+    return Fail(cmd, s.failure());
+  }
   if (tty) std::cerr << "\n";
   std::cout << "recruit tune: " << out->runs << " runs (" << out->executed << " made, "
             << out->reused << " reused) in " << out->rounds << " rounds; the lattice grid would "

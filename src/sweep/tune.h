@@ -96,8 +96,12 @@ Result<TuneOutcome> Tune(const PreparedSweep& p, const TuneDefinition& d, int th
 DtRow SummarizeDt(double dT, const std::vector<sim::RunSummary>& runs, const TuneCriterion& c,
                   const TuneSettings& s);
 
-// tune.json (everything, machine-readable) and tune.md (the report) into `d.sweep.out`.
-Status WriteTuneReport(const PreparedSweep& p, const TuneDefinition& d, const TuneOutcome& o);
+// tune.json (everything, machine-readable) and tune.md (the report) into `d.sweep.out`; with a
+// renderer also window.png/.svg (per search the fraction of seeds meeting against log dT with its
+// Wilson band, the level, the edges, a censored one dotted with an arrowhead out of the range, and
+// the recommended dT), linked from tune.md.
+Status WriteTuneReport(const PreparedSweep& p, const TuneDefinition& d, const TuneOutcome& o,
+                       const FigureRenderer& render = {});
 std::string TuneMarkdown(const PreparedSweep& p, const TuneDefinition& d, const TuneOutcome& o);
 nlohmann::json TuneJson(const TuneDefinition& d, const TuneOutcome& o);
 

@@ -56,6 +56,85 @@ std::string EdgeText(const TuneColumn& c, const TuneSettings& s, bool lower,
 
 std::string Percent(double x) { return std::isfinite(x) ? fmt::format("{:.1f}", 100 * x) : "-"; }
 
+plot::Series VerticalLine(double x, const std::string& label, plot::Color color,
+                          plot::LineStyle style, double width = 1.5) {
+  plot::Series v;
+  v.label = label;
+  v.x = {x, x};
+  v.y = {0, 1};
+  v.color = color;
+  v.style = style;
+  v.width = width;
+  return v;
+}
+
+// One panel per search: the fraction of seeds meeting against log10 dT with its Wilson band, the
+// level, the edges (solid; a censored edge dotted at the lattice's end with an arrowhead pointing
+// out of the range) and the recommended dT.
+plot::Figure WindowFigure(const PreparedSweep& p, const TuneDefinition& d, const TuneOutcome& o) {
+  const DtLattice lattice(d.settings);
+  plot::Figure fig;
+  fig.title = p.task.name + ": fraction of seeds meeting the criterion against dT";
+  const plot::Color blue{0.12, 0.47, 0.71}, red{0.84, 0.15, 0.16}, green{0.17, 0.63, 0.17},
+      grey{0.4, 0.4, 0.4};
+  for (const auto& c : o.columns) {
+    plot::Axes ax;
+    ax.x_label = fmt::format("log10 dT (s); {}, {}, lambda {:g}", TunePlantLabel(c.plant_values),
+                             c.estimator, c.lambda);
+    ax.y_label = "fraction meeting";
+    ax.y_range = plot::Range{0, 1};
+    plot::Band band;
+    band.label = fmt::format("{:.0f} % Wilson interval", 100 * d.settings.confidence);
+    band.color = {blue.r, blue.g, blue.b, 0.25};
+    plot::Series frac;
+    frac.label = "seeds meeting / seeds";
+    frac.color = blue;
+    for (const auto& r : c.rows) {
+      const double x = std::log10(r.dT);
+      band.x.push_back(x);
+      band.lo.push_back(r.fraction.lo);
+      band.hi.push_back(r.fraction.hi);
+      frac.x.push_back(x);
+      frac.y.push_back(r.seeds ? static_cast<double>(r.meeting) / r.seeds : std::nan(""));
+    }
+    ax.bands.push_back(band);
+    ax.series.push_back(frac);
+    const double x0 = std::log10(lattice.dT(0)), x1 = std::log10(lattice.dT(lattice.size() - 1));
+    plot::Series level;
+    level.label = fmt::format("level {:.2f}", d.settings.level);
+    level.x = {x0, x1};
+    level.y = {d.settings.level, d.settings.level};
+    level.color = grey;
+    level.style = plot::LineStyle::kDashed;
+    ax.series.push_back(level);
+    if (c.window.found) {
+      for (const bool lower : {true, false}) {
+        const Edge& e = lower ? c.window.lower : c.window.upper;
+        const double x = std::log10(lower ? c.lower_edge : c.upper_edge);
+        const std::string name = lower ? "lower edge" : "upper edge";
+        if (!e.censored) {
+          ax.series.push_back(VerticalLine(x, name, red, plot::LineStyle::kSolid));
+          continue;
+        }
+        ax.series.push_back(
+            VerticalLine(x, name + " (censored: beyond the range)", red, plot::LineStyle::kDotted));
+        // An arrowhead at mid height pointing out of the range.
+        const double w = 0.04 * (x1 - x0), dir = lower ? -1 : 1;
+        plot::Series arrow;
+        arrow.x = {x, x + dir * w, x};
+        arrow.y = {0.45, 0.5, 0.55};
+        arrow.color = red;
+        arrow.width = 1.5;
+        ax.series.push_back(arrow);
+      }
+      ax.series.push_back(VerticalLine(std::log10(c.recommended), "recommended dT", green,
+                                       plot::LineStyle::kDashed));
+    }
+    fig.panels.push_back(ax);
+  }
+  return fig;
+}
+
 }  // namespace
 
 std::string TuneMarkdown(const PreparedSweep& p, const TuneDefinition& d, const TuneOutcome& o) {
@@ -225,13 +304,32 @@ nlohmann::json TuneJson(const TuneDefinition& d, const TuneOutcome& o) {
   return j;
 }
 
-Status WriteTuneReport(const PreparedSweep& p, const TuneDefinition& d, const TuneOutcome& o) {
+Status WriteTuneReport(const PreparedSweep& p, const TuneDefinition& d, const TuneOutcome& o,
+                       const FigureRenderer& render) {
   const fs::path dir(d.sweep.out);
+  if (render) {
+    const plot::Figure fig = WindowFigure(p, d, o);
+    const int h = 120 + 260 * static_cast<int>(std::max<size_t>(1, fig.panels.size()));
+    for (const auto f : {plot::Format::kPng, plot::Format::kSvg}) {
+      auto bytes = render(fig, 900, h, f);
+      if (!bytes.ok()) return Error{"tune figure: " + bytes.error(), bytes.code()};
+      const std::string file = f == plot::Format::kPng ? "window.png" : "window.svg";
+      if (Status s = WriteFileAtomically((dir / file).string(), *bytes); !s.ok()) {
+        return IoError(s.error());
+      }
+    }
+  }
   if (Status s = WriteFileAtomically((dir / "tune.json").string(), TuneJson(d, o).dump(1) + "\n");
       !s.ok()) {
     return IoError(s.error());
   }
-  if (Status s = WriteFileAtomically((dir / "tune.md").string(), TuneMarkdown(p, d, o)); !s.ok()) {
+  std::string md = TuneMarkdown(p, d, o);
+  if (render) {
+    md +=
+        "\n## Figure\n\n![fraction of seeds meeting against dT, with the window's edges (dotted "
+        "with an arrowhead: censored) and the recommended dT](window.png)\n";
+  }
+  if (Status s = WriteFileAtomically((dir / "tune.md").string(), md); !s.ok()) {
     return IoError(s.error());
   }
   return Status::Ok();
