@@ -68,6 +68,9 @@ int RunTuneCommand(TuneArgs& a) {
   if (!prep.ok()) return Fail(cmd, prep.failure());
   d.criterion.tracking = prep->criterion;  // options over the sweep file's criterion
   if (a.quantum < 0) d.settings.dT_quantum = sweep::PhysicsTimestep(*prep);
+  if (std::string why = sweep::CheckTuneSettings(d.settings); !why.empty()) {
+    return Fail(cmd, why, exit_code::kUsage);
+  }
   const bool tty = ::isatty(STDERR_FILENO);
   std::mutex mu;
   auto t0 = std::chrono::steady_clock::now();

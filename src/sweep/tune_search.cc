@@ -20,7 +20,10 @@ std::string CheckTuneSettings(const TuneSettings& s) {
   }
   if (s.initial_points < 2) return "--initial-points must be >= 2";
   if (!(s.dT_quantum >= 0) || s.dT_quantum > s.dT_min) {
-    return fmt::format("dT quantum {}: must be in [0, --dT-range min {}]", s.dT_quantum, s.dT_min);
+    return fmt::format(
+        "--dT-range min {} is below the dT quantum {} s (periods are its whole multiples; by "
+        "default the physics timestep; --dT-quantum)",
+        s.dT_min, s.dT_quantum);
   }
   if (s.initial_seeds < 1 || s.max_seeds < s.initial_seeds) {
     return fmt::format("--seeds {} / --max-seeds {}: need 1 <= seeds <= max-seeds", s.initial_seeds,

@@ -1,0 +1,85 @@
+// The tune's judgement of runs: each part of the criterion counted on the seeds that break it,
+// the overshoot's statistics over every step of every seed (against a direct computation), and
+// the datasheet limits (a run past one never meets).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "sweep/tune.h"
+
+namespace recruit::sweep {
+namespace {
+
+sim::RunSummary FakeRun(std::vector<double> step_overshoots, double settled, double peak_c = 50) {
+  sim::RunSummary r;
+  double sum = 0;
+  for (double x : step_overshoots) {
+    sim::StepResponse s;
+    s.step = {5, 0, 10, 20};
+    s.overshoot = x;
+    r.steps.push_back(s);
+    sum += x;
+  }
+  r.metrics.overshoot = sum / step_overshoots.size();
+  r.metrics.max_overshoot = *std::max_element(step_overshoots.begin(), step_overshoots.end());
+  r.metrics.settled_fraction = settled;
+  r.metrics.estimator_rmse = 2;
+  r.metrics.mean_nees = std::nan("");
+  sim::BundleSummary b;
+  b.peak_temperature = peak_c;
+  b.max_temperature = 100;
+  b.peak_wire_stress = 100e6;
+  b.max_wire_stress = 200e6;
+  r.bundles.push_back(b);
+  return r;
+}
+
+TEST(TuneSeed, EachPartOfTheCriterionIsCountedOnItsSeeds) {
+  TuneCriterion c;  // 10 % mean overshoot, 90 % settled
+  c.max_step_overshoot = 0.2;
+  const std::vector<sim::RunSummary> runs = {
+      FakeRun({0.02, 0.04}, 1.0),        // meets
+      FakeRun({0.15, 0.12}, 1.0),        // mean overshoot 13.5 %
+      FakeRun({0.01, 0.25}, 1.0),        // mean 13 % and worst step 25 %
+      FakeRun({0.0, 0.219}, 1.0),        // mean 10.95 % and worst 21.9 %
+      FakeRun({0.0, 0.0}, 0.5),          // settling
+      FakeRun({0.01, 0.02}, 1.0, 120)};  // 120 C against a 100 C limit
+  EXPECT_TRUE(CheckSeed(runs[0], c).meets());
+  EXPECT_TRUE(CheckSeed(runs[5], c).limits);
+  EXPECT_FALSE(CheckSeed(runs[5], c).meets());
+  TuneSettings s;
+  const DtRow row = SummarizeDt(0.5, runs, c, s);
+  EXPECT_EQ(row.seeds, 6);
+  EXPECT_EQ(row.meeting, 1);
+  EXPECT_EQ(row.fail_overshoot, 3);
+  EXPECT_EQ(row.fail_worst_step, 2);
+  EXPECT_EQ(row.fail_settling, 1);
+  EXPECT_EQ(row.fail_limits, 1);
+  EXPECT_DOUBLE_EQ(row.worst_temperature_ratio, 1.2);
+  EXPECT_DOUBLE_EQ(row.worst_stress_ratio, 0.5);
+  // 12 steps: mean, worst, and the 95th percentile interpolated between the sorted 11th and 12th
+  // (position 0.95 * 11 = 10.45).
+  std::vector<double> all = {0.02, 0.04, 0.15, 0.12, 0.01, 0.25, 0.0, 0.219, 0.0, 0.0, 0.01, 0.02};
+  double sum = 0;
+  for (double x : all) sum += x;
+  std::sort(all.begin(), all.end());
+  EXPECT_NEAR(row.overshoot_mean, sum / 12, 1e-12);
+  EXPECT_DOUBLE_EQ(row.overshoot_worst, 0.25);
+  EXPECT_NEAR(row.overshoot_p95, all[10] + 0.45 * (all[11] - all[10]), 1e-12);
+  // 1 of 6: the Wilson interval of the report.
+  const Interval w = WilsonInterval(1, 6, NormalQuantile(0.95));
+  EXPECT_DOUBLE_EQ(row.fraction.lo, w.lo);
+  EXPECT_EQ(row.verdict, Verdict::kFails);
+  EXPECT_TRUE(std::isnan(row.mean_nees));
+}
+
+TEST(TuneSeed, WithoutAStepLimitTheWorstStepPasses) {
+  TuneCriterion c;  // no limit on the worst step: the 21.9 % step in a 9 % mean passes
+  EXPECT_TRUE(CheckSeed(FakeRun({0.0, 0.05, 0.219, 0.1}, 1.0), c).meets());
+  c.max_step_overshoot = 0.2;
+  EXPECT_FALSE(CheckSeed(FakeRun({0.0, 0.05, 0.219, 0.1}, 1.0), c).meets());
+}
+
+}  // namespace
+}  // namespace recruit::sweep
