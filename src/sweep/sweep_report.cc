@@ -326,6 +326,7 @@ std::string ReportMarkdown(const ReportInput& in, const std::vector<Recommendati
       }
     }
   }
+  md += in.seed_reasons;
   if (with_figures) {
     md += "\n## Figures\n\n![criterion margin against dT](margin.png)\n";
     if (!axes.empty()) md += "\n![critical dT against each plant axis](critical_dt.png)\n";

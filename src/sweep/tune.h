@@ -96,6 +96,14 @@ Result<TuneOutcome> Tune(const PreparedSweep& p, const TuneDefinition& d, int th
 DtRow SummarizeDt(double dT, const std::vector<sim::RunSummary>& runs, const TuneCriterion& c,
                   const TuneSettings& s);
 
+// For a sweep's report: per cell (plant point, estimator, lambda, dT, in grid order) its seeds
+// judged one by one (CheckSeed): seeds meeting with the 95 % Wilson interval, why the others
+// fail (each part of the criterion, on how many seeds), the step overshoot's mean, 95th
+// percentile and worst step, and the runs past a datasheet limit. runs[i] was made for grid[i].
+std::string SeedReasonsMarkdown(const std::vector<SweepRun>& grid,
+                                const std::vector<sim::RunSummary>& runs,
+                                const TrackingCriterion& criterion);
+
 // tune.json (everything, machine-readable) and tune.md (the report) into `d.sweep.out`; with a
 // renderer also window.png/.svg (per search the fraction of seeds meeting against log dT with its
 // Wilson band, the level, the edges, a censored one dotted with an arrowhead out of the range, and

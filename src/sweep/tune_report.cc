@@ -7,6 +7,8 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <map>
+#include <tuple>
 
 #include "common/atomic_file.h"
 #include "sweep/tune.h"
@@ -136,6 +138,44 @@ plot::Figure WindowFigure(const PreparedSweep& p, const TuneDefinition& d, const
 }
 
 }  // namespace
+
+std::string SeedReasonsMarkdown(const std::vector<SweepRun>& grid,
+                                const std::vector<sim::RunSummary>& runs,
+                                const TrackingCriterion& criterion) {
+  using Key = std::tuple<int, std::string, double, double>;
+  std::vector<Key> order;
+  std::map<Key, std::vector<sim::RunSummary>> cells;
+  std::map<Key, const SweepRun*> first;
+  for (size_t i = 0; i < runs.size() && i < grid.size(); ++i) {
+    const Key k{grid[i].plant, grid[i].estimator, grid[i].lambda, grid[i].dT};
+    if (!cells.count(k)) {
+      order.push_back(k);
+      first[k] = &grid[i];
+    }
+    cells[k].push_back(runs[i]);
+  }
+  TuneCriterion c;
+  c.tracking = criterion;
+  const TuneSettings s;  // the 95 % interval
+  std::string md =
+      "\n## Seeds one by one\n\nEach seed's own run against the criterion (its mean step "
+      "overshoot, its settled fraction, its wires' datasheet limits): the seeds meeting with the "
+      "95 % Wilson interval of that fraction, why the others fail (each part, on how many "
+      "seeds), and the step overshoot over every step of every seed.\n\n"
+      "| plant | estimator | lambda | dT (s) | seeds meeting (95 % interval) | why it fails "
+      "(seeds) "
+      "| overshoot mean / p95 / worst step (%) | runs past a limit |\n"
+      "|---|---|---|---|---|---|---|---|\n";
+  for (const Key& k : order) {
+    const DtRow r = SummarizeDt(std::get<3>(k), cells[k], c, s);
+    md += fmt::format("| {} | {} | {} | {} | {}/{} ({:.0f}-{:.0f} %) | {} | {} / {} / {} | {} |\n",
+                      TunePlantLabel(first[k]->plant_values), std::get<1>(k), std::get<2>(k),
+                      std::get<3>(k), r.meeting, r.seeds, 100 * r.fraction.lo, 100 * r.fraction.hi,
+                      Why(r), Percent(r.overshoot_mean), Percent(r.overshoot_p95),
+                      Percent(r.overshoot_worst), r.fail_limits);
+  }
+  return md;
+}
 
 std::string TuneMarkdown(const PreparedSweep& p, const TuneDefinition& d, const TuneOutcome& o) {
   const TuneSettings& s = d.settings;
