@@ -1,6 +1,7 @@
 // The tune's judgement of runs: each part of the criterion counted on the seeds that break it,
 // the overshoot's statistics over every step of every seed (against a direct computation), and
 // the datasheet limits (a run past one never meets).
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -79,6 +80,39 @@ TEST(TuneSeed, WithoutAStepLimitTheWorstStepPasses) {
   EXPECT_TRUE(CheckSeed(FakeRun({0.0, 0.05, 0.219, 0.1}, 1.0), c).meets());
   c.max_step_overshoot = 0.2;
   EXPECT_FALSE(CheckSeed(FakeRun({0.0, 0.05, 0.219, 0.1}, 1.0), c).meets());
+}
+
+TEST(TuneSeed, TheSweepReportGivesEachCellsReasons) {
+  // Two cells of a sweep grid (dT 0.5 and 1, three seeds each), runs in grid order.
+  std::vector<SweepRun> grid;
+  std::vector<sim::RunSummary> runs;
+  for (double dT : {0.5, 1.0}) {
+    for (int seed = 0; seed < 3; ++seed) {
+      SweepRun g;
+      g.dT = dT;
+      g.lambda = 0.2;
+      g.estimator = "output";
+      g.seed_index = seed;
+      grid.push_back(g);
+      // At 0.5 s two seeds overshoot; at 1 s one leaves half its steps unsettled.
+      runs.push_back(dT < 1 ? FakeRun({seed < 2 ? 0.3 : 0.01, 0.02}, 1.0)
+                            : FakeRun({0.01, 0.02}, seed == 0 ? 0.5 : 1.0));
+    }
+  }
+  const std::string md = SeedReasonsMarkdown(grid, runs, TrackingCriterion{});
+  // At 0.5 s the steps are 0.3, 0.02, 0.3, 0.02, 0.01, 0.02: mean 0.67 / 6 = 11.2 %, and the 95th
+  // percentile at sorted position 0.95 * 5 = 4.75 lies between the two 0.3 steps.
+  const double z = NormalQuantile(0.95);
+  const Interval a = WilsonInterval(1, 3, z), b = WilsonInterval(2, 3, z);
+  EXPECT_NE(
+      md.find(fmt::format("| 0.5 | 1/3 ({:.0f}-{:.0f} %) | overshoot 2/3 | 11.2 / 30.0 / 30.0 |",
+                          100 * a.lo, 100 * a.hi)),
+      std::string::npos)
+      << md;
+  EXPECT_NE(
+      md.find(fmt::format("| 1 | 2/3 ({:.0f}-{:.0f} %) | settling 1/3 |", 100 * b.lo, 100 * b.hi)),
+      std::string::npos)
+      << md;
 }
 
 }  // namespace
