@@ -3,7 +3,8 @@
 // round runs the batch the search asks for with the sweep's runner (threads, one record per run
 // under <out>/runs keyed and hashed as a sweep's, so a stopped search started again reuses every
 // run it made) and judges each run on its own: its mean step overshoot, its settled fraction, its
-// worst step (optional limit) and the datasheet limits of its wires. Writes tune.json and tune.md.
+// worst step (optional limit) and the datasheet limits of its wires. Writes tune.json, tune.md and
+// window.png/.svg. A shard (TuneDefinition::shard_k/n) runs every n-th search.
 #pragma once
 
 #include <limits>
@@ -92,7 +93,7 @@ double PhysicsTimestep(const PreparedSweep& p);
 Result<TuneOutcome> Tune(const PreparedSweep& p, const TuneDefinition& d, int threads,
                          const TuneHooks& hooks);
 
-// The per-column rows from runs already judged: `runs[k][s]` is seed s at lattice index k.
+// One period's row from its runs (seed indices 0..n-1), each judged by CheckSeed.
 DtRow SummarizeDt(double dT, const std::vector<sim::RunSummary>& runs, const TuneCriterion& c,
                   const TuneSettings& s);
 
