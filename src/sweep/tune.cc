@@ -76,6 +76,16 @@ DtRow SummarizeDt(double dT, const std::vector<sim::RunSummary>& runs, const Tun
     row.fail_worst_step += ch.worst_step;
     row.fail_limits += ch.limits;
     for (const auto& st : r.steps) steps.push_back(st.overshoot);
+    for (const auto& w : r.warnings) {
+      if (w.find("exceeds the limit") != std::string::npos) continue;  // counted as limits
+      auto it = std::find_if(row.warnings.begin(), row.warnings.end(),
+                             [&w](const auto& x) { return x.first == w; });
+      if (it == row.warnings.end()) {
+        row.warnings.emplace_back(w, 1);
+      } else {
+        ++it->second;
+      }
+    }
     settled += r.metrics.settled_fraction;
     rmse += r.metrics.estimator_rmse;
     if (std::isfinite(r.metrics.mean_nees)) {

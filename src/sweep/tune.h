@@ -46,6 +46,9 @@ struct DtRow {
   double worst_temperature_ratio = 0, worst_stress_ratio = 0;
   // The estimator against the true count (the filter model's quality at this dT).
   double estimator_rmse = 0, mean_nees = 0;
+  // The runs' other warnings (e.g. an identified model explaining too little of held-out force,
+  // sim/run_task.h), each with the number of runs that gave it; limit excesses are counted above.
+  std::vector<std::pair<std::string, int>> warnings;
 };
 
 // The search's result for one plant point, estimator and lambda.

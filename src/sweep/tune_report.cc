@@ -260,6 +260,11 @@ std::string TuneMarkdown(const PreparedSweep& p, const TuneDefinition& d, const 
           r.worst_stress_ratio > 1 ? " (exceeded)" : "", r.estimator_rmse,
           std::isfinite(r.mean_nees) ? fmt::format("{:.2f}", r.mean_nees) : std::string("-"));
     }
+    for (const auto& r : col.rows) {
+      for (const auto& [text, n] : r.warnings) {
+        md += fmt::format("\nAt dT {} s, {} of {} runs: {}\n", r.dT, n, r.seeds, text);
+      }
+    }
     int limit_runs = 0;
     double worst_t = 0, worst_s = 0;
     for (const auto& r : col.rows) {
@@ -327,7 +332,8 @@ nlohmann::json TuneJson(const TuneDefinition& d, const TuneOutcome& o) {
                       {"worst_temperature_ratio", r.worst_temperature_ratio},
                       {"worst_stress_ratio", r.worst_stress_ratio},
                       {"estimator_rmse", r.estimator_rmse},
-                      {"mean_nees", num(r.mean_nees)}});
+                      {"mean_nees", num(r.mean_nees)},
+                      {"warnings", r.warnings}});
     }
     cols.push_back({{"plant", c.plant},
                     {"plant_values", pv},

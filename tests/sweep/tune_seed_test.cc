@@ -39,13 +39,16 @@ sim::RunSummary FakeRun(std::vector<double> step_overshoots, double settled, dou
 TEST(TuneSeed, EachPartOfTheCriterionIsCountedOnItsSeeds) {
   TuneCriterion c;  // 10 % mean overshoot, 90 % settled
   c.max_step_overshoot = 0.2;
-  const std::vector<sim::RunSummary> runs = {
+  std::vector<sim::RunSummary> runs = {
       FakeRun({0.02, 0.04}, 1.0),        // meets
       FakeRun({0.15, 0.12}, 1.0),        // mean overshoot 13.5 %
       FakeRun({0.01, 0.25}, 1.0),        // mean 13 % and worst step 25 %
       FakeRun({0.0, 0.219}, 1.0),        // mean 10.95 % and worst 21.9 %
       FakeRun({0.0, 0.0}, 0.5),          // settling
       FakeRun({0.01, 0.02}, 1.0, 120)};  // 120 C against a 100 C limit
+  runs[4].warnings = {"bundle: its identified model explains R^2 = 0.50 of held-out force",
+                      "bundle: peak unit temperature 120.0 C exceeds the limit 100.0 C"};
+  runs[5].warnings = runs[4].warnings;
   EXPECT_TRUE(CheckSeed(runs[0], c).meets());
   EXPECT_TRUE(CheckSeed(runs[5], c).limits);
   EXPECT_FALSE(CheckSeed(runs[5], c).meets());
@@ -73,6 +76,9 @@ TEST(TuneSeed, EachPartOfTheCriterionIsCountedOnItsSeeds) {
   EXPECT_DOUBLE_EQ(row.fraction.lo, w.lo);
   EXPECT_EQ(row.verdict, Verdict::kFails);
   EXPECT_TRUE(std::isnan(row.mean_nees));
+  // The model-quality warning counted on its two runs; the limit line is counted as limits.
+  ASSERT_EQ(row.warnings.size(), 1u);
+  EXPECT_EQ(row.warnings[0].second, 2);
 }
 
 TEST(TuneSeed, WithoutAStepLimitTheWorstStepPasses) {
