@@ -11,6 +11,7 @@ void AddFilterCommand(CLI::App& app, int& exit_code);    // filter_command.cc
 void AddIdentifyCommand(CLI::App& app, int& exit_code);  // identify_command.cc
 void AddSimulateCommand(CLI::App& app, int& exit_code);  // simulate_command.cc
 void AddSweepCommand(CLI::App& app, int& exit_code);     // sweep_command.cc
+void AddTuneCommand(CLI::App& app, int& exit_code);      // tune_command.cc
 void AddRenderCommand(CLI::App& app, int& exit_code);    // render_command.cc
 void AddPlotCommand(CLI::App& app, int& exit_code);      // plot_command.cc
 void AddTuneLoopCommand(CLI::App& app, int& exit_code);  // tune_loop_command.cc

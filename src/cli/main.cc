@@ -58,7 +58,8 @@ int main(int argc, char** argv) {
                   {"attach", cli::AddAttachCommand},
                   {"export", cli::AddExportCommand},
                   {"replay", cli::AddReplayCommand},
-                  {"sil", cli::AddSilCommand}};
+                  {"sil", cli::AddSilCommand},
+                  {"tune", cli::AddTuneCommand}};
   const std::string first = argc > 1 ? argv[1] : "";
   bool named = false;
   for (const auto& c : commands) named |= first == c.name;

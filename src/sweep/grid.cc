@@ -148,6 +148,20 @@ Result<RunSummary> RunSummaryFromJson(const json& j) {
       sr.settled = st.at("settled");
       s.steps.push_back(sr);
     }
+    // The wires' peaks against their limits and the warnings (absent in older records).
+    for (const json& b : j.value("bundles", json::array())) {
+      sim::BundleSummary bs;
+      bs.actuator = b.at("actuator").get<std::string>();
+      bs.estimator_rmse = b.at("estimator_rmse").get<double>();
+      bs.mean_nees = b.at("mean_nees").is_number() ? b.at("mean_nees").get<double>() : std::nan("");
+      bs.estimator_within3 = b.at("estimator_within3").get<double>();
+      bs.peak_temperature = b.at("peak_temperature").get<double>();
+      bs.peak_wire_stress = b.at("peak_wire_stress").get<double>();
+      bs.max_temperature = b.at("max_temperature").get<double>();
+      bs.max_wire_stress = b.at("max_wire_stress").get<double>();
+      s.bundles.push_back(bs);
+    }
+    s.warnings = j.value("warnings", std::vector<std::string>{});
     return s;
   } catch (const json::exception& e) {
     return Error{std::string("run record: ") + e.what()};

@@ -17,6 +17,7 @@
 #include "common/version.h"
 #include "sim/run_task.h"
 #include "sweep/latency.h"
+#include "sweep/tune.h"
 
 namespace recruit::sweep {
 namespace {
@@ -226,6 +227,11 @@ Result<PreparedSweep> Prepare(const SweepDefinition& d) {
   return p;
 }
 
+std::string InputHash(const PreparedSweep& p, const SweepRun& run) {
+  std::map<std::string, std::string> contents;
+  return RunInputHash(p.plant.at(run.plant), p.spec, run, contents);
+}
+
 Result<FileLock> OpenOutput(const PreparedSweep& p, const SweepDefinition& d) {
   // The outputs must not replace the inputs (a task file kept in the output folder).
   for (const char* name :
@@ -257,7 +263,8 @@ Status WriteReports(const PreparedSweep& p, const std::vector<sim::RunSummary>& 
         StabilityMapOptions(out, p.task.name, static_cast<int>(p.spec.estimators.size()));
     if (Status s = draw.stability_map(map); !s.ok()) return IoError(s.error());
   }
-  ReportInput in{p.task.name, p.description, p.criterion, cells, {}};
+  ReportInput in{p.task.name, p.description, p.criterion, cells, {}, {}};
+  in.seed_reasons = SeedReasonsMarkdown(p.grid, runs, p.criterion);
   // The output-only loop's latency bound needs each plant point's force latency (one open-loop
   // step of its model, ~0.1 s each); a point whose model cannot do it gets none (NaN).
   if (std::find(p.spec.estimators.begin(), p.spec.estimators.end(), "output") !=

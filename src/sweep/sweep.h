@@ -69,6 +69,10 @@ struct PreparedSweep {
 // with a bad grid, kIo for a file that cannot be read or written, else kBadInput.
 Result<PreparedSweep> Prepare(const SweepDefinition& d);
 
+// The input hash of a run of `p` (SweepRun::input_hash) at any dT, lambda, estimator and seed,
+// as Prepare sets it for the grid's runs: the tune makes runs off the grid.
+std::string InputHash(const PreparedSweep& p, const SweepRun& run);
+
 // Checks that no output replaces an input (kUsage), creates `d.out` and takes its lock (kIo).
 Result<FileLock> OpenOutput(const PreparedSweep& p, const SweepDefinition& d);
 

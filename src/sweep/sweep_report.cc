@@ -9,6 +9,7 @@
 
 #include "common/atomic_file.h"
 #include "sweep/latency.h"
+#include "sweep/tune_search.h"
 
 namespace recruit::sweep {
 namespace {
@@ -257,9 +258,12 @@ std::string ReportMarkdown(const ReportInput& in, const std::vector<Recommendati
       "# Sampling-period report: {}\n\n{}\n\nCriterion: mean step overshoot <= {:.0f} % and at "
       "least {:.0f} % of steps settled within the band, over all seeds of a cell. Margin = "
       "min(overshoot limit - overshoot, settled fraction - required fraction). Recommended dT = "
-      "the shortest dT tried that meets the criterion; confidence = Phi(margin / se), se = the "
-      "standard error of the seeds' own margins; critical dT = where the margin crosses 0, "
-      "interpolated in log dT (<= when the shortest dT tried already meets).{}\n\n"
+      "the shortest dT tried that meets the criterion (`recruit tune` finds the window and a dT "
+      "with room to both edges); se = the standard error of the seeds' own margins; seeds "
+      "meeting = the seeds whose own run meets the criterion, with the 95 % Wilson interval of "
+      "that fraction; critical dT = where the margin crosses 0, interpolated in log dT "
+      "(censored, \"< x\", when the shortest dT tried already meets: extend the grid below "
+      "it).{}\n\n"
       "## Recommended dT per plant point\n\n",
       in.title, in.description, 100 * in.criterion.max_overshoot, 100 * in.criterion.min_settled,
       bound ? fmt::format(
@@ -277,21 +281,22 @@ std::string ReportMarkdown(const ReportInput& in, const std::vector<Recommendati
     rule += "|---";
   }
   md += head +
-        "| estimator | lambda | recommended dT (s) | margin ± se | confidence | seeds meeting | "
+        "| estimator | lambda | recommended dT (s) | margin ± se | seeds meeting (95 % interval) | "
         "critical dT (s) |" +
         (bound ? " tau (s) | latency bound dT (s) |" : "") + "\n" + rule +
-        "|---|---|---|---|---|---|---|" + (bound ? "---|---|" : "") + "\n";
+        "|---|---|---|---|---|---|" + (bound ? "---|---|" : "") + "\n";
   for (const auto& r : recs) {
     std::string row = fmt::format("| {} ", r.plant);
     for (const auto& [name, v] : r.plant_values) row += fmt::format("| {} ", v);
     if (r.found) {
-      row += fmt::format("| {} | {} | {} | {:+.3f} ± {:.3f} | {} | {}/{} | {}{} |", r.estimator,
-                         r.lambda, r.dT, r.margin, r.margin_se, Fmt(100 * r.confidence, "{:.0f} %"),
-                         r.seeds_meeting, r.seeds, r.censored ? "<= " : "",
-                         Fmt(r.critical_dT, "{:.3g}"));
+      const Interval w = WilsonInterval(r.seeds_meeting, r.seeds, NormalQuantile(0.95));
+      row += fmt::format(
+          "| {} | {} | {} | {:+.3f} ± {:.3f} | {}/{} ({:.0f}-{:.0f} %) | {}{} |", r.estimator,
+          r.lambda, r.dT, r.margin, r.margin_se, r.seeds_meeting, r.seeds, 100 * w.lo, 100 * w.hi,
+          Fmt(r.critical_dT, r.censored ? "< {:.3g}" : "{:.3g}"),
+          r.censored ? " (censored: below the shortest dT tried; extend the grid)" : "");
     } else {
-      row +=
-          fmt::format("| {} | {} | none of the dT tried | - | - | - | - |", r.estimator, r.lambda);
+      row += fmt::format("| {} | {} | none of the dT tried | - | - | - |", r.estimator, r.lambda);
     }
     if (bound) {
       const double tau =
@@ -321,6 +326,7 @@ std::string ReportMarkdown(const ReportInput& in, const std::vector<Recommendati
       }
     }
   }
+  md += in.seed_reasons;
   if (with_figures) {
     md += "\n## Figures\n\n![criterion margin against dT](margin.png)\n";
     if (!axes.empty()) md += "\n![critical dT against each plant axis](critical_dt.png)\n";

@@ -28,6 +28,9 @@ struct ReportInput {
   // Per plant point: the agonist's force latency tau (s, sweep/latency.h; NaN = unknown). Empty:
   // no latency bound in the report.
   std::vector<double> latency;
+  // Markdown appended to the report's tables (before the figures): the seeds' reasons per cell
+  // (sweep/tune.h SeedReasonsMarkdown).
+  std::string seed_reasons;
 };
 
 // The Markdown text (figure links relative to the report); figures are listed only if made,
