@@ -124,6 +124,11 @@ struct Channel {
   control::RecruitmentController controller;
   EstimatorScoreAccumulator score;  // the estimate against the truth at the control instants
   SwitchingCounter switches;        // on-count after each broadcast
+  // Control instants at which the reference needed more than the working units could give, and
+  // at which the stuck units alone gave more (RecruitmentController::saturation; only estimators
+  // that count failed units set it).
+  long out_of_reach = 0, stuck_over = 0;
+  long instants = 0;
 };
 
 // The filter model file of bundle i for `spec`: the task's (its "{bundle}" replaced by the
@@ -353,6 +358,9 @@ Status ControlInstantStep(const Task& task, AngleLoop& loop, JointLoops* joints,
       ci.broadcast[i] = c.Step(force_ref[i], ci.sensed_force[i], ci.tendon_length[i]);
       ci.estimated_on[i] = c.estimated_on();
       ci.estimated_on_variance[i] = c.estimated_on_variance();
+      channels[i].out_of_reach += c.saturation() > 0;
+      channels[i].stuck_over += c.saturation() < 0;
+      ++channels[i].instants;
     }
     if (hook != nullptr) {
       if (Status st = hook->OnInstant(ci); !st.ok()) return st;
@@ -440,7 +448,7 @@ void Summarize(const Task& task, const Plant& plant, const SignalMetrics& sig,
       mt.mean_nees = es.mean_nees;
       mt.estimator_within3 = es.within3;
     }
-    char buf[200];
+    char buf[320];
     if (bs.peak_temperature > lim.max_temperature) {
       std::snprintf(buf, sizeof buf, "%s: peak unit temperature %.1f C exceeds the limit %.1f C",
                     bs.actuator.c_str(), bs.peak_temperature, lim.max_temperature);
@@ -449,6 +457,21 @@ void Summarize(const Task& task, const Plant& plant, const SignalMetrics& sig,
     if (bs.peak_wire_stress > lim.max_wire_stress) {
       std::snprintf(buf, sizeof buf, "%s: peak wire stress %.1f MPa exceeds the limit %.1f MPa",
                     bs.actuator.c_str(), bs.peak_wire_stress / 1e6, lim.max_wire_stress / 1e6);
+      s.warnings.push_back(buf);
+    }
+    if (ch.out_of_reach > 0) {
+      std::snprintf(
+          buf, sizeof buf,
+          "%s: the reference needed more than the working units could give at %ld of "
+          "%ld control instants (the law asked for every working unit there, without wind-up)",
+          bs.actuator.c_str(), ch.out_of_reach, ch.instants);
+      s.warnings.push_back(buf);
+    }
+    if (ch.stuck_over > 0) {
+      std::snprintf(buf, sizeof buf,
+                    "%s: the stuck units alone pulled more than the reference at %ld of %ld "
+                    "control instants",
+                    bs.actuator.c_str(), ch.stuck_over, ch.instants);
       s.warnings.push_back(buf);
     }
   }
