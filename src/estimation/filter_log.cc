@@ -7,8 +7,8 @@
 #include <cstring>
 #include <sstream>
 
-#include "estimation/bench_log.h"
 #include "common/short_text.h"
+#include "estimation/bench_log.h"
 #include "estimation/json_matrix.h"
 #include "estimation/population_chain.h"
 #include "estimation/shortest_double.h"

@@ -10,6 +10,8 @@
 extern "C" {
 #endif
 
+/* @NAME@ are the generator's placeholders, kept as they are: */
+/* clang-format off */
 typedef @REAL@ recruit_real;
 
 #define RECRUIT_NUM_BUNDLES @NB@
@@ -17,6 +19,7 @@ typedef @REAL@ recruit_real;
 #define RECRUIT_MAX_ENTRIES @NNZMAX@ /* largest number of nonzeros of a bundle's A */
 #define RECRUIT_PACKED (RECRUIT_MAX_STATES * (RECRUIT_MAX_STATES + 1) / 2)
 #define RECRUIT_TRACKS_ANGLE @ANGLE@ /* 1: reference and outer loop in rad; 0: force (N) */
+/* clang-format on */
 
 /* A bundle's constants (the identified model, unit geometry, gains): in recruit_controller.c. */
 typedef struct recruit_bundle_params recruit_bundle_params;
@@ -74,8 +77,7 @@ void recruit_step(recruit_controller *c, const recruit_input *in, recruit_output
 void recruit_bundle_init(recruit_bundle *b, int index);
 void recruit_bundle_step(recruit_bundle *b, recruit_work *work, recruit_real force_reference,
                          recruit_real force, recruit_real length, recruit_real *p_on,
-                         recruit_real *p_off, recruit_real *estimated_on,
-                         recruit_real *variance);
+                         recruit_real *p_off, recruit_real *estimated_on, recruit_real *variance);
 
 #ifdef __cplusplus
 }

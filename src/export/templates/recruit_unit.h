@@ -45,9 +45,9 @@ uint32_t recruit_pcg32_next(recruit_pcg32 *g);
 /* One unit: its heater command and its generator. */
 typedef struct {
   recruit_pcg32 rng;
-  uint8_t bundle;    /* the bundle it belongs to */
-  uint8_t on;        /* heater command: 1 on, 0 off */
-  uint8_t has_last;  /* a frame was taken (last_sequence is valid) */
+  uint8_t bundle;   /* the bundle it belongs to */
+  uint8_t on;       /* heater command: 1 on, 0 off */
+  uint8_t has_last; /* a frame was taken (last_sequence is valid) */
   uint16_t last_sequence;
 } recruit_unit;
 
