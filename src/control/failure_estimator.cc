@@ -3,21 +3,16 @@
 #include <cmath>
 #include <string>
 
+#include "control/kalman_estimator.h"
+
 namespace recruit::control {
 
 Result<std::unique_ptr<FailureOnCountEstimator>> FailureOnCountEstimator::Create(
     const FilterModel& model, CovarianceMode mode, const FailureFilterParams& params,
     std::optional<UnitForceMap> output, double relative_noise) {
-  if (output && output->num_states() != model.num_states()) {
-    return Error{"estimator: the unit force map has " + std::to_string(output->num_states()) +
-                 " states, the model " + std::to_string(model.num_states())};
-  }
-  if (!std::isfinite(relative_noise) || relative_noise < 0) {
-    return Error{"estimator: relative_noise = " + std::to_string(relative_noise) +
-                 " must be finite and >= 0"};
-  }
+  RECRUIT_TRY(CheckEstimatorInputs(model, output, relative_noise));
   auto filter = FailureKalmanFilter::Create(model, mode, params);
-  if (!filter) return Error{filter.error()};
+  if (!filter) return filter.failure();
   return std::unique_ptr<FailureOnCountEstimator>(new FailureOnCountEstimator(
       model, std::move(filter).value(), std::move(output), relative_noise));
 }

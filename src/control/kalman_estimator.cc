@@ -4,9 +4,8 @@
 
 namespace recruit::control {
 
-Result<std::unique_ptr<KalmanOnCountEstimator>> KalmanOnCountEstimator::Create(
-    const FilterModel& model, CovarianceMode mode, std::optional<UnitForceMap> output,
-    double relative_noise) {
+Status CheckEstimatorInputs(const FilterModel& model, const std::optional<UnitForceMap>& output,
+                            double relative_noise) {
   if (Status s = model.Validate(); !s) return Error{s.error(), s.code()};
   if (model.transition != TransitionSource::kBroadcast) {
     return Error{
@@ -25,6 +24,13 @@ Result<std::unique_ptr<KalmanOnCountEstimator>> KalmanOnCountEstimator::Create(
     return Error{"estimator: relative_noise = " + std::to_string(relative_noise) +
                  " must be finite and >= 0"};
   }
+  return {};
+}
+
+Result<std::unique_ptr<KalmanOnCountEstimator>> KalmanOnCountEstimator::Create(
+    const FilterModel& model, CovarianceMode mode, std::optional<UnitForceMap> output,
+    double relative_noise) {
+  RECRUIT_TRY(CheckEstimatorInputs(model, output, relative_noise));
   auto filter = PopulationKalmanFilter::Create(model, mode);
   if (!filter) return Error{filter.error(), filter.code()};
   return std::unique_ptr<KalmanOnCountEstimator>(new KalmanOnCountEstimator(

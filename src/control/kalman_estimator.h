@@ -14,6 +14,11 @@
 
 namespace recruit::control {
 
+// What every population-filter estimator needs of its inputs: a valid broadcast model with one
+// output, a unit force map of as many states, a finite relative noise >= 0.
+Status CheckEstimatorInputs(const FilterModel& model, const std::optional<UnitForceMap>& output,
+                            double relative_noise);
+
 class KalmanOnCountEstimator final : public OnCountEstimator {
  public:
   // `model` must be a single-output model with a broadcast transition; the filter starts from
