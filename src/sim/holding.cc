@@ -79,18 +79,4 @@ JointHolding HoldJoint(const Plant& plant, int j, const Eigen::VectorXd& r,
   return h;
 }
 
-std::vector<UnitForce> PhysicsUnitForces(const Plant& plant) {
-  std::vector<UnitForce> out;
-  for (int i = 0; i < plant.num_bundles(); ++i) {
-    const int b = plant.bundle_index(i);
-    const sma::UnitModel* unit = &plant.host().bundle(b).unit();
-    const double prestretch = unit->params().prestretch;
-    const double ref = plant.host().unit_ref_length(b);
-    out.push_back([unit, prestretch, ref](double L) {
-      return std::max(0.0, unit->Tension(0.0, prestretch + (L - ref)));
-    });
-  }
-  return out;
-}
-
 }  // namespace recruit::sim

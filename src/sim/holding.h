@@ -39,8 +39,4 @@ JointHolding HoldJoint(const Plant& plant, int j, const Eigen::VectorXd& r,
                        const std::vector<UnitForce>& on_unit_force, double co_contraction,
                        const Eigen::VectorXd& price);
 
-// Each bundle's unit force map from its units' physics (a unit fully transformed at the
-// extension the length gives), for when no controller and identified model exist yet.
-std::vector<UnitForce> PhysicsUnitForces(const Plant& plant);
-
 }  // namespace recruit::sim

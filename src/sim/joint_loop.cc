@@ -116,8 +116,7 @@ Result<JointDesignRecord> JointLoops::Design(const Plant& plant, int j, const Ei
   return rec;
 }
 
-void JointLoops::Step(double t, const Plant& plant, const std::vector<double>& capacity,
-                      std::vector<double>& force_ref) {
+void JointLoops::Step(double t, const Plant& plant, std::vector<double>& force_ref) {
   const int nj = plant.num_joints(), nb = plant.num_bundles();
   const Eigen::VectorXd r = LoopReference(plant, t);
   // Gains for this pose: designed once per reference value (a step's target).
@@ -181,7 +180,8 @@ void JointLoops::Step(double t, const Plant& plant, const std::vector<double>& c
   // combination of counts that comes nearest it (control::RoundToUnits).
   const Eigen::VectorXd tensions = control::RoundToUnits(p, continuous, unit_force, units);
   for (int i = 0; i < nb; ++i) {
-    force_ref[i] = unit_force[i] > 0 ? tensions[i] / unit_force[i] * capacity[i] / units[i] : 0.0;
+    const double count = unit_force[i] > 0 ? tensions[i] / unit_force[i] : 0.0;
+    force_ref[i] = count * on_unit_force_[i](plant.UnitLength(i));
   }
 }
 

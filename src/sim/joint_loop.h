@@ -49,10 +49,8 @@ class JointLoops {
                                    std::vector<control::ActuatorResponse> responses,
                                    std::vector<UnitForce> on_unit_force, double dT);
 
-  // The force reference (N) of every bundle at a control instant; `capacity` is each bundle's
-  // tension with every unit on at its present length.
-  void Step(double t, const Plant& plant, const std::vector<double>& capacity,
-            std::vector<double>& force_ref);
+  // The force reference (N) of every bundle at a control instant.
+  void Step(double t, const Plant& plant, std::vector<double>& force_ref);
 
   // Every design made so far, in the order made.
   const std::vector<JointDesignRecord>& designs() const { return designs_; }

@@ -294,15 +294,9 @@ std::vector<UnitForce> UnitForces(const std::vector<Channel>& channels) {
 // force task; for an angle task the outer loop's net force, split into agonist and antagonist
 // on top of their tone.
 void ForceReferences(const Task& task, AngleLoop& loop, JointLoops* joints, const Plant& plant,
-                     const std::vector<Channel>& channels, double t, double dT,
-                     std::vector<double>& force_ref) {
+                     double t, double dT, std::vector<double>& force_ref) {
   if (joints != nullptr) {
-    // Each bundle's capacity: every unit on, at its tendon's present length.
-    std::vector<double> capacity(plant.num_bundles());
-    for (int i = 0; i < plant.num_bundles(); ++i) {
-      capacity[i] = plant.num_units(i) * channels[i].controller.OnUnitForce(plant.UnitLength(i));
-    }
-    joints->Step(t, plant, capacity, force_ref);
+    joints->Step(t, plant, force_ref);
     return;
   }
   const double r = task.reference(t);
@@ -351,7 +345,7 @@ Status ControlInstantStep(const Task& task, AngleLoop& loop, JointLoops* joints,
     if (Status st = hook->OnInstant(ci); !st.ok()) return st;
     force_ref = ci.force_reference;
   } else {
-    ForceReferences(task, loop, joints, plant, channels, t, dT, force_ref);
+    ForceReferences(task, loop, joints, plant, t, dT, force_ref);
     for (int i = 0; i < nb; ++i) {
       control::RecruitmentController& c = channels[i].controller;
       ci.force_reference[i] = force_ref[i];

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -81,6 +82,22 @@ std::vector<Case> Cases() {
   std::vector<Case> out;
   out.push_back({OneJointPlant(kRoot + "/models/elbow_arm.xml", 0.05), {15, 40, 65}});
   out.push_back({OneJointPlant(LeverModel(), 0.05), {-4, 0, 4}});
+  return out;
+}
+
+// Each bundle's unit force map from its units' physics: a unit fully transformed at the
+// extension the length gives.
+std::vector<UnitForce> PhysicsUnitForces(const Plant& plant) {
+  std::vector<UnitForce> out;
+  for (int i = 0; i < plant.num_bundles(); ++i) {
+    const int b = plant.bundle_index(i);
+    const sma::UnitModel* unit = &plant.host().bundle(b).unit();
+    const double prestretch = unit->params().prestretch;
+    const double ref = plant.host().unit_ref_length(b);
+    out.push_back([unit, prestretch, ref](double L) {
+      return std::max(0.0, unit->Tension(0.0, prestretch + (L - ref)));
+    });
+  }
   return out;
 }
 
