@@ -1,5 +1,6 @@
 #include "common/json_fields.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "common/short_text.h"
@@ -14,6 +15,21 @@ std::string Join(const std::set<std::string>& s) {
   std::string out;
   for (const auto& x : s) out += (out.empty() ? "" : ", ") + x;
   return out;
+}
+
+// "2 x 3", "r x 3" (any number of rows), ...
+std::string Shape(int rows, int cols) {
+  return (rows >= 0 ? std::to_string(rows) : std::string("r")) + " x " +
+         (cols >= 0 ? std::to_string(cols) : std::string("c"));
+}
+
+// A finite number, else "field: must be a finite number, got X".
+Status FiniteNumber(const json& v, const std::string& field, double* out) {
+  if (!v.is_number() || !std::isfinite(v.get<double>())) {
+    return Error{field + ": must be a finite number, got " + ShortText(v.dump())};
+  }
+  *out = v.get<double>();
+  return Status::Ok();
 }
 
 }  // namespace
@@ -75,6 +91,133 @@ Status Unsigned(const json& j, const std::string& key, const std::string& where,
     return Error{where + "." + key + ": " + ShortText(v.dump()) + "; allowed: a whole number >= 0"};
   }
   *out = v.get<std::uint64_t>();
+  return Status::Ok();
+}
+
+Status OneOf(const json& j, const std::string& key, const std::string& where, std::string* out,
+             bool required, const std::vector<std::string>& allowed) {
+  std::string names;
+  for (const auto& a : allowed) names += (names.empty() ? "" : ", ") + json(a).dump();
+  if (!j.contains(key)) {
+    if (required) return Error{where + ": missing field '" + key + "' (one of " + names + ")"};
+    return Status::Ok();
+  }
+  const json& v = j.at(key);
+  if (!v.is_string() ||
+      std::find(allowed.begin(), allowed.end(), v.get<std::string>()) == allowed.end()) {
+    return Error{where + "." + key + ": " + ShortText(v.dump()) + "; allowed: " + names};
+  }
+  *out = v.get<std::string>();
+  return Status::Ok();
+}
+
+Status Strings(const json& j, const std::string& key, const std::string& where,
+               std::vector<std::string>* out, bool required) {
+  if (!j.contains(key)) {
+    if (required) return Error{where + ": missing field '" + key + "' (an array of names)"};
+    return Status::Ok();
+  }
+  const json& v = j.at(key);
+  if (!v.is_array() || v.empty()) {
+    return Error{where + "." + key + ": must be a non-empty array of names, got " +
+                 ShortText(v.dump())};
+  }
+  std::vector<std::string> names;
+  for (size_t i = 0; i < v.size(); ++i) {
+    if (!v[i].is_string() || v[i].get<std::string>().empty()) {
+      return Error{where + "." + key + "[" + std::to_string(i) +
+                   "]: must be a non-empty string, got " + ShortText(v[i].dump())};
+    }
+    names.push_back(v[i].get<std::string>());
+  }
+  *out = std::move(names);
+  return Status::Ok();
+}
+
+Status Object(const json& j, const std::string& key, const std::string& where, bool required,
+              const std::string& allowed) {
+  if (!j.contains(key)) {
+    if (required) return Error{where + ": missing field '" + key + "' (" + allowed + ")"};
+    return Status::Ok();
+  }
+  if (!j.at(key).is_object()) {
+    return Error{where + "." + key + ": must be an object (" + allowed + "), got " +
+                 ShortText(j.at(key).dump())};
+  }
+  return Status::Ok();
+}
+
+Result<Eigen::MatrixXd> MatrixValue(const json& v, const std::string& field, int rows, int cols) {
+  const std::string shape = Shape(rows, cols);
+  if (!v.is_array()) {
+    return Error{field + ": must be an array of rows (a " + shape + " matrix, row-major), got " +
+                 ShortText(v.dump())};
+  }
+  const int r = static_cast<int>(v.size());
+  if (rows >= 0 && r != rows) {
+    return Error{field + ": must have " + std::to_string(rows) + " rows (a " + shape +
+                 " matrix), got " + std::to_string(r)};
+  }
+  int c = cols;
+  if (r > 0 && c < 0) c = v[0].is_array() ? static_cast<int>(v[0].size()) : -1;
+  if (c < 0) c = 0;
+  Eigen::MatrixXd M(r, c);
+  for (int i = 0; i < r; ++i) {
+    const json& row = v[i];
+    const std::string at = field + "[" + std::to_string(i) + "]";
+    if (!row.is_array() || static_cast<int>(row.size()) != c) {
+      return Error{at + ": must be an array of " + std::to_string(c) + " numbers (row " +
+                   std::to_string(i) + " of a " + shape + " matrix), got " + ShortText(row.dump())};
+    }
+    for (int k = 0; k < c; ++k) {
+      RECRUIT_TRY(FiniteNumber(row[k], at + "[" + std::to_string(k) + "]", &M(i, k)));
+    }
+  }
+  return M;
+}
+
+Result<Eigen::VectorXd> VectorValue(const json& v, const std::string& field, int size) {
+  if (!v.is_array()) {
+    return Error{field + ": must be an array of " +
+                 (size >= 0 ? std::to_string(size) + " " : std::string()) + "numbers, got " +
+                 ShortText(v.dump())};
+  }
+  const int n = static_cast<int>(v.size());
+  if (size >= 0 && n != size) {
+    return Error{field + ": must have " + std::to_string(size) + " entries, got " +
+                 std::to_string(n)};
+  }
+  Eigen::VectorXd x(n);
+  for (int i = 0; i < n; ++i) {
+    RECRUIT_TRY(FiniteNumber(v[i], field + "[" + std::to_string(i) + "]", &x(i)));
+  }
+  return x;
+}
+
+Status Matrix(const json& j, const std::string& key, const std::string& where, Eigen::MatrixXd* out,
+              bool required, int rows, int cols) {
+  if (!j.contains(key)) {
+    if (required) {
+      return Error{where + ": missing field '" + key + "' (a " + Shape(rows, cols) +
+                   " matrix, an array of rows)"};
+    }
+    return Status::Ok();
+  }
+  auto M = MatrixValue(j.at(key), where + "." + key, rows, cols);
+  if (!M.ok()) return M.failure();
+  *out = std::move(M).value();
+  return Status::Ok();
+}
+
+Status Vector(const json& j, const std::string& key, const std::string& where, Eigen::VectorXd* out,
+              bool required, int size) {
+  if (!j.contains(key)) {
+    if (required) return Error{where + ": missing field '" + key + "' (an array of numbers)"};
+    return Status::Ok();
+  }
+  auto v = VectorValue(j.at(key), where + "." + key, size);
+  if (!v.ok()) return v.failure();
+  *out = std::move(v).value();
   return Status::Ok();
 }
 

@@ -1,6 +1,6 @@
 // Checked reads of JSON fields, one set for every input file read from JSON (tasks, sweep files,
 // filter models): each names the field as `where.key`, quotes a bad value shortened and says
-// what is allowed. A missing optional field leaves *out unchanged.
+// what is allowed. A missing optional field leaves *out unchanged. Every failure is bad input.
 #pragma once
 
 #include <Eigen/Core>
@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <set>
 #include <string>
+#include <vector>
 
 #include "common/result.h"
 
@@ -30,6 +31,32 @@ Status Integer(const nlohmann::json& j, const std::string& key, const std::strin
 // A whole number >= 0 that fits 64 bits (seeds).
 Status Unsigned(const nlohmann::json& j, const std::string& key, const std::string& where,
                 std::uint64_t* out, bool required);
+
+// One of the strings `allowed` ("where.key: \"x\"; allowed: \"a\", \"b\"").
+Status OneOf(const nlohmann::json& j, const std::string& key, const std::string& where,
+             std::string* out, bool required, const std::vector<std::string>& allowed);
+
+// A non-empty array of non-empty strings (names).
+Status Strings(const nlohmann::json& j, const std::string& key, const std::string& where,
+               std::vector<std::string>* out, bool required);
+
+// An object; `allowed` says what it holds, for the messages. Nothing is read.
+Status Object(const nlohmann::json& j, const std::string& key, const std::string& where,
+              bool required, const std::string& allowed);
+
+// A rows x cols matrix: an array of `rows` arrays of `cols` finite numbers (row-major);
+// rows / cols < 0: any.
+Status Matrix(const nlohmann::json& j, const std::string& key, const std::string& where,
+              Eigen::MatrixXd* out, bool required, int rows, int cols);
+
+// An array of `size` finite numbers (size < 0: any).
+Status Vector(const nlohmann::json& j, const std::string& key, const std::string& where,
+              Eigen::VectorXd* out, bool required, int size);
+
+// Matrix and Vector of a value already found; `field` names it ("model.json.H").
+Result<Eigen::MatrixXd> MatrixValue(const nlohmann::json& v, const std::string& field, int rows,
+                                    int cols);
+Result<Eigen::VectorXd> VectorValue(const nlohmann::json& v, const std::string& field, int size);
 
 // A non-empty string.
 Status String(const nlohmann::json& j, const std::string& key, const std::string& where,

@@ -1,19 +1,26 @@
-// Reading Eigen matrices and vectors from JSON with messages naming the file and field.
+// The filter model file's JSON: its parser (field paths in its messages) and Eigen matrices and
+// vectors written as arrays of rows. They are read by the common checkers (common/json_fields.h).
 #pragma once
 
 #include <Eigen/Dense>
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "common/json_fields.h"
 #include "common/result.h"
 
 namespace recruit::json_io {
 
-// A JSON array of `rows` arrays of `cols` finite numbers (row-major). rows/cols < 0: any.
-Result<Eigen::MatrixXd> ReadMatrix(const nlohmann::json& j, const std::string& field, int rows,
-                                   int cols);
-// A JSON array of `size` finite numbers (size < 0: any).
-Result<Eigen::VectorXd> ReadVector(const nlohmann::json& j, const std::string& field, int size);
+// json_fields::MatrixValue / VectorValue (the broadcast transition's reader calls them by these
+// names).
+inline Result<Eigen::MatrixXd> ReadMatrix(const nlohmann::json& j, const std::string& field,
+                                          int rows, int cols) {
+  return json_fields::MatrixValue(j, field, rows, cols);
+}
+inline Result<Eigen::VectorXd> ReadVector(const nlohmann::json& j, const std::string& field,
+                                          int size) {
+  return json_fields::VectorValue(j, field, size);
+}
 
 // The deepest nesting ParseJson accepts (filter model files nest 4 levels).
 inline constexpr int kMaxJsonDepth = 64;

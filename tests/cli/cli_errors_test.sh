@@ -79,6 +79,17 @@ bad_input_code)  # bad file content: exit 3 (task and filter model), message nam
   printf 't,y\n0,1\n' > log.csv
   expect 3 "$RECRUIT" filter --model model.json --log log.csv --out f.csv
   [ ! -e f.csv ] || fail "filter wrote on error"
+  # A filter model's fields are checked in the words of task and sweep files: file.key, the
+  # value, what is allowed (src/common/json_fields.h).
+  good='"states": ["off", "on"], "H": [[0, 0.45]], "R": [[0.09]], "transition": {"type": "explicit"}'
+  for bad in '"N": 60, "Hx": 1|model.json: unknown field '"'"'Hx'"'"'; allowed: G, H, N' \
+             '"N": -3|model.json.N: -3; allowed: a whole number of agents >= 1' \
+             '"N": "60"|model.json.N: "60"; allowed: a whole number of agents >= 1'; do
+    printf '{%s, %s}' "$good" "${bad%%|*}" > model.json
+    expect 3 "$RECRUIT" filter --model model.json --log log.csv --out f.csv
+    grep -qF "${bad#*|}" err || fail "no '${bad#*|}'"
+  done
+  [ ! -e f.csv ] || fail "filter wrote on error"
   ;;
 io_code)  # an output that cannot be written: exit 4
   expect 4 "$RECRUIT" simulate --task "$TASK" --duration 2 --out o --summary /proc/nonexistent/s.json

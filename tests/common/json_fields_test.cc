@@ -2,7 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <limits>
+#include <string>
+#include <vector>
 
 namespace recruit::json_fields {
 namespace {
@@ -66,6 +69,53 @@ TEST(JsonFields, StringsBooleansAndVectors) {
   EXPECT_TRUE(Vec3(j, "v", "w", &v).ok());
   EXPECT_EQ(v, Eigen::Vector3d(1, 2, 3));
   EXPECT_FALSE(Vec3(j, "w", "w", &v).ok());
+}
+
+TEST(JsonFields, ChoicesNamesAndObjects) {
+  const json j =
+      json::parse(R"({"type": "magic", "ok": "b", "names": ["a", ""], "o": {}, "n": 1})");
+  std::string s;
+  EXPECT_TRUE(OneOf(j, "ok", "w", &s, true, {"a", "b"}).ok());
+  EXPECT_EQ(s, "b");
+  EXPECT_EQ(OneOf(j, "type", "w", &s, true, {"a", "b"}).error(),
+            "w.type: \"magic\"; allowed: \"a\", \"b\"");
+  EXPECT_EQ(OneOf(j, "absent", "w", &s, true, {"a", "b"}).error(),
+            "w: missing field 'absent' (one of \"a\", \"b\")");
+  std::vector<std::string> names = {"kept"};
+  EXPECT_EQ(Strings(j, "names", "w", &names, true).error(),
+            "w.names[1]: must be a non-empty string, got \"\"");
+  EXPECT_EQ(names, std::vector<std::string>{"kept"});  // unchanged on error
+  EXPECT_EQ(Strings(j, "n", "w", &names, true).error(),
+            "w.n: must be a non-empty array of names, got 1");
+  EXPECT_TRUE(Object(j, "o", "w", true, "{x}").ok());
+  EXPECT_TRUE(Object(j, "absent", "w", false, "{x}").ok());
+  EXPECT_EQ(Object(j, "n", "w", false, "{x}").error(), "w.n: must be an object ({x}), got 1");
+}
+
+TEST(JsonFields, MatricesAndVectorsNameTheEntry) {
+  const json j = json::parse(R"({"M": [[1, 2], [3, 4]], "ragged": [[1, 2], [3]],
+                                 "text": [[1, "x"]], "v": [1, 2, 3], "flat": 5})");
+  Eigen::MatrixXd M;
+  ASSERT_TRUE(Matrix(j, "M", "w", &M, true, -1, 2).ok());
+  EXPECT_EQ(M, (Eigen::MatrixXd(2, 2) << 1, 2, 3, 4).finished());  // row-major
+  EXPECT_EQ(Matrix(j, "M", "w", &M, true, 3, 2).error(),
+            "w.M: must have 3 rows (a 3 x 2 matrix), got 2");
+  EXPECT_EQ(Matrix(j, "ragged", "w", &M, true, -1, -1).error(),
+            "w.ragged[1]: must be an array of 2 numbers (row 1 of a r x c matrix), got [3]");
+  EXPECT_EQ(Matrix(j, "text", "w", &M, true, 1, 2).error(),
+            "w.text[0][1]: must be a finite number, got \"x\"");
+  EXPECT_EQ(Matrix(j, "flat", "w", &M, true, 1, 1).error(),
+            "w.flat: must be an array of rows (a 1 x 1 matrix, row-major), got 5");
+  EXPECT_EQ(Matrix(j, "absent", "w", &M, true, 2, 2).error(),
+            "w: missing field 'absent' (a 2 x 2 matrix, an array of rows)");
+  Eigen::VectorXd v;
+  ASSERT_TRUE(Vector(j, "v", "w", &v, true, 3).ok());
+  EXPECT_EQ(v, Eigen::Vector3d(1, 2, 3));
+  EXPECT_EQ(Vector(j, "v", "w", &v, true, 2).error(), "w.v: must have 2 entries, got 3");
+  // A NaN can only come from a document made in code (JSON has none): refused too.
+  const json nan = {{"v", {1.0, std::nan("")}}};
+  EXPECT_EQ(Vector(nan, "v", "w", &v, true, -1).error(),
+            "w.v[1]: must be a finite number, got null");
 }
 
 TEST(JsonFields, LongValuesAreShortenedInMessages) {

@@ -166,6 +166,7 @@ struct BadCase {
   std::string log;
   std::string extra;
   std::string expected;  // in stderr
+  int code = 3;          // the exit code (docs/reliability.md): 3 bad input, 2 usage
 };
 
 TEST_F(EstimationCli, BadInputGivesClearMessageNonZeroExitAndNoOutput) {
@@ -185,7 +186,8 @@ TEST_F(EstimationCli, BadInputGivesClearMessageNonZeroExitAndNoOutput) {
       {"wrong H dimensions",
        R"({"states": ["off", "on"], "N": 60, "H": [[0, 0.45, 1]], "R": [[0.09]],
            "transition": {"type": "explicit"}})",
-       kGoodLog, "", "H: row 0 must be an array of 2 numbers"},
+       kGoodLog, "",
+       ".H[0]: must be an array of 2 numbers (row 0 of a r x 2 matrix), got [0,0.45,1]"},
       {"malformed JSON", "{\"states\": [\"off\", \"on\"], \"N\": 60,", kGoodLog, "",
        "malformed JSON"},
       {"malformed CSV row", kTwoStateModel, "t,p_on,p_off,y\n0,0.2,0\n", "",
@@ -195,12 +197,12 @@ TEST_F(EstimationCli, BadInputGivesClearMessageNonZeroExitAndNoOutput) {
       {"inputs missing mid-log", kTwoStateModel, "p_on,p_off,y\n0.2,0,1\n,,2\n0.1,0.1,3\n", "",
        ":3: inputs are empty; only the last row may omit them"},
       {"empty log", kTwoStateModel, "", "", "empty log"},
-      {"missing model file", "", kGoodLog, "", "model.json"},
+      {"missing model file", "", kGoodLog, "", "model.json", 2},
       {"exact filter too large",
        R"({"states": ["a", "b", "c"], "N": 1000, "H": [[0, 0.2, 0.45]], "R": [[0.09]],
            "transition": {"type": "constant", "A": [[0.9, 0, 0.1], [0.1, 0.9, 0], [0, 0.1, 0.9]]}})",
        "y\n1.0\n", "--estimator exact", "more than 200000 count vectors"},
-      {"unknown estimator", kTwoStateModel, kGoodLog, "--estimator magic", "magic"},
+      {"unknown estimator", kTwoStateModel, kGoodLog, "--estimator magic", "magic", 2},
   };
   for (const auto& c : cases) {
     SCOPED_TRACE(c.name);
@@ -210,7 +212,7 @@ TEST_F(EstimationCli, BadInputGivesClearMessageNonZeroExitAndNoOutput) {
     const std::string log = Write("log.csv", c.log);
     const RunResult r =
         RunRecruit("filter --model " + model + " --log " + log + " --out " + Out() + " " + c.extra);
-    EXPECT_NE(r.exit_code, 0);
+    EXPECT_EQ(r.exit_code, c.code) << r.err;
     EXPECT_NE(r.err.find(c.expected), std::string::npos) << r.err;
     EXPECT_TRUE(NoOutput());
   }
@@ -220,7 +222,7 @@ TEST_F(EstimationCli, UnwritableOutputFails) {
   const RunResult r =
       RunRecruit("filter --model " + Write("model.json", kTwoStateModel) + " --log " +
                  Write("log.csv", kGoodLog) + " --out /nonexistent_dir/out.csv");
-  EXPECT_NE(r.exit_code, 0);
+  EXPECT_EQ(r.exit_code, 4);  // I/O
   EXPECT_NE(r.err.find("cannot write '/nonexistent_dir/out.csv'"), std::string::npos) << r.err;
 }
 

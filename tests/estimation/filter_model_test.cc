@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "common/exit_codes.h"
 #include "estimation/count_filter.h"
 #include "estimation/filter_log.h"
 #include "estimation/population_chain.h"
@@ -83,48 +84,119 @@ nlohmann::json GoodJson() {
                    "on_target": 1, "off_target": 0}})");
 }
 
+// Every class of bad field gets the words of the common checkers (common/json_fields.h), as task
+// and sweep files do: the file and key, the value (shortened) and what is allowed; each is bad
+// input, exit code 3.
 TEST(EstimationFilterModel, ClearErrorsForBadFields) {
   ASSERT_TRUE(FilterModel::FromJsonValue(GoodJson(), "m.json").ok());
   struct Case {
-    std::string pointer;
+    std::string pointer;  // the field replaced ("-" + pointer: removed)
     nlohmann::json value;
     std::string expected;
   };
+  const auto parse = [](const char* text) { return nlohmann::json::parse(text); };
   const std::vector<Case> cases = {
-      {"/N", -3, "m.json: N: required, a positive integer"},
-      {"/H", nlohmann::json::parse("[[0, 0.45, 1]]"), "m.json: H: row 0 must be an array of 2"},
-      {"/R", nlohmann::json::parse("[[-1]]"), "m.json: R: must be positive definite"},
-      {"/R", nlohmann::json::parse("[[1, 0]]"), "m.json: R: row 0 must be an array of 1"},
-      {"/transition/type", "magic", "transition.type: \"magic\" is not one of"},
-      {"/transition/interior", nlohmann::json::parse("[[0.9, 0], [0.2, 1]]"),
-       "transition.interior: column 0 sums to 1.1"},
-      {"/transition/dt", 0, "transition.dt: must be a positive"},
-      {"/states", nlohmann::json::parse(R"(["off", "off"])"), "duplicate name 'off'"},
+      // an unknown key, at the top and inside an object
+      {"/Hx", 1,
+       "m.json: unknown field 'Hx'; allowed: G, H, N, Qw, R, format, identification, initial, "
+       "states, transition, version"},
+      {"/transition/A", parse("[[1, 0], [0, 1]]"),
+       "m.json.transition: unknown field 'A'; allowed: dt, interior, is_on, off_target, "
+       "on_target, type"},
+      {"/initial", parse(R"({"x1": [60, 0]})"),
+       "m.json.initial: unknown field 'x1'; allowed: P0, x0"},
+      // a required field missing
+      {"-/N", nullptr, "m.json: missing field 'N' (a whole number of agents >= 1)"},
+      {"-/H", nullptr, "m.json: missing field 'H' (a r x 2 matrix, an array of rows)"},
+      {"-/transition", nullptr, "m.json: missing field 'transition' (an object with \"type\""},
+      {"/G", parse("[[0], [0]]"), "m.json: missing field 'Qw' (G and Qw come together"},
+      // a value of the wrong type or out of range
+      {"/N", -3, "m.json.N: -3; allowed: a whole number of agents >= 1"},
+      {"/N", 2.5, "m.json.N: 2.5; allowed: a whole number of agents >= 1"},
+      {"/N", "60", "m.json.N: \"60\"; allowed: a whole number of agents >= 1"},
+      {"/format", "recruit.task",
+       "m.json.format: \"recruit.task\"; allowed: \"recruit.filter_model\""},
+      {"/version", 2, "m.json.version: 2; allowed: 1 (the only version)"},
+      {"/transition/type", "magic",
+       "m.json.transition.type: \"magic\"; allowed: \"broadcast\", \"explicit\", \"constant\""},
+      {"/states", parse(R"(["off", 3])"), "m.json.states[1]: must be a non-empty string, got 3"},
+      {"/states", parse("[]"), "m.json.states: must be a non-empty array of names, got []"},
+      {"/initial", 5, "m.json.initial: must be an object ({\"x0\", \"P0\"}), got 5"},
+      {"/transition", "broadcast", "m.json.transition: must be an object (an object with"},
+      // a matrix or vector of the wrong shape, or an entry that is not a number
+      {"/H", parse("[[0, 0.45, 1]]"),
+       "m.json.H[0]: must be an array of 2 numbers (row 0 of a r x 2 matrix), got [0,0.45,1]"},
+      {"/H", parse("[]"), "m.json.H: must have at least one row (one per output), got none"},
+      {"/H", 0.45, "m.json.H: must be an array of rows (a r x 2 matrix, row-major), got 0.45"},
+      {"/R", parse("[[1, 0]]"),
+       "m.json.R[0]: must be an array of 1 numbers (row 0 of a 1 x 1 matrix), got [1,0]"},
+      {"/R", parse("[[0.09], [1]]"), "m.json.R: must have 1 rows (a 1 x 1 matrix), got 2"},
+      {"/R", parse(R"([["a"]])"), "m.json.R[0][0]: must be a finite number, got \"a\""},
+      {"/initial", parse(R"({"x0": [60]})"), "m.json.initial.x0: must have 2 entries, got 1"},
+      {"/initial", parse(R"({"x0": [60, null]})"),
+       "m.json.initial.x0[1]: must be a finite number, got null"},
+      // values that are each allowed but not together, or not as a matrix
+      {"/R", parse("[[-1]]"), "m.json.R: must be positive definite"},
+      {"/initial", parse(R"({"x0": [50, 9]})"),
+       "m.json.initial.x0: must sum to N = 60, sums to 59"},
+      {"/states", parse(R"(["off", "off"])"), "m.json.states: duplicate name 'off'"},
+      // the broadcast transition's own fields
+      {"/transition/interior", parse("[[0.9, 0], [0.2, 1]]"),
+       "m.json.transition.interior: column 0 sums to 1.1"},
+      {"/transition/interior", parse("[[0.9, 0]]"),
+       "m.json.transition.interior: must have 2 rows (a 2 x 2 matrix), got 1"},
+      {"/transition/dt", 0, "m.json.transition.dt: must be a positive"},
   };
   for (const auto& c : cases) {
+    SCOPED_TRACE(c.pointer + " " + c.value.dump());
     nlohmann::json j = GoodJson();
-    j[nlohmann::json::json_pointer(c.pointer)] = c.value;
+    if (c.pointer[0] == '-') {
+      j.erase(c.pointer.substr(2));
+    } else {
+      j[nlohmann::json::json_pointer(c.pointer)] = c.value;
+    }
     auto f = FilterModel::FromJsonValue(j, "m.json");
-    ASSERT_FALSE(f.ok()) << c.pointer;
+    ASSERT_FALSE(f.ok());
     EXPECT_NE(f.error().find(c.expected), std::string::npos) << f.error();
+    EXPECT_EQ(exit_code::Of(f.failure()), exit_code::kBadInput) << f.error();
   }
   nlohmann::json j = GoodJson();
   j["G"] = nlohmann::json::parse("[[1], [0]]");
   j["Qw"] = nlohmann::json::parse("[[0.5]]");
   auto f = FilterModel::FromJsonValue(j, "m.json");
   ASSERT_FALSE(f.ok());
-  EXPECT_NE(f.error().find("zero column sums"), std::string::npos) << f.error();
+  EXPECT_NE(f.error().find("m.json.G, Qw: G Qw G^T must have zero column sums"), std::string::npos)
+      << f.error();
+  EXPECT_EQ(exit_code::Of(f.failure()), exit_code::kBadInput);
+}
+
+// The optional fields, given as identify writes them, are accepted and read: format, version,
+// an explicit initial belief and the identification record (its held-out R^2).
+TEST(EstimationFilterModel, OptionalFieldsAreRead) {
+  nlohmann::json j = GoodJson();
+  j["format"] = "recruit.filter_model";
+  j["version"] = 1;
+  j["initial"] = nlohmann::json::parse(R"({"x0": [50, 10], "P0": [[1, -1], [-1, 1]]})");
+  j["identification"] = nlohmann::json::parse(R"({"holdout": {"r2": 0.75}, "dT": 0.5})");
+  auto f = FilterModel::FromJsonValue(j, "m.json");
+  ASSERT_TRUE(f.ok()) << f.error();
+  EXPECT_EQ(f->x0, Eigen::Vector2d(50, 10));
+  EXPECT_EQ(f->P0, (Eigen::Matrix2d{{1, -1}, {-1, 1}}));
+  EXPECT_EQ(f->holdout_r2, 0.75);
+  EXPECT_TRUE(std::isnan(FilterModel::FromJsonValue(GoodJson(), "m.json")->holdout_r2));
 }
 
 TEST(EstimationFilterModel, MissingAndMalformedFiles) {
   auto missing = FilterModel::FromJson("/nonexistent/dir/model.json");
   ASSERT_FALSE(missing.ok());
   EXPECT_NE(missing.error().find("/nonexistent/dir/model.json"), std::string::npos);
+  EXPECT_EQ(exit_code::Of(missing.failure()), exit_code::kIo);  // the file cannot be read
   const std::string path = testing::TempDir() + "/estimation_malformed.json";
   std::ofstream(path) << "{\"states\": [\"off\", ";
   auto bad = FilterModel::FromJson(path);
   ASSERT_FALSE(bad.ok());
   EXPECT_NE(bad.error().find("malformed JSON"), std::string::npos) << bad.error();
+  EXPECT_EQ(exit_code::Of(bad.failure()), exit_code::kBadInput);
   std::remove(path.c_str());
 }
 
@@ -146,6 +218,7 @@ TEST(EstimationFilterModel, NumberTooLargeForADoubleNamesFileAndField) {
   EXPECT_NE(f.error().find(path + ": field H[0][1]: number '1e999' is too large for a double"),
             std::string::npos)
       << f.error();
+  EXPECT_EQ(exit_code::Of(f.failure()), exit_code::kBadInput);
   std::remove(path.c_str());
 }
 
@@ -158,6 +231,7 @@ TEST(EstimationFilterModel, DeepNestingIsRejectedBeforeRecursion) {
   ASSERT_FALSE(f.ok());
   EXPECT_NE(f.error().find(path + ": field states[0]"), std::string::npos) << f.error();
   EXPECT_NE(f.error().find("nested deeper than 64 levels"), std::string::npos) << f.error();
+  EXPECT_EQ(exit_code::Of(f.failure()), exit_code::kBadInput);
   std::remove(path.c_str());
 }
 
