@@ -124,7 +124,7 @@ Result<bool> ParseControlInstant(std::string_view cell, const std::string& where
 
 Result<BenchLog> ReadBenchLog(const std::string& path) {
   auto text = ReadFile(path);
-  if (!text.ok()) return Error{text.error()};
+  if (!text.ok()) return text.failure();
   return ParseBenchLog(*text, path);
 }
 
@@ -148,7 +148,7 @@ Result<BenchLog> ParseBenchLog(const std::string& text, const std::string& path)
   BenchSplitCsv(line, cells);
   const std::vector<std::string> header(cells.begin(), cells.end());
   auto cols = FindBenchLogColumns(header, path + ":" + std::to_string(line_no));
-  if (!cols.ok()) return Error{cols.error()};
+  if (!cols.ok()) return cols.failure();
   BenchLog log;
   log.path = path;
   for (const auto& b : cols->bundles) log.bundles.push_back({b.name, {}, {}, {}});
@@ -162,7 +162,7 @@ Result<BenchLog> ParseBenchLog(const std::string& text, const std::string& path)
     }
     if (cols->control_instant >= 0) {
       auto instant = ParseControlInstant(cells[cols->control_instant], where);
-      if (!instant.ok()) return Error{instant.error()};
+      if (!instant.ok()) return instant.failure();
       if (!*instant) continue;
     }
     auto number = [&](int col, double lo, double hi, double* v) -> Status {
@@ -173,7 +173,7 @@ Result<BenchLog> ParseBenchLog(const std::string& text, const std::string& path)
     };
     const double inf = INFINITY;
     double t;
-    if (Status s = number(cols->time, -inf, inf, &t); !s.ok()) return Error{s.error()};
+    if (Status s = number(cols->time, -inf, inf, &t); !s.ok()) return s.failure();
     if (!log.time.empty() && !(t > log.time.back())) {
       return Error{where + ": time " + ShortText(cells[cols->time]) +
                    " s does not increase (control instants in time order)"};
@@ -183,16 +183,16 @@ Result<BenchLog> ParseBenchLog(const std::string& text, const std::string& path)
     for (size_t i = 0; i < cols->bundles.size(); ++i) {
       const auto& c = cols->bundles[i];
       double on, off, f;
-      if (Status s = number(c.p_on, 0, 1, &on); !s.ok()) return Error{s.error()};
-      if (Status s = number(c.p_off, 0, 1, &off); !s.ok()) return Error{s.error()};
-      if (Status s = number(c.sensed_force, -inf, inf, &f); !s.ok()) return Error{s.error()};
+      if (Status s = number(c.p_on, 0, 1, &on); !s.ok()) return s.failure();
+      if (Status s = number(c.p_off, 0, 1, &off); !s.ok()) return s.failure();
+      if (Status s = number(c.sensed_force, -inf, inf, &f); !s.ok()) return s.failure();
       log.bundles[i].p_on.push_back(on);
       log.bundles[i].p_off.push_back(off);
       log.bundles[i].sensed_force.push_back(f);
     }
     for (size_t j = 0; j < cols->angles.size(); ++j) {
       double a;
-      if (Status s = number(cols->angles[j].col, -inf, inf, &a); !s.ok()) return Error{s.error()};
+      if (Status s = number(cols->angles[j].col, -inf, inf, &a); !s.ok()) return s.failure();
       log.angles[j].value.push_back(a);
     }
   }

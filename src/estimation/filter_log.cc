@@ -196,9 +196,9 @@ Status FilterLogReader::ReadBenchHeader() {
   names_.assign(cells_.begin(), cells_.end());
   num_cols_ = names_.size();
   auto cols = FindBenchLogColumns(names_, where);
-  if (!cols.ok()) return Error{cols.error()};
+  if (!cols.ok()) return cols.failure();
   auto b = SelectBenchBundle(*cols, bundle_, path_);
-  if (!b.ok()) return Error{b.error()};
+  if (!b.ok()) return b.failure();
   const BenchLogColumns::Bundle& c = cols->bundles[*b];
   bench_ = true;
   t_col_ = cols->time;
@@ -227,7 +227,7 @@ Result<bool> FilterLogReader::Next(FilterLogRow& row) {
     if (cells_.size() != num_cols_) break;  // reported below
     const std::string at = path_ + ":" + std::to_string(line_no_);
     auto instant = ParseControlInstant(cells_[instant_col_], at);
-    if (!instant.ok()) return Error{instant.error()};
+    if (!instant.ok()) return instant.failure();
     if (*instant) break;
   }
   auto where = [&] { return path_ + ":" + std::to_string(line_no_); };

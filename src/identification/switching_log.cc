@@ -28,11 +28,11 @@ std::vector<std::string> SplitCsv(const std::string& line) {
 Result<SwitchingLog> FromBenchLog(const std::string& path, int num_units,
                                   const std::string& bundle) {
   auto bench = ReadBenchLog(path);
-  if (!bench.ok()) return Error{bench.error()};
+  if (!bench.ok()) return bench.failure();
   BenchLogColumns names;
   for (const auto& b : bench->bundles) names.bundles.push_back({b.name});
   auto i = SelectBenchBundle(names, bundle, path);
-  if (!i.ok()) return Error{i.error()};
+  if (!i.ok()) return i.failure();
   const BenchLog::Bundle& b = bench->bundles[*i];
   SwitchingLog log;
   log.num_units = num_units;
@@ -41,7 +41,7 @@ Result<SwitchingLog> FromBenchLog(const std::string& path, int num_units,
   log.p_on = b.p_on;
   log.p_off = b.p_off;
   log.force = b.sensed_force;
-  if (Status s = log.Validate(path); !s) return Error{s.error()};
+  if (Status s = log.Validate(path); !s) return s.failure();
   return log;
 }
 

@@ -24,7 +24,7 @@ std::string Names(const std::vector<std::string>& v) {
 
 Result<ReplayPlan> PlanReplay(const sim::Task& task, const BenchLog& log) {
   auto plant_or = sim::Plant::Create(task, /*drawn=*/false);
-  if (!plant_or.ok()) return Error{plant_or.error()};
+  if (!plant_or.ok()) return plant_or.failure();
   const sim::Plant& plant = **plant_or;
   ReplayPlan plan;
   plan.dT = log.dT;
@@ -70,14 +70,14 @@ Result<ReplayPlan> PlanReplay(const sim::Task& task, const BenchLog& log) {
 Result<std::vector<std::vector<double>>> ReplayOnce(const sim::Task& task, const BenchLog& log,
                                                     const ReplayPlan& plan, std::uint64_t seed) {
   auto plant_or = sim::Plant::Create(task, /*drawn=*/false);
-  if (!plant_or.ok()) return Error{plant_or.error()};
+  if (!plant_or.ok()) return plant_or.failure();
   sim::Plant& plant = **plant_or;
   plant.Reset(seed);
   const int nb = plant.num_bundles();
   std::vector<sim::ForceSensor> sensors;
   for (int i = 0; i < nb; ++i) {
     auto s = sim::ForceSensor::Create(task.sensor, Rng::DeriveSeed(seed, kSensorStream + i));
-    if (!s.ok()) return Error{task.source + ".sensor: " + s.error()};
+    if (!s.ok()) return s.failure().In(task.source + ".sensor: ");
     sensors.push_back(std::move(s).value());
   }
   const int n = log.size();
@@ -93,12 +93,12 @@ Result<std::vector<std::vector<double>>> ReplayOnce(const sim::Task& task, const
       for (int i = 0; i < nb; ++i) {
         const BenchLog::Bundle& b = log.bundles[plan.log_bundle[i]];
         if (Status st = plant.Broadcast(i, b.p_on[k], b.p_off[k]); !st.ok()) {
-          return Error{log.path + ":" + std::to_string(log.line[k]) + ": " + st.error()};
+          return st.failure().In(log.path + ":" + std::to_string(log.line[k]) + ": ");
         }
       }
     }
     plant.Step();
-    if (Status st = plant.CheckFinite(); !st.ok()) return Error{task.source + ": " + st.error()};
+    if (Status st = plant.CheckFinite(); !st.ok()) return st.failure().In(task.source + ": ");
     if (!instant) continue;
     for (size_t s = 0; s < plan.signals.size(); ++s) {
       const Signal& sig = plan.signals[s];

@@ -13,7 +13,7 @@ Result<ReplayResult> RunReplay(const sim::Task& task, const BenchLog& log,
     return Error{"--seeds " + std::to_string(options.num_seeds) + ": at least 3 replays"};
   }
   auto plan = PlanReplay(task, log);
-  if (!plan.ok()) return Error{plan.error()};
+  if (!plan.ok()) return plan.failure();
   ReplayResult r;
   r.log_path = log.path;
   r.task_source = task.source;
@@ -27,13 +27,13 @@ Result<ReplayResult> RunReplay(const sim::Task& task, const BenchLog& log,
   r.runs.assign(ns, {});
   for (int a = 0; a < options.num_seeds; ++a) {
     auto run = ReplayOnce(task, log, r.plan, options.first_seed + a);
-    if (!run.ok()) return Error{run.error()};
+    if (!run.ok()) return run.failure();
     for (size_t s = 0; s < ns; ++s) r.runs[s].push_back(std::move((*run)[s]));
   }
   for (size_t s = 0; s < ns; ++s) {
     auto c = CompareSignal(r.plan.signals[s].recorded, r.runs[s], r.dT, r.options.max_lag,
                            options.criterion);
-    if (!c.ok()) return Error{c.error()};
+    if (!c.ok()) return c.failure();
     r.flagged = r.flagged || c->flagged;
     r.comparisons.push_back(std::move(c).value());
   }
