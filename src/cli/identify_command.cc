@@ -15,6 +15,7 @@
 #include "common/atomic_file.h"
 #include "common/output_path.h"
 #include "control/on_count_estimator.h"
+#include "control/sampling_period.h"
 #include "identification/bench_recorder.h"
 #include "identification/excitation.h"
 #include "identification/identification.h"
@@ -30,7 +31,7 @@ struct IdentifyArgs {
   std::string actuator;
   std::string log_in;
   int units = 60;
-  double dT = 0.5;
+  double dT = control::kDefaultDT;  // --bench; a --log's is read from its time column
   int states = 20;
   double duration = 900;
   double settle = 8;
@@ -154,19 +155,21 @@ int RunIdentify(const IdentifyArgs& a, const std::string& command_line) {
     return Fail("identify", "--states " + std::to_string(a.states) + ": must be even and >= 4",
                 exit_code::kUsage);
   }
-  if (a.log_in.empty() && (!(a.dT > 0) || !(a.duration > 0) || !(a.settle > 0))) {
-    return Fail("identify", "--dt, --duration and --settle must be > 0", exit_code::kUsage);
-  }
-  std::string out = a.output;
-  if (out.empty() && !a.log_in.empty()) out = DefaultModelFile(a.dT, a.states);
-  if (!out.empty()) {
-    if (Status s = CheckNotAnInput(out, "--output", {{"--log", a.log_in}, {"--bench", a.bench}});
-        !s.ok()) {
+  auto refused = [&a](const std::string& out) {
+    return CheckNotAnInput(out, "--output", {{"--log", a.log_in}, {"--bench", a.bench}});
+  };
+  if (!a.output.empty()) {
+    if (Status s = refused(a.output); !s.ok())
       return Fail("identify", s.error(), exit_code::kUsage);
-    }
   }
   auto j = a.log_in.empty() ? IdentifyFromBench(a, command_line) : IdentifyFromLog(a, command_line);
   if (!j) return Fail("identify", j.failure());
+  std::string out = a.output;
+  if (out.empty() && !a.log_in.empty()) {
+    // Named by the log's dT, read from its time column.
+    out = DefaultModelFile((*j)["identification"]["dT"].get<double>(), a.states);
+    if (Status s = refused(out); !s.ok()) return Fail("identify", s.error(), exit_code::kUsage);
+  }
   if (out.empty()) {
     // The model cache, where simulate and sweep look for it (identification/model_cache.h).
     const auto& plant = (*j)["identification"]["plant"];
@@ -203,8 +206,11 @@ void AddIdentifyCommand(CLI::App& app, int& exit_code) {
   cmd->add_option("--units", args->units, "units in the bundle of a --log")
       ->capture_default_str()
       ->check(CLI::Range(1, 1000000));
-  cmd->add_option("--dt", args->dT, "sampling period dT, s (bench), > 0")
-      ->check(Positive())
+  cmd->add_option("--dt", args->dT,
+                  "sampling period dT, s, of the bench's recording; the default is the "
+                  "controller's, as in simulate and task files (a --log's is read from its "
+                  "time column)")
+      ->check(SamplingPeriod())
       ->capture_default_str();
   cmd->add_option("--states", args->states, "model states m (even, >= 4)")->capture_default_str();
   cmd->add_option("--duration", args->duration, "bench experiment length, s, > 0")

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "common/result.h"
+#include "control/sampling_period.h"
 #include "identification/plant_identification.h"
 
 namespace recruit::identification {
@@ -29,7 +30,7 @@ struct ModelRequest {
   std::string model_path;  // the MJCF the plant is loaded from
   std::string actuator;    // the bundle
   nlohmann::json plant;    // its PlantRecord
-  double dT = 0.5;
+  double dT = control::kDefaultDT;
   int num_states = 20;
 };
 

@@ -165,8 +165,9 @@ Result<PlantIdentification> IdentifyOnPlant(const std::string& model_path,
                                             const std::string& actuator,
                                             const PlantIdentificationOptions& o,
                                             const std::string& command) {
-  if (!(o.dT > 0) || !(o.duration > 0) || !(o.settle > 0) || !(o.check_duration > 0)) {
-    return Error{"identify: dT, duration, settle and check duration must be > 0 s"};
+  RECRUIT_TRY(control::CheckDT(o.dT, "identify"));
+  if (!(o.duration > 0) || !(o.settle > 0) || !(o.check_duration > 0)) {
+    return Error{"identify: duration, settle and check duration must be > 0 s"};
   }
   // 1-2. The chain and its forces, held at the longest tendon.
   auto rec = RecordBench(model_path, actuator, ExcitationFor(o, o.duration, o.seed), o.dT, o.seed);

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "common/result.h"
+#include "control/sampling_period.h"
 #include "identification/identification.h"
 
 namespace recruit::identification {
@@ -27,11 +28,11 @@ namespace recruit::identification {
 constexpr int kIdentificationVersion = 1;
 
 struct PlantIdentificationOptions {
-  double dT = 0.5;        // s
-  int num_states = 20;    // even, >= 4
-  double duration = 900;  // s recorded for the fit
-  double settle = 8;      // s a unit takes to settle (the excitation's holds)
-  double holdout = 0.3;   // last fraction of the log held out
+  double dT = control::kDefaultDT;  // s
+  int num_states = 20;              // even, >= 4
+  double duration = 900;            // s recorded for the fit
+  double settle = 8;                // s a unit takes to settle (the excitation's holds)
+  double holdout = 0.3;             // last fraction of the log held out
   double smoothness = 1e-3;
   std::uint64_t seed = 1;
   // Places in the tendon's length range (0 shortest, 1 longest) of the check recordings.

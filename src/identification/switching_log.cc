@@ -138,7 +138,7 @@ Status SwitchingLog::Validate(const std::string& where) const {
                  "differ in length"};
   }
   if (num_units < 1) return Error{where + ": num_units must be >= 1"};
-  if (!(dT > 0) || !std::isfinite(dT)) return Error{where + ": dT must be > 0 s"};
+  RECRUIT_TRY(control::CheckDT(dT, where));
   for (size_t k = 0; k < n; ++k) {
     for (auto [v, name] : {std::pair{p_on[k], "p_on"}, std::pair{p_off[k], "p_off"},
                            std::pair{has_realized() ? realized_on[k] : 0.0, "realized_on"},

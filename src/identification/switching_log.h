@@ -15,12 +15,13 @@
 #include <vector>
 
 #include "common/result.h"
+#include "control/sampling_period.h"
 
 namespace recruit::identification {
 
 struct SwitchingLog {
   int num_units = 60;
-  double dT = 0.5;  // s
+  double dT = control::kDefaultDT;  // s
   std::vector<double> time, p_on, p_off, force;
   std::vector<double> true_on;  // optional ground truth (debug interface); empty when unknown
   std::vector<double> realized_on, realized_off;  // optional, see above; empty when unknown

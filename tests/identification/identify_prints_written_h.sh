@@ -9,7 +9,7 @@ W=$3
 cd "$2"
 rm -rf "$W"
 mkdir -p "$W"
-"$R" identify --duration 120 --save-log "$W/bench_log.csv" -o "$W/bench.json" \
+"$R" identify --dt 0.5 --duration 120 --save-log "$W/bench_log.csv" -o "$W/bench.json" \
   > "$W/bench.out" 2> "$W/bench.err"
 "$R" identify --log "$W/bench_log.csv" --units 60 -o "$W/log.json" > "$W/log.out"
 python3 - "$W" <<'PY'
