@@ -91,8 +91,15 @@ bad_input_code)  # bad file content: exit 3 (task and filter model), message nam
   done
   [ ! -e f.csv ] || fail "filter wrote on error"
   ;;
-io_code)  # an output that cannot be written: exit 4
+io_code)  # an output that cannot be written, an input that cannot be read: exit 4
   expect 4 "$RECRUIT" simulate --task "$TASK" --duration 2 --out o --summary /proc/nonexistent/s.json
+  # A socket exists (so the options' existence checks pass) but cannot be opened, even by root.
+  python3 -c "import socket; socket.socket(socket.AF_UNIX).bind('sock')" || fail "no socket"
+  expect 4 "$RECRUIT" simulate --task sock --out o
+  expect 4 "$RECRUIT" filter --model sock --log sock --out f.csv
+  expect 4 "$RECRUIT" identify --log sock -o m.json
+  expect 4 "$RECRUIT" replay --log sock --task "$TASK" --out r  # was 3: the class was lost
+  grep -q "cannot open 'sock'" err || fail "replay does not say it cannot open the log"
   ;;
 name_escape)  # a task name with .., / or an absolute path never writes outside --out
   for name in '"../escaped"' '"/tmp/recruit_abs_escape"' '"a/b"' '"x\u001b[2J"'; do
