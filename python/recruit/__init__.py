@@ -248,34 +248,56 @@ def _as_list(x, kind):
     return [kind(v) for v in (x if isinstance(x, (list, tuple, _np.ndarray)) else [x])]
 
 
-def sweep(task_path: PathLike, *, dT: Union[float, Sequence[float]],
-          lam: Union[float, Sequence[float]] = (0.2,),
-          estimator: Union[str, Sequence[str]] = ("output", "kalman-augmented"), seeds: int = 1,
-          base_seed: int = 1, duration: Optional[float] = None,
-          filter_model: Optional[PathLike] = None, threads: int = 0) -> Dict[str, Any]:
-    """A grid of closed-loop runs (dT x lam x estimator x seeds), as `recruit sweep`.
+def sweep(task_path: Optional[PathLike] = None, *,
+          dT: Optional[Union[float, Sequence[float]]] = None,
+          lam: Optional[Union[float, Sequence[float]]] = None,
+          estimator: Optional[Union[str, Sequence[str]]] = None, seeds: Optional[int] = None,
+          base_seed: Optional[int] = None, duration: Optional[float] = None,
+          filter_model: Optional[PathLike] = None, sweep_file: Optional[PathLike] = None,
+          threads: int = 0) -> Dict[str, Any]:
+    """A grid of closed-loop runs (plant points x dT x lam x estimator x seeds), as `recruit sweep`.
 
-    Runs on `threads` threads (0: all cores) with the GIL released. Seed index s runs with seed
-    Rng::DeriveSeed(base_seed, s), as the CLI: the same arguments give the same results.
-    Returns a column dict, one row per run in grid order (dT outermost, then lam, estimator,
-    seed index): dT, lambda, estimator, seed_index, seed, duration, wall_seconds, physics_steps
-    and one column per name in METRICS (tracking_rmse, overshoot, ...; mean_nees is NaN without
-    a variance, num_steps is an integer). pandas.DataFrame(...) takes it directly;
-    aggregate(...) gives the per-cell table. Not resumable: every call runs every point.
+    Prepared as `recruit sweep --task ... --sweep ...` prepares it (C++ sweep::Prepare): a
+    `sweep_file` (docs/sweep.md) gives the task, plant axes and controller values; an argument
+    given here overrides the file's, and one given in neither takes its default here: lam 0.2,
+    estimator ("output", "kalman-augmented"), seeds 1, base_seed 1 (dT has none: give it here or
+    in the file). Runs on `threads` threads (0: all cores) with the GIL released. Seed index s
+    runs with seed Rng::DeriveSeed(base_seed, s), as the CLI: the same arguments give the same
+    results. Returns a column dict, one row per run in grid order (plant point outermost, then
+    dT, lam, estimator, seed index): with plant axes first plant (the point's index) and one
+    column per axis, then dT, lambda, estimator, seed_index, seed, duration, wall_seconds,
+    physics_steps and one column per name in METRICS (tracking_rmse, overshoot, ...; mean_nees
+    is NaN without a variance, num_steps is an integer). pandas.DataFrame(...) takes it
+    directly; aggregate(...) gives the per-cell table. Not resumable: every call runs every
+    point.
     """
+    if dT is None and sweep_file is None:
+        raise ValueError("dT: required without a sweep file (its controller.dT)")
+    given = [name for name, v in (("task", task_path), ("dT", dT), ("lambda", lam),
+                                  ("estimator", estimator), ("seeds", seeds),
+                                  ("base-seed", base_seed)) if v is not None]
     with _tempfile.TemporaryDirectory(prefix="recruit-sweep-") as out:
-        text = _recruit.sweep_json(str(task_path), _as_list(dT, float), _as_list(lam, float),
-                                   _as_list(estimator, str), int(seeds), int(base_seed),
-                                   None if duration is None else float(duration),
-                                   None if filter_model is None else str(filter_model),
-                                   int(threads), out)
+        text = _recruit.sweep_json(
+            "" if task_path is None else str(task_path),
+            None if sweep_file is None else str(sweep_file),
+            [] if dT is None else _as_list(dT, float),
+            [0.2] if lam is None else _as_list(lam, float),
+            ["output", "kalman-augmented"] if estimator is None else _as_list(estimator, str),
+            1 if seeds is None else int(seeds), 1 if base_seed is None else int(base_seed), given,
+            None if duration is None else float(duration),
+            None if filter_model is None else str(filter_model), int(threads), out)
     runs = _json.loads(text)
 
     def col(key, dtype=float, get=None):
         get = get or (lambda r: r[key])
         return _np.array([get(r) for r in runs], dtype=dtype)
 
-    out = {
+    out = {}
+    if runs and runs[0]["plant_values"]:
+        out["plant"] = col("plant", _np.int64)
+        for a, (name, _) in enumerate(runs[0]["plant_values"]):
+            out[name] = col(name, get=lambda r, a=a: r["plant_values"][a][1])
+    out.update({
         "dT": col("dT"),
         "lambda": col("lambda"),
         "estimator": [r["estimator"] for r in runs],
@@ -284,7 +306,7 @@ def sweep(task_path: PathLike, *, dT: Union[float, Sequence[float]],
         "duration": col("duration"),
         "wall_seconds": col("wall_seconds"),
         "physics_steps": col("physics_steps", _np.int64),
-    }
+    })
     for k in METRICS:
         # JSON has no NaN: a missing value (mean_nees of an estimator without variance) is null.
         out[k] = col(k, _np.int64 if k in _INTEGER_METRICS else float,
@@ -300,9 +322,15 @@ def aggregate(runs: Mapping[str, Any], max_overshoot: float = 0.10,
     lambda, estimator, seeds, the seeds' mean of each metric the table shows (overshoot_mean,
     overshoot_sd, settling_time_mean, settled_fraction, tracking_rmse_mean, ...),
     meets_criterion, margin. A cell meets the criterion when its mean overshoot <= max_overshoot
-    and its settled fraction >= min_settled.
+    and its settled fraction >= min_settled. Runs with plant axes (a "plant" column, then the
+    axis columns up to "dT", as sweep(...) returns them) give cells per plant point, with those
+    columns first, as table.csv.
     """
-    return _recruit.aggregate(dict(runs), float(max_overshoot), float(min_settled))
+    keys = list(runs.keys())
+    axes = []
+    if "plant" in keys and "dT" in keys:
+        axes = keys[keys.index("plant") + 1:keys.index("dT")]
+    return _recruit.aggregate(dict(runs), float(max_overshoot), float(min_settled), axes)
 
 
 __all__ = ["FilterModel", "KalmanFilter", "ExactFilter", "ParticleFilter", "Bundles",

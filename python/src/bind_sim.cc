@@ -5,6 +5,7 @@
 #include <pybind11/stl.h>
 
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -14,6 +15,7 @@
 #include "sim/run_task.h"
 #include "sim/task.h"
 #include "sweep/grid.h"
+#include "sweep/sweep.h"
 #include "sweep/table.h"
 
 namespace recruit::py_bind {
@@ -119,38 +121,51 @@ py::tuple Simulate(const std::string& task_path, const py::object& estimator,
                         trace_every > 0 ? py::object(trace.Columns()) : py::object(py::none()));
 }
 
-// The runs of a sweep as one JSON array text; each run's summary gets its grid position
-// (seed_index). `out_dir` holds the per-run records (RunSweep's resume files).
-std::string Sweep(const std::string& task_path, const std::vector<double>& dTs,
-                  const std::vector<double>& lambdas, const std::vector<std::string>& estimators,
-                  int seeds, uint64_t base_seed, const py::object& duration,
+// The runs of a sweep as one JSON array text, prepared as `recruit sweep` prepares them
+// (sweep::Prepare: the sweep file's controller values and plant axes under the options `given`,
+// the task of each plant point, the grid, each run's input hash) and run as it runs them; each
+// run's summary gets its grid position (seed_index, plant, plant_values). `out_dir` holds the
+// per-run records (RunSweep's resume files) and the models of the plant points.
+std::string Sweep(const std::string& task_path, const py::object& sweep_file,
+                  const std::vector<double>& dTs, const std::vector<double>& lambdas,
+                  const std::vector<std::string>& estimators, int seeds, uint64_t base_seed,
+                  const std::vector<std::string>& given, const py::object& duration,
                   const py::object& filter_model, int threads, const std::string& out_dir) {
   if (threads < 0) Fail("threads: must be >= 0 (0: all cores)");
-  const sim::Task task = Take(sim::Task::FromFile(task_path));
-  sweep::SweepSpec spec;
-  spec.identify_missing_models = true;  // as `recruit sweep` does
-  spec.dTs = dTs;
-  spec.lambdas = lambdas;
-  spec.estimators = estimators;
-  spec.seeds = seeds;
-  spec.base_seed = base_seed;
-  spec.duration = Opt<double>(duration);
-  spec.filter_model = Opt<std::string>(filter_model);
-  const std::vector<sweep::SweepRun> grid = Take(sweep::ExpandGrid(spec));
-  // As `recruit sweep` runs each grid point (src/cli/sweep_command.cc).
-  auto run = [&task, &spec](const sweep::SweepRun& g) {
-    return sim::RunTask(task, sweep::RunOptionsFor(g, spec));
+  sweep::SweepDefinition d;
+  d.task = task_path;
+  d.sweep_file = Opt<std::string>(sweep_file).value_or("");
+  d.out = out_dir;
+  d.dTs = dTs;
+  d.lambdas = lambdas;
+  d.estimators = estimators;
+  d.seeds = seeds;
+  d.base_seed = base_seed;
+  d.given = std::set<std::string>(given.begin(), given.end());
+  if (const std::optional<double> t = Opt<double>(duration)) {
+    if (!(*t > 0)) Fail("duration: must be > 0 s");
+    d.duration = *t;  // else the sweep file's, else the task's
+  }
+  d.filter_model = Opt<std::string>(filter_model).value_or("");
+  d.identify_missing_models = true;  // as `recruit sweep` does
+  const sweep::PreparedSweep p = Take(sweep::Prepare(d));
+  // As sweep::Run runs each grid point.
+  auto run = [&p](const sweep::SweepRun& g) {
+    return sim::RunTask(p.plant[g.plant].task, sweep::RunOptionsFor(g, p.spec));
   };
   std::optional<Result<sweep::SweepOutcome>> outcome;
   {
     py::gil_scoped_release release;
-    outcome.emplace(sweep::RunSweep(grid, out_dir, run, threads));
+    outcome.emplace(sweep::RunSweep(p.grid, out_dir, run, threads));
   }
   const sweep::SweepOutcome o = Take(std::move(*outcome));
   nlohmann::json runs = nlohmann::json::array();
   for (size_t i = 0; i < o.runs.size(); ++i) {
     nlohmann::json j = o.runs[i].ToJson();
-    j["seed_index"] = grid[i].seed_index;
+    j["seed_index"] = p.grid[i].seed_index;
+    j["plant"] = p.grid[i].plant;
+    j["plant_values"] = nlohmann::json::array();
+    for (const auto& [name, v] : p.grid[i].plant_values) j["plant_values"].push_back({name, v});
     runs.push_back(std::move(j));
   }
   return runs.dump();
@@ -158,22 +173,32 @@ std::string Sweep(const std::string& task_path, const std::vector<double>& dTs,
 
 // Cells of a run column dict (sweep's): per (dT, lambda, estimator), as table.csv. The metric
 // columns come from sim::kMetricFields: those the cells aggregate are read, the cells' written.
-py::dict AggregateColumns(const py::dict& runs, double max_overshoot, double min_settled) {
+// With plant axes (sweep(..., sweep_file=...)) the cells are per plant point too: `plant_axes`
+// names the axis columns, and runs has a "plant" column.
+py::dict AggregateColumns(const py::dict& runs, double max_overshoot, double min_settled,
+                          const std::vector<std::string>& plant_axes) {
   if (!runs.contains("estimator")) Fail("aggregate: runs has no column 'estimator'");
   const auto est = runs["estimator"].cast<std::vector<std::string>>();
   const Eigen::Index n = static_cast<Eigen::Index>(est.size());
-  auto column = [&runs, n](const char* name) {
-    if (!runs.contains(name)) Fail(std::string("aggregate: runs has no column '") + name + "'");
-    Eigen::VectorXd v = ToVector(runs[name], name);
+  auto column = [&runs, n](const std::string& name) {
+    if (!runs.contains(name)) Fail("aggregate: runs has no column '" + name + "'");
+    Eigen::VectorXd v = ToVector(runs[py::str(name)], name);
     if (v.size() != n) Fail("aggregate: the columns of runs differ in length");
     return v;
   };
   const Eigen::VectorXd dT = column("dT"), lambda = column("lambda");
   std::vector<sim::RunSummary> rs(n);
+  std::vector<sweep::SweepRun> grid(n);
+  const Eigen::VectorXd plant = plant_axes.empty() ? Eigen::VectorXd::Zero(n) : column("plant");
+  std::vector<Eigen::VectorXd> axes;
+  for (const auto& name : plant_axes) axes.push_back(column(name));
   for (Eigen::Index i = 0; i < n; ++i) {
-    rs[i].dT = dT(i);
-    rs[i].lambda = lambda(i);
-    rs[i].estimator = est[i];
+    rs[i].dT = grid[i].dT = dT(i);
+    rs[i].lambda = grid[i].lambda = lambda(i);
+    rs[i].estimator = grid[i].estimator = est[i];
+    grid[i].plant = static_cast<int>(plant(i));
+    for (size_t a = 0; a < axes.size(); ++a)
+      grid[i].plant_values.push_back({plant_axes[a], axes[a](i)});
   }
   for (const sim::MetricField& f : sim::kMetricFields) {
     if (!f.cell_mean) continue;
@@ -183,7 +208,8 @@ py::dict AggregateColumns(const py::dict& runs, double max_overshoot, double min
   sweep::TrackingCriterion criterion;
   criterion.max_overshoot = max_overshoot;
   criterion.min_settled = min_settled;
-  const std::vector<sweep::CellStats> cells = sweep::Aggregate(rs, criterion);
+  const std::vector<sweep::CellStats> cells =
+      plant_axes.empty() ? sweep::Aggregate(rs, criterion) : sweep::Aggregate(grid, rs, criterion);
   // Column names and order as table.csv (sweep::CellColumns).
   const std::vector<std::string> names = sim::CellMetricColumns();
   std::vector<std::string> estimators;
@@ -205,6 +231,16 @@ py::dict AggregateColumns(const py::dict& runs, double max_overshoot, double min
     return FromVector(Eigen::Map<const Eigen::VectorXd>(x.data(), x.size()));
   };
   py::dict out;
+  if (!plant_axes.empty()) {  // first, as in table.csv
+    std::vector<int> plants;
+    for (const auto& c : cells) plants.push_back(c.plant);
+    out["plant"] = py::array_t<int>(plants.size(), plants.data());
+    for (size_t a = 0; a < plant_axes.size(); ++a) {
+      std::vector<double> v;
+      for (const auto& c : cells) v.push_back(c.plant_values.at(a).second);
+      out[py::str(plant_axes[a])] = arr(v);
+    }
+  }
   out["dT"] = arr(dTs);
   out["lambda"] = arr(lambdas);
   out["estimator"] = estimators;
@@ -239,12 +275,14 @@ void BindSim(py::module_& mod) {
           py::arg("lam") = py::none(), py::arg("force_noise_std") = py::none(),
           py::arg("duration") = py::none(), py::arg("seed") = 1, py::arg("trace_every") = 1,
           "One closed-loop run -> (summary JSON text, trace column dict or None).");
-  mod.def("sweep_json", &Sweep, py::arg("task_path"), py::arg("dT"), py::arg("lam"),
-          py::arg("estimator"), py::arg("seeds"), py::arg("base_seed"), py::arg("duration"),
-          py::arg("filter_model"), py::arg("threads"), py::arg("out_dir"),
-          "A grid of runs -> JSON array text of the run summaries (with seed_index).");
+  mod.def("sweep_json", &Sweep, py::arg("task_path"), py::arg("sweep_file"), py::arg("dT"),
+          py::arg("lam"), py::arg("estimator"), py::arg("seeds"), py::arg("base_seed"),
+          py::arg("given"), py::arg("duration"), py::arg("filter_model"), py::arg("threads"),
+          py::arg("out_dir"),
+          "A sweep prepared as `recruit sweep` prepares it -> JSON array text of the run "
+          "summaries (with seed_index, plant, plant_values).");
   mod.def("aggregate", &AggregateColumns, py::arg("runs"), py::arg("max_overshoot") = 0.10,
-          py::arg("min_settled") = 0.90,
+          py::arg("min_settled") = 0.90, py::arg("plant_axes") = std::vector<std::string>{},
           "A sweep's run columns -> cell columns (as `recruit sweep`'s table.csv).");
   mod.attr("METRIC_FIELDS") = MetricFields();
   const std::vector<std::string> columns = sweep::CellColumns();

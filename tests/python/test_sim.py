@@ -129,10 +129,64 @@ def test_sweep_and_aggregate_are_the_cli_sweep(tmp_path, monkeypatch):
     assert not np.array_equal(other["tracking_rmse"], runs["tracking_rmse"][4:])
 
 
-def test_sweep_errors_are_value_errors():
+def test_sweep_with_a_sweep_file_is_the_cli_sweep(tmp_path):
+    """A sweep file (plant axes, controller values) is prepared as `recruit sweep --sweep`
+    prepares it: the same grid, seeds and metrics, and aggregate gives table.csv's cells per
+    plant point; an argument given to sweep() overrides the file's as a CLI option does."""
+    cli = _cli()
+    spec = tmp_path / "noise.json"
+    spec.write_text(json.dumps({
+        "task": TASK,
+        "duration": 10,
+        "controller": {"dT": [2], "lambda": [0.3], "estimator": ["output"], "seeds": 2,
+                       "base_seed": 5},
+        "plant": {"axes": [{"name": "noise_std", "path": "/sensor/noise_std",
+                            "values": [0.02, 0.5]}]},
+    }))
+    out = tmp_path / "cli"
+    subprocess.run([cli, "sweep", "--sweep", str(spec), "--out", str(out), "--threads", "2"],
+                   check=True, capture_output=True)
+    runs = recruit.sweep(sweep_file=spec, threads=2)
+    assert list(runs)[:3] == ["plant", "noise_std", "dT"]
+    assert list(runs["plant"]) == [0, 0, 1, 1]
+    assert list(runs["noise_std"]) == [0.02, 0.02, 0.5, 0.5]
+    assert list(runs["lambda"]) == [0.3] * 4
+    assert np.allclose(runs["duration"], 10.0, rtol=1e-12)  # the simulated time
+    for i in range(4):
+        key = "p{:04d}_dT2_l0.3_output_s{}".format(runs["plant"][i], runs["seed_index"][i])
+        with open(out / "runs" / (key + ".json")) as f:
+            j = json.load(f)
+        assert j["seed"] == runs["seed"][i]
+        for k, v in j["metrics"].items():
+            assert (np.isnan(runs[k][i]) if v is None else runs[k][i] == v), (key, k)
+    # The louder load cell changes the runs: the axis was applied.
+    assert runs["estimator_rmse"][0] != runs["estimator_rmse"][2]
+    cells = recruit.aggregate(runs)
+    with open(out / "table.csv") as f:
+        table = list(csv.DictReader(f))
+    assert list(cells)[:3] == ["plant", "noise_std", "dT"] and len(table) == 2
+    for i, row in enumerate(table):
+        assert str(cells["plant"][i]) == row["plant"]
+        assert float(row["noise_std"]) == cells["noise_std"][i]
+        for k in ("overshoot_mean", "tracking_rmse_mean", "margin"):
+            assert float(row[k]) == cells[k][i], k
+    # Given here, a value overrides the file's (as --seeds and --lambda do).
+    more = recruit.sweep(sweep_file=spec, seeds=1, lam=0.2, threads=2)
+    assert list(more["seed_index"]) == [0, 0] and list(more["lambda"]) == [0.2, 0.2]
+
+
+def test_sweep_errors_are_value_errors(tmp_path):
     with pytest.raises(ValueError, match="lambda"):
         recruit.sweep(TASK, dT=1.0, lam=2.0, duration=2.0)
     with pytest.raises(ValueError, match="seeds"):
         recruit.sweep(TASK, dT=1.0, seeds=0, duration=2.0)
+    with pytest.raises(ValueError, match="dT: required"):
+        recruit.sweep(TASK, duration=2.0)
+    with pytest.raises(ValueError, match="duration"):
+        recruit.sweep(TASK, dT=1.0, duration=0.0)
+    with pytest.raises(ValueError, match="unknown field 'colour'"):  # the sweep file's checks
+        bad = tmp_path / "bad.json"
+        bad.write_text('{"colour": 1}')
+        recruit.sweep(TASK, dT=1.0, sweep_file=bad)
     with pytest.raises(ValueError, match="no column"):
         recruit.aggregate({"dT": [1.0]})
