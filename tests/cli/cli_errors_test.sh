@@ -40,8 +40,11 @@ usage_range)  # range errors: exit 2, say what is allowed, never print DBL_MAX
   done
   expect 2 "$RECRUIT" sweep --task "$TASK" --seeds 0 --out o
   expect 2 "$RECRUIT" sweep --task "$TASK" --estimator bogus --out o
-  expect 2 "$RECRUIT" identify --dt -0.5
-  grep -q "1.79769e+308" err && fail "DBL_MAX printed by identify"
+  for bad in -0.5 2000; do  # the controller's rule for dT (control/sampling_period.h)
+    expect 2 "$RECRUIT" identify --dt $bad
+    grep -q "1.79769e+308" err && fail "DBL_MAX printed by identify"
+    grep -q "must be a finite number > 0 and <= 1000" err || fail "identify --dt $bad: no rule"
+  done
   [ ! -e o ] || fail "a usage error created --out"
   ;;
 usage_same_code_everywhere)  # an unknown option and a missing input: 2 for every command
