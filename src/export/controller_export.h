@@ -10,12 +10,12 @@
 #include <vector>
 
 #include "common/result.h"
+#include "export/c_writer.h"
 #include "sim/run_task.h"
 #include "sim/task.h"
 
 namespace recruit::exporter {
 
-enum class Precision { kDouble, kFloat };
 // "double" or "float".
 Result<Precision> ParsePrecision(const std::string& name);
 
