@@ -12,7 +12,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
+#include <fstream>
 #include <memory>
+#include <sstream>
 
 #include "attach/attach.h"
 #include "common/step_observer.h"
@@ -475,6 +478,142 @@ TEST(ExportAutoLoop, AReferenceOffTheScheduleUsesTheNearestPose) {
   EXPECT_EQ(ctl->pose(&exact), p);
   EXPECT_FALSE(exact);
   for (double v : out) EXPECT_FALSE(std::isinf(v));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Cortex-M4F: a self-tuned task's float package cross-compiled (the flow of export_test.cc's
+// ExportM4 test, docs/export.md), its flash and RAM, and a recorded run replayed under QEMU
+// against the host build of the same source.
+
+constexpr const char* kM4Flags =
+    "-mcpu=cortex-m4 -mthumb -mfpu=fpv4-sp-d16 -mfloat-abi=hard -std=c99 -Os -ffp-contract=off "
+    "-fno-math-errno -Wall -Wextra -Wdouble-promotion -Werror -ffunction-sections "
+    "-fdata-sections";
+
+std::string ReadText(const std::filesystem::path& p) {
+  std::ifstream in(p);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+std::string FloatHex(double v) {
+  const float f = static_cast<float>(v);
+  uint32_t u;
+  std::memcpy(&u, &f, sizeof u);
+  char buf[16];
+  std::snprintf(buf, sizeof buf, "%08lx", static_cast<unsigned long>(u));
+  return buf;
+}
+
+// replay.c's output: its rows of bit patterns, and the SysTick ticks and steps.
+struct Replayed {
+  std::vector<std::string> rows;
+  unsigned long ticks = 0;
+  int steps = 0;
+};
+
+Replayed ParseReplay(const std::string& text) {
+  Replayed r;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) {
+    if (std::sscanf(line.c_str(), "ticks %lu steps %d", &r.ticks, &r.steps) == 2) continue;
+    if (!line.empty()) r.rows.push_back(line);
+  }
+  return r;
+}
+
+TEST(ExportAutoLoopM4, CrossCompilesAndReplaysUnderQemu) {
+  if (!testing::HasTool("arm-none-eabi-gcc") || !testing::HasTool("qemu-system-arm")) {
+    GTEST_SKIP() << "arm-none-eabi-gcc or qemu-system-arm is not installed "
+                    "(scripts/install-deps.sh installs them)";
+  }
+  const std::string m4 = kSrc + "/tests/export/m4/";
+  for (const AutoCase& c : {Cases()[1], Cases()[2], Cases()[3]}) {
+    auto pkg = ExportController(LoadTask(c), Options(c, 1), Precision::kFloat);
+    ASSERT_TRUE(pkg.ok()) << pkg.error();
+    const auto dir = FreshDir("m4_auto");
+    testing::WriteFiles(pkg->files, dir);
+    const std::string d = dir.string() + "/";
+    auto sh = [&](const std::string& cmd) {
+      const int rc = testing::Shell("cd " + d + " && ( " + cmd + " ) > cmd.log 2>&1");
+      EXPECT_EQ(rc, 0) << cmd << "\n" << ReadText(dir / "cmd.log");
+      return rc == 0;
+    };
+    const std::string cc = std::string("arm-none-eabi-gcc ") + kM4Flags;
+    ASSERT_TRUE(sh(cc + " -fstack-usage -c recruit_controller.c"));
+    ASSERT_TRUE(sh(cc + " -I. -nostdlib -T " + m4 + "m4.ld -Wl,--gc-sections " + m4 + "startup.c " +
+                   m4 + "size_main.c recruit_controller.o -lm -lc -lgcc -o size.elf"));
+    ASSERT_TRUE(
+        sh("arm-none-eabi-size recruit_controller.o size.elf > size.txt && arm-none-eabi-nm -S "
+           "size.elf > nm.txt && arm-none-eabi-nm -u recruit_controller.o > undefined.txt"));
+    unsigned long otext = 0, text = 0, data = 0, ctx = 0, stack = 0;
+    {
+      std::istringstream in(ReadText(dir / "size.txt"));
+      for (std::string line; std::getline(in, line);) {
+        unsigned long t, da;
+        char name[256];
+        if (std::sscanf(line.c_str(), "%lu %lu %*u %*u %*x %255s", &t, &da, name) == 3) {
+          if (std::string(name) == "size.elf") text = t, data = da;
+          if (std::string(name) == "recruit_controller.o") otext = t;
+        }
+      }
+      std::istringstream nm(ReadText(dir / "nm.txt"));
+      for (std::string line; std::getline(nm, line);) {
+        unsigned long addr, size;
+        char type, name[256];
+        if (std::sscanf(line.c_str(), "%lx %lx %c %255s", &addr, &size, &type, name) == 4 &&
+            (type == 'b' || type == 'B') && std::string(name) == "ctl") {
+          ctx += size;
+        }
+      }
+      std::istringstream su(ReadText(dir / "recruit_controller.su"));
+      for (std::string line; std::getline(su, line);) {
+        const size_t tab = line.find('\t');
+        if (tab != std::string::npos) stack += std::strtoul(line.c_str() + tab + 1, nullptr, 10);
+      }
+    }
+    const std::string undefined = ReadText(dir / "undefined.txt");
+    for (const char* bad : {"malloc", "free", "printf", "sbrk"}) {
+      EXPECT_EQ(undefined.find(bad), std::string::npos) << undefined;
+    }
+
+    // A recorded run, replayed on the host and on the M4.
+    const RecordedRun run = RunCase(c, 3, nullptr);
+    {
+      std::ofstream out(dir / "log.txt");
+      out << run.instants.size() << " " << run.instants.front().decided.sensed_force.size() << "\n";
+      for (const Instant& k : run.instants) {
+        for (double v : k.in) out << FloatHex(v) << " ";
+        out << "\n";
+      }
+    }
+    ASSERT_TRUE(sh(std::string(RECRUIT_HOST_CC) + " " + testing::HostCFlags() +
+                   " -I. recruit_controller.c " + m4 + "replay.c -lm -o replay_host && " +
+                   "./replay_host log.txt > host.txt"));
+    ASSERT_TRUE(sh(cc + " -I. -DUSE_NEWLIB -DM4_SYSTICK -nostartfiles --specs=rdimon.specs -T " +
+                   m4 + "m4.ld -Wl,--gc-sections " + m4 + "startup.c " + m4 +
+                   "replay.c recruit_controller.c -lm -o replay.elf"));
+    ASSERT_TRUE(
+        sh("timeout 120 qemu-system-arm -M mps2-an386 -nographic -no-reboot -icount shift=0 "
+           "-semihosting-config enable=on,target=native -kernel replay.elf -append log.txt > "
+           "m4.txt"));
+    const Replayed host = ParseReplay(ReadText(dir / "host.txt"));
+    const Replayed target = ParseReplay(ReadText(dir / "m4.txt"));
+    const size_t nb = run.instants.front().decided.sensed_force.size();
+    ASSERT_EQ(host.rows.size(), run.instants.size() * nb);
+    ASSERT_EQ(target.rows.size(), host.rows.size());
+    ASSERT_EQ(target.steps, static_cast<int>(run.instants.size()));
+    size_t same = 0;
+    for (size_t r = 0; r < host.rows.size(); ++r) same += host.rows[r] == target.rows[r] ? 1 : 0;
+    // No sinf in these packages: IEEE arithmetic and libm's sqrt, floor, ceil on both sides.
+    EXPECT_EQ(same, host.rows.size()) << c.label << ": the M4 and the host build differ";
+    std::printf(
+        "m4 %s: recruit_controller.o text %lu, program flash %lu (text %lu, data %lu), context "
+        "%lu, stack frames %lu, RAM %lu; %zu outputs bit-identical to the host build of %zu; "
+        "about %.0f instructions per control step (%lu ticks over %d steps)\n",
+        c.label.c_str(), otext, text + data, text, data, ctx, stack, ctx + stack, same,
+        host.rows.size(), 40.0 * target.ticks / target.steps, target.ticks, target.steps);
+    EXPECT_GT(target.ticks, 0u);
+  }
 }
 
 }  // namespace
