@@ -354,9 +354,9 @@ TEST(ExportAutoLoop, FloatStaysWithinItsStatedBound) {
     const Deviation d = Replay(*ctl, run.instants);
     std::printf(
         "%s float: first other count at %g s; before it broadcast %.3g, estimate %.3g, force "
-        "reference %.3g; %d of %d outputs with another count\n",
+        "reference %.3g; variance %.3g; %d of %d outputs with another count\n",
         c.label.c_str(), d.first_flip, d.broadcast_before, d.estimate_before, d.force_reference,
-        d.flipped, d.outputs);
+        d.variance, d.flipped, d.outputs);
     worst.broadcast = std::max(worst.broadcast, d.broadcast);
     worst.estimate = std::max(worst.estimate, d.estimate);
     worst.variance = std::max(worst.variance, d.variance);
