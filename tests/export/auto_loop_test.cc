@@ -15,10 +15,12 @@
 #include <cstring>
 #include <fstream>
 #include <memory>
+#include <random>
 #include <sstream>
 
 #include "attach/attach.h"
 #include "common/step_observer.h"
+#include "control/torque_allocation.h"
 #include "export/controller_export.h"
 #include "sim/plant.h"
 #include "sim/run_task.h"
@@ -459,6 +461,97 @@ TEST(ExportAutoLoop, FloatGivesTheSameMetricsOver20Seeds) {
           << c.label << " " << fields[f];
     }
   }
+}
+
+// The package's allocation and rounding against src/control/torque_allocation.cc on random
+// problems of the two-joint arm's shape (six bundles; one or two joint rows and up to two
+// stiffness rows; arms of both signs and sizes, floors at 5 % of capacity, prices >= 1):
+// bit-identical tensions and whole-unit choices.
+TEST(ExportAutoLoop, AllocationAndRoundingAreTheControllersBitForBit) {
+  auto pkg = ExportController(LoadTask(Cases()[2]), Options(Cases()[2], 1), Precision::kDouble);
+  ASSERT_TRUE(pkg.ok()) << pkg.error();
+  const auto dir = FreshDir("alloc");
+  testing::WriteFiles(pkg->files, dir);
+  const std::string so = (dir / "liballoc.so").string();
+  ASSERT_EQ(testing::Shell(std::string(RECRUIT_HOST_CC) + " " + testing::HostCFlags() +
+                           " -Wno-unused-function -fPIC -shared -I" + dir.string() + " " + kSrc +
+                           "/tests/export/alloc_shim.c -lm -o " + so),
+            0);
+  void* h = dlopen(so.c_str(), RTLD_NOW | RTLD_LOCAL);
+  ASSERT_NE(h, nullptr) << dlerror();
+  using Tensions = void (*)(int, const double*, const double*, const double*, const double*,
+                            const double*, double*);
+  using Round = void (*)(int, const double*, const double*, const double*, const double*,
+                         const double*, const double*, const double*, double*);
+  const auto nb_of = reinterpret_cast<int (*)()>(dlsym(h, "alloc_bundles"));
+  const auto rows_of = reinterpret_cast<int (*)()>(dlsym(h, "alloc_max_rows"));
+  const auto units_of = reinterpret_cast<int (*)(int)>(dlsym(h, "alloc_units"));
+  const auto tensions = reinterpret_cast<Tensions>(dlsym(h, "alloc_tensions"));
+  const auto round = reinterpret_cast<Round>(dlsym(h, "alloc_round"));
+  ASSERT_TRUE(nb_of && rows_of && units_of && tensions && round);
+  const int nb = nb_of();
+  ASSERT_EQ(nb, 6);
+  ASSERT_EQ(rows_of(), 4);
+  Eigen::VectorXi units(nb);
+  for (int b = 0; b < nb; ++b) units[b] = units_of(b);
+  std::mt19937_64 gen(11);
+  std::uniform_real_distribution<double> u(-1, 1);
+  int differ = 0, rounded_differ = 0, n = 0, at_bound = 0;
+  for (int rows = 1; rows <= 4; ++rows) {
+    for (int trial = 0; trial < 5000; ++trial, ++n) {
+      control::AllocationProblem p;
+      p.arms.resize(rows, nb);
+      p.torque.resize(rows);
+      p.cap.resize(nb);
+      p.floor.resize(nb);
+      p.price.resize(nb);
+      std::vector<double> arms(rows * nb);
+      for (int j = 0; j < rows; ++j) {
+        p.torque[j] = (j < 2 ? 3 : 0.3) * u(gen);  // N m, or a stiffness row's N m/rad
+        for (int b = 0; b < nb; ++b) {
+          // a bundle that does not cross a joint: a rounding-size arm, as on the two-joint arm
+          p.arms(j, b) = b % 3 == 2 && j == 0 ? 1e-18 * u(gen) : (j < 2 ? 0.01 : 0.003) * u(gen);
+          arms[j * nb + b] = p.arms(j, b);
+        }
+      }
+      for (int b = 0; b < nb; ++b) {
+        p.cap[b] = 50 + 250 * std::abs(u(gen));
+        p.floor[b] = 0.05 * p.cap[b];
+        p.price[b] = 1 + 2 * std::abs(u(gen));
+      }
+      const Eigen::VectorXd want = control::AllocateTensions(p);
+      std::vector<double> got(nb);
+      tensions(rows, arms.data(), p.torque.data(), p.floor.data(), p.cap.data(), p.price.data(),
+               got.data());
+      for (int b = 0; b < nb; ++b) {
+        at_bound += want[b] == p.floor[b] || want[b] == p.cap[b];
+        if (got[b] != want[b]) {
+          ++differ;
+          break;
+        }
+      }
+      Eigen::VectorXd unit_force(nb);
+      for (int b = 0; b < nb; ++b) unit_force[b] = p.cap[b] / units[b];
+      const Eigen::VectorXd whole = control::RoundToUnits(p, want, unit_force, units);
+      std::vector<double> got_whole(nb);
+      round(rows, arms.data(), p.torque.data(), p.floor.data(), p.cap.data(), p.price.data(),
+            want.data(), unit_force.data(), got_whole.data());
+      for (int b = 0; b < nb; ++b) {
+        if (got_whole[b] != whole[b]) {
+          ++rounded_differ;
+          break;
+        }
+      }
+    }
+  }
+  dlclose(h);
+  std::printf(
+      "allocation: %d problems, %d bundle tensions at a bound; %d allocations and %d "
+      "roundings differ from the C++ ones\n",
+      n, at_bound, differ, rounded_differ);
+  EXPECT_GT(at_bound, n);  // the box constraints are active, not only the free minimum
+  EXPECT_EQ(differ, 0);
+  EXPECT_EQ(rounded_differ, 0);
 }
 
 // A reference the schedule never reaches: the nearest pose's design, flagged.
