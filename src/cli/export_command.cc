@@ -1,10 +1,13 @@
 // recruit export --task T [--dT S --lambda L --estimator E | --sweep DIR] --out DIR: the task's
 // tuned controller as a C99 package for a microcontroller (recruit_controller.h/.c) and the
 // unit side with the broadcast's wire format (recruit_unit.h/.c), docs/export.md.
+#include <cstdio>
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <optional>
+#include <string>
 
 #include "cli/commands.h"
 #include "cli/errors.h"
@@ -19,6 +22,7 @@ namespace {
 
 struct ExportArgs {
   std::string task, out, sweep, precision = "float";
+  int plant_point = -1;  // with --sweep over plant axes
   sim::RunOptions run;
 };
 
@@ -29,14 +33,33 @@ int RunExport(const ExportArgs& a) {
   auto task = sim::Task::FromFile(a.task);
   if (!task.ok()) return Fail(cmd, task.failure());
   sim::RunOptions run = a.run;
+  nlohmann::json sweep_note;  // export.json's "sweep" with plant axes
   if (!a.sweep.empty()) {
     const sim::ControllerSettings s = sim::EffectiveSettings(*task, run);
-    auto choice = exporter::SweepChoice(a.sweep, *task, s.estimator);
+    auto choice = exporter::SweepChoice(a.sweep, *task, s.estimator, a.plant_point);
     if (!choice) return Fail(cmd, choice.failure().In("--sweep: "));
     run.dT = choice->dT;
     run.lambda = choice->lambda;
+    std::string point;
+    if (choice->plant_task) {
+      // The controller of the sweep's plant at that point: its task and model.
+      task = std::move(*choice->plant_task);
+      nlohmann::json values = nlohmann::json::object();
+      point = " at plant point " + std::to_string(choice->plant_point) + " (";
+      for (const auto& [name, v] : choice->plant_values) {
+        values[name] = v;
+        char num[32];
+        std::snprintf(num, sizeof num, "%g", v);
+        point += (point.back() == '(' ? "" : ", ") + name + " " + num;
+      }
+      point += ")";
+      sweep_note = {{"folder", a.sweep},
+                    {"plant_point", choice->plant_point},
+                    {"plant_values", values},
+                    {"model", task->model_path}};
+    }
     std::cout << "sweep " << a.sweep << " recommends dT " << choice->dT << " s, lambda "
-              << choice->lambda << " for " << s.estimator << " (" << choice->why << ")\n";
+              << choice->lambda << " for " << s.estimator << point << " (" << choice->why << ")\n";
   }
   const sim::ControllerSettings settings = sim::EffectiveSettings(*task, run);
   const std::vector<std::pair<std::string, std::string>> inputs = {
@@ -45,6 +68,14 @@ int RunExport(const ExportArgs& a) {
       {"the filter model", settings.filter_model}};
   auto pkg = exporter::ExportController(*task, run, *precision);
   if (!pkg.ok()) return Fail(cmd, pkg.failure());
+  if (!sweep_note.is_null()) {
+    for (exporter::ExportedFile& f : pkg->files) {
+      if (f.name != "export.json") continue;
+      nlohmann::json m = nlohmann::json::parse(f.contents);
+      m["sweep"] = sweep_note;
+      f.contents = m.dump(2) + "\n";
+    }
+  }
   const std::filesystem::path out(a.out);
   for (const exporter::ExportedFile& f : pkg->files) {
     if (Status s = CheckNotAnInput((out / f.name).string(), "--out", inputs); !s.ok()) {
@@ -112,13 +143,21 @@ void AddExportCommand(CLI::App& app, int& exit_code) {
          "identified for the bundle and dT]")
       ->type_name("FILE")
       ->check(CLI::ExistingFile);
-  cmd->add_option("--sweep", args->sweep,
-                  "A `recruit sweep` output folder of this task: export with the dT and lambda "
-                  "its report recommends for the estimator")
-      ->type_name("DIR")
-      ->check(CLI::ExistingDirectory)
-      ->excludes(dT)
-      ->excludes(lambda);
+  auto* sweep =
+      cmd->add_option("--sweep", args->sweep,
+                      "A `recruit sweep` output folder of this task: export with the dT and lambda "
+                      "its report recommends for the estimator")
+          ->type_name("DIR")
+          ->check(CLI::ExistingDirectory)
+          ->excludes(dT)
+          ->excludes(lambda);
+  cmd->add_option("--plant-point", args->plant_point,
+                  "With a --sweep over plant axes: export for the sweep's plant at this point "
+                  "(table.md's plant column): its task and model with the point's values, and "
+                  "the dT and lambda recommended there")
+      ->type_name("K")
+      ->check(CLI::NonNegativeNumber)
+      ->needs(sweep);
   cmd->add_option("--precision", args->precision, "double or float")
       ->capture_default_str()
       ->check(CLI::IsMember({"double", "float"}));

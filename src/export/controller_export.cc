@@ -10,6 +10,8 @@
 #include "control/kalman_estimator.h"
 #include "control/output_estimator.h"
 #include "control/unit_force_map.h"
+#include "export/auto_loop_export.h"
+#include "export/c_writer.h"
 #include "export/templates.h"
 
 namespace recruit::exporter {
@@ -134,38 +136,6 @@ Result<BundleConstants> Constants(const sim::BundleController& bc, const std::st
   return out;
 }
 
-// C literals of the package's type: exact round trip for double (%.17g), the nearest float
-// (%.9g with an f suffix) for float.
-class Writer {
- public:
-  explicit Writer(Precision p) : p_(p) {}
-  std::string Num(double v) const {
-    char buf[64];
-    if (p_ == Precision::kFloat) {
-      std::snprintf(buf, sizeof buf, "%.9g", static_cast<double>(static_cast<float>(v)));
-    } else {
-      std::snprintf(buf, sizeof buf, "%.17g", v);
-    }
-    std::string s = buf;
-    if (s.find_first_of(".e") == std::string::npos) s += ".0";
-    return p_ == Precision::kFloat ? s + "f" : s;
-  }
-  template <class T>
-  std::string Array(const std::string& type, const std::string& name, const std::vector<T>& v,
-                    bool real) const {
-    std::string s = "static const " + type + " " + name + "[" + std::to_string(v.size()) + "] = {";
-    for (size_t i = 0; i < v.size(); ++i) {
-      s += (i % 6 == 0 ? "\n    " : " ") +
-           (real ? Num(static_cast<double>(v[i])) : std::to_string(static_cast<long>(v[i])));
-      if (i + 1 < v.size()) s += ",";
-    }
-    return s + "};\n";
-  }
-
- private:
-  Precision p_;
-};
-
 std::string BundleBlock(const BundleConstants& b, int i, const Writer& w) {
   const std::string n = "b" + std::to_string(i) + "_";
   std::string s = "/* Bundle " + std::to_string(i) + ": \"" + b.actuator + "\", " +
@@ -270,12 +240,7 @@ std::vector<ExportedFile> UnitPackage() {
 Result<ExportedPackage> ExportController(const sim::Task& task, const sim::RunOptions& options,
                                          Precision precision) {
   const std::string where = task.source.empty() ? task.name : task.source;
-  if (task.auto_loop) {
-    return Error{where +
-                 ": \"outer_loop\": \"auto\" (the self-tuned joint loops) is not exported yet; "
-                 "export a force task or an angle task with hand-set outer_loop gains"};
-  }
-  if (task.tracked == sim::Tracked::kAngle && !task.outer) {
+  if (task.tracked == sim::Tracked::kAngle && !task.outer && !task.auto_loop) {
     return Error{where + ": an angle task needs its outer_loop gains to be exported"};
   }
   const sim::ControllerSettings settings = sim::EffectiveSettings(task, options);
@@ -291,6 +256,35 @@ Result<ExportedPackage> ExportController(const sim::Task& task, const sim::RunOp
     bundles.push_back(std::move(b).value());
   }
   const int nb = static_cast<int>(bundles.size());
+  const Writer w(precision);
+  LoopCode loop;
+  std::vector<std::string> notes;
+  nlohmann::json poses = nlohmann::json::array();
+  if (task.auto_loop) {
+    auto frozen = FreezeAutoLoop(task, options, *controllers);
+    if (!frozen) return Error{frozen.error(), frozen.code()};
+    loop = AutoLoopCode(*frozen, w);
+    notes = frozen->notes;
+    for (const FrozenPose& p : frozen->poses) {
+      nlohmann::json gains = nlohmann::json::array();
+      for (const FrozenJointSetting& g : p.joint) {
+        gains.push_back({{"kp", g.kp}, {"ki", g.ki}, {"kd", g.kd}, {"holds", g.holds}});
+      }
+      poses.push_back({{"reference_rad", p.reference},
+                       {"first_time", p.first_time},
+                       {"feedforward", p.feedforward},
+                       {"gains", gains}});
+    }
+  } else {
+    loop.state = "  recruit_real integral; /* rad s */";
+    loop.input =
+        "  recruit_real reference;        /* the task's reference: N (force task) or rad (angle "
+        "task) */\n"
+        "  recruit_real angle;            /* rad, the joint encoder (angle tasks) */\n"
+        "  recruit_real angular_velocity; /* rad/s (angle tasks) */";
+    loop.init = "  c->integral = RK(0);";
+    loop.outer = OuterLoopBlock(task, nb, settings.dT, w);
+  }
   // At least a 2-state filter's room: an output-estimator package's (unused) filter code
   // then indexes no array of length 1 (which compilers warn of).
   int mmax = 2, nnzmax = 4;
@@ -298,7 +292,6 @@ Result<ExportedPackage> ExportController(const sim::Task& task, const sim::RunOp
     mmax = std::max(mmax, b.m);
     if (b.m > 0) nnzmax = std::max(nnzmax, b.ptr.back());
   }
-  const Writer w(precision);
   const bool f = precision == Precision::kFloat;
   char settings_line[300];
   std::snprintf(settings_line, sizeof settings_line,
@@ -318,7 +311,13 @@ Result<ExportedPackage> ExportController(const sim::Task& task, const sim::RunOp
     ReplaceAll(*s, "@TASK@", task.name);
     ReplaceAll(*s, "@VERSION@", std::string(ProjectVersion()) + " (" + CodeVersion() + ")");
     ReplaceAll(*s, "@SETTINGS@", settings_line);
-    ReplaceAll(*s, "@MATH@", f ? "sqrtf, sinf, fabsf" : "sqrt, sin, fabs");
+    ReplaceAll(*s, "@MATH@",
+               task.auto_loop ? (f ? "sqrtf, fabsf, floorf, ceilf" : "sqrt, fabs, floor, ceil")
+                              : (f ? "sqrtf, sinf, fabsf" : "sqrt, sin, fabs"));
+    ReplaceAll(*s, "@LOOP_DEFINES@", loop.defines);
+    ReplaceAll(*s, "@LOOP_STATE@", loop.state);
+    ReplaceAll(*s, "@LOOP_INPUT@", loop.input);
+    ReplaceAll(*s, "@LOOP_INIT@", loop.init);
     ReplaceAll(*s, "@REAL@", f ? "float" : "double");
     ReplaceAll(*s, "@NB@", std::to_string(nb));
     ReplaceAll(*s, "@MMAX@", std::to_string(mmax));
@@ -330,7 +329,7 @@ Result<ExportedPackage> ExportController(const sim::Task& task, const sim::RunOp
     ReplaceAll(*s, "@FABS@", f ? "fabsf" : "fabs");
   }
   ReplaceAll(c, "@CONSTANTS@", constants);
-  ReplaceAll(c, "@OUTER@", OuterLoopBlock(task, nb, settings.dT, w));
+  ReplaceAll(c, "@OUTER@", loop.outer);
 
   ExportedPackage pkg;
   pkg.summary = "task " + task.name + ": " + settings_line;
@@ -351,6 +350,11 @@ Result<ExportedPackage> ExportController(const sim::Task& task, const sim::RunOp
                   {"length_aware", b.length_aware}});
   }
   manifest["bundles"] = jb;
+  if (task.auto_loop) {
+    manifest["outer_loop"] = "auto";
+    manifest["poses"] = poses;
+    manifest["notes"] = notes;
+  }
   pkg.files = {{"recruit_controller.h", h}, {"recruit_controller.c", c}};
   for (ExportedFile& u : UnitPackage()) pkg.files.push_back(std::move(u));
   pkg.files.push_back({"export.json", manifest.dump(2) + "\n"});

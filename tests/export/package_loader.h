@@ -81,7 +81,9 @@ class LoadedController {
     bundles_ = reinterpret_cast<int (*)()>(dlsym(handle_, "shim_bundles"));
     init_ = reinterpret_cast<void (*)(void*)>(dlsym(handle_, "shim_init"));
     step_ = reinterpret_cast<void (*)(void*, const double*, double*)>(dlsym(handle_, "shim_step"));
-    if (!size_ || !bundles_ || !init_ || !step_) {
+    joints_ = reinterpret_cast<int (*)()>(dlsym(handle_, "shim_joints"));
+    pose_ = reinterpret_cast<int (*)(const void*, int*)>(dlsym(handle_, "shim_pose"));
+    if (!size_ || !bundles_ || !init_ || !step_ || !joints_ || !pose_) {
       error_ = "shim symbols missing";
       return;
     }
@@ -96,10 +98,19 @@ class LoadedController {
 
   const std::string& error() const { return error_; }
   int bundles() const { return bundles_(); }
+  int joints() const { return joints_(); }
+  // The self-tuned loops' reference pose of the last step (-1 without them) and whether the
+  // references matched it exactly.
+  int pose(bool* exact) const {
+    int e = 0;
+    const int p = pose_(ctx_.data(), &e);
+    *exact = e != 0;
+    return p;
+  }
   size_t context_size() const { return size_(); }
   void Init() { init_(ctx_.data()); }
-  // in: reference, angle, velocity, force[nb], length[nb]; out: 5 per bundle (force reference,
-  // p_on, p_off, estimated on, variance).
+  // in: reference[nj], angle[nj], velocity[nj], force[nb], length[nb]; out: 5 per bundle (force
+  // reference, p_on, p_off, estimated on, variance).
   void Step(const std::vector<double>& in, std::vector<double>& out) {
     out.resize(5 * bundles());
     step_(ctx_.data(), in.data(), out.data());
@@ -112,6 +123,8 @@ class LoadedController {
   int (*bundles_)() = nullptr;
   void (*init_)(void*) = nullptr;
   void (*step_)(void*, const double*, double*) = nullptr;
+  int (*joints_)() = nullptr;
+  int (*pose_)(const void*, int*) = nullptr;
   std::vector<unsigned char> ctx_;
 };
 

@@ -362,7 +362,7 @@ void recruit_bundle_step(recruit_bundle *b, recruit_work *w, recruit_real force_
 void recruit_init(recruit_controller *c) {
   int i;
   for (i = 0; i < RECRUIT_NUM_BUNDLES; ++i) recruit_bundle_init(&c->bundle[i], i);
-  c->integral = RK(0);
+@LOOP_INIT@
 }
 
 @OUTER@

@@ -19,7 +19,7 @@ typedef @REAL@ recruit_real;
 #define RECRUIT_MAX_ENTRIES @NNZMAX@ /* largest number of nonzeros of a bundle's A */
 #define RECRUIT_PACKED (RECRUIT_MAX_STATES * (RECRUIT_MAX_STATES + 1) / 2)
 #define RECRUIT_TRACKS_ANGLE @ANGLE@ /* 1: reference and outer loop in rad; 0: force (N) */
-/* clang-format on */
+@LOOP_DEFINES@/* clang-format on */
 
 /* A bundle's constants (the identified model, unit geometry, gains): in recruit_controller.c. */
 typedef struct recruit_bundle_params recruit_bundle_params;
@@ -46,14 +46,12 @@ typedef struct {
 typedef struct {
   recruit_bundle bundle[RECRUIT_NUM_BUNDLES];
   recruit_work work;
-  recruit_real integral; /* rad s */
+@LOOP_STATE@
 } recruit_controller;
 
 /* What the controller reads at a control instant (every dT = @DT@ s). */
 typedef struct {
-  recruit_real reference;        /* the task's reference: N (force task) or rad (angle task) */
-  recruit_real angle;            /* rad, the joint encoder (angle tasks) */
-  recruit_real angular_velocity; /* rad/s (angle tasks) */
+@LOOP_INPUT@
   recruit_real force[RECRUIT_NUM_BUNDLES];  /* N, each bundle's load cell; NaN = lost sample */
   recruit_real length[RECRUIT_NUM_BUNDLES]; /* m, each bundle's length coordinate; NaN = none */
 } recruit_input;

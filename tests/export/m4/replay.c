@@ -2,7 +2,8 @@
  * prints every output's bit pattern; the same source for the host and the Cortex-M4F under
  * QEMU (tests/export/export_test.cc compares the two).
  * Log: "instants bundles", then per instant the float bit patterns (hex) of reference, angle,
- * angular velocity, force[nb], length[nb] (newlib's strtof misrounds: bits, not decimals).
+ * angular velocity (each per driven joint for the self-tuned loops: nj of each), force[nb],
+ * length[nb] (newlib's strtof misrounds: bits, not decimals).
  * Output: per instant and bundle "k i force_reference p_on p_off estimated_on variance" (hex
  * bits), then "ticks T" (SysTick ticks spent in recruit_step with QEMU's -icount shift=0: one
  * tick per 40 instructions; 0 on the host). */
@@ -11,6 +12,11 @@
 #include <string.h>
 
 #include "recruit_controller.h"
+
+#ifndef RECRUIT_AUTO_LOOP
+#define RECRUIT_NUM_JOINTS 1
+#endif
+#define NV (3 * RECRUIT_NUM_JOINTS + 2 * RECRUIT_NUM_BUNDLES)
 
 static recruit_controller ctl; /* static: its size is the package's RAM (.bss) */
 
@@ -60,18 +66,27 @@ int main(int argc, char **argv) {
   recruit_init(&ctl);
   tick_start();
   for (k = 0; k < n; ++k) {
-    recruit_real v[3 + 2 * RECRUIT_NUM_BUNDLES];
+    const int nj = RECRUIT_NUM_JOINTS;
+    recruit_real v[NV];
     uint32_t t0, t1;
-    for (i = 0; i < 3 + 2 * RECRUIT_NUM_BUNDLES; ++i) {
+    for (i = 0; i < NV; ++i) {
       if (fscanf(f, "%lx", &b) != 1) return 5;
       v[i] = real_of(b);
     }
+#ifdef RECRUIT_AUTO_LOOP
+    for (i = 0; i < nj; ++i) {
+      in.reference[i] = v[i];
+      in.angle[i] = v[nj + i];
+      in.angular_velocity[i] = v[2 * nj + i];
+    }
+#else
     in.reference = v[0];
     in.angle = v[1];
     in.angular_velocity = v[2];
+#endif
     for (i = 0; i < nb; ++i) {
-      in.force[i] = v[3 + i];
-      in.length[i] = v[3 + nb + i];
+      in.force[i] = v[3 * nj + i];
+      in.length[i] = v[3 * nj + nb + i];
     }
     t0 = tick_now();
     recruit_step(&ctl, &in, &out);
