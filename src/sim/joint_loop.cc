@@ -95,10 +95,13 @@ Result<JointDesignRecord> JointLoops::Design(const Plant& plant, int j, const Ei
   rec.dynamics.damping = plant.JointDamping(j);
   // The response of the joint's torque: the allocation gives a demand to the fastest bundles
   // that can meet it, so the slower of the fastest bundle on each side sets it.
-  const Eigen::MatrixXd arms = plant.MomentArms();
+  // Arms at the reference pose, so the design does not depend on where the limb is; a bundle
+  // that does not cross the joint has an arm of rounding size, of either sign.
+  const Eigen::MatrixXd arms = plant.MomentArmsAt(r);
+  const double tiny = 1e-9 * arms.row(j).cwiseAbs().maxCoeff();
   const control::ActuatorResponse* side[2] = {nullptr, nullptr};  // flexing, extending
   for (int i = 0; i < plant.num_bundles(); ++i) {
-    if (arms(j, i) == 0) continue;
+    if (std::abs(arms(j, i)) <= tiny) continue;
     const control::ActuatorResponse*& s = side[arms(j, i) > 0 ? 0 : 1];
     if (s == nullptr || responses_[i].TimeTo(0.63) < s->TimeTo(0.63)) s = &responses_[i];
   }
