@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "attach/holding_load.h"
 #include "attach/report.h"
 #include "attach/spec_edit.h"
 #include "attach/starter_task.h"
@@ -107,6 +108,7 @@ Result<std::vector<BundleReport>> Probe(const mjSpec* spec, const std::vector<st
     for (const sma::TendonJump& jump : r.jumps) b.jumps.push_back(sma::JumpText(mm, jump));
     b.length_min = r.length_min;
     b.length_max = r.length_max;
+    b.holding = SampleHoldingLoad(mm, d.get(), b.tendon_id, r.joints, r.usable_lo, r.usable_hi);
     mju_copy(d->qpos, mm->qpos0, mm->nq);
     mj_kinematics(mm, d.get());
     mj_comPos(mm, d.get());
@@ -119,8 +121,9 @@ Result<std::vector<BundleReport>> Probe(const mjSpec* spec, const std::vector<st
 
 Status Size(std::vector<BundleReport>& bundles, const SizingLimits& limits) {
   for (BundleReport& b : bundles) {
-    SizingInput in{b.name,       b.peak_force, b.length_max - b.length_min,
-                   b.length_min, b.length_max, b.ref_length};
+    SizingInput in{b.name,           b.peak_force, b.length_max - b.length_min,
+                   b.length_min,     b.length_max, b.ref_length,
+                   b.holding.force()};
     auto design = SizeBundle(in, limits);
     if (!design.ok()) return Error{design.error(), design.code()};
     b.design = std::move(design).value();

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "attach/holding_load.h"
 #include "attach/lengthrange.h"
 #include "attach/sizing.h"
 #include "common/result.h"
@@ -42,6 +43,7 @@ struct BundleReport {
   std::vector<JointUse> joints;
   std::vector<std::string> jumps;  // "elbow at 114 deg (376.0 -> 211.0 mm)"
   double length_min = 0, length_max = 0, ref_length = 0;
+  HoldingLoad holding;  // the limb's own weight at the tendon (sizing's resolution)
   std::string instance, sensor;
   BundleDesign design;
 };

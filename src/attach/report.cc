@@ -65,6 +65,12 @@ std::string DesignTable(const AttachReport& r) {
          F("%.4g", u.series_spring) + " N/m, prestretch " + F("%.4g", 1000 * u.prestretch) +
          " mm, gear " + F("%g", d.gear) + "\n";
     if (!d.transmission.empty()) t += "  transmission: " + d.transmission + "\n";
+    if (b.holding.force() > 0) {
+      t += "  resolution: one unit " + F("%.3g", d.force_mid / d.units) + " N, " +
+           F("%.2g", 100 * d.force_mid / d.units / b.holding.force()) + " % of the " +
+           F("%.4g", b.holding.force()) + " N that holds the limb's weight (" +
+           F("%.3g", b.holding.torque) + " N m at " + F("%.3g", 1000 * b.holding.arm) + " mm)\n";
+    }
     t += "  force all on: " + F("%.4g", d.force_short) + " / " + F("%.4g", d.force_mid) + " / " +
          F("%.4g", d.force_long) + " N (shortest / mid / longest tendon); stroke " +
          F("%.1f", 1000 * d.stroke) + " mm\n";
@@ -113,6 +119,7 @@ nlohmann::json ReportJson(const AttachReport& r) {
                             {"jumps", b.jumps},
                             {"tendon_length", {b.length_min, b.length_max}},
                             {"ref_length", b.ref_length},
+                            {"holding_force", b.holding.force()},
                             {"gear", d.gear},
                             {"transmission", d.transmission},
                             {"config", config},

@@ -45,6 +45,29 @@ Result<sma::UnitModel> DesignUnit(double d, double length, int series, const Siz
   return unit;
 }
 
+// Fewer wires per unit and more units, so that one unit is at most 1/units_per_holding_force of
+// the force that holds the limb's own weight (the wires, so the force, unchanged).
+void RefineForResolution(const SizingInput& in, const SizingLimits& limits, BundleDesign& out) {
+  if (!(in.holding_force > 0) || limits.units_per_holding_force <= 0) return;
+  const double wanted =
+      std::ceil(limits.units_per_holding_force * in.peak_force / in.holding_force);
+  const int target = static_cast<int>(std::min<double>(wanted, limits.max_units_resolution));
+  const int wires = out.units * out.unit.parallel;
+  const int parallel = std::max(1, wires / target);
+  if (out.units < target && parallel < out.unit.parallel) {
+    out.unit.parallel = parallel;
+    out.units = (wires + parallel - 1) / parallel;
+  }
+  if (out.units < wanted) {
+    out.notes.push_back("resolution: " + std::to_string(out.units) + " units (at most " +
+                        std::to_string(limits.max_units_resolution) +
+                        ", one wire each at least), fewer than the " + Num(wanted) +
+                        " that would make one unit 1/" +
+                        std::to_string(limits.units_per_holding_force) +
+                        " of the limb's holding force (" + Num(in.holding_force) + " N)");
+  }
+}
+
 }  // namespace
 
 const std::vector<double>& StockDiameters() {
@@ -72,6 +95,10 @@ Result<BundleDesign> SizeBundle(const SizingInput& in, const SizingLimits& limit
   if (!(std::isfinite(in.excursion) && in.excursion >= 0 && std::isfinite(in.length_min) &&
         std::isfinite(in.length_max) && std::isfinite(in.ref_length))) {
     return Error{where + "tendon excursion " + Num(in.excursion) + " m is invalid"};
+  }
+  if (!(limits.stroke_use >= 0.2 && limits.stroke_use <= 0.95)) {
+    return Error{where + "stroke use " + Num(limits.stroke_use) +
+                 " is invalid: must be in 0.2..0.95"};
   }
   BundleDesign out;
   const double eps_L = sma::UnitParams{}.eps_L;
@@ -146,6 +173,7 @@ Result<BundleDesign> SizeBundle(const SizingInput& in, const SizingLimits& limit
     }
   }
   if (!chosen) return Error{where + "no stock wire meets the force"};
+  RefineForResolution(in, limits, out);
   auto u = sma::UnitModel::Create(out.unit);
   if (!u.ok()) return Error{where + u.error(), u.code()};
   const sma::UnitLimits datasheet = sma::UnitLimits::ForWire(out.unit.wire_diameter);

@@ -16,9 +16,12 @@ namespace recruit::attach {
 
 // Bounds of a credible unit (docs/sma-units.md, "Sizing a bundle").
 struct SizingLimits {
-  double max_segment_length = 0.25;    // m of active wire per segment
-  int max_series = 4;                  // segments per unit: at most 1 m of active wire per unit
-  double stroke_use = 0.5;             // fraction of the stroke the excursion may use
+  double max_segment_length = 0.25;  // m of active wire per segment
+  int max_series = 4;                // segments per unit: at most 1 m of active wire per unit
+  // Fraction of the stroke the excursion uses: the rest is the hot units' stretch at the
+  // tendon's shortest, so it sets how steeply a bundle's force falls as it shortens (its own
+  // stiffness, which holds a joint whose moment arms grow with the angle).
+  double stroke_use = 0.85;
   double design_stress = 0.8 * 172e6;  // Pa: a hot wire's stress at the tendon's longest
   double steady_temperature = 115;     // C: a held-on wire's steady temperature (<= 120)
   int max_units = 100;                 // units per bundle (the controller's resolution)
@@ -28,6 +31,10 @@ struct SizingLimits {
   double max_time_constant = 2.0;
   int max_units_fast = 300;          // units a bundle of such thinner wires may have
   double min_segment_length = 0.03;  // m
+  // Resolution: at least this many units' force in the load the bundle holds
+  // (SizingInput::holding_force), up to max_units_resolution units.
+  int units_per_holding_force = 50;
+  int max_units_resolution = 1000;
 };
 
 // Stock Flexinol diameters (m), thinnest first.
@@ -39,7 +46,8 @@ struct SizingInput {
   double excursion = 0;   // m: tendon length range over the usable joint ranges
   double length_min = 0;  // m: the tendon's shortest and longest (usable)
   double length_max = 0;
-  double ref_length = 0;  // m: tendon length at qpos0 (the plugin's default ref_length)
+  double ref_length = 0;     // m: tendon length at qpos0 (the plugin's default ref_length)
+  double holding_force = 0;  // N at the tendon that holds its limb's own weight (0: unknown)
 };
 
 struct BundleDesign {

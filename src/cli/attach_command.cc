@@ -95,6 +95,16 @@ void AddAttachCommand(CLI::App& app, int& exit_code) {
                   "more wires: bandwidth against heating power")
       ->check(NumberIn(0, true, 1e3, "seconds"))
       ->capture_default_str();
+  sub->add_option("--stroke-use", args->options.limits.stroke_use,
+                  "fraction of a unit's stroke the tendon's excursion uses: the rest sets how "
+                  "steeply a bundle's force falls as it shortens (its own stiffness)")
+      ->check(NumberIn(0.2, false, 0.95, "a fraction in 0.2..0.95"))
+      ->capture_default_str();
+  sub->add_option("--units-per-holding-force", args->options.limits.units_per_holding_force,
+                  "units whose force makes up the force that holds the limb's own weight (the "
+                  "counts' resolution); 0: no such rule")
+      ->check(CLI::Range(0, 1000))
+      ->capture_default_str();
   sub->callback([args, &exit_code] { exit_code = RunAttach(*args); });
 }
 

@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "attach/holding_load.h"
 #include "attach/sizing.h"
 #include "common/mujoco_load.h"
 #include "plugin/sma_host.h"
@@ -269,6 +270,72 @@ TEST(Sizing, MatchesForceWithinLimitsAndCoversTheStroke) {
 }
 
 // gear g: extension = prestretch + g (L - L_ref); the tendon gets g x the bundle's tension.
+// The sizing stroke rule: at the tendon, a hot unit's force is its stiffness times its stretch,
+// which is zero a distance s0 = (1/stroke_use - 1) g E below the tendon's shortest, so the
+// relative slope f'/f at the tendon is 1 / (s0 / g + L - L_min): closed form at the shortest.
+TEST(Sizing, TheStrokeRuleSetsTheBundlesForceLengthSlope) {
+  for (double use : {0.5, 0.85}) {
+    SizingLimits limits;
+    limits.stroke_use = use;
+    SizingInput in{"b", 100, 0.04, 0.2, 0.24, 0.22};
+    auto d = SizeBundle(in, limits);
+    ASSERT_TRUE(d.ok()) << d.error();
+    // Force at the shortest over the longest: s0 / (s0 + g E) = 1 - use.
+    EXPECT_NEAR(d->force_short / d->force_long, 1 - use, 1e-9) << use;
+  }
+}
+
+// Resolution: a bundle gets enough units that one is 1/50 of the force holding its limb's
+// weight, by fewer wires per unit (the same wires: the force is unchanged), never past the cap.
+TEST(Sizing, ResolutionGivesMoreSmallerUnitsForTheSameForce) {
+  SizingInput in{"b", 900, 0.04, 0.1, 0.14, 0.12};
+  auto coarse = SizeBundle(in);
+  ASSERT_TRUE(coarse.ok()) << coarse.error();
+  in.holding_force = 60;  // 50 units per 60 N: 750 units of 1.2 N
+  auto fine = SizeBundle(in);
+  ASSERT_TRUE(fine.ok()) << fine.error();
+  const int wires = coarse->units * coarse->unit.parallel;
+  const int fine_wires = fine->units * fine->unit.parallel;
+  EXPECT_GT(fine->units, coarse->units);
+  EXPECT_GE(fine->units, std::min(750, wires));
+  // The same wires, up to rounding the last unit up.
+  EXPECT_GE(fine_wires, wires);
+  EXPECT_LT(fine_wires, wires + fine->unit.parallel);
+  EXPECT_NEAR(fine->force_mid / coarse->force_mid, double(fine_wires) / wires, 1e-9);
+  EXPECT_THAT(fine->notes, testing::Not(testing::Contains(testing::HasSubstr("resolution"))));
+  // Asking for 45,000 units: the cap (or one wire per unit) stops it, and a note says so.
+  in.holding_force = 1;
+  auto capped = SizeBundle(in);
+  ASSERT_TRUE(capped.ok()) << capped.error();
+  EXPECT_LT(capped->units, 2 * SizingLimits{}.max_units_resolution);
+  EXPECT_THAT(capped->notes, testing::Contains(testing::HasSubstr("resolution")));
+}
+
+// The holding load against closed forms: a rod of mass m with its centre l from a hinge,
+// swept over -90..90 deg under gravity (largest torque m g l, horizontal), pulled by a fixed
+// tendon of moment arm r (force m g l / r); with gravity off, a joint spring k: k x the largest
+// distance from its spring reference.
+TEST(HoldingLoad, GravityAndSpringsOverTheTendonsArm) {
+  const char* xml = R"(<mujoco><option gravity="0 0 -9.81"/>
+  <worldbody><body><joint name="h" type="hinge" axis="0 1 0" range="-90 90" stiffness="%g"
+      springref="30"/><geom type="sphere" size="0.01" pos="0 0 -0.25" mass="2"/></body></worldbody>
+  <tendon><fixed name="t"><joint joint="h" coef="0.02"/></fixed></tendon></mujoco>)";
+  for (double k : {0.0, 3.0}) {
+    char text[1000];
+    std::snprintf(text, sizeof text, xml, k);
+    auto m = LoadModelFromString(text);
+    ASSERT_TRUE(m.ok()) << m.error();
+    if (k > 0) (*m)->opt.gravity[2] = 0;
+    DataPtr d(mj_makeData(m->get()));
+    const double lo = -M_PI / 2, hi = M_PI / 2;
+    const HoldingLoad load = SampleHoldingLoad(m->get(), d.get(), 0, {0}, {lo}, {hi});
+    const double torque = k > 0 ? k * (M_PI / 6 - lo) : 2 * 9.81 * 0.25;  // springref 30 deg
+    EXPECT_NEAR(load.torque, torque, 1e-9 * torque) << k;
+    EXPECT_NEAR(load.arm, 0.02, 1e-12);
+    EXPECT_NEAR(load.force(), torque / 0.02, 1e-6 * torque / 0.02);
+  }
+}
+
 TEST(Gear, IsATransmissionWithTheClosedForm) {
   const char* xml = R"(<mujoco>
   <extension><plugin plugin="recruit.sma"><instance name="u">

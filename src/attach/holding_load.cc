@@ -1,0 +1,42 @@
+#include "attach/holding_load.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace recruit::attach {
+namespace {
+
+// d(length)/d(qvel[dof]) from MuJoCo's sparse tendon Jacobian (its row of the tendon).
+double TendonArm(const mjModel* m, const mjData* d, int tendon, int dof) {
+  const int adr = m->ten_J_rowadr[tendon];
+  for (int k = 0; k < m->ten_J_rownnz[tendon]; ++k) {
+    if (m->ten_J_colind[adr + k] == dof) return d->ten_J[adr + k];
+  }
+  return 0;
+}
+
+}  // namespace
+
+HoldingLoad SampleHoldingLoad(const mjModel* m, mjData* d, int tendon,
+                              const std::vector<int>& joints, const std::vector<double>& lo,
+                              const std::vector<double>& hi) {
+  constexpr int kPoints = 33;
+  HoldingLoad best;
+  for (std::size_t i = 0; i < joints.size(); ++i) {
+    const int j = joints[i], dof = m->jnt_dofadr[j];
+    HoldingLoad load;
+    for (int k = 0; k < kPoints; ++k) {
+      mju_copy(d->qpos, m->qpos0, m->nq);
+      mju_zero(d->qvel, m->nv);
+      d->qpos[m->jnt_qposadr[j]] = lo[i] + (hi[i] - lo[i]) * k / (kPoints - 1);
+      mj_fwdPosition(m, d);
+      mj_fwdVelocity(m, d);  // qfrc_bias (gravity at rest) and qfrc_passive (springs)
+      load.torque = std::max(load.torque, std::abs(d->qfrc_bias[dof] - d->qfrc_passive[dof]));
+      load.arm = std::max(load.arm, std::abs(TendonArm(m, d, tendon, dof)));
+    }
+    if (load.force() > best.force()) best = load;
+  }
+  return best;
+}
+
+}  // namespace recruit::attach
