@@ -98,7 +98,7 @@ Result<BundleConstants> Constants(const sim::BundleController& bc, const std::st
     // The controller's own map of the settled on unit (RecruitmentController::Create).
     auto on = control::UnitForceMap::FromForces(*p.geometry, p.geometry->unit.prestretch,
                                                 Eigen::VectorXd::Constant(1, p.unit_force));
-    if (!on) return Error{where + ": " + on.error()};
+    if (!on) return on.failure().In(where + ": ");
     out.on_k = Stiffness(on->unit(), on->fractions()[0]);
     out.on_c = on->fractions()[0] * on->unit().recoverable_stretch();
   }
@@ -248,11 +248,11 @@ Result<ExportedPackage> ExportController(const sim::Task& task, const sim::RunOp
     return Error{where + ": controller.dT must be finite and > 0 s"};
   }
   auto controllers = sim::TaskControllers(task, options);
-  if (!controllers) return Error{controllers.error()};
+  if (!controllers) return controllers.failure();
   std::vector<BundleConstants> bundles;
   for (const sim::BundleController& bc : *controllers) {
     auto b = Constants(bc, where + ": bundle '" + bc.actuator + "'");
-    if (!b) return Error{b.error()};
+    if (!b) return b.failure();
     bundles.push_back(std::move(b).value());
   }
   const int nb = static_cast<int>(bundles.size());

@@ -38,7 +38,7 @@ Result<double> Number(const std::string& text, const std::string& where) {
 // seeds, meets_criterion, margin); `has_plant`: the table has a plant column.
 Result<std::vector<sweep::CellStats>> ReadCells(const std::string& path, bool* has_plant) {
   auto text = ReadFile(path);
-  if (!text) return Error{text.error()};
+  if (!text) return text.failure();
   std::stringstream in(*text);
   std::string line;
   std::getline(in, line);
@@ -72,11 +72,11 @@ Result<std::vector<sweep::CellStats>> ReadCells(const std::string& path, bool* h
     auto s = Number(f[c_s], where + ", seeds");
     auto g = Number(f[c_g], where + ", margin");
     for (const Result<double>* r : {&dt, &l, &s, &g}) {
-      if (!*r) return Error{r->error()};
+      if (!*r) return r->failure();
     }
     if (c_p >= 0) {
       auto pl = Number(f[c_p], where + ", plant");
-      if (!pl) return Error{pl.error()};
+      if (!pl) return pl.failure();
       c.plant = static_cast<int>(*pl);
     }
     c.dT = *dt;
@@ -99,27 +99,27 @@ Result<sim::Task> PlantTask(const std::string& dir, const sim::Task& task, int k
   namespace fs = std::filesystem;
   const std::string id_path = (fs::path(dir) / "sweep.json").string();
   auto id = LoadJsonFile(id_path);
-  if (!id) return Error{id.error()};
+  if (!id) return id.failure();
   if (!id->contains("sweep") || !(*id)["sweep"].is_string()) {
     return Error{id_path + ": names no sweep file (\"sweep\"), so its plant points are unknown"};
   }
   const std::string sweep_path = (*id)["sweep"].get<std::string>();
   auto file = sweep::SweepFile::FromFile(sweep_path);
-  if (!file) return Error{file.error()};
+  if (!file) return file.failure();
   auto points = sweep::PlantPoints(*file);
-  if (!points) return Error{points.error()};
+  if (!points) return points.failure();
   const int n = static_cast<int>(points->size());
   if (k < 0 || k >= n) {
     return Error{"--plant-point " + std::to_string(k) + ": the sweep has " + std::to_string(n) +
                  " plant points (0.." + std::to_string(n - 1) + ", table.md's plant column)"};
   }
   auto task_text = ReadFile(task.source);
-  if (!task_text) return Error{task_text.error()};
+  if (!task_text) return task_text.failure();
   auto model_text = ReadFile(task.model_path);
-  if (!model_text) return Error{model_text.error()};
+  if (!model_text) return model_text.failure();
   auto in = sweep::ApplyPlantPoint(*task_text, *model_text, file->axes, (*points)[k],
                                    "sweep file '" + sweep_path + "'");
-  if (!in) return Error{in.error()};
+  if (!in) return in.failure();
   values = (*points)[k].values;
   std::string text = in->task_text;
   if (in->model_edited) {
@@ -148,7 +148,7 @@ Result<SweepSettings> SweepChoice(const std::string& dir, const sim::Task& task,
   namespace fs = std::filesystem;
   const std::string md = (fs::path(dir) / "table.md").string();
   auto title = ReadFile(md);
-  if (!title) return Error{title.error() + " (not a `recruit sweep` output folder?)"};
+  if (!title) return Error{title.error() + " (not a `recruit sweep` output folder?)", title.code()};
   const std::string first = title->substr(0, title->find('\n'));
   if (first != "# Sweep: " + task.name) {
     return Error{md + ": the sweep is of another task (\"" + first.substr(0, 60) +
@@ -157,7 +157,7 @@ Result<SweepSettings> SweepChoice(const std::string& dir, const sim::Task& task,
   bool has_plant = false;
   const std::string csv = (fs::path(dir) / "table.csv").string();
   auto cells = ReadCells(csv, &has_plant);
-  if (!cells) return Error{cells.error()};
+  if (!cells) return cells.failure();
   if (has_plant && plant_point < 0) {
     int points = 0;
     for (const sweep::CellStats& c : *cells) points = std::max(points, c.plant + 1);

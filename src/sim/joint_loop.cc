@@ -114,7 +114,7 @@ Result<JointDesignRecord> JointLoops::Design(const Plant& plant, int j, const Ei
   control::LoopTarget target = target_;
   target.torque_error = rec.torque_error / rec.step;
   auto d = control::DesignJointLoop(rec.dynamics, *act, dT_, target);
-  if (!d.ok()) return Error{"joint '" + rec.joint + "': " + d.error()};
+  if (!d.ok()) return d.failure().In("joint '" + rec.joint + "': ");
   rec.design = std::move(d).value();
   return rec;
 }

@@ -639,13 +639,13 @@ Result<std::vector<BundleController>> TaskControllers(const Task& task, const Ru
   const std::string where = task.source.empty() ? task.name : task.source;
   const ControllerSettings settings = EffectiveSettings(task, options);
   auto plant_or = Plant::Create(task, /*drawn=*/false);
-  if (!plant_or.ok()) return Error{plant_or.error()};
+  if (!plant_or.ok()) return plant_or.failure();
   Plant& plant = **plant_or;
   plant.Reset(options.seed);
   double identify_s = 0;
   std::vector<std::string> warnings;
   auto channels = MakeChannels(task, settings, plant, options, where, identify_s, warnings);
-  if (!channels.ok()) return Error{channels.error()};
+  if (!channels.ok()) return channels.failure();
   std::vector<BundleController> out;
   for (int i = 0; i < plant.num_bundles(); ++i) {
     out.push_back({plant.bundle_name(i), std::move((*channels)[i].controller)});

@@ -107,6 +107,9 @@ io_code)  # an output that cannot be written, an input that cannot be read: exit
   expect 4 "$RECRUIT" identify --log sock -o m.json
   expect 4 "$RECRUIT" replay --log sock --task "$TASK" --out r  # was 3: the class was lost
   grep -q "cannot open 'sock'" err || fail "replay does not say it cannot open the log"
+  expect 4 "$RECRUIT" export --task "$TASK" --estimator kalman-augmented --filter-model sock \
+    --out ex  # was 3: the class was lost
+  [ ! -e ex ] || fail "export wrote on an I/O error"
   ;;
 name_escape)  # a task name with .., / or an absolute path never writes outside --out
   for name in '"../escaped"' '"/tmp/recruit_abs_escape"' '"a/b"' '"x\u001b[2J"'; do
