@@ -22,10 +22,14 @@ struct HeldPose {
   std::string text;
 };
 
-// The pose of the first limited 1-dof joint that moves `tendon`, sampled over its range, whose
-// tendon length is at `place` of the length range (0 shortest, 1 longest).
+// The pose of the limited 1-dof joint that moves `tendon` the most (the first of equals),
+// sampled over its range, whose tendon length is at `place` of that joint's length range (0
+// shortest, 1 longest), the other joints at qpos0. (A joint that barely moves the tendon, such
+// as a finger's abduction for its extensor, would hold it where a unit pulls little.)
 HeldPose ChoosePose(const mjModel* m, mjData* d, int tendon, double place) {
   constexpr int kSamples = 201;
+  HeldPose chosen;
+  double chosen_span = 0;
   for (int j = 0; j < m->njnt; ++j) {
     const int type = m->jnt_type[j];
     if ((type != mjJNT_HINGE && type != mjJNT_SLIDE) || !m->jnt_limited[j]) continue;
@@ -42,7 +46,7 @@ HeldPose ChoosePose(const mjModel* m, mjData* d, int tendon, double place) {
       len[i] = d->ten_length[tendon];
     }
     const auto [mn, mx] = std::minmax_element(len.begin(), len.end());
-    if (*mx - *mn < 1e-9) continue;  // does not move this tendon
+    if (*mx - *mn < 1e-9 || *mx - *mn <= chosen_span) continue;  // moves it less
     const double want = *mn + place * (*mx - *mn);
     int best = 0;
     for (int i = 1; i < kSamples; ++i) {
@@ -61,10 +65,11 @@ HeldPose ChoosePose(const mjModel* m, mjData* d, int tendon, double place) {
       std::snprintf(buf, sizeof buf, "%s %.4f m", name ? name : "joint", q[best]);
     }
     p.text = buf;
-    mju_copy(d->qpos, m->qpos0, m->nq);
-    return p;
+    chosen = p;
+    chosen_span = *mx - *mn;
   }
-  return {};
+  mju_copy(d->qpos, m->qpos0, m->nq);
+  return chosen;
 }
 
 // Holds the pose before each physics step: the joint at q and every velocity zero; with a

@@ -34,8 +34,8 @@ struct BenchRecording {
 
 struct RecordOptions {
   // Where to hold the limb: 0 = the shortest tendon length over the joints' ranges, 1 = the
-  // longest. The first limited hinge or slide joint that moves the tendon is set (others stay
-  // at qpos0); a model without one (a fixed bench) is recorded as it is.
+  // longest. The limited hinge or slide joint that moves the tendon the most is set (others
+  // stay at qpos0); a model without one (a fixed bench) is recorded as it is.
   double length_place = 1.0;
   // > 0: instead of holding, drive the joint over its range and back with this period (s), to
   // record the units while the tendon moves (the fit's checks; docs/identification.md).

@@ -195,6 +195,29 @@ TEST(SwitchingLog, CsvRoundTripsAndBadFilesNameTheLineAndColumn) {
   std::filesystem::remove(path);
 }
 
+// The pose is set on the joint that moves the tendon the most: here the second of two hinges
+// (a fixed tendon, length 0.001 a + 0.02 b), held at its longest, b = 1 rad.
+TEST(Identification, BenchHoldsTheJointThatMovesTheTendonMost) {
+  const std::string path = TempPath("two_hinges.xml");
+  std::ofstream(path) << R"(<mujoco><compiler angle="radian"/>
+  <extension><plugin plugin="recruit.sma"><instance name="u">
+    <config key="units" value="10"/></instance></plugin></extension>
+  <worldbody><body><joint name="a" type="hinge" axis="0 1 0" range="-1 1"/>
+    <geom size="0.01" mass="0.1"/><body><joint name="b" type="hinge" axis="0 1 0" range="-1 1"/>
+    <geom size="0.01" mass="0.1"/></body></body></worldbody>
+  <tendon><fixed name="t"><joint joint="a" coef="0.001"/><joint joint="b" coef="0.02"/></fixed>
+  </tendon>
+  <actuator><plugin name="p" instance="u" tendon="t" ctrlrange="-1 1"/></actuator>
+</mujoco>)";
+  const Excitation e = MakeExcitation(2, 4, 5);
+  auto rec = RecordBench(path, "p", e, 0.5, 5);
+  ASSERT_TRUE(rec.ok()) << rec.error();
+  ASSERT_FALSE(rec->lengths.empty());
+  // The bundle's length coordinate is gear (1) x the tendon's length: 0.02 x 1 rad.
+  EXPECT_NEAR(rec->lengths.front(), 0.02, 1e-9);
+  std::filesystem::remove(path);
+}
+
 TEST(Identification, BenchFitPredictsHeldOutForceBetterThanTheTwoStateModel) {
   // 300 s of the excitation on the isometric bench at dT = 0.5 s; the last 30 % held out.
   const Excitation e = MakeExcitation(16, 600, 5);
