@@ -207,7 +207,12 @@ std::vector<Request> NextBatch(const Tallies& t, const TuneSettings& s, const Dt
   const int mid = static_cast<int>(std::floor(0.5 * (lo + hi)));
   if (mid > w.lower.meets && mid < w.upper.meets && !t.count(mid)) {
     out.push_back({mid, s.initial_seeds});
+    return out;
   }
+  // Last, the recommended period on max_seeds seeds: the first period of a near-level plateau to
+  // reach 16 of 16 would otherwise be recommended on its luck. If it no longer meets, the window
+  // is found again without it.
+  if (t.at(w.recommended).seeds < s.max_seeds) out.push_back({w.recommended, s.max_seeds});
   return out;
 }
 

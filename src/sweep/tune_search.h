@@ -10,8 +10,10 @@
 // periods spread over the lattice, decides them, then bisects (in lattice index, i.e. log dT)
 // between the meeting periods at the window's ends and the failing ones beyond, until each edge
 // lies between lattice neighbours (known to the factor q) or the window reaches the lattice's end
-// (a censored edge). Last, the lattice period in the window's middle is tried, so the recommended
-// period (the meeting one farthest from both edges) has room on both sides.
+// (a censored edge). Then the lattice period in the window's middle is tried, so the recommended
+// period (the meeting one farthest from both edges) has room on both sides; last, the recommended
+// period is run on max_seeds seeds and judged again (if it no longer meets, the search goes on
+// with the window found without it).
 #pragma once
 
 #include <map>
@@ -96,7 +98,8 @@ struct Request {
 };
 
 // What to run next; empty when the search is done: every period tried decided (or marginal),
-// both edges resolved and the window's middle tried; or no period meets and none is left to try
+// both edges resolved, the window's middle tried and the recommended period run on max_seeds
+// seeds; or no period meets and none is left to try
 // next to the most promising marginal one (the periods between it and its tried neighbours).
 std::vector<Request> NextBatch(const Tallies& t, const TuneSettings& s, const DtLattice& lattice);
 
