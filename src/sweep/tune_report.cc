@@ -36,6 +36,44 @@ std::string Why(const DtRow& r) {
   return s.empty() ? "-" : s;
 }
 
+const DtRow* RowAt(const TuneColumn& c, double dT) {
+  for (const auto& r : c.rows) {
+    if (r.dT == dT) return &r;
+  }
+  return nullptr;
+}
+
+std::string FractionText(const DtRow& r) {
+  return fmt::format("{}/{} ({:.0f}-{:.0f} %)", r.meeting, r.seeds, 100 * r.fraction.lo,
+                     100 * r.fraction.hi);
+}
+
+// No period meets: the closest one (the largest fraction meeting), its verdict and why, and what
+// would decide a marginal one.
+std::string NoWindowText(const TuneColumn& c, const TuneSettings& s) {
+  const DtRow* best = nullptr;
+  for (const auto& r : c.rows) {
+    const double f = r.seeds ? static_cast<double>(r.meeting) / r.seeds : 0;
+    if (!best || f > static_cast<double>(best->meeting) / std::max(1, best->seeds)) best = &r;
+  }
+  if (!best) return "none: no dT tried meets";
+  int runs = 0, past_limits = 0;
+  for (const auto& r : c.rows) {
+    runs += r.seeds;
+    past_limits += r.fail_limits;
+  }
+  if (past_limits == runs) {
+    return "none: every run is past a datasheet limit (below: Datasheet limits); change the design";
+  }
+  std::string text = fmt::format("none: no dT tried meets; closest {} s, {}, {}", best->dT,
+                                 FractionText(*best), VerdictName(best->verdict));
+  if (best->verdict == Verdict::kMarginal) {
+    text +=
+        fmt::format(" (undecided at {} seeds: raise --max-seeds or lower --level)", s.max_seeds);
+  }
+  return text + (best->meeting < best->seeds ? ": " + Why(*best) : std::string());
+}
+
 std::string EdgeText(const TuneColumn& c, const TuneSettings& s, bool lower,
                      const DtLattice& lattice) {
   if (!c.window.found) return "-";
@@ -52,8 +90,12 @@ std::string EdgeText(const TuneColumn& c, const TuneSettings& s, bool lower,
         "> {} (censored: above the longest dT tried; extend the range, e.g. --dT-range {:g},{:g})",
         last, s.dT_min, s.dT_max * 4);
   }
-  return fmt::format("{:.3g} (fails at {}, meets at {})", lower ? c.lower_edge : c.upper_edge,
-                     lattice.dT(e.fails), lattice.dT(e.meets));
+  // The period beyond the edge fails, or is marginal (undecided at max_seeds: the edge is then
+  // where the claim stops being made, not where the fraction is known to fall below the level).
+  const DtRow* beyond = RowAt(c, lattice.dT(e.fails));
+  return fmt::format("{:.3g} ({} at {}, meets at {})", lower ? c.lower_edge : c.upper_edge,
+                     beyond ? VerdictName(beyond->verdict) : "fails", lattice.dT(e.fails),
+                     lattice.dT(e.meets));
 }
 
 std::string Percent(double x) { return std::isfinite(x) ? fmt::format("{:.1f}", 100 * x) : "-"; }
@@ -213,24 +255,36 @@ std::string TuneMarkdown(const PreparedSweep& p, const TuneDefinition& d, const 
       "dT (s) | margin to the edges | seeds meeting there (95 % interval) |\n"
       "|---|---|---|---|---|---|---|---|\n";
   for (const auto& col : o.columns) {
-    std::string rec = "none: no dT tried meets", margin = "-", frac = "-";
+    std::string rec = NoWindowText(col, s), margin = "-", frac = "-";
     if (col.window.found) {
       rec = fmt::format("{}", col.recommended);
       margin = fmt::format(
           "x{:.2f} above the lower{}, x{:.2f} below the upper{}", col.recommended / col.lower_edge,
           col.window.lower.censored ? " (at least)" : "", col.upper_edge / col.recommended,
           col.window.upper.censored ? " (at least)" : "");
-      for (const auto& r : col.rows) {
-        if (r.dT == col.recommended) {
-          frac = fmt::format("{}/{} ({:.0f}-{:.0f} %)", r.meeting, r.seeds, 100 * r.fraction.lo,
-                             100 * r.fraction.hi);
-        }
-      }
+      if (const DtRow* r = RowAt(col, col.recommended)) frac = FractionText(*r);
     }
     md +=
         fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} |\n", TunePlantLabel(col.plant_values),
                     col.estimator, col.lambda, EdgeText(col, s, true, lattice),
                     EdgeText(col, s, false, lattice), rec, margin, frac);
+  }
+  // Meeting periods outside the window (beyond a marginal or failing one): said, not hidden.
+  for (const auto& col : o.columns) {
+    if (!col.window.found) continue;
+    std::vector<std::string> also;
+    for (const auto& r : col.rows) {
+      if (r.verdict == Verdict::kMeets && (r.dT < lattice.dT(col.window.lower.meets) ||
+                                           r.dT > lattice.dT(col.window.upper.meets))) {
+        also.push_back(fmt::format("{} s ({})", r.dT, FractionText(r)));
+      }
+    }
+    if (!also.empty()) {
+      md += fmt::format(
+          "\n{} / {} / lambda {}: also meeting outside the window, beyond a period that does not "
+          "(see its row below): {}. The window is the longest run of meeting periods tried.\n",
+          TunePlantLabel(col.plant_values), col.estimator, col.lambda, fmt::join(also, ", "));
+    }
   }
   md += fmt::format(
       "\nThe recommended dT is the meeting dT tried farthest (in log dT) from both edges, not the "
