@@ -48,13 +48,17 @@ std::string FractionText(const DtRow& r) {
                      100 * r.fraction.hi);
 }
 
-// No period meets: the closest one (the largest fraction meeting), its verdict and why, and what
-// would decide a marginal one.
+// No period meets: the closest one (the largest fraction meeting; among equals, the fewest breaches
+// of the criterion's parts per seed), its verdict and why, and what would decide a marginal one.
 std::string NoWindowText(const TuneColumn& c, const TuneSettings& s) {
+  auto score = [](const DtRow& r) {
+    const double n = std::max(1, r.seeds);
+    const int parts = r.fail_overshoot + r.fail_settling + r.fail_worst_step + r.fail_limits;
+    return std::make_pair(r.meeting / n, -parts / n);
+  };
   const DtRow* best = nullptr;
   for (const auto& r : c.rows) {
-    const double f = r.seeds ? static_cast<double>(r.meeting) / r.seeds : 0;
-    if (!best || f > static_cast<double>(best->meeting) / std::max(1, best->seeds)) best = &r;
+    if (!best || score(r) > score(*best)) best = &r;
   }
   if (!best) return "none: no dT tried meets";
   int runs = 0, past_limits = 0;

@@ -122,17 +122,20 @@ TEST(TuneSeed, TheSweepReportGivesEachCellsReasons) {
       << md;
 }
 
-// A search's column from (lattice index, seeds, seeds meeting, peak temperature), its window found
-// as Tune finds it; failing seeds fail on settling.
-TuneColumn Column(const std::vector<std::tuple<int, int, int, double>>& cells,
+// A search's column from (lattice index, seeds, seeds meeting, peak temperature, failing seeds'
+// step overshoot), its window found as Tune finds it; failing seeds fail on settling (and on
+// overshoot when theirs is above 10 %).
+TuneColumn Column(const std::vector<std::tuple<int, int, int, double, double>>& cells,
                   const TuneDefinition& d, const DtLattice& lattice) {
   TuneColumn c;
   c.estimator = "output";
   c.lambda = 0.2;
   Tallies t;
-  for (const auto& [k, n, meeting, peak] : cells) {
+  for (const auto& [k, n, meeting, peak, overshoot] : cells) {
     std::vector<sim::RunSummary> runs;
-    for (int i = 0; i < n; ++i) runs.push_back(FakeRun({0.02}, i < meeting ? 1.0 : 0.5, peak));
+    for (int i = 0; i < n; ++i) {
+      runs.push_back(i < meeting ? FakeRun({0.02}, 1.0, peak) : FakeRun({overshoot}, 0.5, peak));
+    }
     c.rows.push_back(SummarizeDt(lattice.dT(k), runs, d.criterion, d.settings));
     t[k] = {c.rows.back().seeds, c.rows.back().meeting};
     c.runs += n;
@@ -152,17 +155,20 @@ TEST(TuneReport, SaysWhatLiesBeyondAnEdgeAndWhyNothingMeets) {
   TuneOutcome o;
   // Meets at 10-11, marginal at 12 (52/64), meets again at 14: the window ends at the marginal
   // period, and the meeting one beyond it is named.
-  o.columns.push_back(Column({{8, 4, 0, 50},
-                              {10, 64, 64, 50},
-                              {11, 16, 16, 50},
-                              {12, 64, 52, 50},
-                              {14, 64, 64, 50},
-                              {16, 4, 0, 50}},
+  o.columns.push_back(Column({{8, 4, 0, 50, 0.02},
+                              {10, 64, 64, 50, 0.02},
+                              {11, 16, 16, 50, 0.02},
+                              {12, 64, 52, 50, 0.02},
+                              {14, 64, 64, 50, 0.02},
+                              {16, 4, 0, 50, 0.02}},
                              d, lattice));
   // Nothing meets; the closest is marginal (56/64): what would decide it.
-  o.columns.push_back(Column({{10, 64, 56, 50}, {20, 4, 0, 50}}, d, lattice));
+  o.columns.push_back(Column({{10, 64, 56, 50, 0.02}, {20, 4, 0, 50, 0.02}}, d, lattice));
   // Every run past its temperature limit (150 of 100 C).
-  o.columns.push_back(Column({{10, 4, 4, 150}, {20, 4, 4, 150}}, d, lattice));
+  o.columns.push_back(Column({{10, 4, 4, 150, 0.02}, {20, 4, 4, 150, 0.02}}, d, lattice));
+  // No seed meets anywhere: the closest is the period breaking fewest parts (settling alone at
+  // 20, against overshoot and settling at 10).
+  o.columns.push_back(Column({{10, 4, 0, 50, 0.5}, {20, 4, 0, 50, 0.02}}, d, lattice));
   const std::string md = TuneMarkdown(p, d, o);
   EXPECT_NE(md.find(fmt::format("(marginal at {}, meets at {})", lattice.dT(12), lattice.dT(11))),
             std::string::npos)
@@ -183,6 +189,10 @@ TEST(TuneReport, SaysWhatLiesBeyondAnEdgeAndWhyNothingMeets) {
             std::string::npos)
       << md;
   EXPECT_NE(md.find("none: every run is past a datasheet limit"), std::string::npos) << md;
+  EXPECT_NE(
+      md.find(fmt::format("closest {} s, 0/4 (0-49 %), fails: settling 4/4 |", lattice.dT(20))),
+      std::string::npos)
+      << md;
 }
 
 }  // namespace
