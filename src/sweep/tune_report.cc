@@ -78,6 +78,32 @@ std::string NoWindowText(const TuneColumn& c, const TuneSettings& s) {
   return text + (best->meeting < best->seeds ? ": " + Why(*best) : std::string());
 }
 
+std::string Percent(double x) { return std::isfinite(x) ? fmt::format("{:.1f}", 100 * x) : "-"; }
+
+// Each recommended dT on the seeds the search never used (TuneDefinition::check_seeds).
+std::string NewSeedsMarkdown(const TuneDefinition& d, const TuneOutcome& o) {
+  std::string md;
+  for (const auto& c : o.columns) {
+    if (c.check.seeds == 0) continue;
+    const DtRow& r = c.check;
+    md += fmt::format("| {} | {} | {} | {} | {} | {} | {} / {} / {} | {:.3f}: {} |\n",
+                      TunePlantLabel(c.plant_values), c.estimator, c.lambda, r.dT, FractionText(r),
+                      Why(r), Percent(r.overshoot_mean), Percent(r.overshoot_p95),
+                      Percent(r.overshoot_worst), c.check_p,
+                      c.check_p < 0.05 ? "**refuted**" : "holds");
+  }
+  if (md.empty()) return md;
+  return fmt::format(
+             "\n## The recommendation on new seeds\n\nEach recommended dT run on {} seeds the "
+             "search never used (base seed {}, under check/). The claim \"at least {:.2f} of "
+             "seeds meet\" is refuted at 5 % when P(X <= seeds meeting) < 0.05 for X ~ "
+             "Binomial(seeds, {:.2f}).\n\n| plant | estimator | lambda | dT (s) | seeds meeting "
+             "(95 % interval) | why it fails (seeds) | overshoot mean / p95 / worst step (%) | "
+             "P(X <= meeting): claim |\n|---|---|---|---|---|---|---|---|\n",
+             d.check_seeds, d.check_base_seed, d.settings.level, d.settings.level) +
+         md;
+}
+
 std::string EdgeText(const TuneColumn& c, const TuneSettings& s, bool lower,
                      const DtLattice& lattice) {
   if (!c.window.found) return "-";
@@ -101,8 +127,6 @@ std::string EdgeText(const TuneColumn& c, const TuneSettings& s, bool lower,
                      beyond ? VerdictName(beyond->verdict) : "fails", lattice.dT(e.fails),
                      lattice.dT(e.meets));
 }
-
-std::string Percent(double x) { return std::isfinite(x) ? fmt::format("{:.1f}", 100 * x) : "-"; }
 
 plot::Series VerticalLine(double x, const std::string& label, plot::Color color,
                           plot::LineStyle style, double width = 1.5) {
@@ -299,6 +323,7 @@ std::string TuneMarkdown(const PreparedSweep& p, const TuneDefinition& d, const 
       "seeds.\n",
       o.shortest_hold);
 
+  md += NewSeedsMarkdown(d, o);
   for (const auto& col : o.columns) {
     md += fmt::format("\n## {} / {} / lambda {}\n\n", TunePlantLabel(col.plant_values),
                       col.estimator, col.lambda);
@@ -401,6 +426,17 @@ nlohmann::json TuneJson(const TuneDefinition& d, const TuneOutcome& o) {
                     {"lower_edge", edge(c.window.lower, c.lower_edge)},
                     {"upper_edge", edge(c.window.upper, c.upper_edge)},
                     {"recommended_dT", num(c.recommended)},
+                    {"check", c.check.seeds == 0
+                                  ? nlohmann::json()
+                                  : nlohmann::json{{"seeds", c.check.seeds},
+                                                   {"meeting", c.check.meeting},
+                                                   {"fraction_lo", c.check.fraction.lo},
+                                                   {"fraction_hi", c.check.fraction.hi},
+                                                   {"fail_overshoot", c.check.fail_overshoot},
+                                                   {"fail_settling", c.check.fail_settling},
+                                                   {"fail_limits", c.check.fail_limits},
+                                                   {"binomial_p", c.check.seeds ? c.check_p : 0},
+                                                   {"refuted", c.check_p < 0.05}}},
                     {"runs", c.runs},
                     {"dTs", rows}});
   }

@@ -41,6 +41,9 @@ std::string CheckTuneSettings(const TuneSettings& s);
 struct Interval {
   double lo = 0, hi = 1;
 };
+// P(X <= k) for X ~ Binomial(n, p): how likely k or fewer of n new seeds meet when a fraction p
+// of all seeds does (a claim "p >= level" is refuted at 5 % when this is below 0.05 at p = level).
+double BinomialCdf(int k, int n, double p);
 // Wilson score interval of a binomial fraction: k of n at normal quantile z (n = 0: [0, 1]).
 Interval WilsonInterval(int k, int n, double z);
 // The two-sided normal quantile of a confidence c in (0, 1): Phi^-1((1 + c) / 2).

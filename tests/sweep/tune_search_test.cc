@@ -29,6 +29,21 @@ TEST(TuneWilson, MatchesItsClosedForms) {
   EXPECT_NEAR(w.hi, 0.9889, 5e-4);
 }
 
+TEST(TuneWilson, BinomialCdfMatchesItsClosedForms) {
+  // P(X <= 12 | 20, 0.8) by the sum of terms C(20, i) 0.8^i 0.2^(20-i), i <= 12, written out.
+  double direct = 0, c = 1;  // c = C(20, i)
+  for (int i = 0; i <= 12; ++i) {
+    direct += c * std::pow(0.8, i) * std::pow(0.2, 20 - i);
+    c = c * (20 - i) / (i + 1);
+  }
+  EXPECT_NEAR(BinomialCdf(12, 20, 0.8), direct, 1e-12);
+  EXPECT_NEAR(BinomialCdf(12, 20, 0.8), 0.0321, 1e-4);
+  EXPECT_NEAR(BinomialCdf(0, 20, 0.8), std::pow(0.2, 20), 1e-25);
+  EXPECT_NEAR(BinomialCdf(19, 20, 0.8), 1 - std::pow(0.8, 20), 1e-12);
+  EXPECT_DOUBLE_EQ(BinomialCdf(20, 20, 0.8), 1.0);
+  EXPECT_DOUBLE_EQ(BinomialCdf(-1, 20, 0.8), 0.0);
+}
+
 TEST(TuneLattice, SpansTheRangeWithinTheTolerance) {
   TuneSettings s;
   const DtLattice l(s);
