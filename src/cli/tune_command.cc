@@ -97,9 +97,18 @@ int RunTuneCommand(TuneArgs& a) {
   if (tty) std::cerr << "\n";
   std::cout << "recruit tune: " << out->runs << " runs (" << out->executed << " made, "
             << out->reused << " reused) in " << out->rounds << " rounds; the lattice grid would "
-            << "need " << out->grid_runs << "; wrote tune.md, tune.json in " << d.sweep.out << "\n";
+            << "need " << out->grid_runs
+            << (out->check_runs ? "; " + std::to_string(out->check_runs) + " on new seeds"
+                                : std::string())
+            << "; wrote tune.md, tune.json in " << d.sweep.out << "\n";
   const std::string md = sweep::TuneMarkdown(*prep, d, *out);
-  const auto a0 = md.find("## Windows"), a1 = md.find("\n## ", a0 + 1);
+  // The windows and, when checked, the recommendations on new seeds.
+  const auto a0 = md.find("## Windows");
+  auto a1 = md.find("\n## ", a0 + 1);
+  const std::string checked = "\n## The recommendation on new seeds";
+  if (a1 != std::string::npos && md.compare(a1, checked.size(), checked) == 0) {
+    a1 = md.find("\n## ", a1 + 1);
+  }
   if (a0 != std::string::npos) std::cout << md.substr(a0, a1 - a0) << "\n";
   return exit_code::kOk;
 }
@@ -183,6 +192,14 @@ void AddTuneCommand(CLI::App& app, int& exit_code) {
       ->capture_default_str();
   cmd->add_option("--max-seeds", s.max_seeds, "Seeds at most per dT")->capture_default_str();
   cmd->add_option("--initial-points", s.initial_points, "dT spread over the range to start from")
+      ->capture_default_str();
+  cmd->add_option("--check-seeds", args->def.check_seeds,
+                  "After the search, run each recommended dT on this many seeds it never used "
+                  "and say whether its claim holds (0: no check)")
+      ->check(CLI::Range(0, 100000))
+      ->capture_default_str();
+  cmd->add_option("--check-base-seed", args->def.check_base_seed,
+                  "Base seed of those new seeds (must differ from --base-seed)")
       ->capture_default_str();
   cmd->add_option("--out", def.out, "Output directory (runs/ inside it makes it resumable)")
       ->capture_default_str();

@@ -31,6 +31,7 @@ struct Column {
   std::string estimator;
   double lambda = 0;
   std::map<int, std::vector<sim::RunSummary>> runs;
+  std::vector<sim::RunSummary> check;  // the recommended dT on new seeds
 };
 
 Tallies TalliesOf(const Column& c, const TuneCriterion& crit) {
@@ -43,6 +44,49 @@ Tallies TalliesOf(const Column& c, const TuneCriterion& crit) {
     }
   }
   return t;
+}
+
+// Runs each search's recommended dT on d.check_seeds new seeds into <out>/check.
+Status CheckOnNewSeeds(const PreparedSweep& p, const TuneDefinition& d, const DtLattice& lattice,
+                       int threads, const TuneHooks& hooks, std::vector<Column>& columns,
+                       TuneOutcome& out) {
+  if (d.check_seeds <= 0) return Status::Ok();
+  std::vector<SweepRun> batch;
+  std::vector<size_t> where;
+  for (size_t c = 0; c < columns.size(); ++c) {
+    const Window w = FindWindow(TalliesOf(columns[c], d.criterion), d.settings, lattice);
+    if (!w.found) continue;
+    for (int s = 0; s < d.check_seeds; ++s) {
+      SweepRun r;
+      r.index = static_cast<int>(batch.size());
+      r.plant = columns[c].plant;
+      r.plant_values = p.spec.plant.empty() ? std::vector<std::pair<std::string, double>>{}
+                                            : p.spec.plant[r.plant].values;
+      r.dT = lattice.dT(w.recommended);
+      r.lambda = columns[c].lambda;
+      r.estimator = columns[c].estimator;
+      r.seed_index = s;
+      r.seed = Rng::DeriveSeed(d.check_base_seed, static_cast<std::uint64_t>(s));
+      r.input_hash = InputHash(p, r);
+      batch.push_back(r);
+      where.push_back(c);
+    }
+  }
+  if (batch.empty()) return Status::Ok();
+  if (hooks.round) hooks.round(out.rounds + 1, static_cast<int>(batch.size()));
+  auto run = [&p](const SweepRun& g) {
+    return sim::RunTask(p.plant[g.plant].task, RunOptionsFor(g, p.spec));
+  };
+  auto done =
+      RunSweep(batch, (fs::path(d.sweep.out) / "check").string(), run, threads, hooks.progress);
+  if (!done.ok()) {
+    return Error{done.error() + " (finished runs are kept; run again to resume)", done.code()};
+  }
+  out.check_runs = static_cast<int>(batch.size());
+  for (size_t i = 0; i < batch.size(); ++i) {
+    columns[where[i]].check.push_back(std::move(done->runs[i]));
+  }
+  return Status::Ok();
 }
 
 }  // namespace
@@ -129,6 +173,12 @@ Result<TuneOutcome> Tune(const PreparedSweep& p, const TuneDefinition& d, int th
   if (std::string why = CheckTuneSettings(d.settings); !why.empty()) {
     return Error{"tune: " + why, ErrorCode::kUsage};
   }
+  if (d.check_seeds > 0 && d.check_base_seed == p.spec.base_seed) {
+    return Error{fmt::format("tune: --check-base-seed {} is the search's --base-seed: the check "
+                             "needs seeds the search never used",
+                             d.check_base_seed),
+                 ErrorCode::kUsage};
+  }
   const DtLattice lattice(d.settings);
   auto lock = OpenOutput(p, d.sweep);
   if (!lock.ok()) return lock.failure();
@@ -191,6 +241,9 @@ Result<TuneOutcome> Tune(const PreparedSweep& p, const TuneDefinition& d, int th
     }
   }
 
+  if (Status s = CheckOnNewSeeds(p, d, lattice, threads, hooks, columns, out); !s.ok()) {
+    return s.failure();
+  }
   out.shortest_hold = std::nan("");
   for (const Column& c : columns) {
     TuneColumn tc;
@@ -213,6 +266,10 @@ Result<TuneOutcome> Tune(const PreparedSweep& p, const TuneDefinition& d, int th
           if (!(hold >= out.shortest_hold)) out.shortest_hold = hold;
         }
       }
+    }
+    if (c.check.size() > 0) {
+      tc.check = SummarizeDt(tc.recommended, c.check, d.criterion, d.settings);
+      tc.check_p = BinomialCdf(tc.check.meeting, tc.check.seeds, d.settings.level);
     }
     out.runs += tc.runs;
     out.grid_runs += static_cast<long>(lattice.size()) * tc.max_seeds_used;

@@ -61,6 +61,11 @@ struct TuneColumn {
   double lower_edge = 0, upper_edge = 0;  // s (EdgeEstimate); NaN without a window
   double recommended = 0;                 // s; NaN without a window
   std::vector<DtRow> rows;                // by dT
+  // The recommended dT run on seeds the search never used (TuneDefinition::check_seeds; seeds == 0
+  // when not checked), and P(X <= meeting) for X ~ Binomial(seeds, level): the claim "at least
+  // `level` of seeds meet" is refuted at 5 % when it is below 0.05.
+  DtRow check;
+  double check_p = 0;
   int runs = 0;
   int max_seeds_used = 0;
 };
@@ -73,12 +78,17 @@ struct TuneDefinition {
   // order) whose index i has i % n == k - 1. The shards' runs/ copied into one folder and the
   // tune run there unsharded reuse them all and report every search.
   int shard_k = 1, shard_n = 1;
+  // After the search, run each recommended dT on this many new seeds, DeriveSeed(check_base_seed,
+  // 0..n-1) (a base seed other than the search's), recorded under <out>/check/runs.
+  int check_seeds = 0;
+  std::uint64_t check_base_seed = 777;
 };
 
 struct TuneOutcome {
   std::vector<TuneColumn> columns;
   int executed = 0, reused = 0, rounds = 0;
   int runs = 0;              // made or reused
+  int check_runs = 0;        // the recommended dTs on new seeds (made or reused), apart
   long grid_runs = 0;        // the lattice grid with the most seeds any period needed, per column
   double shortest_hold = 0;  // s: the shortest step hold of the task's reference
 };

@@ -36,6 +36,74 @@ std::string Why(const DtRow& r) {
   return s.empty() ? "-" : s;
 }
 
+const DtRow* RowAt(const TuneColumn& c, double dT) {
+  for (const auto& r : c.rows) {
+    if (r.dT == dT) return &r;
+  }
+  return nullptr;
+}
+
+std::string FractionText(const DtRow& r) {
+  return fmt::format("{}/{} ({:.0f}-{:.0f} %)", r.meeting, r.seeds, 100 * r.fraction.lo,
+                     100 * r.fraction.hi);
+}
+
+// No period meets: the closest one (the largest fraction meeting; among equals, the fewest breaches
+// of the criterion's parts per seed), its verdict and why, and what would decide a marginal one.
+std::string NoWindowText(const TuneColumn& c, const TuneSettings& s) {
+  auto score = [](const DtRow& r) {
+    const double n = std::max(1, r.seeds);
+    const int parts = r.fail_overshoot + r.fail_settling + r.fail_worst_step + r.fail_limits;
+    return std::make_pair(r.meeting / n, -parts / n);
+  };
+  const DtRow* best = nullptr;
+  for (const auto& r : c.rows) {
+    if (!best || score(r) > score(*best)) best = &r;
+  }
+  if (!best) return "none: no dT tried meets";
+  int runs = 0, past_limits = 0;
+  for (const auto& r : c.rows) {
+    runs += r.seeds;
+    past_limits += r.fail_limits;
+  }
+  if (past_limits == runs) {
+    return "none: every run is past a datasheet limit (below: Datasheet limits); change the design";
+  }
+  std::string text = fmt::format("none: no dT tried meets; closest {} s, {}, {}", best->dT,
+                                 FractionText(*best), VerdictName(best->verdict));
+  if (best->verdict == Verdict::kMarginal) {
+    text +=
+        fmt::format(" (undecided at {} seeds: raise --max-seeds or lower --level)", s.max_seeds);
+  }
+  return text + (best->meeting < best->seeds ? ": " + Why(*best) : std::string());
+}
+
+std::string Percent(double x) { return std::isfinite(x) ? fmt::format("{:.1f}", 100 * x) : "-"; }
+
+// Each recommended dT on the seeds the search never used (TuneDefinition::check_seeds).
+std::string NewSeedsMarkdown(const TuneDefinition& d, const TuneOutcome& o) {
+  std::string md;
+  for (const auto& c : o.columns) {
+    if (c.check.seeds == 0) continue;
+    const DtRow& r = c.check;
+    md += fmt::format("| {} | {} | {} | {} | {} | {} | {} / {} / {} | {:.3f}: {} |\n",
+                      TunePlantLabel(c.plant_values), c.estimator, c.lambda, r.dT, FractionText(r),
+                      Why(r), Percent(r.overshoot_mean), Percent(r.overshoot_p95),
+                      Percent(r.overshoot_worst), c.check_p,
+                      c.check_p < 0.05 ? "**refuted**" : "holds");
+  }
+  if (md.empty()) return md;
+  return fmt::format(
+             "\n## The recommendation on new seeds\n\nEach recommended dT run on {} seeds the "
+             "search never used (base seed {}, under check/). The claim \"at least {:.2f} of "
+             "seeds meet\" is refuted at 5 % when P(X <= seeds meeting) < 0.05 for X ~ "
+             "Binomial(seeds, {:.2f}).\n\n| plant | estimator | lambda | dT (s) | seeds meeting "
+             "(95 % interval) | why it fails (seeds) | overshoot mean / p95 / worst step (%) | "
+             "P(X <= meeting): claim |\n|---|---|---|---|---|---|---|---|\n",
+             d.check_seeds, d.check_base_seed, d.settings.level, d.settings.level) +
+         md;
+}
+
 std::string EdgeText(const TuneColumn& c, const TuneSettings& s, bool lower,
                      const DtLattice& lattice) {
   if (!c.window.found) return "-";
@@ -52,11 +120,13 @@ std::string EdgeText(const TuneColumn& c, const TuneSettings& s, bool lower,
         "> {} (censored: above the longest dT tried; extend the range, e.g. --dT-range {:g},{:g})",
         last, s.dT_min, s.dT_max * 4);
   }
-  return fmt::format("{:.3g} (fails at {}, meets at {})", lower ? c.lower_edge : c.upper_edge,
-                     lattice.dT(e.fails), lattice.dT(e.meets));
+  // The period beyond the edge fails, or is marginal (undecided at max_seeds: the edge is then
+  // where the claim stops being made, not where the fraction is known to fall below the level).
+  const DtRow* beyond = RowAt(c, lattice.dT(e.fails));
+  return fmt::format("{:.3g} ({} at {}, meets at {})", lower ? c.lower_edge : c.upper_edge,
+                     beyond ? VerdictName(beyond->verdict) : "fails", lattice.dT(e.fails),
+                     lattice.dT(e.meets));
 }
-
-std::string Percent(double x) { return std::isfinite(x) ? fmt::format("{:.1f}", 100 * x) : "-"; }
 
 plot::Series VerticalLine(double x, const std::string& label, plot::Color color,
                           plot::LineStyle style, double width = 1.5) {
@@ -213,24 +283,36 @@ std::string TuneMarkdown(const PreparedSweep& p, const TuneDefinition& d, const 
       "dT (s) | margin to the edges | seeds meeting there (95 % interval) |\n"
       "|---|---|---|---|---|---|---|---|\n";
   for (const auto& col : o.columns) {
-    std::string rec = "none: no dT tried meets", margin = "-", frac = "-";
+    std::string rec = NoWindowText(col, s), margin = "-", frac = "-";
     if (col.window.found) {
       rec = fmt::format("{}", col.recommended);
       margin = fmt::format(
           "x{:.2f} above the lower{}, x{:.2f} below the upper{}", col.recommended / col.lower_edge,
           col.window.lower.censored ? " (at least)" : "", col.upper_edge / col.recommended,
           col.window.upper.censored ? " (at least)" : "");
-      for (const auto& r : col.rows) {
-        if (r.dT == col.recommended) {
-          frac = fmt::format("{}/{} ({:.0f}-{:.0f} %)", r.meeting, r.seeds, 100 * r.fraction.lo,
-                             100 * r.fraction.hi);
-        }
-      }
+      if (const DtRow* r = RowAt(col, col.recommended)) frac = FractionText(*r);
     }
     md +=
         fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} |\n", TunePlantLabel(col.plant_values),
                     col.estimator, col.lambda, EdgeText(col, s, true, lattice),
                     EdgeText(col, s, false, lattice), rec, margin, frac);
+  }
+  // Meeting periods outside the window (beyond a marginal or failing one): said, not hidden.
+  for (const auto& col : o.columns) {
+    if (!col.window.found) continue;
+    std::vector<std::string> also;
+    for (const auto& r : col.rows) {
+      if (r.verdict == Verdict::kMeets && (r.dT < lattice.dT(col.window.lower.meets) ||
+                                           r.dT > lattice.dT(col.window.upper.meets))) {
+        also.push_back(fmt::format("{} s ({})", r.dT, FractionText(r)));
+      }
+    }
+    if (!also.empty()) {
+      md += fmt::format(
+          "\n{} / {} / lambda {}: also meeting outside the window, beyond a period that does not "
+          "(see its row below): {}. The window is the longest run of meeting periods tried.\n",
+          TunePlantLabel(col.plant_values), col.estimator, col.lambda, fmt::join(also, ", "));
+    }
   }
   md += fmt::format(
       "\nThe recommended dT is the meeting dT tried farthest (in log dT) from both edges, not the "
@@ -241,6 +323,7 @@ std::string TuneMarkdown(const PreparedSweep& p, const TuneDefinition& d, const 
       "seeds.\n",
       o.shortest_hold);
 
+  md += NewSeedsMarkdown(d, o);
   for (const auto& col : o.columns) {
     md += fmt::format("\n## {} / {} / lambda {}\n\n", TunePlantLabel(col.plant_values),
                       col.estimator, col.lambda);
@@ -343,6 +426,17 @@ nlohmann::json TuneJson(const TuneDefinition& d, const TuneOutcome& o) {
                     {"lower_edge", edge(c.window.lower, c.lower_edge)},
                     {"upper_edge", edge(c.window.upper, c.upper_edge)},
                     {"recommended_dT", num(c.recommended)},
+                    {"check", c.check.seeds == 0
+                                  ? nlohmann::json()
+                                  : nlohmann::json{{"seeds", c.check.seeds},
+                                                   {"meeting", c.check.meeting},
+                                                   {"fraction_lo", c.check.fraction.lo},
+                                                   {"fraction_hi", c.check.fraction.hi},
+                                                   {"fail_overshoot", c.check.fail_overshoot},
+                                                   {"fail_settling", c.check.fail_settling},
+                                                   {"fail_limits", c.check.fail_limits},
+                                                   {"binomial_p", c.check.seeds ? c.check_p : 0},
+                                                   {"refuted", c.check_p < 0.05}}},
                     {"runs", c.runs},
                     {"dTs", rows}});
   }

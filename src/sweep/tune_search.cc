@@ -32,6 +32,19 @@ std::string CheckTuneSettings(const TuneSettings& s) {
   return "";
 }
 
+double BinomialCdf(int k, int n, double p) {
+  if (k < 0) return 0;
+  if (k >= n) return 1;
+  // Terms by the ratio of neighbours, in logs for large n.
+  double sum = 0;
+  for (int i = 0; i <= k; ++i) {
+    const double log_term = std::lgamma(n + 1.0) - std::lgamma(i + 1.0) - std::lgamma(n - i + 1.0) +
+                            (i ? i * std::log(p) : 0.0) + (n - i ? (n - i) * std::log1p(-p) : 0.0);
+    sum += std::exp(log_term);
+  }
+  return std::min(1.0, sum);
+}
+
 Interval WilsonInterval(int k, int n, double z) {
   if (n <= 0) return {0, 1};
   const double p = static_cast<double>(k) / n, z2 = z * z;
@@ -207,7 +220,12 @@ std::vector<Request> NextBatch(const Tallies& t, const TuneSettings& s, const Dt
   const int mid = static_cast<int>(std::floor(0.5 * (lo + hi)));
   if (mid > w.lower.meets && mid < w.upper.meets && !t.count(mid)) {
     out.push_back({mid, s.initial_seeds});
+    return out;
   }
+  // Last, the recommended period on max_seeds seeds: the first period of a near-level plateau to
+  // reach 16 of 16 would otherwise be recommended on its luck. If it no longer meets, the window
+  // is found again without it.
+  if (t.at(w.recommended).seeds < s.max_seeds) out.push_back({w.recommended, s.max_seeds});
   return out;
 }
 

@@ -10,8 +10,10 @@
 // periods spread over the lattice, decides them, then bisects (in lattice index, i.e. log dT)
 // between the meeting periods at the window's ends and the failing ones beyond, until each edge
 // lies between lattice neighbours (known to the factor q) or the window reaches the lattice's end
-// (a censored edge). Last, the lattice period in the window's middle is tried, so the recommended
-// period (the meeting one farthest from both edges) has room on both sides.
+// (a censored edge). Then the lattice period in the window's middle is tried, so the recommended
+// period (the meeting one farthest from both edges) has room on both sides; last, the recommended
+// period is run on max_seeds seeds and judged again (if it no longer meets, the search goes on
+// with the window found without it).
 #pragma once
 
 #include <map>
@@ -39,6 +41,9 @@ std::string CheckTuneSettings(const TuneSettings& s);
 struct Interval {
   double lo = 0, hi = 1;
 };
+// P(X <= k) for X ~ Binomial(n, p): how likely k or fewer of n new seeds meet when a fraction p
+// of all seeds does (a claim "p >= level" is refuted at 5 % when this is below 0.05 at p = level).
+double BinomialCdf(int k, int n, double p);
 // Wilson score interval of a binomial fraction: k of n at normal quantile z (n = 0: [0, 1]).
 Interval WilsonInterval(int k, int n, double z);
 // The two-sided normal quantile of a confidence c in (0, 1): Phi^-1((1 + c) / 2).
@@ -96,7 +101,8 @@ struct Request {
 };
 
 // What to run next; empty when the search is done: every period tried decided (or marginal),
-// both edges resolved and the window's middle tried; or no period meets and none is left to try
+// both edges resolved, the window's middle tried and the recommended period run on max_seeds
+// seeds; or no period meets and none is left to try
 // next to the most promising marginal one (the periods between it and its tried neighbours).
 std::vector<Request> NextBatch(const Tallies& t, const TuneSettings& s, const DtLattice& lattice);
 

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <tuple>
 
 #include "sweep/tune.h"
 
@@ -117,6 +118,79 @@ TEST(TuneSeed, TheSweepReportGivesEachCellsReasons) {
       << md;
   EXPECT_NE(
       md.find(fmt::format("| 1 | 2/3 ({:.0f}-{:.0f} %) | settling 1/3 |", 100 * b.lo, 100 * b.hi)),
+      std::string::npos)
+      << md;
+}
+
+// A search's column from (lattice index, seeds, seeds meeting, peak temperature, failing seeds'
+// step overshoot), its window found as Tune finds it; failing seeds fail on settling (and on
+// overshoot when theirs is above 10 %).
+TuneColumn Column(const std::vector<std::tuple<int, int, int, double, double>>& cells,
+                  const TuneDefinition& d, const DtLattice& lattice) {
+  TuneColumn c;
+  c.estimator = "output";
+  c.lambda = 0.2;
+  Tallies t;
+  for (const auto& [k, n, meeting, peak, overshoot] : cells) {
+    std::vector<sim::RunSummary> runs;
+    for (int i = 0; i < n; ++i) {
+      runs.push_back(i < meeting ? FakeRun({0.02}, 1.0, peak) : FakeRun({overshoot}, 0.5, peak));
+    }
+    c.rows.push_back(SummarizeDt(lattice.dT(k), runs, d.criterion, d.settings));
+    t[k] = {c.rows.back().seeds, c.rows.back().meeting};
+    c.runs += n;
+  }
+  c.window = FindWindow(t, d.settings, lattice);
+  c.lower_edge = c.window.found ? EdgeEstimate(c.window.lower, lattice) : std::nan("");
+  c.upper_edge = c.window.found ? EdgeEstimate(c.window.upper, lattice) : std::nan("");
+  c.recommended = c.window.found ? lattice.dT(c.window.recommended) : std::nan("");
+  return c;
+}
+
+TEST(TuneReport, SaysWhatLiesBeyondAnEdgeAndWhyNothingMeets) {
+  TuneDefinition d;
+  const DtLattice lattice(d.settings);
+  PreparedSweep p;
+  p.task.name = "t";
+  TuneOutcome o;
+  // Meets at 10-11, marginal at 12 (52/64), meets again at 14: the window ends at the marginal
+  // period, and the meeting one beyond it is named.
+  o.columns.push_back(Column({{8, 4, 0, 50, 0.02},
+                              {10, 64, 64, 50, 0.02},
+                              {11, 16, 16, 50, 0.02},
+                              {12, 64, 52, 50, 0.02},
+                              {14, 64, 64, 50, 0.02},
+                              {16, 4, 0, 50, 0.02}},
+                             d, lattice));
+  // Nothing meets; the closest is marginal (56/64): what would decide it.
+  o.columns.push_back(Column({{10, 64, 56, 50, 0.02}, {20, 4, 0, 50, 0.02}}, d, lattice));
+  // Every run past its temperature limit (150 of 100 C).
+  o.columns.push_back(Column({{10, 4, 4, 150, 0.02}, {20, 4, 4, 150, 0.02}}, d, lattice));
+  // No seed meets anywhere: the closest is the period breaking fewest parts (settling alone at
+  // 20, against overshoot and settling at 10).
+  o.columns.push_back(Column({{10, 4, 0, 50, 0.5}, {20, 4, 0, 50, 0.02}}, d, lattice));
+  const std::string md = TuneMarkdown(p, d, o);
+  EXPECT_NE(md.find(fmt::format("(marginal at {}, meets at {})", lattice.dT(12), lattice.dT(11))),
+            std::string::npos)
+      << md;
+  EXPECT_NE(md.find(fmt::format("(fails at {}, meets at {})", lattice.dT(8), lattice.dT(10))),
+            std::string::npos)
+      << md;
+  EXPECT_NE(md.find(fmt::format("also meeting outside the window, beyond a period that does not "
+                                "(see its row below): {} s (64/64",
+                                lattice.dT(14))),
+            std::string::npos)
+      << md;
+  EXPECT_NE(md.find(fmt::format("none: no dT tried meets; closest {} s, 56/64", lattice.dT(10))),
+            std::string::npos)
+      << md;
+  EXPECT_NE(md.find("marginal (undecided at 64 seeds: raise --max-seeds or lower --level): "
+                    "settling 8/64"),
+            std::string::npos)
+      << md;
+  EXPECT_NE(md.find("none: every run is past a datasheet limit"), std::string::npos) << md;
+  EXPECT_NE(
+      md.find(fmt::format("closest {} s, 0/4 (0-49 %), fails: settling 4/4 |", lattice.dT(20))),
       std::string::npos)
       << md;
 }
