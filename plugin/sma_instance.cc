@@ -7,12 +7,14 @@
 #include <cstdlib>
 #include <functional>
 #include <map>
+#include <memory>
 #include <mutex>
 #include <set>
 #include <string>
 #include <string_view>
 #include <tuple>
 #include <utility>
+#include <vector>
 
 #include "common/rng.h"
 #include "common/short_text.h"
@@ -54,6 +56,64 @@ Result<double> ParsePeriod(const std::string& where, const std::string& v) {
                  " is invalid: must be a number of seconds in [0, 1e6] (0 = every timestep)"};
   }
   return p;
+}
+
+// An instance's config values: every BundleConfig key's, the seed's and the broadcast period's.
+struct ConfigValues {
+  std::vector<std::pair<std::string, std::string>> pairs;
+  std::string seed, period;
+};
+
+// The instance's config values, kept per process by the instance's raw attribute bytes in the
+// model (mjModel.plugin_attr: the values MuJoCo's mj_getPluginConfig reads, ~1000 instructions a
+// key): the same bytes give the same values.
+std::shared_ptr<const ConfigValues> Values(const mjModel* m, int instance) {
+  static std::mutex mu;
+  static std::map<std::string, std::shared_ptr<const ConfigValues>> kept;
+  const mjtSize begin = m->plugin_attradr[instance];
+  const mjtSize end = instance + 1 < m->nplugin ? m->plugin_attradr[instance + 1] : m->npluginattr;
+  std::string key(m->plugin_attr + begin, m->plugin_attr + end);
+  {
+    std::lock_guard<std::mutex> guard(mu);
+    if (auto it = kept.find(key); it != kept.end()) return it->second;
+  }
+  auto v = std::make_shared<ConfigValues>();
+  for (const std::string& k : BundleConfig::Keys()) {
+    v->pairs.emplace_back(k, Config(m, instance, k.c_str()));
+  }
+  v->seed = Config(m, instance, kSeedKey);
+  v->period = Config(m, instance, kBroadcastPeriodKey);
+  std::lock_guard<std::mutex> guard(mu);
+  if (kept.size() >= 4096) kept.clear();  // a bound for long-lived processes over many designs
+  return kept.emplace(std::move(key), std::move(v)).first->second;
+}
+
+// A bundle's parsed config and its units' settled on-tension at the config's prestretch, kept
+// per process by the exact text they are made of (actuator name, message prefix, every key and
+// value): a run builds each instance 4-8 times (the compiler's and loader's size queries, one per
+// mjData), and parsing with its physics check and the settling loop were ~2/3 of each build.
+struct ParsedConfig {
+  Result<BundleConfig> config;
+  double settled_force = std::nan("");  // NaN until the first build computes it
+};
+
+std::shared_ptr<ParsedConfig> Parse(const std::string& name, const std::string& where,
+                                    const std::vector<std::pair<std::string, std::string>>& pairs,
+                                    std::mutex** lock) {
+  static std::mutex mu;
+  static std::map<std::string, std::shared_ptr<ParsedConfig>> kept;
+  std::string key = name + '\0' + where;
+  for (const auto& [k, v] : pairs) key += '\0' + k + '\0' + v;
+  *lock = &mu;
+  {
+    std::lock_guard<std::mutex> guard(mu);
+    if (auto it = kept.find(key); it != kept.end()) return it->second;
+  }
+  auto parsed =
+      std::make_shared<ParsedConfig>(ParsedConfig{BundleConfig::FromPairs(name, where, pairs)});
+  std::lock_guard<std::mutex> guard(mu);
+  if (kept.size() >= 4096) kept.clear();  // a bound for long-lived processes over many designs
+  return kept.emplace(std::move(key), std::move(parsed)).first->second;
 }
 
 // Index of actuator a among all recruit.sma actuators of m.
@@ -254,19 +314,17 @@ Result<std::unique_ptr<SmaInstance>> SmaInstance::Build(const mjModel* m, int in
   }
   std::unique_ptr<SmaInstance> p(new SmaInstance);
   p->instance_ = instance;
-  std::vector<std::pair<std::string, std::string>> pairs;
-  for (const std::string& key : BundleConfig::Keys()) {
-    pairs.emplace_back(key, Config(m, instance, key.c_str()));
-  }
+  const std::shared_ptr<const ConfigValues> values = Values(m, instance);
+  const std::vector<std::pair<std::string, std::string>>& pairs = values->pairs;
   int offset = 0;
   for (int a = 0; a < m->nactuator; ++a) {
     if (m->actuator_plugin[a] != instance) continue;
     const std::string name = ActuatorName(m, a);
     const std::string where = "recruit.sma actuator '" + name + "': ";
     if (p->actuators_.empty()) {
-      auto seed = ParseSeed(where, Config(m, instance, kSeedKey));
+      auto seed = ParseSeed(where, values->seed);
       if (!seed.ok()) return Error{seed.error(), seed.code()};
-      auto period = ParsePeriod(where, Config(m, instance, kBroadcastPeriodKey));
+      auto period = ParsePeriod(where, values->period);
       if (!period.ok()) return Error{period.error(), period.code()};
       p->seed_ = *seed;
       p->broadcast_period_ = *period;
@@ -275,7 +333,9 @@ Result<std::unique_ptr<SmaInstance>> SmaInstance::Build(const mjModel* m, int in
       Status ok = CheckActuator(m, a, where);
       if (!ok.ok()) return Error{ok.error(), ok.code()};
     }
-    auto cfg = BundleConfig::FromPairs(name, where + "config ", pairs);
+    std::mutex* mu = nullptr;
+    const std::shared_ptr<ParsedConfig> parsed = Parse(name, where + "config ", pairs, &mu);
+    const Result<BundleConfig>& cfg = parsed->config;
     if (!cfg.ok()) return Error{cfg.error(), cfg.code()};
     auto bundle = SmaBundle::Create(*cfg, m->opt.timestep);
     if (!bundle.ok()) return Error{where + bundle.error(), bundle.code()};
@@ -286,7 +346,13 @@ Result<std::unique_ptr<SmaInstance>> SmaInstance::Build(const mjModel* m, int in
     act.gear = m->actuator_gear[6 * a];
     act.ref_length =
         std::isnan(cfg->ref_length) ? m->actuator_length0[a] : act.gear * cfg->ref_length;
-    act.settled_force = act.model.SettledOnTension(cfg->unit.prestretch);
+    {
+      std::lock_guard<std::mutex> guard(*mu);
+      if (std::isnan(parsed->settled_force)) {
+        parsed->settled_force = act.model.SettledOnTension(cfg->unit.prestretch);
+      }
+      act.settled_force = parsed->settled_force;
+    }
     offset += kSlots + act.model.state_size();
     p->actuators_.push_back(std::move(act));
   }
