@@ -33,9 +33,12 @@ std::string ModelPath(const char* file) {
          file;
 }
 
-std::string BenchWithUnits(int units, int update_ms) {
+// The bench with `units` units and the update period; without `truth`, minus the plugin's
+// ground-truth sensor (the muscle bench has none: like for like).
+std::string BenchWithUnits(int units, int update_ms, bool truth = true) {
   char buf[256];
-  std::snprintf(buf, sizeof buf, "/tmp/recruit_sma_bench_%d_%d.xml", units, update_ms);
+  std::snprintf(buf, sizeof buf, "/tmp/recruit_sma_bench_%d_%d%s.xml", units, update_ms,
+                truth ? "" : "_notruth");
   std::FILE* in = std::fopen(ModelPath("isometric_bench.xml").c_str(), "r");
   std::string xml;
   char chunk[4096];
@@ -49,6 +52,7 @@ std::string BenchWithUnits(int units, int update_ms) {
                                                       std::to_string(units) +
                                                       "\"/><config key=\"update_period\" value=\"" +
                                                       std::to_string(update_ms * 1e-3) + "\"/>");
+  if (!truth) replace("<plugin name=\"bundle_truth\" instance=\"bundle_units\"/>", "");
   std::FILE* out = std::fopen(buf, "w");
   std::fwrite(xml.data(), 1, xml.size(), out);
   std::fclose(out);
@@ -126,12 +130,14 @@ double ThreadCpuSeconds() {
 }
 
 // Interleaved blocks of 1000 steps of each model; counter "ratio" = SMA CPU time / muscle CPU
-// time.
+// time. truth 0: without the plugin's ground-truth sensor, which the muscle bench has no
+// counterpart of (the bench's other three sensors are in both).
 void BM_SmaOverMuscle(benchmark::State& state) {
   const auto regime = static_cast<Regime>(state.range(0));
   const int update_ms = static_cast<int>(state.range(1));
+  const bool truth = state.range(2) != 0;
   mjModel* mm = Load(ModelPath("isometric_bench_muscle.xml"));
-  mjModel* ms = Load(BenchWithUnits(60, update_ms));
+  mjModel* ms = Load(BenchWithUnits(60, update_ms, truth));
   auto p = SmaHost::Create(ms);
   mjData* dm = mj_makeData(mm);
   mjData* ds = mj_makeData(ms);
@@ -162,10 +168,13 @@ void BM_SmaOverMuscle(benchmark::State& state) {
   mj_deleteModel(ms);
 }
 BENCHMARK(BM_SmaOverMuscle)
-    ->ArgNames({"regime", "update_ms"})
-    ->Args({0, 0})
-    ->Args({1, 0})
-    ->Args({1, 10})
+    ->ArgNames({"regime", "update_ms", "truth"})
+    ->Args({0, 0, 1})
+    ->Args({1, 0, 1})
+    ->Args({1, 10, 1})
+    ->Args({0, 0, 0})
+    ->Args({1, 0, 0})
+    ->Args({1, 10, 0})
     ->Iterations(48);
 
 }  // namespace
