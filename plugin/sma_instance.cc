@@ -1,5 +1,7 @@
 #include "plugin/sma_instance.h"
 
+#include <mujoco/mjxmacro.h>
+
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
@@ -184,13 +186,47 @@ bool IsSmaInstance(const mjModel* m, int instance) {
   return instance >= 0 && instance < m->nplugin && s >= 0 && m->plugin[instance] == s;
 }
 
-// True the first time (m, instance) is seen with this content: init runs for every mjData, the
-// check needs thousands of kinematics passes, so it runs once per distinct compiled model.
-static std::size_t ModelContentHash(const mjModel* m) {
-  return std::hash<std::string_view>()(
-      std::string_view(static_cast<const char*>(m->buffer), static_cast<std::size_t>(m->nbuffer)));
+// True if the pointer field `name` of mjModel holds asset data that only collision and rendering
+// read (meshes, skins, height fields, textures, bounding volumes, octrees): nothing the load
+// checks compute from (designs, kinematics and tendons).
+static bool AssetData(std::string_view name) {
+  for (std::string_view prefix : {"mesh_", "skin_", "hfield_", "tex_", "bvh_", "oct_"}) {
+    if (name.substr(0, prefix.size()) == prefix) return true;
+  }
+  return false;
 }
 
+// Content hash of what the load checks read: every size and every array of the model but the
+// asset data above. A MyoSuite arm's buffer is mostly its 74 meshes: hashing all of it, once per
+// bundle and mjData, was half of a short run's instructions (2.2 of 4.2 G).
+static std::size_t ModelContentHash(const mjModel* m) {
+  std::size_t h = 0;
+  auto mix = [&h](const void* p, std::size_t bytes) {
+    const std::size_t x =
+        std::hash<std::string_view>()(std::string_view(static_cast<const char*>(p), bytes));
+    h = (h ^ x) * 0x100000001b3ull + 0x9e3779b97f4a7c15ull;
+  };
+  long long sizes[] = {
+#define X(name) static_cast<long long>(m->name),
+      MJMODEL_SIZES
+#undef X
+  };
+  mix(sizes, sizeof sizes);
+  MJMODEL_POINTERS_PREAMBLE(m)
+  (void)nuser_body, (void)nuser_jnt, (void)nuser_geom, (void)nuser_site, (void)nuser_cam;
+  (void)nuser_tendon, (void)nuser_actuator, (void)nuser_sensor, (void)nq, (void)nv, (void)na;
+  (void)nu, (void)nmocap, (void)nplastic;
+#define X(type, name, nr, nc) \
+  if (!AssetData(#name)) mix(m->name, sizeof(type) * static_cast<std::size_t>(m->nr) * (nc));
+#define XNV X
+  MJMODEL_POINTERS
+#undef XNV
+#undef X
+  return h;
+}
+
+// True the first time (m, instance) is seen with this content: init runs for every mjData, the
+// check needs thousands of kinematics passes, so it runs once per distinct compiled model.
 static bool FirstCheck(const mjModel* m, int instance) {
   static std::mutex mu;
   static std::set<std::pair<std::size_t, int>> seen;
