@@ -14,6 +14,9 @@
 // POSIX), so concurrent runs and threads see a whole entry or none; two writers of one key write
 // the same bytes. The mjb bytes carry their size and hash: a damaged entry is a miss.
 //
+// What the compiler prints (MuJoCo's warnings) is printed by the run that compiles, not by the
+// runs that load the entry; what the plugin prints at mj_makeData is printed by every run.
+//
 // Folder: RECRUIT_COMPILED_CACHE, else $XDG_CACHE_HOME/recruit/compiled, else
 // ~/.cache/recruit/compiled; RECRUIT_COMPILED_CACHE=off turns the cache off. File name: the FNV-1a
 // 64 hash (common/content_hash.h) of the entry's header and XML, .mjb.
