@@ -72,19 +72,24 @@ struct ConfigValues {
 std::shared_ptr<const ConfigValues> Values(const mjModel* m, int instance) {
   static std::mutex mu;
   static std::map<std::string, std::shared_ptr<const ConfigValues>> kept;
+  auto read = [&] {
+    auto v = std::make_shared<ConfigValues>();
+    for (const std::string& k : BundleConfig::Keys()) {
+      v->pairs.emplace_back(k, Config(m, instance, k.c_str()));
+    }
+    v->seed = Config(m, instance, kSeedKey);
+    v->period = Config(m, instance, kBroadcastPeriodKey);
+    return v;
+  };
   const mjtSize begin = m->plugin_attradr[instance];
   const mjtSize end = instance + 1 < m->nplugin ? m->plugin_attradr[instance + 1] : m->npluginattr;
+  if (!(0 <= begin && begin <= end && end <= m->npluginattr)) return read();  // not kept
   std::string key(m->plugin_attr + begin, m->plugin_attr + end);
   {
     std::lock_guard<std::mutex> guard(mu);
     if (auto it = kept.find(key); it != kept.end()) return it->second;
   }
-  auto v = std::make_shared<ConfigValues>();
-  for (const std::string& k : BundleConfig::Keys()) {
-    v->pairs.emplace_back(k, Config(m, instance, k.c_str()));
-  }
-  v->seed = Config(m, instance, kSeedKey);
-  v->period = Config(m, instance, kBroadcastPeriodKey);
+  auto v = read();
   std::lock_guard<std::mutex> guard(mu);
   if (kept.size() >= 4096) kept.clear();  // a bound for long-lived processes over many designs
   return kept.emplace(std::move(key), std::move(v)).first->second;
