@@ -8,11 +8,12 @@
 // MuJoCo's version and this code's (CodeVersion), and the plugins' compile-time answers. An entry
 // holds all of those but the last in full (the XML bytes too, compared byte for byte: no hash is
 // trusted), the name of the plugin at each of the model's plugin slots, and the mjb bytes. On a
-// hit the plugins' state sizes are asked again (mjpPlugin::nstate) and must match the model's;
-// any difference, a corrupt entry or a model MuJoCo cannot load is a miss, compiled afresh and
-// written over. Entries are written to a temporary sibling and renamed into place (atomic on
-// POSIX), so concurrent runs and threads see a whole entry or none; two writers of one key write
-// the same bytes. The mjb bytes carry their size and hash: a damaged entry is a miss.
+// hit the plugins' state and sensor sizes are asked again (mjpPlugin::nstate, nsensordata) and
+// must match the model's; any difference, a corrupt entry or a model MuJoCo cannot load is a
+// miss, compiled afresh and written over. Entries are written to a temporary sibling and
+// renamed into place (atomic on POSIX), so concurrent runs and threads see a whole entry or none;
+// two writers of one key write the same bytes. The mjb bytes carry their size and hash: a damaged
+// entry is a miss.
 //
 // What the compiler prints (MuJoCo's warnings) is printed by the run that compiles, not by the
 // runs that load the entry; what the plugin prints at mj_makeData is printed by every run.
@@ -87,13 +88,19 @@ inline std::string PluginNames(const mjModel* m) {
 }
 
 // True if every plugin instance of `m` (loaded from an entry) is the plugin it was compiled with
-// and gives the state size it was compiled with.
+// and gives the state and sensor sizes it was compiled with.
 inline bool PluginsAgree(const mjModel* m, std::string_view names) {
   if (PluginNames(m) != names) return false;
   for (int i = 0; i < m->nplugin; ++i) {
     const mjpPlugin* p = mjp_getPluginAtSlot(m->plugin[i]);
     const int n = p->nstate != nullptr ? p->nstate(m, i) : 0;
     if (n != m->plugin_statenum[i]) return false;
+  }
+  for (int j = 0; j < m->nsensor; ++j) {  // a plugin sensor's size is the plugin's answer too
+    const int i = m->sensor_plugin[j];
+    if (i < 0) continue;
+    const mjpPlugin* p = mjp_getPluginAtSlot(m->plugin[i]);
+    if (p->nsensordata == nullptr || p->nsensordata(m, i, j) != m->sensor_dim[j]) return false;
   }
   return true;
 }
