@@ -23,6 +23,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <memory>
@@ -92,6 +93,14 @@ Result<Limb> Prepare(const std::string& name) {
   }
   char tmpl[] = "/tmp/recruit_own_limb_XXXXXX";
   if (mkdtemp(tmpl) == nullptr) return Error{"cannot make a temporary folder"};
+  // Removed when the program ends.
+  static std::vector<std::string> folders;
+  if (folders.empty()) {
+    std::atexit([] {
+      for (const std::string& f : folders) std::filesystem::remove_all(f);
+    });
+  }
+  folders.push_back(tmpl);
   attach::AttachOptions o;
   o.model = limb.muscle_xml;
   o.muscles = {"all"};
