@@ -7,10 +7,12 @@
 // from its text, the caller's variant of the compile (e.g. "what only renders read is left out"),
 // MuJoCo's version and this code's (CodeVersion), and the plugins' compile-time answers. An entry
 // holds all of those but the last in full (the XML bytes too, compared byte for byte: no hash is
-// trusted), the name of the plugin at each of the model's plugin slots, and the mjb bytes. On a
-// hit the plugins' state and sensor sizes are asked again (mjpPlugin::nstate, nsensordata) and
-// must match the model's; any difference, a corrupt entry or a model MuJoCo cannot load is a
-// miss, compiled afresh and written over. Entries are written to a temporary sibling and
+// trusted), this process's plugin registry (a model names its plugins by registry slot), the slot
+// and name of each of the model's plugin instances (checked before MuJoCo loads the mjb: its
+// validation needs every slot filled), and the mjb bytes. On a hit the plugins' state and sensor
+// sizes are asked again (mjpPlugin::nstate, nsensordata) and must match the model's; any
+// difference, a corrupt entry or a model MuJoCo cannot load is a miss, compiled afresh and
+// written over. Entries are written to a temporary sibling and
 // renamed into place (atomic on POSIX), so concurrent runs and threads see a whole entry or none;
 // two writers of one key write the same bytes. The mjb bytes carry their size and hash: a damaged
 // entry is a miss.
@@ -71,20 +73,49 @@ inline bool ReadsNoOtherFile(std::string_view xml) {
   return true;
 }
 
-// The entry's header: everything the compiled model depends on apart from the XML and plugins.
-inline std::string Header(std::string_view variant) {
-  return std::string("recruit compiled model 1\n") + CodeVersion() + "\n" + mj_versionString() +
-         "\n" + std::string(variant) + "\n";
+// The name of the plugin registered at `slot` in this process, "?" for none.
+inline std::string SlotName(int slot) {
+  const mjpPlugin* p = slot >= 0 && slot < mjp_pluginCount() ? mjp_getPluginAtSlot(slot) : nullptr;
+  return p != nullptr && p->name != nullptr ? p->name : "?";
 }
 
-// The name of the plugin at each of the model's plugin instances, comma-separated.
+// The entry's header: everything the compiled model depends on apart from the XML and plugins'
+// answers, this process's plugin registry among it (a model names its plugins by slot, and
+// processes register them in different orders: the Python package's MuJoCo has its own).
+inline std::string Header(std::string_view variant) {
+  std::string registry;
+  for (int slot = 0; slot < mjp_pluginCount(); ++slot) registry += SlotName(slot) + ",";
+  return std::string("recruit compiled model 2\n") + CodeVersion() + "\n" + mj_versionString() +
+         "\n" + std::string(variant) + "\n" + registry + "\n";
+}
+
+// The slot and name of the plugin at each of the model's plugin instances, "slot:name,".
 inline std::string PluginNames(const mjModel* m) {
   std::string names;
   for (int i = 0; i < m->nplugin; ++i) {
-    const mjpPlugin* p = mjp_getPluginAtSlot(m->plugin[i]);
-    names += std::string(p != nullptr && p->name != nullptr ? p->name : "?") + ",";
+    names += std::to_string(m->plugin[i]) + ":" + SlotName(m->plugin[i]) + ",";
   }
   return names;
+}
+
+// True if every "slot:name," of `names` is registered here under that name: checked before
+// MuJoCo loads the mjb, whose validation needs every slot it names filled.
+inline bool SlotsRegistered(std::string_view names) {
+  std::size_t at = 0;
+  while (at < names.size()) {
+    const std::size_t colon = names.find(':', at), comma = names.find(',', at);
+    if (colon == std::string_view::npos || comma == std::string_view::npos || colon > comma) {
+      return false;
+    }
+    const std::string slot(names.substr(at, colon - at));
+    if (slot.empty() || slot.find_first_not_of("0123456789") != std::string::npos ||
+        slot.size() > 6 ||
+        SlotName(std::stoi(slot)) != names.substr(colon + 1, comma - colon - 1)) {
+      return false;
+    }
+    at = comma + 1;
+  }
+  return true;
 }
 
 // True if every plugin instance of `m` (loaded from an entry) is the plugin it was compiled with
@@ -137,7 +168,7 @@ inline mjModel* LoadEntry(const std::string& path, const std::string& header,
   const std::optional<std::string> read = ReadWhole(path);
   if (!read) return nullptr;
   const std::string& bytes = *read;
-  // header, plugin names + "\n", XML size + "\n", XML, MjbLine, mjb
+  // header, plugin slots and names + "\n", XML size + "\n", XML, MjbLine, mjb
   if (bytes.compare(0, header.size(), header) != 0) return nullptr;
   std::size_t at = header.size();
   const std::size_t names_end = bytes.find('\n', at);
@@ -154,6 +185,7 @@ inline mjModel* LoadEntry(const std::string& path, const std::string& header,
   if (line_end == std::string::npos) return nullptr;
   const std::string_view mjb = std::string_view(bytes).substr(line_end + 1);
   if (bytes.compare(at, line_end + 1 - at, MjbLine(mjb)) != 0) return nullptr;
+  if (!SlotsRegistered(names)) return nullptr;
   mjModel* m = mj_loadModelBuffer(mjb.data(), static_cast<mjtSize>(mjb.size()));
   if (m != nullptr && !PluginsAgree(m, names)) {
     mj_deleteModel(m);

@@ -175,20 +175,58 @@ TEST_F(CompiledModelCache, LeavesModelsThatReadOtherFilesToTheCompiler) {
 }
 
 TEST_F(CompiledModelCache, TreatsDamagedOrForeignEntriesAsMisses) {
+  // A plugin of another kind at another slot (one without sensors: MuJoCo's loader stops the
+  // process on a plugin sensor whose slot holds it), registered before the entry is made.
+  static const int other_slot = [] {
+    mjpPlugin p;
+    mjp_defaultPlugin(&p);
+    p.name = "recruit.test_other";
+    p.capabilityflags = mjPLUGIN_PASSIVE;
+    return mjp_registerPlugin(&p);
+  }();
+  ASSERT_GE(other_slot, 0);
   mj_deleteModel(Load(kBench));
   ASSERT_EQ(Entries(), 1);
   const fs::path entry = fs::directory_iterator(cache_)->path();
   const std::string good = Slurp(entry.string());
-  // Cut short, one mjb byte flipped, another plugin named at the instance's slot.
+  // The line after the header: "slot:name," of the model's plugin instance.
+  const std::string header = compiled_cache::Header("test");
+  ASSERT_EQ(good.compare(0, header.size(), header), 0);
+  const std::size_t line_end = good.find('\n', header.size());
+  const std::string slots = good.substr(header.size(), line_end - header.size());
+  const std::size_t colon = slots.find(':');
+  ASSERT_NE(colon, std::string::npos);
+  EXPECT_EQ(slots.substr(colon), ":recruit.sma,");
+  auto with_slots = [&](const std::string& line) {
+    return good.substr(0, header.size()) + line + good.substr(line_end);
+  };
+  // Cut short; one mjb byte flipped; another process's registry in the header; the instance's
+  // slot empty here, or holding the other plugin (a model names its plugins by slot, and
+  // processes register plugins in different orders); another plugin's name at its slot.
   std::string flipped = good;
   flipped[flipped.size() - 100] ^= 1;
-  std::string foreign = good;
-  const std::size_t at = foreign.find("recruit.sma,");
-  ASSERT_NE(at, std::string::npos);
-  foreign.replace(at, 11, "recruit.smx");
+  std::string registry = good;
+  registry.insert(header.size() - 1, "mujoco.pid,");
+  const std::vector<std::string> bad = {good.substr(0, good.size() / 2),
+                                        flipped,
+                                        registry,
+                                        with_slots("999:recruit.sma,"),
+                                        with_slots(std::to_string(other_slot) + ":recruit.sma,"),
+                                        with_slots(slots.substr(0, colon) + ":recruit.smx,")};
+  // An mjb whose instance names the other plugin's slot, as a process that registered
+  // recruit.sma there would write it: MuJoCo's loader would stop the process on it.
+  char err[1000];
+  mjModel* moved = mj_loadXML(kBench.c_str(), nullptr, err, sizeof err);
+  ASSERT_NE(moved, nullptr) << err;
+  moved->plugin[0] = other_slot;
+  const std::string xml = Slurp(kBench), mjb = Bytes(moved);
+  mj_deleteModel(moved);
+  std::vector<std::string> all = bad;
+  all.push_back(header + std::to_string(other_slot) + ":recruit.sma,\n" +
+                std::to_string(xml.size()) + "\n" + xml + compiled_cache::MjbLine(mjb) + mjb);
   int expected = 1;
-  for (const std::string& bad : {good.substr(0, good.size() / 2), flipped, foreign}) {
-    Write(entry.string(), bad);
+  for (const std::string& b : all) {
+    Write(entry.string(), b);
     mjModel* m = Load(kBench);
     ASSERT_NE(m, nullptr);
     EXPECT_EQ(compiles_, ++expected);
