@@ -1,5 +1,7 @@
 #include "plugin/sma_instance.h"
 
+#include <mujoco/mjxmacro.h>
+
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
@@ -7,12 +9,14 @@
 #include <cstdlib>
 #include <functional>
 #include <map>
+#include <memory>
 #include <mutex>
 #include <set>
 #include <string>
 #include <string_view>
 #include <tuple>
 #include <utility>
+#include <vector>
 
 #include "common/rng.h"
 #include "common/short_text.h"
@@ -54,6 +58,69 @@ Result<double> ParsePeriod(const std::string& where, const std::string& v) {
                  " is invalid: must be a number of seconds in [0, 1e6] (0 = every timestep)"};
   }
   return p;
+}
+
+// An instance's config values: every BundleConfig key's, the seed's and the broadcast period's.
+struct ConfigValues {
+  std::vector<std::pair<std::string, std::string>> pairs;
+  std::string seed, period;
+};
+
+// The instance's config values, kept per process by the instance's raw attribute bytes in the
+// model (mjModel.plugin_attr: the values MuJoCo's mj_getPluginConfig reads, ~1000 instructions a
+// key): the same bytes give the same values.
+std::shared_ptr<const ConfigValues> Values(const mjModel* m, int instance) {
+  static std::mutex mu;
+  static std::map<std::string, std::shared_ptr<const ConfigValues>> kept;
+  auto read = [&] {
+    auto v = std::make_shared<ConfigValues>();
+    for (const std::string& k : BundleConfig::Keys()) {
+      v->pairs.emplace_back(k, Config(m, instance, k.c_str()));
+    }
+    v->seed = Config(m, instance, kSeedKey);
+    v->period = Config(m, instance, kBroadcastPeriodKey);
+    return v;
+  };
+  const mjtSize begin = m->plugin_attradr[instance];
+  const mjtSize end = instance + 1 < m->nplugin ? m->plugin_attradr[instance + 1] : m->npluginattr;
+  if (!(0 <= begin && begin <= end && end <= m->npluginattr)) return read();  // not kept
+  std::string key(m->plugin_attr + begin, m->plugin_attr + end);
+  {
+    std::lock_guard<std::mutex> guard(mu);
+    if (auto it = kept.find(key); it != kept.end()) return it->second;
+  }
+  auto v = read();
+  std::lock_guard<std::mutex> guard(mu);
+  if (kept.size() >= 4096) kept.clear();  // a bound for long-lived processes over many designs
+  return kept.emplace(std::move(key), std::move(v)).first->second;
+}
+
+// A bundle's parsed config and its units' settled on-tension at the config's prestretch, kept
+// per process by the exact text they are made of (actuator name, message prefix, every key and
+// value): a run builds each instance 4-8 times (the compiler's and loader's size queries, one per
+// mjData), and parsing with its physics check and the settling loop were ~2/3 of each build.
+struct ParsedConfig {
+  Result<BundleConfig> config;
+  double settled_force = std::nan("");  // NaN until the first build computes it
+};
+
+std::shared_ptr<ParsedConfig> Parse(const std::string& name, const std::string& where,
+                                    const std::vector<std::pair<std::string, std::string>>& pairs,
+                                    std::mutex** lock) {
+  static std::mutex mu;
+  static std::map<std::string, std::shared_ptr<ParsedConfig>> kept;
+  std::string key = name + '\0' + where;
+  for (const auto& [k, v] : pairs) key += '\0' + k + '\0' + v;
+  *lock = &mu;
+  {
+    std::lock_guard<std::mutex> guard(mu);
+    if (auto it = kept.find(key); it != kept.end()) return it->second;
+  }
+  auto parsed =
+      std::make_shared<ParsedConfig>(ParsedConfig{BundleConfig::FromPairs(name, where, pairs)});
+  std::lock_guard<std::mutex> guard(mu);
+  if (kept.size() >= 4096) kept.clear();  // a bound for long-lived processes over many designs
+  return kept.emplace(std::move(key), std::move(parsed)).first->second;
 }
 
 // Index of actuator a among all recruit.sma actuators of m.
@@ -124,13 +191,47 @@ bool IsSmaInstance(const mjModel* m, int instance) {
   return instance >= 0 && instance < m->nplugin && s >= 0 && m->plugin[instance] == s;
 }
 
-// True the first time (m, instance) is seen with this content: init runs for every mjData, the
-// check needs thousands of kinematics passes, so it runs once per distinct compiled model.
-static std::size_t ModelContentHash(const mjModel* m) {
-  return std::hash<std::string_view>()(
-      std::string_view(static_cast<const char*>(m->buffer), static_cast<std::size_t>(m->nbuffer)));
+// True if the pointer field `name` of mjModel holds asset data that only collision and rendering
+// read (meshes, skins, height fields, textures, bounding volumes, octrees): nothing the load
+// checks compute from (designs, kinematics and tendons).
+static bool AssetData(std::string_view name) {
+  for (std::string_view prefix : {"mesh_", "skin_", "hfield_", "tex_", "bvh_", "oct_"}) {
+    if (name.substr(0, prefix.size()) == prefix) return true;
+  }
+  return false;
 }
 
+// Content hash of what the load checks read: every size and every array of the model but the
+// asset data above. A MyoSuite arm's buffer is mostly its 74 meshes: hashing all of it, once per
+// bundle and mjData, was half of a short run's instructions (2.2 of 4.2 G).
+static std::size_t ModelContentHash(const mjModel* m) {
+  std::size_t h = 0;
+  auto mix = [&h](const void* p, std::size_t bytes) {
+    const std::size_t x =
+        std::hash<std::string_view>()(std::string_view(static_cast<const char*>(p), bytes));
+    h = (h ^ x) * 0x100000001b3ull + 0x9e3779b97f4a7c15ull;
+  };
+  long long sizes[] = {
+#define X(name) static_cast<long long>(m->name),
+      MJMODEL_SIZES
+#undef X
+  };
+  mix(sizes, sizeof sizes);
+  MJMODEL_POINTERS_PREAMBLE(m)
+  (void)nuser_body, (void)nuser_jnt, (void)nuser_geom, (void)nuser_site, (void)nuser_cam;
+  (void)nuser_tendon, (void)nuser_actuator, (void)nuser_sensor, (void)nq, (void)nv, (void)na;
+  (void)nu, (void)nmocap, (void)nplastic;
+#define X(type, name, nr, nc) \
+  if (!AssetData(#name)) mix(m->name, sizeof(type) * static_cast<std::size_t>(m->nr) * (nc));
+#define XNV X
+  MJMODEL_POINTERS
+#undef XNV
+#undef X
+  return h;
+}
+
+// True the first time (m, instance) is seen with this content: init runs for every mjData, the
+// check needs thousands of kinematics passes, so it runs once per distinct compiled model.
 static bool FirstCheck(const mjModel* m, int instance) {
   static std::mutex mu;
   static std::set<std::pair<std::size_t, int>> seen;
@@ -254,19 +355,17 @@ Result<std::unique_ptr<SmaInstance>> SmaInstance::Build(const mjModel* m, int in
   }
   std::unique_ptr<SmaInstance> p(new SmaInstance);
   p->instance_ = instance;
-  std::vector<std::pair<std::string, std::string>> pairs;
-  for (const std::string& key : BundleConfig::Keys()) {
-    pairs.emplace_back(key, Config(m, instance, key.c_str()));
-  }
+  const std::shared_ptr<const ConfigValues> values = Values(m, instance);
+  const std::vector<std::pair<std::string, std::string>>& pairs = values->pairs;
   int offset = 0;
   for (int a = 0; a < m->nactuator; ++a) {
     if (m->actuator_plugin[a] != instance) continue;
     const std::string name = ActuatorName(m, a);
     const std::string where = "recruit.sma actuator '" + name + "': ";
     if (p->actuators_.empty()) {
-      auto seed = ParseSeed(where, Config(m, instance, kSeedKey));
+      auto seed = ParseSeed(where, values->seed);
       if (!seed.ok()) return Error{seed.error(), seed.code()};
-      auto period = ParsePeriod(where, Config(m, instance, kBroadcastPeriodKey));
+      auto period = ParsePeriod(where, values->period);
       if (!period.ok()) return Error{period.error(), period.code()};
       p->seed_ = *seed;
       p->broadcast_period_ = *period;
@@ -275,7 +374,9 @@ Result<std::unique_ptr<SmaInstance>> SmaInstance::Build(const mjModel* m, int in
       Status ok = CheckActuator(m, a, where);
       if (!ok.ok()) return Error{ok.error(), ok.code()};
     }
-    auto cfg = BundleConfig::FromPairs(name, where + "config ", pairs);
+    std::mutex* mu = nullptr;
+    const std::shared_ptr<ParsedConfig> parsed = Parse(name, where + "config ", pairs, &mu);
+    const Result<BundleConfig>& cfg = parsed->config;
     if (!cfg.ok()) return Error{cfg.error(), cfg.code()};
     auto bundle = SmaBundle::Create(*cfg, m->opt.timestep);
     if (!bundle.ok()) return Error{where + bundle.error(), bundle.code()};
@@ -286,7 +387,13 @@ Result<std::unique_ptr<SmaInstance>> SmaInstance::Build(const mjModel* m, int in
     act.gear = m->actuator_gear[6 * a];
     act.ref_length =
         std::isnan(cfg->ref_length) ? m->actuator_length0[a] : act.gear * cfg->ref_length;
-    act.settled_force = act.model.SettledOnTension(cfg->unit.prestretch);
+    {
+      std::lock_guard<std::mutex> guard(*mu);
+      if (std::isnan(parsed->settled_force)) {
+        parsed->settled_force = act.model.SettledOnTension(cfg->unit.prestretch);
+      }
+      act.settled_force = parsed->settled_force;
+    }
     offset += kSlots + act.model.state_size();
     p->actuators_.push_back(std::move(act));
   }

@@ -414,7 +414,11 @@ void UnitModel::AdvanceCohorts(const Cohorts& c, int n, double stretch, double d
   const BatchParams& bp = batch_;
   const BatchCohorts bc{c.on, c.temperature, c.xi, c.t_eff, c.heat_scale, c.cool_scale};
 #ifdef RECRUIT_SMA_AVX512_CLONE
-  if (UseAvx512(isa)) return batch_avx512::AdvanceCohorts(bp, bc, n, stretch, decay);
+  // Up to four cohorts (an arm's bundle in a closed loop) fill AVX2's one block, whose update
+  // costs 0.81-0.83x the AVX-512 one's half-empty block; from five on they cost about the same,
+  // 0.96x for eight (plugin_bench BM_KernelAvx512OverAvx2: thread CPU time, transforming cohorts).
+  const bool few = n <= 4 && isa == Isa::kAuto && UseAvx2(isa);
+  if (UseAvx512(isa) && !few) return batch_avx512::AdvanceCohorts(bp, bc, n, stretch, decay);
 #endif
 #ifdef RECRUIT_SMA_AVX2_CLONE
   if (UseAvx2(isa)) return batch_avx2::AdvanceCohorts(bp, bc, n, stretch, decay);

@@ -135,8 +135,9 @@ class UnitModel {
     double* heat_scale;
     double* cool_scale;
   };
-  // Kernel: kAuto = AVX-512 (8 lanes) for the update and AVX2 for the sums when this build has
-  // those clones and the CPU runs them, else AVX2, else the build's own instruction set (kBase).
+  // Kernel: kAuto = AVX-512 (8 lanes) for the update of more than four cohorts (AVX2 for up to
+  // four) and AVX2 for the sums when this build has those clones and the CPU runs them, else
+  // AVX2, else the build's own instruction set (kBase).
   // kAvx512 uses AVX2 for the sums. Tests run each.
   enum class Isa { kAuto, kBase, kAvx2, kAvx512 };
   void AdvanceCohorts(const Cohorts& c, int n, double stretch, double decay,

@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <string>
+#include <vector>
 
 #include "plugin/sma_host.h"
 
@@ -33,9 +34,12 @@ std::string ModelPath(const char* file) {
          file;
 }
 
-std::string BenchWithUnits(int units, int update_ms) {
+// The bench with `units` units and the update period; without `truth`, minus the plugin's
+// ground-truth sensor (the muscle bench has none: like for like).
+std::string BenchWithUnits(int units, int update_ms, bool truth = true) {
   char buf[256];
-  std::snprintf(buf, sizeof buf, "/tmp/recruit_sma_bench_%d_%d.xml", units, update_ms);
+  std::snprintf(buf, sizeof buf, "/tmp/recruit_sma_bench_%d_%d%s.xml", units, update_ms,
+                truth ? "" : "_notruth");
   std::FILE* in = std::fopen(ModelPath("isometric_bench.xml").c_str(), "r");
   std::string xml;
   char chunk[4096];
@@ -49,6 +53,7 @@ std::string BenchWithUnits(int units, int update_ms) {
                                                       std::to_string(units) +
                                                       "\"/><config key=\"update_period\" value=\"" +
                                                       std::to_string(update_ms * 1e-3) + "\"/>");
+  if (!truth) replace("<plugin name=\"bundle_truth\" instance=\"bundle_units\"/>", "");
   std::FILE* out = std::fopen(buf, "w");
   std::fwrite(xml.data(), 1, xml.size(), out);
   std::fclose(out);
@@ -126,12 +131,14 @@ double ThreadCpuSeconds() {
 }
 
 // Interleaved blocks of 1000 steps of each model; counter "ratio" = SMA CPU time / muscle CPU
-// time.
+// time. truth 0: without the plugin's ground-truth sensor, which the muscle bench has no
+// counterpart of (the bench's other three sensors are in both).
 void BM_SmaOverMuscle(benchmark::State& state) {
   const auto regime = static_cast<Regime>(state.range(0));
   const int update_ms = static_cast<int>(state.range(1));
+  const bool truth = state.range(2) != 0;
   mjModel* mm = Load(ModelPath("isometric_bench_muscle.xml"));
-  mjModel* ms = Load(BenchWithUnits(60, update_ms));
+  mjModel* ms = Load(BenchWithUnits(60, update_ms, truth));
   auto p = SmaHost::Create(ms);
   mjData* dm = mj_makeData(mm);
   mjData* ds = mj_makeData(ms);
@@ -162,10 +169,59 @@ void BM_SmaOverMuscle(benchmark::State& state) {
   mj_deleteModel(ms);
 }
 BENCHMARK(BM_SmaOverMuscle)
-    ->ArgNames({"regime", "update_ms"})
-    ->Args({0, 0})
-    ->Args({1, 0})
-    ->Args({1, 10})
+    ->ArgNames({"regime", "update_ms", "truth"})
+    ->Args({0, 0, 1})
+    ->Args({1, 0, 1})
+    ->Args({1, 10, 1})
+    ->Args({0, 0, 0})
+    ->Args({1, 0, 0})
+    ->Args({1, 10, 0})
     ->Iterations(48);
+
+// The cohort update's kernels side by side on n cohorts that transform at every step (each
+// switched every 1.5 s, 0.7 s apart), interleaved in blocks of 1000 steps: counter "ratio" =
+// AVX-512 CPU time / AVX2 CPU time (UnitModel::AdvanceCohorts takes AVX2 for up to 4 cohorts).
+void BM_KernelAvx512OverAvx2(benchmark::State& state) {
+  using recruit::sma::UnitModel;
+  const int n = static_cast<int>(state.range(0));
+  if (!UnitModel::HasAvx512()) return state.SkipWithError("no AVX-512 kernel on this CPU");
+  const recruit::sma::UnitParams params;
+  auto model = UnitModel::Create(params);
+  const double stretch = params.prestretch, decay = model->DecayFactor(1e-3);
+  const recruit::sma::UnitState rest = recruit::sma::RestState(*model, stretch);
+  struct Fields {
+    std::vector<double> on, T, xi, te, hs, cs;
+  } f[2];
+  for (Fields& x : f) {
+    x.on.assign(n, 0);
+    x.T.assign(n, rest.temperature);
+    x.xi.assign(n, rest.xi);
+    x.te.assign(n, rest.t_eff);
+    x.hs.assign(n, rest.heat_scale);
+    x.cs.assign(n, rest.cool_scale);
+  }
+  const UnitModel::Isa isa[2] = {UnitModel::Isa::kAvx2, UnitModel::Isa::kAvx512};
+  double t[2] = {0, 0};
+  long i0 = 0;
+  for (auto _ : state) {
+    for (int k = 0; k < 2; ++k) {
+      Fields& x = f[k];
+      const UnitModel::Cohorts c{x.on.data(), x.T.data(),  x.xi.data(),
+                                 x.te.data(), x.hs.data(), x.cs.data()};
+      const double start = ThreadCpuSeconds();
+      for (long i = i0; i < i0 + 1000; ++i) {
+        for (int j = 0; j < n; ++j) x.on[j] = ((i + 700 * j) / 1500) % 2;
+        model->AdvanceCohorts(c, n, stretch, decay, isa[k]);
+      }
+      t[k] += ThreadCpuSeconds() - start;
+    }
+    i0 += 1000;
+  }
+  if (f[0].xi != f[1].xi || f[0].T != f[1].T) state.SkipWithError("kernels differ");
+  state.counters["ratio"] = t[1] / t[0];
+  state.counters["avx2_ns"] = 1e9 * t[0] / (1000.0 * state.iterations());
+  state.counters["avx512_ns"] = 1e9 * t[1] / (1000.0 * state.iterations());
+}
+BENCHMARK(BM_KernelAvx512OverAvx2)->ArgName("cohorts")->DenseRange(2, 8)->Iterations(400);
 
 }  // namespace

@@ -297,7 +297,8 @@ TEST(BatchedCohortSums, ObserveEqualsTheSeparateSumsAndTheScalarMaximum) {
 // The merge pass's order without a sort (MergeOrder) against std::sort with the merge's
 // comparator: the same permutation whenever it answers; it answers for distinct keys and gives
 // up on ties (equal temperatures, +0 and -0), NaN and on values other than 0 and 1, where the
-// merge sorts as before. Each kernel, cohort counts around the SIMD widths.
+// merge sorts as before. Each kernel, cohort counts around the SIMD widths, up to the 320 cohorts
+// the merge asks it for.
 TEST(MergeOrder, IsStdSortsOrderForDistinctKeysAndGivesUpOnTies) {
   std::vector<UnitModel::Isa> isas = {UnitModel::Isa::kAuto, UnitModel::Isa::kBase};
   if (UnitModel::HasAvx2()) isas.push_back(UnitModel::Isa::kAvx2);
@@ -313,7 +314,13 @@ TEST(MergeOrder, IsStdSortsOrderForDistinctKeysAndGivesUpOnTies) {
     return idx;
   };
   int answered = 0, gave_up = 0;
-  for (int n = 1; n <= 64; ++n) {
+  // Every count up to 64, then counts around the SIMD widths up to and past the merge's limit
+  // (320).
+  std::vector<int> counts;
+  for (int n = 1; n <= 64; ++n) counts.push_back(n);
+  for (int n : {65, 67, 100, 127, 128, 129, 255, 256, 257, 300, 319, 320, 321, 512})
+    counts.push_back(n);
+  for (int n : counts) {
     for (int trial = 0; trial < 20; ++trial) {
       std::vector<double> on(n), t(n);
       for (int j = 0; j < n; ++j) {
