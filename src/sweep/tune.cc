@@ -192,7 +192,7 @@ Result<TuneOutcome> Tune(const PreparedSweep& p, const TuneDefinition& d, int th
     for (double lambda : p.spec.lambdas) {
       for (const auto& est : p.spec.estimators) {
         if (search++ % d.shard_n == d.shard_k - 1) {
-          columns.push_back({static_cast<int>(pl), est, lambda, {}});
+          columns.push_back({static_cast<int>(pl), est, lambda, {}, {}});
         }
       }
     }

@@ -98,7 +98,9 @@ TEST(FailureLoop, OutOfReachSaturatesAndRecoversWithoutWindUp) {
     int saturated = 0, n = 0;
     for (const auto& r : *run) {
       if (r.t >= 80 && r.t < 130) saturated += r.saturation == 1, ++n;
-      if (r.t >= 150) EXPECT_EQ(r.saturation, 0) << r.t;
+      if (r.t >= 150) {
+        EXPECT_EQ(r.saturation, 0) << r.t;
+      }
     }
     EXPECT_GE(saturated, 0.9 * n) << "seed " << seed;
     EXPECT_LT(fl::MeanError(*run, 150, 180), fl::MeanError(*base, 150, 180) + 0.15);

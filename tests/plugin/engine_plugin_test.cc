@@ -118,7 +118,9 @@ TEST(EnginePlugin, CtrlHeldAtOneGivesTheFig4TraceOfTheMujocoFreeBundle) {
     mj_step(m.get(), d.get());
     // mj_step's forward pass used the units' state at the step's start; then they advanced.
     const double expected = ref.bundle.Tension(ref.s.data(), ref.stretch);
-    if (step == 1000) ASSERT_TRUE(ref.bundle.Broadcast(ref.s.data(), 1, 0, ref.stretch).ok());
+    if (step == 1000) {
+      ASSERT_TRUE(ref.bundle.Broadcast(ref.s.data(), 1, 0, ref.stretch).ok());
+    }
     ref.bundle.Advance(ref.s.data(), ref.stretch, dt);
     max_diff = std::max(max_diff, std::abs(-d->actuator_force[0] - expected));
     trace.push_back(-d->actuator_force[0]);
@@ -156,7 +158,9 @@ TEST(EnginePlugin, IsometricBenchFileFollowsTheRigidReferenceWithinOnePercent) {
   std::vector<double> r;
   for (int i = 0; i < static_cast<int>(f.size()); ++i) {
     r.push_back(ref.bundle.Tension(ref.s.data(), ref.stretch));
-    if (i == 1000) ASSERT_TRUE(ref.bundle.Broadcast(ref.s.data(), 1, 0, ref.stretch).ok());
+    if (i == 1000) {
+      ASSERT_TRUE(ref.bundle.Broadcast(ref.s.data(), 1, 0, ref.stretch).ok());
+    }
     ref.bundle.Advance(ref.s.data(), ref.stretch, dt);
   }
   for (size_t i = 0; i < f.size(); ++i) {
@@ -198,9 +202,13 @@ TEST(EnginePlugin, CtrlZeroChangesNothing) {
     const double* blk = Block(m.get(), d.get(), 0, 0, n);
     std::copy(blk + 1, blk + 5, rng_before.begin());
     mj_step(m.get(), d.get());
-    if (broadcast) ASSERT_TRUE(ref.bundle.Broadcast(ref.s.data(), 0.5, 0, ref.stretch).ok());
+    if (broadcast) {
+      ASSERT_TRUE(ref.bundle.Broadcast(ref.s.data(), 0.5, 0, ref.stretch).ok());
+    }
     ref.bundle.Advance(ref.s.data(), ref.stretch, dt);
-    if (!broadcast) ASSERT_TRUE(SameBits(rng_before.data(), blk + 1, 4)) << "step " << step;
+    if (!broadcast) {
+      ASSERT_TRUE(SameBits(rng_before.data(), blk + 1, 4)) << "step " << step;
+    }
     ASSERT_TRUE(SameBits(ref.s.data(), blk, n)) << "step " << step;
   }
   const int on = ref.bundle.OnCount(ref.s.data());

@@ -208,7 +208,9 @@ TEST(Failures, ScheduledFailuresMatchAPerUnitSimulation) {
   for (int step = 0; step < 1000; ++step) b.Advance(s.data(), x, dt);
   for (int i = 0; i < units; ++i) {
     const int mode = b.UnitFailure(s.data(), i);
-    if (mode == 1) EXPECT_NEAR(b.UnitTemperature(s.data(), i), b.config().unit.ambient, 1e-3);
+    if (mode == 1) {
+      EXPECT_NEAR(b.UnitTemperature(s.data(), i), b.config().unit.ambient, 1e-3);
+    }
     if (mode != 1) {
       EXPECT_TRUE(b.UnitOn(s.data(), i));
     }

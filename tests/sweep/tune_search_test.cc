@@ -64,7 +64,9 @@ TEST(TuneLattice, PeriodsAreWholeMultiplesOfTheQuantum) {
   for (int k = 0; k < l.size(); ++k) {
     const double m = l.dT(k) / s.dT_quantum;
     EXPECT_NEAR(m, std::round(m), 1e-9) << l.dT(k);
-    if (k > 0) EXPECT_GT(l.dT(k), l.dT(k - 1));
+    if (k > 0) {
+      EXPECT_GT(l.dT(k), l.dT(k - 1));
+    }
   }
 }
 
