@@ -166,19 +166,21 @@ Result<BundleFailures> ReadBundleFailures(const json& f, const std::string& actu
       std::int64_t count = 0;
       std::string mode;
       RECRUIT_TRY(Number(s[i], "time", w, &t, true, 0, 1e9, false, "seconds after reset, 0..1e9"));
-      RECRUIT_TRY(json_fields::Integer(s[i], "count", w, &count, true, 1, 1000000,
-                                       "a whole number of units >= 1"));
+      RECRUIT_TRY(json_fields::Integer(s[i], "count", w, &count, true, 0, 1000000,
+                                       "a whole number of units, 0..1000000"));
       RECRUIT_TRY(String(s[i], "mode", w, &mode, true));
       if (mode != "open" && mode != "stuck") {
         return Error{w + ".mode: '" + ShortText(mode, 40) + "'; allowed: open, stuck"};
       }
-      text += fmt::format("{}{:.17g}:{}:{}", text.empty() ? "" : ",", t, count, mode);
+      // 0 units: nothing fails then (a sweep's baseline point of a count axis).
+      if (count > 0)
+        text += fmt::format("{}{:.17g}:{}:{}", text.empty() ? "" : ",", t, count, mode);
     }
-    b.keys.emplace_back("failures", text);
+    if (!text.empty()) b.keys.emplace_back("failures", text);
   }
   for (const Key& k : kFatigue) RECRUIT_TRY(add(k));
-  if (b.keys.empty()) return Error{where + ": gives no failure key"};
-  return b;
+  if (f.empty()) return Error{where + ": gives no failure key"};
+  return b;  // no keys when every scheduled count is 0: the bundle runs as without failures
 }
 
 Status ReadFailures(const json& j, const std::string& file, Task& task) {
@@ -191,7 +193,7 @@ Status ReadFailures(const json& j, const std::string& file, Task& task) {
   for (auto it = f.begin(); it != f.end(); ++it) {
     auto b = ReadBundleFailures(it.value(), it.key(), where + "." + it.key());
     if (!b.ok()) return Error{b.error(), b.code()};
-    task.failures.push_back(std::move(b).value());
+    if (!b->keys.empty()) task.failures.push_back(std::move(b).value());
   }
   return Status::Ok();
 }

@@ -265,6 +265,7 @@ Status WriteReports(const PreparedSweep& p, const std::vector<sim::RunSummary>& 
   }
   ReportInput in{p.task.name, p.description, p.criterion, cells, {}, {}};
   in.seed_reasons = SeedReasonsMarkdown(p.grid, runs, p.criterion);
+  in.unit = p.task.tracked == sim::Tracked::kForce ? "N" : "rad";
   // The output-only loop's latency bound needs each plant point's force latency (one open-loop
   // step of its model, ~0.1 s each); a point whose model cannot do it gets none (NaN).
   if (std::find(p.spec.estimators.begin(), p.spec.estimators.end(), "output") !=

@@ -11,6 +11,7 @@
 #include "common/json_fields.h"
 #include "common/json_file.h"
 #include "common/short_text.h"
+#include "control/on_count_estimator.h"
 #include "control/sampling_period.h"
 #include "sweep/sampling.h"
 
@@ -174,10 +175,10 @@ Result<SweepFile> SweepFile::FromJsonText(const std::string& text, const std::st
         return Error{where + ".estimator: must be a name or a non-empty array of names"};
       }
       for (const json& x : list) {
-        static const std::set<std::string> kKnown = {"output", "kalman2", "kalman-augmented"};
-        if (!x.is_string() || !kKnown.count(x.get<std::string>())) {
+        // The kinds a task's controller takes (control::EstimatorSpec::Parse).
+        if (!x.is_string() || !control::EstimatorSpec::Parse(x.get<std::string>()).ok()) {
           return Error{where + ".estimator: " + ShortText(x.dump()) +
-                       "; allowed: output, kalman2, kalman-augmented"};
+                       "; allowed: output, kalman2, kalman-augmented, kalman-failures"};
         }
         f.estimators.push_back(x.get<std::string>());
       }
@@ -364,6 +365,12 @@ Result<PlantInputs> ApplyPlantPoint(const std::string& task_text, const std::str
     }
     const json::json_pointer ptr(a.path);
     const json::json_pointer parent = ptr.parent_pointer();
+    // A failure key of a bundle the task gives no failures ("/failures/BUNDLE/open_rate"): the
+    // objects on the way are made (the task's check then names a bad bundle or key).
+    if (a.path.rfind("/failures/", 0) == 0 &&
+        ptr.parent_pointer().parent_pointer().to_string() == "/failures") {
+      if (!doc.contains(parent)) doc[parent] = json::object();
+    }
     if (!doc.contains(parent)) {
       return Error{label + ": the task has no '" + parent.to_string() + "'"};
     }

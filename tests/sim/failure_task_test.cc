@@ -71,6 +71,18 @@ TEST(FailureTask, KeysInTheTaskRunAsKeysInTheModel) {
   }
 }
 
+// A schedule of 0 units (a sweep's baseline point) is the task without failures, bit for bit.
+TEST(FailureTask, ZeroUnitsScheduledIsTheTaskWithoutFailures) {
+  const std::string model = kRoot + "/models/isometric_bench.xml";
+  auto none = RunText(BenchTask(model, ""), "n.json");
+  auto zero = RunText(BenchTask(model, R"(, "failures": {"bundle":
+      {"schedule": [{"time": 10, "count": 0, "mode": "open"}]}})"),
+                      "z.json");
+  ASSERT_TRUE(none.ok() && zero.ok());
+  EXPECT_EQ(zero->metrics.tracking_rmse, none->metrics.tracking_rmse);
+  EXPECT_EQ(zero->bundles[0].estimator_rmse, none->bundles[0].estimator_rmse);
+}
+
 TEST(FailureTask, BadKeysAreNamedWithTheirValueAndWhatIsAllowed) {
   const std::string model = kRoot + "/models/isometric_bench.xml";
   struct Case {
@@ -84,7 +96,7 @@ TEST(FailureTask, BadKeysAreNamedWithTheirValueAndWhatIsAllowed) {
        "open_per_cycle + stuck_per_cycle = 1.3; allowed: at most 1"},
       {R"({"bundle": {"schedule": [{"time": 3, "count": 2, "mode": "broken"}]}})",
        "t.json.failures.bundle.schedule[0].mode: 'broken'; allowed: open, stuck"},
-      {R"({"bundle": {"schedule": [{"time": 3, "count": 0, "mode": "open"}]}})",
+      {R"({"bundle": {"schedule": [{"time": 3, "count": -1, "mode": "open"}]}})",
        "t.json.failures.bundle.schedule[0].count"},
       {R"({"bundle": {}})", "t.json.failures.bundle: gives no failure key"},
       {R"([1])", "t.json.failures: must be an object"},
