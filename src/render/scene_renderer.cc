@@ -132,6 +132,10 @@ void SceneRenderer::AddPlotPoint(const TelemetrySample& sample) {
   if (plots_) plots_->Add(sample);
 }
 
+void SceneRenderer::AddPlotPoint(const mjModel* m, const mjData* d, const TelemetrySample& sample) {
+  if (plots_) plots_->Add(sample, counts_.Read(m, d, sample));
+}
+
 void SceneRenderer::DrawPanel(const TelemetrySample* s, mjrRect viewport) {
   std::string titles, values;
   auto row = [&](const std::string& title, const std::string& value) {
@@ -198,13 +202,18 @@ Status SceneRenderer::Render(const mjModel* m, const mjData* d, const TelemetryS
   const int side = plots_ ? options_.width * 9 / 20 : 0;
   const mjrRect scene_viewport = {0, 0, options_.width - side, below};
   mjr_render(scene_viewport, &scene_, &context_);
+  // Each bundle's working/open/stuck units, when its units can fail (none otherwise).
+  const std::vector<std::optional<UnitCounts>> counts =
+      sample ? counts_.Read(m, d, *sample) : std::vector<std::optional<UnitCounts>>{};
   if (sample && options_.labels) {
-    DrawTendonLabels(PlaceTendonLabels(m, d, scene_, scene_viewport, *sample), scene_viewport,
-                     &context_);
+    DrawTendonLabels(PlaceTendonLabels(m, d, scene_, scene_viewport, *sample, counts),
+                     scene_viewport, &context_);
   }
   if (sample && options_.heat_colours && options_.heat_key) {
     // Bottom left, over the floor: the arm and its reach stay clear.
-    DrawHeatKey(ch / 2, ch / 2 + HeatKeyHeight(&context_), 0, &context_);
+    const std::vector<std::string> rows = HeatKeyRows(*sample, counts);
+    DrawHeatKey(ch / 2, ch / 2 + HeatKeyHeight(&context_, static_cast<int>(rows.size())), 0,
+                &context_, rows);
   }
   if (options_.text_panel) {
     const mjrRect strip = {0, below, options_.width, title_h};
