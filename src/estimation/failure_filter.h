@@ -103,7 +103,7 @@ struct FailureFilterParams {
   // log-likelihood ratio passes glr_threshold with at least glr_min_count units lost.
   bool detect = true;
   int glr_window = 40;
-  double glr_threshold = 12;
+  double glr_threshold = 13;
   double glr_min_count = 1;
   double glr_max_std = 2;  // units: only hypotheses whose count is known to within this
   // After a declaration into a class, every prediction adds the Qz of independent failures into
