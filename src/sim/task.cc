@@ -1,7 +1,5 @@
 #include "sim/task.h"
 
-#include <fmt/format.h>
-
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -106,6 +104,13 @@ Status ReadJointsForm(const json& j, const std::string& file, Task& task) {
   return Status::Ok();
 }
 
+// A number as the plugin reads it back exactly (%.17g; "%g" for messages).
+std::string Digits(double v, const char* format = "%.17g") {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, format, v);
+  return buf;
+}
+
 // The plugin's failure keys of one bundle, checked against plugin/README.md's ranges:
 // {"open_rate", "stuck_rate", "open_per_cycle", "stuck_per_cycle", "schedule": [{"time",
 // "count", "mode"}], "fatigue_loss", "fatigue_cycles", "fatigue_stress", "fatigue_exponent"}.
@@ -138,7 +143,7 @@ Result<BundleFailures> ReadBundleFailures(const json& f, const std::string& actu
     if (!f.contains(k.name)) return Status::Ok();
     double v = 0;
     RECRUIT_TRY(Number(f, k.name, where, &v, true, k.lo, k.hi, k.lo_open, k.allowed));
-    b.keys.emplace_back(k.name, fmt::format("{:.17g}", v));
+    b.keys.emplace_back(k.name, Digits(v));
     return Status::Ok();
   };
   for (const Key& k : kRates) RECRUIT_TRY(add(k));
@@ -147,7 +152,7 @@ Result<BundleFailures> ReadBundleFailures(const json& f, const std::string& actu
     if (key == "open_per_cycle" || key == "stuck_per_cycle") per_cycle += std::stod(value);
   }
   if (per_cycle > 1) {
-    return Error{where + ": open_per_cycle + stuck_per_cycle = " + fmt::format("{:g}", per_cycle) +
+    return Error{where + ": open_per_cycle + stuck_per_cycle = " + Digits(per_cycle, "%g") +
                  "; allowed: at most 1"};
   }
   if (f.contains("schedule")) {
@@ -174,7 +179,7 @@ Result<BundleFailures> ReadBundleFailures(const json& f, const std::string& actu
       }
       // 0 units: nothing fails then (a sweep's baseline point of a count axis).
       if (count > 0)
-        text += fmt::format("{}{:.17g}:{}:{}", text.empty() ? "" : ",", t, count, mode);
+        text += (text.empty() ? "" : ",") + Digits(t) + ":" + std::to_string(count) + ":" + mode;
     }
     if (!text.empty()) b.keys.emplace_back("failures", text);
   }
