@@ -185,6 +185,7 @@ void FailureKalmanFilter::Reset() {
   glr_.Clear();
   declarations_ = 0;
   declared_last_ = false;
+  last_declared_ = {};
   declared_class_[1] = declared_class_[2] = false;
   if (params_.open_hazard > 0 || params_.stuck_hazard > 0 || params_.scale_variance > 0) Augment();
 }

@@ -124,7 +124,7 @@ class FailureKalmanFilter {
   void Reset();
   // The working states' output row (1 x m) and R for the next Update.
   void SetOutput(const Eigen::MatrixXd& H, const Eigen::MatrixXd& R);
-  // Measurement update with the force y; runs the CUSUM (and a declaration).
+  // Measurement update with the force y; runs the GLR (and a declaration).
   void Update(double y);
   // Time update with the broadcast just sent.
   void PredictBroadcast(double p_on, double p_off);
