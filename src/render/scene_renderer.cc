@@ -136,7 +136,8 @@ void SceneRenderer::AddPlotPoint(const mjModel* m, const mjData* d, const Teleme
   if (plots_) plots_->Add(sample, counts_.Read(m, d, sample));
 }
 
-void SceneRenderer::DrawPanel(const TelemetrySample* s, mjrRect viewport) {
+void SceneRenderer::DrawPanel(const TelemetrySample* s, mjrRect viewport,
+                              const std::vector<std::optional<UnitCounts>>& counts) {
   std::string titles, values;
   auto row = [&](const std::string& title, const std::string& value) {
     if (!titles.empty()) {
@@ -157,14 +158,20 @@ void SceneRenderer::DrawPanel(const TelemetrySample* s, mjrRect viewport) {
                     s->reference);
       row("force", buf);
     }
-    for (const BundleTelemetry& b : s->bundles) {
+    for (size_t i = 0; i < s->bundles.size(); ++i) {
+      const BundleTelemetry& b = s->bundles[i];
       if (std::isfinite(b.estimated_on)) {
         std::snprintf(buf, sizeof(buf), "%d on, est %.1f, heat %s", b.true_on, b.estimated_on,
                       Fraction(b.heat).c_str());
       } else {
         std::snprintf(buf, sizeof(buf), "%d on, heat %s", b.true_on, Fraction(b.heat).c_str());
       }
-      row(b.actuator, buf);
+      std::string value = buf;
+      if (i < counts.size() && counts[i]) {
+        value += ", " + std::to_string(counts[i]->working) + "/" +
+                 std::to_string(counts[i]->total()) + " working";
+      }
+      row(b.actuator, value);
     }
   }
   if (titles.empty()) return;
@@ -227,7 +234,7 @@ Status SceneRenderer::Render(const mjModel* m, const mjData* d, const TelemetryS
     mjr_rectangle(column, 0.05f, 0.05f, 0.08f, 1.f);
     plots_->Draw(column, &context_);
   } else if (options_.text_panel) {
-    DrawPanel(sample, scene_viewport);
+    DrawPanel(sample, scene_viewport, counts);
   }
   mjr_readPixels(rgb, nullptr, viewport, &context_);
   if (const int err = mjr_getError(); err != 0) {

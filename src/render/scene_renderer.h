@@ -99,7 +99,8 @@ class SceneRenderer {
 
  private:
   SceneRenderer(const RenderOptions& options, const RunLabel& label);
-  void DrawPanel(const TelemetrySample* sample, mjrRect viewport);
+  void DrawPanel(const TelemetrySample* sample, mjrRect viewport,
+                 const std::vector<std::optional<UnitCounts>>& counts);
 
   RenderOptions options_;
   RunLabel label_;
