@@ -166,10 +166,11 @@ void AddDefinitionOptions(CLI::App* cmd, sweep::SweepDefinition* a) {
             ->check(Fraction())
             ->capture_default_str(),
         "lambda");
-  track(cmd->add_option("--estimator", a->estimators,
-                        "Estimators, comma separated (output, kalman2, kalman-augmented)")
+  track(cmd->add_option(
+               "--estimator", a->estimators,
+               "Estimators, comma separated (output, kalman2, kalman-augmented, kalman-failures)")
             ->delimiter(',')
-            ->check(CLI::IsMember({"output", "kalman2", "kalman-augmented"}))
+            ->check(CLI::IsMember({"output", "kalman2", "kalman-augmented", "kalman-failures"}))
             ->capture_default_str(),
         "estimator");
   track(cmd->add_option("--seeds", a->seeds, "Seeds per grid cell, 1..100000")

@@ -34,6 +34,88 @@ Eigen::MatrixXd AugmentedTransition(const BroadcastTransitionModel& chain, doubl
   return A;
 }
 
+FailureGlr::FailureGlr(const BroadcastTransitionModel& chain, int window)
+    : m_(chain.num_states()), window_(window) {
+  for (int j = 0; j < m_; ++j) {
+    entry_[1].push_back(m_ + OpenEntry(chain, j));
+    entry_[2].push_back(2 * m_ + StuckEntry(chain, j));
+  }
+  truth_ = Eigen::MatrixXd::Zero(3 * m_, 2 * window_);
+  filt_ = Eigen::MatrixXd::Zero(3 * m_, 2 * window_);
+  d_ = Eigen::VectorXd::Zero(2 * window_);
+  C_ = Eigen::VectorXd::Zero(2 * window_);
+  age_.assign(2 * window_, -1);
+}
+
+void FailureGlr::Clear() {
+  std::fill(age_.begin(), age_.end(), -1);
+  next_ = 0;
+}
+
+void FailureGlr::Open(const Eigen::VectorXd& x_prior) {
+  const Eigen::VectorXd w = x_prior.head(m_).cwiseMax(0.0);
+  const double W = w.sum();
+  for (int to : {1, 2}) {
+    const int col = (to - 1) * window_ + next_;
+    truth_.col(col).setZero();
+    filt_.col(col).setZero();
+    d_[col] = C_[col] = 0;
+    age_[col] = -1;
+    if (!(W > 0)) continue;
+    for (int j = 0; j < m_; ++j) {
+      truth_(j, col) -= w[j] / W;
+      truth_(entry_[to][j], col) += w[j] / W;
+    }
+    age_[col] = 0;
+  }
+  next_ = (next_ + 1) % window_;
+}
+
+void FailureGlr::Update(double nu, double s, const Eigen::RowVectorXd& h,
+                        const Eigen::VectorXd& K) {
+  const Eigen::RowVectorXd rho = h * (truth_ - filt_);
+  d_ += rho.transpose() * (nu / s);
+  C_ += rho.transpose().cwiseAbs2() / s;
+  filt_ += K * rho;
+}
+
+void FailureGlr::Predict(const Eigen::MatrixXd& A) {
+  truth_ = A * truth_;
+  filt_ = A * filt_;
+  for (int& a : age_) a += a >= 0 ? 1 : 0;
+}
+
+FailureGlr::Best FailureGlr::Hypothesis(int to, int age) const {
+  Best b;
+  for (int col = (to - 1) * window_; col < to * window_; ++col) {
+    if (age_[col] != age || !(C_[col] > 0)) continue;
+    b.to = to;
+    b.age = age;
+    b.count = d_[col] / C_[col];
+    b.variance = 1 / C_[col];
+    b.llr = d_[col] > 0 ? d_[col] * d_[col] / (2 * C_[col]) : 0.0;
+    b.deviation = truth_.col(col) - filt_.col(col);
+  }
+  return b;
+}
+
+FailureGlr::Best FailureGlr::Strongest(double max_std) const {
+  Best b;
+  const double min_information = 1 / (max_std * max_std);
+  for (int col = 0; col < 2 * window_; ++col) {
+    if (age_[col] < 0 || !(C_[col] >= min_information) || !(d_[col] > 0)) continue;
+    const double llr = d_[col] * d_[col] / (2 * C_[col]);
+    if (llr <= b.llr) continue;
+    b.to = col < window_ ? 1 : 2;
+    b.age = age_[col];
+    b.count = d_[col] / C_[col];
+    b.variance = 1 / C_[col];
+    b.llr = llr;
+    b.deviation = truth_.col(col) - filt_.col(col);
+  }
+  return b;
+}
+
 Status FailureFilterParams::Validate() const {
   auto prob = [](double v) { return std::isfinite(v) && v >= 0 && v <= 1; };
   if (!prob(open_hazard) || !prob(stuck_hazard) || open_hazard + stuck_hazard > 1) {
@@ -41,25 +123,25 @@ Status FailureFilterParams::Validate() const {
                  " and stuck_hazard = " + std::to_string(stuck_hazard) +
                  " must be probabilities per control period adding to at most 1"};
   }
-  if (!(std::isfinite(cusum_drift) && cusum_drift >= 0)) {
-    return Error{"failure filter: cusum_drift = " + std::to_string(cusum_drift) +
-                 " must be finite and >= 0"};
+  if (!(glr_window >= 1 && glr_window <= 1000)) {
+    return Error{"failure filter: glr_window = " + std::to_string(glr_window) +
+                 " must be 1..1000 control instants"};
   }
-  if (!(std::isfinite(cusum_threshold) && cusum_threshold > 0)) {
-    return Error{"failure filter: cusum_threshold = " + std::to_string(cusum_threshold) +
+  if (!(std::isfinite(glr_threshold) && glr_threshold > 0)) {
+    return Error{"failure filter: glr_threshold = " + std::to_string(glr_threshold) +
                  " must be finite and > 0"};
   }
-  if (!(jump_hazard >= 0 && jump_hazard <= 1)) {
-    return Error{"failure filter: jump_hazard = " + std::to_string(jump_hazard) +
-                 " must be in [0, 1]"};
+  if (!(std::isfinite(glr_max_std) && glr_max_std > 0)) {
+    return Error{"failure filter: glr_max_std = " + std::to_string(glr_max_std) +
+                 " must be finite and > 0 (units)"};
+  }
+  if (!(std::isfinite(glr_min_count) && glr_min_count >= 0)) {
+    return Error{"failure filter: glr_min_count = " + std::to_string(glr_min_count) +
+                 " must be finite and >= 0"};
   }
   if (!(settle_hazard >= 0 && settle_hazard <= 1)) {
     return Error{"failure filter: settle_hazard = " + std::to_string(settle_hazard) +
                  " must be in [0, 1]"};
-  }
-  if (!(std::isfinite(jump_fraction_std) && jump_fraction_std >= 0)) {
-    return Error{"failure filter: jump_fraction_std = " + std::to_string(jump_fraction_std) +
-                 " must be finite and >= 0"};
   }
   if (!(std::isfinite(scale_variance) && scale_variance >= 0)) {
     return Error{"failure filter: scale_variance = " + std::to_string(scale_variance) +
@@ -85,7 +167,11 @@ Result<FailureKalmanFilter> FailureKalmanFilter::Create(const FilterModel& model
 
 FailureKalmanFilter::FailureKalmanFilter(FilterModel model, CovarianceMode mode,
                                          FailureFilterParams params, PopulationKalmanFilter inner)
-    : model_(std::move(model)), mode_(mode), params_(params), inner_(std::move(inner)) {
+    : model_(std::move(model)),
+      mode_(mode),
+      params_(params),
+      inner_(std::move(inner)),
+      glr_(model_.broadcast, params.glr_window) {
   m_ = model_.num_states();
   N_ = static_cast<double>(model_.N);
   H_ = model_.H;
@@ -96,11 +182,10 @@ FailureKalmanFilter::FailureKalmanFilter(FilterModel model, CovarianceMode mode,
 void FailureKalmanFilter::Reset() {
   inner_.Reset(model_.x0, model_.P0);
   augmented_ = false;
-  history_.clear();
-  onset_low_ = onset_high_ = 0;
-  g_low_ = g_high_ = 0;
+  glr_.Clear();
   declarations_ = 0;
   declared_last_ = false;
+  last_declared_ = {};
   declared_class_[1] = declared_class_[2] = false;
   if (params_.open_hazard > 0 || params_.stuck_hazard > 0 || params_.scale_variance > 0) Augment();
 }
@@ -159,18 +244,22 @@ Eigen::MatrixXd FailureKalmanFilter::JumpQz(const Eigen::VectorXd& xq, double q,
   return ProcessCovarianceQz(J, xq);
 }
 
-Eigen::MatrixXd FailureKalmanFilter::JumpCovariance(int to) const {
-  // A common cause (a lost connector, a burnt driver bank) takes a fraction f of the working
-  // units, in proportion to each state's count: dX = f v, v = sum_j x_j (e_fail(j) - e_j).
+void FailureKalmanFilter::Declare(const FailureGlr::Best& best) {
+  if (!augmented_) Augment();
   const int n = 3 * m_;
+  // The estimate moves by k^ (truth - estimate) per lost unit; its covariance grows by Var(k^)
+  // along that direction and by the spread of which states k^ independent failures leave from.
+  x_.head(n) += best.count * best.deviation;
   const Eigen::VectorXd xq = ProjectOntoSimplex(x_.head(n), N_);
-  Eigen::VectorXd v = Eigen::VectorXd::Zero(n);
-  for (int j = 0; j < m_; ++j) {
-    v[j] -= xq[j];
-    v[FailEntry(j, to)] += xq[j];
-  }
-  const double sf = params_.jump_fraction_std;
-  return sf * sf * v * v.transpose() + JumpQz(xq, params_.jump_hazard, to);
+  const double W = xq.head(m_).sum();
+  const double q = W > 0 ? std::min(1.0, best.count / W) : 0.0;
+  P_.topLeftCorner(n, n) +=
+      best.variance * best.deviation * best.deviation.transpose() + JumpQz(xq, q, best.to);
+  ++declarations_;
+  declared_last_ = true;
+  declared_class_[best.to] = true;
+  last_declared_ = best;
+  glr_.Clear();
 }
 
 Eigen::RowVectorXd FailureKalmanFilter::OutputRow(const Eigen::MatrixXd& H) const {
@@ -192,7 +281,8 @@ void FailureKalmanFilter::UpdateCore(double y, const Eigen::MatrixXd& H, double 
   // Kalman update in Joseph form (r = 1), linearised in c.
   const Eigen::RowVectorXd h = OutputRow(H);
   const double s = h * P_ * h.transpose() + R;
-  const Eigen::VectorXd K = P_ * h.transpose() / s;
+  last_gain_ = P_ * h.transpose() / s;
+  const Eigen::VectorXd& K = last_gain_;
   x_ += K * (y - Predicted(H));
   const Eigen::MatrixXd IKH = Eigen::MatrixXd::Identity(3 * m_ + 1, 3 * m_ + 1) - K * h;
   P_ = IKH * P_ * IKH.transpose() + K * R * K.transpose();
@@ -202,22 +292,8 @@ void FailureKalmanFilter::UpdateCore(double y, const Eigen::MatrixXd& H, double 
 
 void FailureKalmanFilter::Update(double y) {
   declared_last_ = false;
-  // The prior of this instant, for a replay from the onset of a change.
-  History rec;
-  rec.y = y;
-  rec.H = H_;
-  rec.R = R_(0, 0);
-  if (augmented_) {
-    rec.x = x_;
-    rec.P = P_;
-  } else {
-    rec.x = Eigen::VectorXd::Zero(3 * m_ + 1);
-    rec.x.head(m_) = inner_.estimate();
-    rec.x[3 * m_] = 1;
-    rec.P = Eigen::MatrixXd::Zero(3 * m_ + 1, 3 * m_ + 1);
-    rec.P.topLeftCorner(m_, m_) = inner_.covariance();
-  }
-  // Innovation and its variance on the filter that runs now (read only).
+  const int n = 3 * m_;
+  // The innovation and its variance on the filter that runs now, and the prior for the GLR.
   double nu, s;
   if (augmented_) {
     const Eigen::RowVectorXd h = OutputRow(H_);
@@ -228,66 +304,43 @@ void FailureKalmanFilter::Update(double y) {
     nu = y - hw.dot(inner_.estimate());
     s = hw * inner_.covariance() * hw.transpose() + R_(0, 0);
   }
-  history_.push_back(std::move(rec));
-  if (static_cast<int>(history_.size()) > kHistory) history_.pop_front();
-  int declared_to = 0;
-  if (params_.detect && s > 0) {
-    const double e = nu / std::sqrt(s);
-    // The onset: instants since each statistic last left 0.
-    onset_low_ = g_low_ == 0 ? 0 : onset_low_ + 1;
-    onset_high_ = g_high_ == 0 ? 0 : onset_high_ + 1;
-    g_low_ = std::max(0.0, g_low_ - e - params_.cusum_drift);
-    g_high_ = std::max(0.0, g_high_ + e - params_.cusum_drift);
-    if (g_low_ > params_.cusum_threshold) declared_to = 1;   // force short: open
-    if (g_high_ > params_.cusum_threshold) declared_to = 2;  // force over: stuck
+  const bool test = params_.detect && s > 0 && std::isfinite(nu);
+  if (test) glr_.Open(estimate());
+  Eigen::VectorXd K = Eigen::VectorXd::Zero(n);
+  if (augmented_) {
+    UpdateCore(y, H_, R_(0, 0));
+    K = last_gain_.head(n);
+  } else {
+    Eigen::VectorXd yv(1);
+    yv[0] = y;
+    inner_.Update(yv);
+    K.head(m_) = inner_.gain().col(0);
   }
-  if (declared_to == 0) {
-    if (augmented_) {
-      UpdateCore(y, H_, R_(0, 0));
-    } else {
-      Eigen::VectorXd yv(1);
-      yv[0] = y;
-      inner_.Update(yv);
-    }
-    return;
-  }
-  // A declared failure: back to the prior at the onset, the jump there, then the measurements
-  // and broadcasts since, replayed.
-  const int back =
-      std::min(declared_to == 1 ? onset_low_ : onset_high_, static_cast<int>(history_.size()) - 1);
-  g_low_ = g_high_ = 0;
-  onset_low_ = onset_high_ = 0;
-  ++declarations_;
-  declared_last_ = true;
-  declared_class_[declared_to] = true;
-  augmented_ = true;
-  const int first = static_cast<int>(history_.size()) - 1 - back;
-  x_ = history_[first].x;
-  P_ = history_[first].P;
-  P_.topLeftCorner(3 * m_, 3 * m_) += JumpCovariance(declared_to);
-  for (int i = first; i < static_cast<int>(history_.size()); ++i) {
-    const History& r = history_[i];
-    UpdateCore(r.y, r.H, r.R);
-    if (i + 1 < static_cast<int>(history_.size())) PredictCore(r.p_on, r.p_off);
+  if (!test) return;
+  // The true force's row on the 3m states: every unit pulls, the working ones scaled by c.
+  Eigen::RowVectorXd h(n);
+  h << force_scale() * H_.row(0), H_.row(0), H_.row(0);
+  glr_.Update(nu, s, h, K);
+  const FailureGlr::Best best = glr_.Strongest(params_.glr_max_std);
+  if (best.to != 0 && best.llr > params_.glr_threshold && best.count >= params_.glr_min_count) {
+    Declare(best);
   }
 }
 
 void FailureKalmanFilter::PredictBroadcast(double p_on, double p_off) {
-  if (!history_.empty()) {
-    history_.back().p_on = p_on;
-    history_.back().p_off = p_off;
-  }
+  const int n = 3 * m_;
+  A_.topLeftCorner(n, n) =
+      AugmentedTransition(model_.broadcast, p_on, p_off, params_.open_hazard, params_.stuck_hazard);
+  if (params_.detect) glr_.Predict(A_.topLeftCorner(n, n));
   if (!augmented_) {
     inner_.PredictBroadcast(p_on, p_off);
     return;
   }
-  PredictCore(p_on, p_off);
+  PredictCore();
 }
 
-void FailureKalmanFilter::PredictCore(double p_on, double p_off) {
+void FailureKalmanFilter::PredictCore() {
   const int n = 3 * m_;
-  A_.topLeftCorner(n, n) =
-      AugmentedTransition(model_.broadcast, p_on, p_off, params_.open_hazard, params_.stuck_hazard);
   const auto A = A_.topLeftCorner(n, n);
   Eigen::MatrixXd Q = Eigen::MatrixXd::Zero(n + 1, n + 1);
   if (mode_ == CovarianceMode::kExtended) {

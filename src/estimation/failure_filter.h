@@ -15,16 +15,15 @@
 // paper's Qz(X) = diag(A X) - A diag(X) A^T holds as it is.
 //
 // Abrupt failures (a broken lead, a burnt driver) are far likelier at once than the prior hazard
-// says; a two-sided CUSUM on the normalised innovations e = (y - y^) / sqrt(S) declares one
-// (force persistently below the prediction: open; above: stuck). A declaration goes back to the
-// prior at the CUSUM's onset (the instant its statistic last left 0, at most kHistory instants
-// back), adds there the covariance of a jump into the failed class: a common cause taking a
-// fraction f of the working units in proportion to each state's count, sd_f^2 v v^T with
-// v = sum_j x_j (e_fail(j) - e_j), plus the Qz of one step with independent failures of
-// probability q_J; the mean is unchanged. The measurements and broadcasts since the onset are
-// replayed, and place the failed units. From then on every prediction adds the Qz of
-// independent failures into the declared class with probability q_S (mean unchanged), so that
-// units lost while off are found when the controller fails to recruit them.
+// says; a generalised likelihood ratio test (FailureGlr, Willsky and Jones 1976) over the number
+// k of units lost into a class at an onset tau within the last `glr_window` instants declares
+// one. Each hypothesis (class, tau) carries the signature of one lost unit on the innovations
+// through the running filter's own gains and broadcasts; the maximum-likelihood k and tau and
+// the ratio follow in closed form. A declaration corrects the running estimate by k^ times the
+// hypothesis's state deviation (truth minus estimate, per lost unit) and adds Var(k^) times its
+// outer product and the spread of which states the units were lost from; the GLR then starts
+// again. From then on every prediction adds the Qz of independent failures into the declared
+// class with probability q_S (mean unchanged), when q_S > 0.
 //
 // Until the first declaration, with zero prior hazards and no fatigue estimate, the failed
 // classes hold 0 exactly and the filter is the paper's filter (PopulationKalmanFilter) on x_w,
@@ -32,7 +31,7 @@
 #pragma once
 
 #include <Eigen/Dense>
-#include <deque>
+#include <vector>
 
 #include "common/result.h"
 #include "estimation/filter_model.h"
@@ -49,23 +48,67 @@ Eigen::MatrixXd AugmentedTransition(const BroadcastTransitionModel& chain, doubl
 int OpenEntry(const BroadcastTransitionModel& chain, int j);
 int StuckEntry(const BroadcastTransitionModel& chain, int j);
 
+// The generalised likelihood ratio test for an abrupt loss of k units into a failed class (1
+// open, 2 stuck) at an unknown onset tau within the last `window` control instants, on the
+// innovations of a Kalman filter that assumes no loss (Willsky and Jones, IEEE TAC 21(1) 1976).
+// A hypothesis (class, tau) moves one unit, distributed as the working units were at tau, into
+// the class: in the 3m augmented states the truth then deviates by delta(t) (delta(tau) =
+// sum_j w_j (e_fail(j) - e_j), then propagated by the chain with the broadcasts sent), the
+// filter's estimate by f(t) (f += K rho at each update, then the same propagation), and the
+// innovations by k rho(t) with rho = h (delta - f). With d = sum rho nu / s and C = sum rho^2 / s,
+//   k^ = d / C,  Var(k^) = 1 / C,  log-likelihood ratio l = d^2 / (2 C)   (k^ > 0 only).
+// The filter's gains are taken as given (linear in the data), so the signatures are exact for a
+// linear filter and first-order for the extended one.
+class FailureGlr {
+ public:
+  FailureGlr(const BroadcastTransitionModel& chain, int window);
+  void Clear();
+  // Opens the hypotheses "units fail now" for the prior at this instant (3m, before its update).
+  void Open(const Eigen::VectorXd& x_prior);
+  // The update of this instant: innovation nu = y - y^, its variance s, the output row of the
+  // true force on the 3m states h, the filter's gain on the 3m states K.
+  void Update(double nu, double s, const Eigen::RowVectorXd& h, const Eigen::VectorXd& K);
+  // The time update with the 3m transition the filter used.
+  void Predict(const Eigen::MatrixXd& A);
+
+  struct Best {
+    int to = 0;                 // class (0: no hypothesis with k^ > 0)
+    int age = 0;                // instants since the onset
+    double count = 0;           // k^, units
+    double variance = 0;        // 1 / C, units^2
+    double llr = 0;             // d^2 / (2 C)
+    Eigen::VectorXd deviation;  // delta - f now, per lost unit (3m)
+  };
+  // The hypothesis with the largest ratio among those whose count is known to within
+  // `max_std` units (C >= 1 / max_std^2: a fresh onset's one innovation fits any count).
+  Best Strongest(double max_std) const;
+  // The hypothesis of class `to` with onset `age` instants ago (to = 0 if there is none; its
+  // ratio is 0 when k^ <= 0).
+  Best Hypothesis(int to, int age) const;
+
+ private:
+  int m_ = 0, window_ = 0, next_ = 0;
+  std::vector<int> entry_[3];  // entry_[to][j]: the failed state (within 3m) of working state j
+  // Column (to - 1) * window + slot: the hypotheses of each class, a ring over the onsets.
+  Eigen::MatrixXd truth_, filt_;
+  Eigen::VectorXd d_, C_;
+  std::vector<int> age_;  // -1: slot unused
+};
+
 struct FailureFilterParams {
   // Prior probabilities, per control period, that a working unit in a heated state fails open or
   // stuck (e.g. rate per hour heated x dT / 3600).
   double open_hazard = 0, stuck_hazard = 0;
-  // Detection: CUSUM drift k and threshold h on the normalised innovations (two-sided).
+  // Detection: the GLR over onsets within the last glr_window instants declares when its largest
+  // log-likelihood ratio passes glr_threshold with at least glr_min_count units lost.
   bool detect = true;
-  double cusum_drift = 1.0;
-  double cusum_threshold = 8;
-  // The covariance jump at a declaration: a common cause that takes a fraction f of the working
-  // units in proportion to each state's count (std of f), plus independent failures with
-  // probability jump_hazard per working unit.
-  double jump_fraction_std = 0.3;
-  double jump_hazard = 0.005;
+  int glr_window = 40;
+  double glr_threshold = 13;
+  double glr_min_count = 1;
+  double glr_max_std = 2;  // units: only hypotheses whose count is known to within this
   // After a declaration into a class, every prediction adds the Qz of independent failures into
-  // it with this probability (the mean is not moved): the count of failed units stays free to
-  // follow what later broadcasts reveal (units lost while off show only when recruited).
-  double settle_hazard = 0.05;
+  // it with this probability (the mean is not moved).
+  double settle_hazard = 0;
   // Random-walk variance of the working units' force scale per control period; 0 = c fixed at 1.
   double scale_variance = 0;
 
@@ -81,7 +124,7 @@ class FailureKalmanFilter {
   void Reset();
   // The working states' output row (1 x m) and R for the next Update.
   void SetOutput(const Eigen::MatrixXd& H, const Eigen::MatrixXd& R);
-  // Measurement update with the force y; runs the CUSUM (and a declaration).
+  // Measurement update with the force y; runs the GLR (and a declaration).
   void Update(double y);
   // Time update with the broadcast just sent.
   void PredictBroadcast(double p_on, double p_off);
@@ -101,6 +144,8 @@ class FailureKalmanFilter {
   // Failures declared since Reset, and whether the last Update declared one.
   int declarations() const { return declarations_; }
   bool declared_last() const { return declared_last_; }
+  // The GLR's hypothesis at the last declaration (class, onset age, count, variance, ratio).
+  const FailureGlr::Best& last_declared() const { return last_declared_; }
   // The paper's filter that runs until the augmented one takes over.
   const PopulationKalmanFilter& working_filter() const { return inner_; }
 
@@ -114,13 +159,14 @@ class FailureKalmanFilter {
   // Qz of one step with independent failures of probability q from every working state into
   // class `to` at a feasible X (3m entries).
   Eigen::MatrixXd JumpQz(const Eigen::VectorXd& xq, double q, int to) const;
-  // The covariance added at a declared failure into class `to`.
-  Eigen::MatrixXd JumpCovariance(int to) const;
+  // Corrects the estimate for the strongest hypothesis of the GLR (a declaration).
+  void Declare(const FailureGlr::Best& best);
   // The augmented output row [c H, H, H, dy/dc] for the working-state row H.
   Eigen::RowVectorXd OutputRow(const Eigen::MatrixXd& H) const;
   double Predicted(const Eigen::MatrixXd& H) const;
   void UpdateCore(double y, const Eigen::MatrixXd& H, double R);
-  void PredictCore(double p_on, double p_off);
+  // The augmented time update with the transition in A_.
+  void PredictCore();
 
   FilterModel model_;
   CovarianceMode mode_;
@@ -134,20 +180,12 @@ class FailureKalmanFilter {
   Eigen::MatrixXd H_, R_;  // the working states' output (1 x m), noise
   mutable Eigen::VectorXd view_x_;
   mutable Eigen::MatrixXd view_P_;
-  double g_low_ = 0, g_high_ = 0;                   // CUSUM statistics
+  FailureGlr glr_;
+  Eigen::VectorXd last_gain_;                       // K of the last augmented update (3m + 1)
   bool declared_class_[3] = {false, false, false};  // classes declared since Reset
   int declarations_ = 0;
   bool declared_last_ = false;
-  // One control instant as the filter saw it: the prior (augmented form), the measurement and
-  // its output model, the broadcast that followed. A declaration replays from the onset.
-  struct History {
-    Eigen::VectorXd x;
-    Eigen::MatrixXd P, H;
-    double R = 0, y = 0, p_on = 0, p_off = 0;
-  };
-  static constexpr int kHistory = 40;
-  std::deque<History> history_;
-  int onset_low_ = 0, onset_high_ = 0;  // instants since each CUSUM statistic left 0
+  FailureGlr::Best last_declared_;
 };
 
 }  // namespace recruit

@@ -38,7 +38,8 @@ std::optional<Pixel> ProjectToViewport(const mjvScene& scene, mjrRect viewport, 
 }
 
 std::vector<TendonLabel> PlaceTendonLabels(const mjModel* m, const mjData* d, const mjvScene& scene,
-                                           mjrRect viewport, const TelemetrySample& sample) {
+                                           mjrRect viewport, const TelemetrySample& sample,
+                                           const std::vector<std::optional<UnitCounts>>& counts) {
   std::vector<TendonLabel> labels;
   std::vector<double> mean_x;  // projected x of each tendon's first segment
   const int n = static_cast<int>(sample.bundles.size());
@@ -57,6 +58,10 @@ std::vector<TendonLabel> PlaceTendonLabels(const mjModel* m, const mjData* d, co
     if (!pa || !pm) continue;
     char text[160];
     std::snprintf(text, sizeof(text), "%s %.0f C", bt.actuator.c_str(), bt.mean_temperature);
+    if (b < static_cast<int>(counts.size()) && counts[b]) {
+      std::snprintf(text, sizeof(text), "%s %.0f C, %d/%d working", bt.actuator.c_str(),
+                    bt.mean_temperature, counts[b]->working, counts[b]->total());
+    }
     labels.push_back({text, *pa, false});
     mean_x.push_back(pm->x);
   }
@@ -88,12 +93,22 @@ void DrawTendonLabels(const std::vector<TendonLabel>& labels, mjrRect viewport,
   }
 }
 
-int HeatKeyHeight(const mjrContext* con) {
+int HeatKeyHeight(const mjrContext* con, int rows) {
   const int ch = con->charHeight;
-  return 2 * (ch + ch / 4) + std::max(4, ch / 2) + 2 * (ch / 4);
+  return (2 + rows) * (ch + ch / 4) + std::max(4, ch / 2) + 2 * (ch / 4);
 }
 
-int DrawHeatKey(int left, int top, int width, const mjrContext* con) {
+std::vector<std::string> HeatKeyRows(const TelemetrySample& sample,
+                                     const std::vector<std::optional<UnitCounts>>& counts) {
+  std::vector<std::string> rows;
+  for (size_t b = 0; b < sample.bundles.size() && b < counts.size(); ++b) {
+    if (counts[b]) rows.push_back(sample.bundles[b].actuator + ": " + WorkingText(*counts[b]));
+  }
+  return rows;
+}
+
+int DrawHeatKey(int left, int top, int width, const mjrContext* con,
+                const std::vector<std::string>& rows) {
   const int ch = con->charHeight;
   const int row = ch + ch / 4;
   const int bar = std::max(4, ch / 2);
@@ -101,7 +116,8 @@ int DrawHeatKey(int left, int top, int width, const mjrContext* con) {
   const std::string title = "tendon heat";
   const std::string lo = "ambient", hi = "on-state";
   width = std::max(width, TextWidth(lo + "  " + hi, con) + 2 * pad);
-  const int height = 2 * row + bar + 2 * pad;
+  for (const std::string& r : rows) width = std::max(width, TextWidth(r, con) + 2 * pad);
+  const int height = HeatKeyHeight(con, static_cast<int>(rows.size()));
   mjr_rectangle({left, top - height, width, height}, 0.1f, 0.1f, 0.12f, 0.75f);
   mjr_label({left + pad, top - pad - row, TextWidth(title, con), row}, mjFONT_NORMAL, title.c_str(),
             0, 0, 0, 0, 1, 1, 1, con);
@@ -118,6 +134,12 @@ int DrawHeatKey(int left, int top, int width, const mjrContext* con) {
             0.85f, 0.85f, 0.85f, con);
   mjr_label({left + width - pad - TextWidth(hi, con), label_y, TextWidth(hi, con), row},
             mjFONT_NORMAL, hi.c_str(), 0, 0, 0, 0, 0.85f, 0.85f, 0.85f, con);
+  // The units still working of each bundle whose units can fail (working vs total).
+  for (size_t i = 0; i < rows.size(); ++i) {
+    const int y = label_y - static_cast<int>(i + 1) * row;
+    mjr_label({left + pad, y, TextWidth(rows[i], con), row}, mjFONT_NORMAL, rows[i].c_str(), 0, 0,
+              0, 0, 1.f, 0.85f, 0.4f, con);
+  }
   return height;
 }
 

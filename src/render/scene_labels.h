@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "common/telemetry.h"
+#include "render/unit_counts.h"
 
 namespace recruit::render {
 
@@ -31,8 +32,10 @@ struct TendonLabel {
 // One label per bundle whose tendon has a path: anchored at fraction (b + 1) / (n + 1) of the
 // tendon's first segment (so labels of parallel tendons are staggered); the tendon drawn
 // leftmost gets its text on the left, the others on the right.
-std::vector<TendonLabel> PlaceTendonLabels(const mjModel* m, const mjData* d, const mjvScene& scene,
-                                           mjrRect viewport, const TelemetrySample& sample);
+// A bundle with unit counts (`counts`, in the sample's order; empty: none) adds "54/60 working".
+std::vector<TendonLabel> PlaceTendonLabels(
+    const mjModel* m, const mjData* d, const mjvScene& scene, mjrRect viewport,
+    const TelemetrySample& sample, const std::vector<std::optional<UnitCounts>>& counts = {});
 
 // Draws the labels (leader line, text on a dark box). `offset` is the viewport's origin in the
 // frame.
@@ -40,9 +43,14 @@ void DrawTendonLabels(const std::vector<TendonLabel>& labels, mjrRect viewport,
                       const mjrContext* con);
 
 // Draws the heat colour key (a gradient bar with "ambient" and "on-state" at its ends) with its
-// top-left corner at (left, top), and returns its height in pixels.
-int DrawHeatKey(int left, int top, int width, const mjrContext* con);
-int HeatKeyHeight(const mjrContext* con);
+// top-left corner at (left, top), and returns its height in pixels. `rows` (e.g. each failing
+// bundle's "flexor: 54 of 60 working (6 open)", HeatKeyRows) are written under the bar.
+int DrawHeatKey(int left, int top, int width, const mjrContext* con,
+                const std::vector<std::string>& rows = {});
+int HeatKeyHeight(const mjrContext* con, int rows = 0);
+// The key's rows for the bundles that have unit counts: "NAME: WorkingText".
+std::vector<std::string> HeatKeyRows(const TelemetrySample& sample,
+                                     const std::vector<std::optional<UnitCounts>>& counts);
 
 // Text width in pixels in the context's normal font.
 int TextWidth(const std::string& s, const mjrContext* con);

@@ -132,7 +132,12 @@ void SceneRenderer::AddPlotPoint(const TelemetrySample& sample) {
   if (plots_) plots_->Add(sample);
 }
 
-void SceneRenderer::DrawPanel(const TelemetrySample* s, mjrRect viewport) {
+void SceneRenderer::AddPlotPoint(const mjModel* m, const mjData* d, const TelemetrySample& sample) {
+  if (plots_) plots_->Add(sample, counts_.Read(m, d, sample));
+}
+
+void SceneRenderer::DrawPanel(const TelemetrySample* s, mjrRect viewport,
+                              const std::vector<std::optional<UnitCounts>>& counts) {
   std::string titles, values;
   auto row = [&](const std::string& title, const std::string& value) {
     if (!titles.empty()) {
@@ -153,14 +158,20 @@ void SceneRenderer::DrawPanel(const TelemetrySample* s, mjrRect viewport) {
                     s->reference);
       row("force", buf);
     }
-    for (const BundleTelemetry& b : s->bundles) {
+    for (size_t i = 0; i < s->bundles.size(); ++i) {
+      const BundleTelemetry& b = s->bundles[i];
       if (std::isfinite(b.estimated_on)) {
         std::snprintf(buf, sizeof(buf), "%d on, est %.1f, heat %s", b.true_on, b.estimated_on,
                       Fraction(b.heat).c_str());
       } else {
         std::snprintf(buf, sizeof(buf), "%d on, heat %s", b.true_on, Fraction(b.heat).c_str());
       }
-      row(b.actuator, buf);
+      std::string value = buf;
+      if (i < counts.size() && counts[i]) {
+        value += ", " + std::to_string(counts[i]->working) + "/" +
+                 std::to_string(counts[i]->total()) + " working";
+      }
+      row(b.actuator, value);
     }
   }
   if (titles.empty()) return;
@@ -198,13 +209,18 @@ Status SceneRenderer::Render(const mjModel* m, const mjData* d, const TelemetryS
   const int side = plots_ ? options_.width * 9 / 20 : 0;
   const mjrRect scene_viewport = {0, 0, options_.width - side, below};
   mjr_render(scene_viewport, &scene_, &context_);
+  // Each bundle's working/open/stuck units, when its units can fail (none otherwise).
+  const std::vector<std::optional<UnitCounts>> counts =
+      sample ? counts_.Read(m, d, *sample) : std::vector<std::optional<UnitCounts>>{};
   if (sample && options_.labels) {
-    DrawTendonLabels(PlaceTendonLabels(m, d, scene_, scene_viewport, *sample), scene_viewport,
-                     &context_);
+    DrawTendonLabels(PlaceTendonLabels(m, d, scene_, scene_viewport, *sample, counts),
+                     scene_viewport, &context_);
   }
   if (sample && options_.heat_colours && options_.heat_key) {
     // Bottom left, over the floor: the arm and its reach stay clear.
-    DrawHeatKey(ch / 2, ch / 2 + HeatKeyHeight(&context_), 0, &context_);
+    const std::vector<std::string> rows = HeatKeyRows(*sample, counts);
+    DrawHeatKey(ch / 2, ch / 2 + HeatKeyHeight(&context_, static_cast<int>(rows.size())), 0,
+                &context_, rows);
   }
   if (options_.text_panel) {
     const mjrRect strip = {0, below, options_.width, title_h};
@@ -218,7 +234,7 @@ Status SceneRenderer::Render(const mjModel* m, const mjData* d, const TelemetryS
     mjr_rectangle(column, 0.05f, 0.05f, 0.08f, 1.f);
     plots_->Draw(column, &context_);
   } else if (options_.text_panel) {
-    DrawPanel(sample, scene_viewport);
+    DrawPanel(sample, scene_viewport, counts);
   }
   mjr_readPixels(rgb, nullptr, viewport, &context_);
   if (const int err = mjr_getError(); err != 0) {

@@ -18,6 +18,7 @@
 #include "render/camera.h"
 #include "render/gl_context.h"
 #include "render/telemetry_plots.h"
+#include "render/unit_counts.h"
 
 namespace recruit::render {
 
@@ -81,6 +82,8 @@ class SceneRenderer {
 
   // Adds the sample to the scrolling plots (the recorder calls it once per frame).
   void AddPlotPoint(const TelemetrySample& sample);
+  // The same with the bundles' unit counts read from `d` (render/unit_counts.h).
+  void AddPlotPoint(const mjModel* m, const mjData* d, const TelemetrySample& sample);
 
   // Renders the state in `d` into `rgb` (width * height * 3 bytes, rows bottom-up). `sample`
   // may be null (no heat colours, no panel values). `d` is read only; mjv_updateScene's
@@ -96,7 +99,8 @@ class SceneRenderer {
 
  private:
   SceneRenderer(const RenderOptions& options, const RunLabel& label);
-  void DrawPanel(const TelemetrySample* sample, mjrRect viewport);
+  void DrawPanel(const TelemetrySample* sample, mjrRect viewport,
+                 const std::vector<std::optional<UnitCounts>>& counts);
 
   RenderOptions options_;
   RunLabel label_;
@@ -110,6 +114,7 @@ class SceneRenderer {
   bool scene_made_ = false;
   bool context_made_ = false;
   std::unique_ptr<TelemetryPlots> plots_;
+  UnitCountReader counts_;  // failing bundles' working/open/stuck units
   int last_recoloured_ = 0;
 };
 

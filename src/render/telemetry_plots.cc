@@ -137,7 +137,8 @@ TextMetrics TextMetrics::FromContext(const mjrContext* con) {
 
 TelemetryPlots::TelemetryPlots(double window) : window_(window > 0 ? window : 20.0) {}
 
-void TelemetryPlots::Configure(const TelemetrySample& s) {
+void TelemetryPlots::Configure(const TelemetrySample& s,
+                               const std::vector<std::optional<UnitCounts>>& counts_of) {
   configured_ = true;
   angle_ = s.reference_unit == "rad";
   const int nb = std::min<int>(s.bundles.size(), kMaxBundles);
@@ -174,11 +175,27 @@ void TelemetryPlots::Configure(const TelemetrySample& s) {
     const float* c = kBundleRgb[b];
     counts.bands.push_back({"+-2 sd", {c[0], c[1], c[2], 0.4f}, {}, {}, {}});
   }
+  working_line_.assign(nb, -1);
+  for (int b = 0; b < nb && b < static_cast<int>(counts_of.size()); ++b) {
+    if (!counts_of[b]) continue;
+    working_line_[b] = static_cast<int>(counts.lines.size());
+    const float* c = kBundleRgb[b];
+    const std::array<float, 3> grey = {0.45f + 0.2f * c[0], 0.45f + 0.2f * c[1],
+                                       0.45f + 0.2f * c[2]};
+    counts.lines.push_back({nb > 1 ? s.bundles[b].actuator + " working" : "working",
+                            grey,
+                            LineStyle::kStairs,
+                            {},
+                            {}});
+  }
   panels_.push_back(std::move(counts));
 }
 
-void TelemetryPlots::Add(const TelemetrySample& s) {
-  if (!configured_) Configure(s);
+void TelemetryPlots::Add(const TelemetrySample& s) { Add(s, {}); }
+
+void TelemetryPlots::Add(const TelemetrySample& s,
+                         const std::vector<std::optional<UnitCounts>>& unit_counts) {
+  if (!configured_) Configure(s, unit_counts);
   now_ = s.time;
   auto push = [&](PlotLine& l, double y) {
     if (!std::isfinite(s.time) || !std::isfinite(y)) return;
@@ -198,6 +215,9 @@ void TelemetryPlots::Add(const TelemetrySample& s) {
     }
     push(counts.lines[2 * b], bt.true_on);
     push(counts.lines[2 * b + 1], bt.estimated_on);
+    if (working_line_[b] >= 0 && b < static_cast<int>(unit_counts.size()) && unit_counts[b]) {
+      push(counts.lines[working_line_[b]], unit_counts[b]->working);
+    }
     if (std::isfinite(bt.estimated_on) && std::isfinite(bt.estimated_on_std)) {
       PlotBand& band = counts.bands[b];
       band.had_data = true;

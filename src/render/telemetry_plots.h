@@ -3,8 +3,9 @@
 //   - force task: force and its reference (N); angle task: joint angle and its reference (deg),
 //     then each bundle's force with the force reference its controller tracks (N);
 //   - each bundle's true on-count (solid stairs) and the estimator's count (dashed, lighter) with
-//     the filter's estimated_on +- 2 estimated_on_std band (translucent, under the lines); the
-//     count axis starts at zero.
+//     the filter's estimated_on +- 2 estimated_on_std band (translucent, under the lines), and
+//     for a bundle whose units can fail the units still working (grey stairs); the count axis
+//     starts at zero.
 // Rules (tests/render/telemetry_plots_test.cc): the legend sits in its own strip above each
 // panel, never over data; ticks are integer multiples of a 1-2-5 x 10^k step with the units in
 // the panel title; the whole window is kept however long it is (each line is thinned to fit
@@ -21,6 +22,7 @@
 #include <vector>
 
 #include "common/telemetry.h"
+#include "render/unit_counts.h"
 
 namespace recruit::render {
 
@@ -67,6 +69,10 @@ class TelemetryPlots {
   // Appends one sample. The panels are chosen at the first sample (its reference unit and
   // bundles).
   void Add(const TelemetrySample& sample);
+  // The same with each bundle's working/open/stuck counts (UnitCountReader): a bundle that has
+  // them at the first sample gets a "working" line (stairs) in the units panel, the units still
+  // working against the total of the axis.
+  void Add(const TelemetrySample& sample, const std::vector<std::optional<UnitCounts>>& counts);
 
   struct PanelBoxes {
     mjrRect legend;  // the legend strip (may have height 0 when the panel has no lines)
@@ -114,7 +120,7 @@ class TelemetryPlots {
     bool include_zero = true;
     bool counts = false;  // unit counts: the axis starts at zero (a band below it is clipped)
   };
-  void Configure(const TelemetrySample& s);
+  void Configure(const TelemetrySample& s, const std::vector<std::optional<UnitCounts>>& counts);
   void Drop(double start);
   int LegendRows(const Panel& p, int width, const TextMetrics& text) const;
   void DrawLegend(const Panel& p, mjrRect box, const mjrContext* con, const TextMetrics& text,
@@ -127,6 +133,7 @@ class TelemetryPlots {
   bool configured_ = false;
   bool angle_ = false;
   std::vector<Panel> panels_;
+  std::vector<int> working_line_;  // per bundle: its "working" line in the units panel, or -1
   std::vector<double> x_ticks_;
 };
 

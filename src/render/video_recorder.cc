@@ -141,7 +141,7 @@ Status VideoRecorder::OnStep(const mjModel* m, const mjData* d, const TelemetryS
 
   auto frame = pipeline_->Acquire();
   if (!frame.ok()) return Error{frame.error(), frame.code()};
-  renderer_->AddPlotPoint(sample);
+  renderer_->AddPlotPoint(m, d, sample);
   if (Status s = renderer_->Render(m, d, &sample, (*frame)->rgb.data()); !s.ok()) {
     (void)pipeline_->Submit(*frame);  // hand the buffer back; the error stops the run
     return s;

@@ -1,14 +1,20 @@
 #include "sim/run_task.h"
 
+#include <fmt/format.h>
 #include <mujoco/mujoco.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <limits>
 #include <memory>
 
+#include "common/atomic_file.h"
+#include "common/content_hash.h"
+#include "common/mujoco_load.h"
 #include "common/mujoco_ptr.h"
 #include "common/rng.h"
 #include "control/kalman_estimator.h"
@@ -589,6 +595,67 @@ class Progress {
   double next_wall_ = 0;
 };
 
+// The plant of a task. With "failures", the model is the task's with each named bundle's
+// failure keys set on its plugin instance, written beside the model (so that relative includes
+// and assets resolve as for the original) for the compiler and removed once loaded; `holder`
+// keeps the task the plant reads (with that model's path). Without them, Plant::Create(task).
+Result<std::unique_ptr<Plant>> CreatePlant(const Task& task, bool drawn, Task& holder) {
+  if (task.failures.empty()) return Plant::Create(task, drawn);
+  const std::string where = (task.source.empty() ? task.name : task.source) + ".failures";
+  auto text = ReadFile(task.model_path);
+  if (!text.ok()) return Error{where + ": " + text.error(), text.code()};
+  auto model = LoadModel(task.model_path);
+  if (!model.ok()) return Error{where + ": " + model.error()};
+  const mjModel* m = model->get();
+  std::string xml = std::move(text).value();
+  std::vector<std::string> instances;  // of the bundles given failures, in the task's order
+  for (const BundleFailures& f : task.failures) {
+    const int id = mj_name2id(m, mjOBJ_ACTUATOR, f.actuator.c_str());
+    if (id < 0 || m->actuator_plugin[id] < 0) {
+      std::string bundles;
+      for (int a = 0; a < m->nu; ++a) {
+        if (m->actuator_plugin[a] < 0) continue;
+        const char* n = mj_id2name(m, mjOBJ_ACTUATOR, a);
+        bundles += (bundles.empty() ? "" : ", ") + std::string(n ? n : "?");
+      }
+      return Error{where + "." + f.actuator + ": no SMA bundle '" + f.actuator + "' in '" +
+                   task.model_path + "'; bundles: " + (bundles.empty() ? "none" : bundles)};
+    }
+    const char* instance = mj_id2name(m, mjOBJ_PLUGIN, m->actuator_plugin[id]);
+    if (instance == nullptr) {
+      return Error{where + "." + f.actuator + ": its plugin instance has no name in '" +
+                   task.model_path + "' (name it: <instance name=\"...\">)"};
+    }
+    if (std::find(instances.begin(), instances.end(), instance) != instances.end()) {
+      return Error{where + "." + f.actuator + ": its plugin instance '" + instance +
+                   "' drives a bundle already given failures; give them once per instance"};
+    }
+    instances.push_back(instance);
+    for (const auto& [key, value] : f.keys) {
+      auto edited = SetPluginConfig(xml, instance, key, value);
+      if (!edited.ok()) return Error{where + "." + f.actuator + ": " + edited.error()};
+      xml = std::move(edited).value();
+    }
+  }
+  namespace fs = std::filesystem;
+  const fs::path original(task.model_path);
+  const fs::path file =
+      original.parent_path() / fmt::format(".{}.failures-{}-{}.xml", original.stem().string(),
+                                           ::getpid(), ContentHash().Add(xml).Hex().substr(0, 12));
+  if (Status st = WriteFileAtomically(file.string(), xml); !st.ok()) {
+    return Error{where + ": cannot write the model with failure keys beside '" + task.model_path +
+                     "': " + st.error(),
+                 st.code()};
+  }
+  holder = task;
+  holder.model_path = file.string();
+  auto plant = Plant::Create(holder, drawn);
+  std::error_code ec;
+  fs::remove(file, ec);
+  if (!plant.ok()) return Error{where + ": " + plant.error(), plant.code()};
+  return plant;
+}
+
 }  // namespace
 
 Result<std::vector<JointDesignRecord>> DesignTaskLoops(const Task& task,
@@ -598,7 +665,8 @@ Result<std::vector<JointDesignRecord>> DesignTaskLoops(const Task& task,
     return Error{where + ".outer_loop: only a task with \"outer_loop\": \"auto\" designs its loop"};
   }
   const ControllerSettings settings = EffectiveSettings(task, options);
-  auto plant_or = Plant::Create(task, /*drawn=*/false);
+  Task holder;
+  auto plant_or = CreatePlant(task, /*drawn=*/false, holder);
   if (!plant_or.ok()) return Error{plant_or.error(), plant_or.code()};
   Plant& plant = **plant_or;
   plant.Reset(options.seed);
@@ -638,7 +706,8 @@ Result<std::vector<JointDesignRecord>> DesignTaskLoops(const Task& task,
 Result<std::vector<BundleController>> TaskControllers(const Task& task, const RunOptions& options) {
   const std::string where = task.source.empty() ? task.name : task.source;
   const ControllerSettings settings = EffectiveSettings(task, options);
-  auto plant_or = Plant::Create(task, /*drawn=*/false);
+  Task holder;
+  auto plant_or = CreatePlant(task, /*drawn=*/false, holder);
   if (!plant_or.ok()) return plant_or.failure();
   Plant& plant = **plant_or;
   plant.Reset(options.seed);
@@ -670,7 +739,8 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
 
   const bool draws = std::any_of(observers.begin(), observers.end(),
                                  [](const StepObserver* o) { return o->Draws(); });
-  auto plant_or = Plant::Create(task, /*drawn=*/draws);
+  Task holder;
+  auto plant_or = CreatePlant(task, /*drawn=*/draws, holder);
   if (!plant_or.ok()) return Error{plant_or.error(), plant_or.code()};
   Plant& plant = **plant_or;
   plant.Reset(options.seed);

@@ -104,6 +104,105 @@ Status ReadJointsForm(const json& j, const std::string& file, Task& task) {
   return Status::Ok();
 }
 
+// A number as the plugin reads it back exactly (%.17g; "%g" for messages).
+std::string Digits(double v, const char* format = "%.17g") {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, format, v);
+  return buf;
+}
+
+// The plugin's failure keys of one bundle, checked against plugin/README.md's ranges:
+// {"open_rate", "stuck_rate", "open_per_cycle", "stuck_per_cycle", "schedule": [{"time",
+// "count", "mode"}], "fatigue_loss", "fatigue_cycles", "fatigue_stress", "fatigue_exponent"}.
+Result<BundleFailures> ReadBundleFailures(const json& f, const std::string& actuator,
+                                          const std::string& where) {
+  if (!f.is_object()) return Error{where + ": must be an object of failure keys"};
+  RECRUIT_TRY(CheckKeys(f,
+                        {"open_rate", "stuck_rate", "open_per_cycle", "stuck_per_cycle", "schedule",
+                         "fatigue_loss", "fatigue_cycles", "fatigue_stress", "fatigue_exponent"},
+                        where));
+  BundleFailures b;
+  b.actuator = actuator;
+  struct Key {
+    const char* name;
+    double lo, hi;
+    bool lo_open;
+    const char* allowed;
+  };
+  static const Key kRates[] = {
+      {"open_rate", 0, 3600, false, "per hour heated, 0 <= open_rate <= 3600"},
+      {"stuck_rate", 0, 3600, false, "per hour heated, 0 <= stuck_rate <= 3600"},
+      {"open_per_cycle", 0, 1, false, "a probability per cycle, 0 <= open_per_cycle <= 1"},
+      {"stuck_per_cycle", 0, 1, false, "a probability per cycle, 0 <= stuck_per_cycle <= 1"}};
+  static const Key kFatigue[] = {
+      {"fatigue_loss", 0, 0.9, false, "a fraction of force, 0 <= fatigue_loss <= 0.9"},
+      {"fatigue_cycles", 0, 1e9, true, "reference cycles, 0 < fatigue_cycles <= 1e9"},
+      {"fatigue_stress", 0, 2e9, true, "Pa, 0 < fatigue_stress <= 2e9"},
+      {"fatigue_exponent", 0, 10, false, "0 <= fatigue_exponent <= 10"}};
+  auto add = [&](const Key& k) -> Status {
+    if (!f.contains(k.name)) return Status::Ok();
+    double v = 0;
+    RECRUIT_TRY(Number(f, k.name, where, &v, true, k.lo, k.hi, k.lo_open, k.allowed));
+    b.keys.emplace_back(k.name, Digits(v));
+    return Status::Ok();
+  };
+  for (const Key& k : kRates) RECRUIT_TRY(add(k));
+  double per_cycle = 0;
+  for (const auto& [key, value] : b.keys) {
+    if (key == "open_per_cycle" || key == "stuck_per_cycle") per_cycle += std::stod(value);
+  }
+  if (per_cycle > 1) {
+    return Error{where + ": open_per_cycle + stuck_per_cycle = " + Digits(per_cycle, "%g") +
+                 "; allowed: at most 1"};
+  }
+  if (f.contains("schedule")) {
+    const json& s = f["schedule"];
+    if (!s.is_array() || s.empty() || s.size() > 1000) {
+      return Error{where + ".schedule: must be an array of 1 to 1000 {\"time\", \"count\", " +
+                   "\"mode\"}, got " + ShortText(s.dump(), 60)};
+    }
+    std::string text;
+    for (size_t i = 0; i < s.size(); ++i) {
+      const std::string w = where + ".schedule[" + std::to_string(i) + "]";
+      if (!s[i].is_object())
+        return Error{w + ": must be an object {\"time\", \"count\", \"mode\"}"};
+      RECRUIT_TRY(CheckKeys(s[i], {"time", "count", "mode"}, w));
+      double t = 0;
+      std::int64_t count = 0;
+      std::string mode;
+      RECRUIT_TRY(Number(s[i], "time", w, &t, true, 0, 1e9, false, "seconds after reset, 0..1e9"));
+      RECRUIT_TRY(json_fields::Integer(s[i], "count", w, &count, true, 0, 1000000,
+                                       "a whole number of units, 0..1000000"));
+      RECRUIT_TRY(String(s[i], "mode", w, &mode, true));
+      if (mode != "open" && mode != "stuck") {
+        return Error{w + ".mode: '" + ShortText(mode, 40) + "'; allowed: open, stuck"};
+      }
+      // 0 units: nothing fails then (a sweep's baseline point of a count axis).
+      if (count > 0)
+        text += (text.empty() ? "" : ",") + Digits(t) + ":" + std::to_string(count) + ":" + mode;
+    }
+    if (!text.empty()) b.keys.emplace_back("failures", text);
+  }
+  for (const Key& k : kFatigue) RECRUIT_TRY(add(k));
+  if (f.empty()) return Error{where + ": gives no failure key"};
+  return b;  // no keys when every scheduled count is 0: the bundle runs as without failures
+}
+
+Status ReadFailures(const json& j, const std::string& file, Task& task) {
+  const json& f = j["failures"];
+  const std::string where = file + ".failures";
+  if (!f.is_object() || f.empty()) {
+    return Error{where + ": must be an object {\"ACTUATOR\": {failure keys}, ...}, got " +
+                 ShortText(f.dump(), 60)};
+  }
+  for (auto it = f.begin(); it != f.end(); ++it) {
+    auto b = ReadBundleFailures(it.value(), it.key(), where + "." + it.key());
+    if (!b.ok()) return Error{b.error(), b.code()};
+    if (!b->keys.empty()) task.failures.push_back(std::move(b).value());
+  }
+  return Status::Ok();
+}
+
 }  // namespace
 
 Result<Task> Task::FromFile(const std::string& path) {
@@ -118,12 +217,12 @@ Result<Task> Task::FromJsonText(const std::string& text, const std::string& sour
   if (!parsed.ok()) return Error{parsed.error(), parsed.code()};
   json j = std::move(parsed).value();
   if (!j.is_object()) return Error{file + ": the task must be a JSON object"};
-  RECRUIT_TRY(
-      CheckKeys(j,
-                {"name", "description", "model", "tracked", "agonist", "antagonist", "joint",
-                 "duration", "timestep", "reference", "controller", "sensor", "outer_loop",
-                 "pushes", "payloads", "settle_band", "joints", "bundles", "co_contraction"},
-                file));
+  RECRUIT_TRY(CheckKeys(j,
+                        {"name",        "description", "model",      "tracked",        "agonist",
+                         "antagonist",  "joint",       "duration",   "timestep",       "reference",
+                         "controller",  "sensor",      "outer_loop", "pushes",         "payloads",
+                         "settle_band", "joints",      "bundles",    "co_contraction", "failures"},
+                        file));
   Task task;
   task.source = source;
   RECRUIT_TRY(String(j, "name", file, &task.name, true));
@@ -275,7 +374,59 @@ Result<Task> Task::FromJsonText(const std::string& text, const std::string& sour
       task.payloads.push_back(pl);
     }
   }
+  if (j.contains("failures")) RECRUIT_TRY(ReadFailures(j, file, task));
   return task;
+}
+
+Result<std::string> SetPluginConfig(const std::string& xml, const std::string& instance,
+                                    const std::string& key, const std::string& value) {
+  std::vector<std::string> seen;
+  size_t pos = 0;
+  while ((pos = xml.find("<instance", pos)) != std::string::npos) {
+    const size_t tag_end = xml.find('>', pos);
+    if (tag_end == std::string::npos) break;
+    const std::string tag = xml.substr(pos, tag_end - pos);
+    const size_t n = tag.find("name=");
+    std::string name;
+    if (n != std::string::npos && n + 6 < tag.size()) {
+      const char q = tag[n + 5];
+      const size_t e = tag.find(q, n + 6);
+      if (e != std::string::npos) name = tag.substr(n + 6, e - n - 6);
+    }
+    if (name != instance) {
+      seen.push_back(name);
+      pos = tag_end;
+      continue;
+    }
+    if (tag.back() == '/') {  // <instance name="x"/>: no config lines yet
+      std::string out = xml.substr(0, pos) + tag.substr(0, tag.size() - 1) + "><config key=\"" +
+                        key + "\" value=\"" + value + "\"/></instance" + xml.substr(tag_end);
+      return out;
+    }
+    const size_t close = xml.find("</instance>", tag_end);
+    if (close == std::string::npos) return Error{"instance '" + instance + "' is not closed"};
+    for (const char q : {'"', '\''}) {
+      const std::string needle = std::string("key=") + q + key + q;
+      const size_t k = xml.find(needle, tag_end);
+      if (k == std::string::npos || k > close) continue;
+      const size_t cfg = xml.rfind("<config", k);
+      const size_t cfg_end = xml.find('>', k);
+      const size_t v = xml.find("value=", cfg);
+      if (cfg == std::string::npos || cfg < tag_end || v == std::string::npos || v > cfg_end) {
+        return Error{"config key '" + key + "' of instance '" + instance + "' has no value"};
+      }
+      const char vq = xml[v + 6];
+      const size_t ve = xml.find(vq, v + 7);
+      return xml.substr(0, v + 7) + value + xml.substr(ve);
+    }
+    return xml.substr(0, tag_end + 1) + "\n        <config key=\"" + key + "\" value=\"" + value +
+           "\"/>" + xml.substr(tag_end + 1);
+  }
+  std::string list;
+  for (const auto& s : seen) list += (list.empty() ? "" : ", ") + s;
+  return Error{
+      "the model has no plugin instance '" + instance + "'" +
+      (list.empty() ? std::string(" (it has no named instances)") : "; instances: " + list)};
 }
 
 }  // namespace recruit::sim

@@ -62,6 +62,14 @@ struct DrivenJoint {
   Reference reference;
 };
 
+// Plant failure settings of one bundle (the plugin's failure and fatigue keys, plugin/README.md
+// "Failures and fatigue"): set on the plugin instance that drives the bundle when the task runs.
+struct BundleFailures {
+  std::string actuator;
+  // (plugin config key, value as the plugin reads it), in the plugin's key order.
+  std::vector<std::pair<std::string, std::string>> keys;
+};
+
 struct Task {
   std::string name;
   std::string description;
@@ -91,10 +99,17 @@ struct Task {
   std::vector<Push> pushes;
   std::vector<Payload> payloads;
   double settle_band = 0.10;  // fraction of each step's size used for settling time
+  // "failures": {ACTUATOR: {...}}: the bundles whose units fail (none: the model's own keys).
+  std::vector<BundleFailures> failures;
 
   static Result<Task> FromFile(const std::string& path);
   // `source` names the file in errors and resolves relative paths (its directory).
   static Result<Task> FromJsonText(const std::string& text, const std::string& source);
 };
+
+// Sets `key`'s value in the plugin instance `instance` of an MJCF text (adds the config line if
+// the key is not there): how a task's failure keys and a sweep's model axes reach the plugin.
+Result<std::string> SetPluginConfig(const std::string& xml, const std::string& instance,
+                                    const std::string& key, const std::string& value);
 
 }  // namespace recruit::sim

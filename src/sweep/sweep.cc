@@ -263,8 +263,9 @@ Status WriteReports(const PreparedSweep& p, const std::vector<sim::RunSummary>& 
         StabilityMapOptions(out, p.task.name, static_cast<int>(p.spec.estimators.size()));
     if (Status s = draw.stability_map(map); !s.ok()) return IoError(s.error());
   }
-  ReportInput in{p.task.name, p.description, p.criterion, cells, {}, {}};
+  ReportInput in{p.task.name, p.description, p.criterion, cells, {}, {}, {}};
   in.seed_reasons = SeedReasonsMarkdown(p.grid, runs, p.criterion);
+  in.unit = p.task.tracked == sim::Tracked::kForce ? "N" : "rad";
   // The output-only loop's latency bound needs each plant point's force latency (one open-loop
   // step of its model, ~0.1 s each); a point whose model cannot do it gets none (NaN).
   if (std::find(p.spec.estimators.begin(), p.spec.estimators.end(), "output") !=

@@ -11,6 +11,7 @@
 #include "common/json_fields.h"
 #include "common/json_file.h"
 #include "common/short_text.h"
+#include "control/on_count_estimator.h"
 #include "control/sampling_period.h"
 #include "sweep/sampling.h"
 
@@ -174,10 +175,10 @@ Result<SweepFile> SweepFile::FromJsonText(const std::string& text, const std::st
         return Error{where + ".estimator: must be a name or a non-empty array of names"};
       }
       for (const json& x : list) {
-        static const std::set<std::string> kKnown = {"output", "kalman2", "kalman-augmented"};
-        if (!x.is_string() || !kKnown.count(x.get<std::string>())) {
+        // The kinds a task's controller takes (control::EstimatorSpec::Parse).
+        if (!x.is_string() || !control::EstimatorSpec::Parse(x.get<std::string>()).ok()) {
           return Error{where + ".estimator: " + ShortText(x.dump()) +
-                       "; allowed: output, kalman2, kalman-augmented"};
+                       "; allowed: output, kalman2, kalman-augmented, kalman-failures"};
         }
         f.estimators.push_back(x.get<std::string>());
       }
@@ -339,57 +340,6 @@ Result<std::vector<sweep::PlantPoint>> PlantPoints(const SweepFile& f) {
   return points;
 }
 
-Result<std::string> SetPluginConfig(const std::string& xml, const std::string& instance,
-                                    const std::string& key, const std::string& value) {
-  std::vector<std::string> seen;
-  size_t pos = 0;
-  while ((pos = xml.find("<instance", pos)) != std::string::npos) {
-    const size_t tag_end = xml.find('>', pos);
-    if (tag_end == std::string::npos) break;
-    const std::string tag = xml.substr(pos, tag_end - pos);
-    const size_t n = tag.find("name=");
-    std::string name;
-    if (n != std::string::npos && n + 6 < tag.size()) {
-      const char q = tag[n + 5];
-      const size_t e = tag.find(q, n + 6);
-      if (e != std::string::npos) name = tag.substr(n + 6, e - n - 6);
-    }
-    if (name != instance) {
-      seen.push_back(name);
-      pos = tag_end;
-      continue;
-    }
-    if (tag.back() == '/') {  // <instance name="x"/>: no config lines yet
-      std::string out = xml.substr(0, pos) + tag.substr(0, tag.size() - 1) + "><config key=\"" +
-                        key + "\" value=\"" + value + "\"/></instance" + xml.substr(tag_end);
-      return out;
-    }
-    const size_t close = xml.find("</instance>", tag_end);
-    if (close == std::string::npos) return Error{"instance '" + instance + "' is not closed"};
-    for (const char q : {'"', '\''}) {
-      const std::string needle = std::string("key=") + q + key + q;
-      const size_t k = xml.find(needle, tag_end);
-      if (k == std::string::npos || k > close) continue;
-      const size_t cfg = xml.rfind("<config", k);
-      const size_t cfg_end = xml.find('>', k);
-      const size_t v = xml.find("value=", cfg);
-      if (cfg == std::string::npos || cfg < tag_end || v == std::string::npos || v > cfg_end) {
-        return Error{"config key '" + key + "' of instance '" + instance + "' has no value"};
-      }
-      const char vq = xml[v + 6];
-      const size_t ve = xml.find(vq, v + 7);
-      return xml.substr(0, v + 7) + value + xml.substr(ve);
-    }
-    return xml.substr(0, tag_end + 1) + "\n        <config key=\"" + key + "\" value=\"" + value +
-           "\"/>" + xml.substr(tag_end + 1);
-  }
-  std::string list;
-  for (const auto& s : seen) list += (list.empty() ? "" : ", ") + s;
-  return Error{
-      "the model has no plugin instance '" + instance + "'" +
-      (list.empty() ? std::string(" (it has no named instances)") : "; instances: " + list)};
-}
-
 Result<PlantInputs> ApplyPlantPoint(const std::string& task_text, const std::string& model_text,
                                     const std::vector<PlantAxis>& axes,
                                     const sweep::PlantPoint& point, const std::string& where) {
@@ -415,6 +365,12 @@ Result<PlantInputs> ApplyPlantPoint(const std::string& task_text, const std::str
     }
     const json::json_pointer ptr(a.path);
     const json::json_pointer parent = ptr.parent_pointer();
+    // A failure key of a bundle the task gives no failures ("/failures/BUNDLE/open_rate"): the
+    // objects on the way are made (the task's check then names a bad bundle or key).
+    if (a.path.rfind("/failures/", 0) == 0 &&
+        ptr.parent_pointer().parent_pointer().to_string() == "/failures") {
+      if (!doc.contains(parent)) doc[parent] = json::object();
+    }
     if (!doc.contains(parent)) {
       return Error{label + ": the task has no '" + parent.to_string() + "'"};
     }

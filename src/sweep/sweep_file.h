@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "common/result.h"
+#include "sim/task.h"
 #include "sweep/grid.h"
 #include "sweep/table.h"
 
@@ -67,9 +68,7 @@ Result<PlantInputs> ApplyPlantPoint(const std::string& task_text, const std::str
                                     const std::vector<PlantAxis>& axes,
                                     const sweep::PlantPoint& point, const std::string& where);
 
-// Sets `key`'s value in the plugin instance `instance` of an MJCF text (adds the config line if
-// the key is not there).
-Result<std::string> SetPluginConfig(const std::string& xml, const std::string& instance,
-                                    const std::string& key, const std::string& value);
+// Sets `key`'s value in the plugin instance `instance` of an MJCF text (sim/task.h).
+using sim::SetPluginConfig;
 
 }  // namespace recruit::sweep

@@ -243,6 +243,57 @@ plot::Figure CriticalFigure(const std::string& title, const std::vector<Recommen
   return fig;
 }
 
+// The tracking the recommended dT achieves against each plant axis: each plant point's mean
+// tracking RMSE over the seeds of its cell at the recommended dT, averaged over the other axes'
+// values at each value of this one; one series per estimator and lambda. With a failure axis
+// (docs/sweep.md) it shows what a failure rate costs in tracking.
+plot::Figure TrackingFigure(const ReportInput& in, const std::vector<Recommendation>& recs) {
+  plot::Figure fig;
+  fig.title = in.title + ": tracking RMSE at the recommended dT against each plant axis";
+  if (recs.empty()) return fig;
+  auto rmse_at = [&](const Recommendation& r) {
+    for (const auto& c : in.cells) {
+      if (c.plant == r.plant && c.estimator == r.estimator && c.lambda == r.lambda &&
+          c.dT == r.dT) {
+        return c.Mean(&sim::RunMetrics::tracking_rmse);
+      }
+    }
+    return std::nan("");
+  };
+  std::vector<std::pair<std::string, double>> groups;
+  for (const auto& r : recs) {
+    auto g = std::make_pair(r.estimator, r.lambda);
+    if (std::find(groups.begin(), groups.end(), g) == groups.end()) groups.push_back(g);
+  }
+  const size_t naxes = recs.front().plant_values.size();
+  for (size_t k = 0; k < naxes; ++k) {
+    plot::Axes ax;
+    ax.x_label = recs.front().plant_values[k].first;
+    ax.y_label = "tracking RMSE at dT" + (in.unit.empty() ? "" : " (" + in.unit + ")");
+    for (size_t gi = 0; gi < groups.size(); ++gi) {
+      std::map<double, std::pair<double, int>> acc;  // axis value -> (sum RMSE, count)
+      for (const auto& r : recs) {
+        const double e = rmse_at(r);
+        if (std::make_pair(r.estimator, r.lambda) != groups[gi] || !r.found || !std::isfinite(e))
+          continue;
+        auto& a = acc[r.plant_values[k].second];
+        a.first += e;
+        ++a.second;
+      }
+      plot::Series s;
+      s.label = fmt::format("{}, lambda {:g}", groups[gi].first, groups[gi].second);
+      s.color = Palette(gi);
+      for (const auto& [x, a] : acc) {
+        s.x.push_back(x);
+        s.y.push_back(a.first / a.second);
+      }
+      if (!s.x.empty()) ax.series.push_back(s);
+    }
+    fig.panels.push_back(ax);
+  }
+  return fig;
+}
+
 std::string Fmt(double x, const char* spec) {
   return std::isfinite(x) ? fmt::format(fmt::runtime(spec), x) : std::string("-");
 }
@@ -329,7 +380,10 @@ std::string ReportMarkdown(const ReportInput& in, const std::vector<Recommendati
   md += in.seed_reasons;
   if (with_figures) {
     md += "\n## Figures\n\n![criterion margin against dT](margin.png)\n";
-    if (!axes.empty()) md += "\n![critical dT against each plant axis](critical_dt.png)\n";
+    if (!axes.empty()) {
+      md += "\n![critical dT against each plant axis](critical_dt.png)\n";
+      md += "\n![tracking RMSE at the recommended dT against each plant axis](tracking.png)\n";
+    }
     if (with_stability_map) {
       md +=
           "\n![stability map: mean step overshoot per dT and lambda, ring = meets the "
@@ -341,7 +395,8 @@ std::string ReportMarkdown(const ReportInput& in, const std::vector<Recommendati
           "ringed cell is the recommended dT; a cell with no ring whose overshoot is within the "
           "limit fails the settling part of the criterion.\n";
     }
-    md += "\nSVG versions: margin.svg" + std::string(axes.empty() ? "" : ", critical_dt.svg") +
+    md += "\nSVG versions: margin.svg" +
+          std::string(axes.empty() ? "" : ", critical_dt.svg, tracking.svg") +
           ". Full per-cell table: table.md, table.csv.\n";
   }
   return md;
@@ -357,6 +412,7 @@ Status WriteReport(const ReportInput& in, const std::string& out_dir,
   std::vector<std::pair<std::string, plot::Figure>> figs = {{"margin", MarginFigure(in, c)}};
   if (!recs.empty() && !recs.front().plant_values.empty()) {
     figs.emplace_back("critical_dt", CriticalFigure(in.title, recs));
+    figs.emplace_back("tracking", TrackingFigure(in, recs));
   }
   for (const auto& [name, fig] : figs) {
     const int h = 120 + 260 * static_cast<int>(std::max<size_t>(1, fig.panels.size()));

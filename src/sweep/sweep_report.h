@@ -2,7 +2,8 @@
 // same, self-contained: figures embedded as PNG data), with the figures as PNG and SVG drawn by
 // src/plot: margin.{png,svg} (criterion margin against dT per plant point, one panel per
 // estimator, with the output-only loop's latency bound dT = lambda tau / c as dotted lines) and
-// critical_dt.{png,svg} (the critical dT against each plant axis). Every file
+// critical_dt.{png,svg} (the critical dT against each plant axis) and tracking.{png,svg} (the
+// tracking RMSE at the recommended dT against each plant axis). Every file
 // depends only on the runs' results, so a merged sharded sweep writes the same bytes.
 #pragma once
 
@@ -31,6 +32,8 @@ struct ReportInput {
   // Markdown appended to the report's tables (before the figures): the seeds' reasons per cell
   // (sweep/tune.h SeedReasonsMarkdown).
   std::string seed_reasons;
+  // The tracked quantity's unit ("N", "rad"; "" = not said), for the tracking figure's axis.
+  std::string unit;
 };
 
 // The Markdown text (figure links relative to the report); figures are listed only if made,

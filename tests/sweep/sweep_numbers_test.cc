@@ -195,7 +195,7 @@ TEST(SweepReportLinks, ReportLinksAndEmbedsTheStabilityMap) {
   const fs::path dir = FreshDir("map");
   ASSERT_TRUE(WriteTables(cells, TrackingCriterion{}, dir.string(), "numbers").ok());
   ASSERT_TRUE(plot::RunPlot(sweep::StabilityMapOptions(dir.string(), "numbers", 1)).ok());
-  const sweep::ReportInput in{"numbers", "a test", TrackingCriterion{}, cells, {}, {}};
+  const sweep::ReportInput in{"numbers", "a test", TrackingCriterion{}, cells, {}, {}, {}};
   ASSERT_TRUE(sweep::WriteReport(in, dir.string(), plot::RenderFigure).ok());
   const std::string md = *ReadFile((dir / "report.md").string());
   EXPECT_NE(md.find("](stability.png)"), std::string::npos) << md;
@@ -211,14 +211,14 @@ TEST(SweepReportLinks, ReportLinksAndEmbedsTheStabilityMap) {
 // the folder is not linked either.
 TEST(SweepReportLinks, NoStabilityMapNoLink) {
   const fs::path dir = FreshDir("nomap");
-  const sweep::ReportInput bare{"numbers", "a test", TrackingCriterion{}, TwoCells({}), {}, {}};
+  const sweep::ReportInput bare{"numbers", "a test", TrackingCriterion{}, TwoCells({}), {}, {}, {}};
   ASSERT_TRUE(sweep::WriteReport(bare, dir.string(), plot::RenderFigure).ok());
   EXPECT_EQ(ReadFile((dir / "report.md").string())->find("stability.png"), std::string::npos);
 
   const fs::path axes = FreshDir("axes");
   ASSERT_TRUE(WriteFileAtomically((axes / "stability.png").string(), "stale").ok());
   const sweep::ReportInput in{
-      "numbers", "a test", TrackingCriterion{}, TwoCells({{"current", 0.29}}), {}, {}};
+      "numbers", "a test", TrackingCriterion{}, TwoCells({{"current", 0.29}}), {}, {}, {}};
   ASSERT_TRUE(sweep::WriteReport(in, axes.string(), plot::RenderFigure).ok());
   const std::string md = *ReadFile((axes / "report.md").string());
   EXPECT_EQ(md.find("stability.png"), std::string::npos);

@@ -653,7 +653,7 @@ TEST(SweepSensitivity, SyntheticPlantGivesItsClosedFormElasticities) {
   EXPECT_NEAR(sens[1].slope, kBeta, 1e-9);
 
   // The report: the table names every plant point, the HTML embeds its figures.
-  sweep::ReportInput in{"synthetic", "a test", crit, cells, {}, {}};
+  sweep::ReportInput in{"synthetic", "a test", crit, cells, {}, {}, {}};
   ASSERT_TRUE(sweep::WriteReport(in, dir.string(), plot::RenderFigure).ok());
   const std::string md = *ReadFile((dir / "report.md").string());
   EXPECT_NE(md.find("| output | 0.2 | a | +0.500 (d ln dT*/d ln x)"), std::string::npos) << md;
