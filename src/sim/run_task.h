@@ -107,6 +107,15 @@ struct RunSummary {
   nlohmann::json loop_designs;           // self-tuned angle tasks: each design made (JSON)
 
   nlohmann::json ToJson() const;
+  // True if a bundle's hottest unit or most stressed wire passed its wire's datasheet limit.
+  bool PastDatasheetLimits() const {
+    for (const BundleSummary& b : bundles) {
+      if (b.peak_temperature > b.max_temperature || b.peak_wire_stress > b.max_wire_stress) {
+        return true;
+      }
+    }
+    return false;
+  }
 };
 
 // The effective settings after applying `options` to the task's defaults.

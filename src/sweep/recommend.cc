@@ -43,6 +43,8 @@ std::vector<Recommendation> Recommend(const std::vector<sweep::CellStats>& cells
       if (i == 0) {
         r.critical_dT = c.dT;
         r.censored = true;
+      } else if (col[i - 1]->margin >= 0) {
+        r.critical_dT = c.dT;  // the shorter dT failed on its wires' limits, not the criterion
       } else {
         const sweep::CellStats& p = *col[i - 1];
         const double f = (0 - p.margin) / (c.margin - p.margin);  // p.margin < 0 <= c.margin

@@ -247,6 +247,24 @@ plot::Figure CriticalFigure(const std::string& title, const std::vector<Recommen
 // tracking RMSE over the seeds of its cell at the recommended dT, averaged over the other axes'
 // values at each value of this one; one series per estimator and lambda. With a failure axis
 // (docs/sweep.md) it shows what a failure rate costs in tracking.
+// The cells a run of which passed a datasheet limit (never recommended), or "".
+std::string PastLimitsText(const std::vector<CellStats>& cells) {
+  std::string list;
+  int n = 0;
+  for (const auto& c : cells) {
+    if (c.runs_past_limits == 0) continue;
+    if (++n <= 12) {
+      list += fmt::format("{}plant {} {} lambda {} dT {} ({}/{} runs)", n > 1 ? "; " : "", c.plant,
+                          c.estimator, c.lambda, c.dT, c.runs_past_limits, c.seeds);
+    }
+  }
+  if (n == 0) return "";
+  return fmt::format(
+      "\n{} cell{} had runs past a datasheet limit of their wires and {} never recommended, "
+      "whatever their tracking: {}{}.\n",
+      n, n > 1 ? "s" : "", n > 1 ? "are" : "is", list, n > 12 ? "; ..." : "");
+}
+
 plot::Figure TrackingFigure(const ReportInput& in, const std::vector<Recommendation>& recs) {
   plot::Figure fig;
   fig.title = in.title + ": tracking RMSE at the recommended dT against each plant axis";
@@ -307,7 +325,8 @@ std::string ReportMarkdown(const ReportInput& in, const std::vector<Recommendati
   const bool bound = !in.latency.empty();
   std::string md = fmt::format(
       "# Sampling-period report: {}\n\n{}\n\nCriterion: mean step overshoot <= {:.0f} % and at "
-      "least {:.0f} % of steps settled within the band, over all seeds of a cell. Margin = "
+      "least {:.0f} % of steps settled within the band, over all seeds of a cell, and no run of "
+      "the cell past a datasheet limit of its wires (temperature, stress). Margin = "
       "min(overshoot limit - overshoot, settled fraction - required fraction). Recommended dT = "
       "the shortest dT tried that meets the criterion (`recruit tune` finds the window and a dT "
       "with room to both edges); se = the standard error of the seeds' own margins; seeds "
@@ -357,6 +376,7 @@ std::string ReportMarkdown(const ReportInput& in, const std::vector<Recommendati
     }
     md += row + "\n";
   }
+  md += PastLimitsText(in.cells);
   if (!sens.empty()) {
     md +=
         "\n## Sensitivities: which plant parameter moves the critical dT most\n\n"

@@ -75,7 +75,9 @@ std::vector<CellStats> Aggregate(const std::vector<SweepRun>& grid,
     std::vector<double> margins;
     for (const RunSummary* r : g) {
       margins.push_back(Margin(criterion, r->metrics.overshoot, r->metrics.settled_fraction));
-      if (margins.back() >= 0) ++c.seeds_meeting;
+      const bool past = r->PastDatasheetLimits();
+      c.runs_past_limits += past;
+      if (margins.back() >= 0 && !past) ++c.seeds_meeting;
     }
     for (size_t k = 0; k < kMetricCount; ++k) {
       const MetricField& f = kMetricFields[k];
@@ -89,7 +91,7 @@ std::vector<CellStats> Aggregate(const std::vector<SweepRun>& grid,
     }
     c.margin =
         Margin(criterion, c.Mean(&RunMetrics::overshoot), c.Mean(&RunMetrics::settled_fraction));
-    c.meets = c.margin >= 0;
+    c.meets = c.margin >= 0 && c.runs_past_limits == 0;
     c.margin_se = Sd(margins) / std::sqrt(static_cast<double>(margins.size()));
     cells.push_back(c);
   }

@@ -32,8 +32,11 @@ struct CellStats {
   std::array<double, sim::kMetricCount> mean{}, sd{};
   double Mean(double sim::RunMetrics::*field) const { return mean.at(sim::MetricIndex(field)); }
   double Sd(double sim::RunMetrics::*field) const { return sd.at(sim::MetricIndex(field)); }
+  // The criterion on the means (margin >= 0), and no run past a datasheet limit: a design that
+  // breaks its own wires' limits is never recommended.
   bool meets = false;
-  double margin = 0;  // min(max_overshoot - overshoot, settled - min_settled); >= 0 iff meets
+  double margin = 0;         // min(max_overshoot - overshoot, settled - min_settled)
+  int runs_past_limits = 0;  // runs in which a wire passed its datasheet limits
   // Over seeds: each seed's own margin (same formula on its run alone), how many meet, and the
   // standard error of their mean (the spread the confidence in the report comes from).
   int seeds_meeting = 0;

@@ -97,10 +97,7 @@ SeedCheck CheckSeed(const sim::RunSummary& run, const TuneCriterion& c) {
   s.overshoot = m.overshoot > c.tracking.max_overshoot;
   s.settling = m.settled_fraction < c.tracking.min_settled;
   s.worst_step = m.max_overshoot > c.max_step_overshoot;
-  for (const auto& b : run.bundles) {
-    s.limits = s.limits || b.peak_temperature > b.max_temperature ||
-               b.peak_wire_stress > b.max_wire_stress;
-  }
+  s.limits = run.PastDatasheetLimits();
   return s;
 }
 

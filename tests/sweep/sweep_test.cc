@@ -215,6 +215,52 @@ TEST(Sweep, ShortestDtIsTheShortestThatMeetsTheCriterion) {
   fs::remove_all(dir);
 }
 
+// A cell whose runs track well but heat a wire past its datasheet limit does not meet: the
+// recommendation is the shortest dT whose runs stay within the limits, and the report says why.
+TEST(Sweep, ADesignPastItsDatasheetLimitsIsNeverRecommended) {
+  std::vector<sim::RunSummary> runs;
+  for (double dT : {0.5, 1.0, 2.0}) {
+    for (int seed = 0; seed < 2; ++seed) {
+      sim::RunSummary r;
+      r.estimator = "output";
+      r.dT = dT;
+      r.lambda = 0.2;
+      r.seed = seed;
+      r.metrics.overshoot = 0.01;  // every cell tracks within the criterion
+      r.metrics.settled_fraction = 1;
+      sim::BundleSummary b;
+      b.max_temperature = 120;
+      b.max_wire_stress = 172e6;
+      b.peak_temperature = dT < 1 && seed == 1 ? 121 : 110;  // one run of dT 0.5 too hot
+      b.peak_wire_stress = 100e6;
+      r.bundles = {b};
+      runs.push_back(r);
+    }
+  }
+  const TrackingCriterion crit;
+  const auto cells = Aggregate(runs, crit);
+  ASSERT_EQ(cells.size(), 3u);
+  EXPECT_FALSE(cells[0].meets);
+  EXPECT_EQ(cells[0].runs_past_limits, 1);
+  EXPECT_EQ(cells[0].seeds_meeting, 1);
+  EXPECT_GE(cells[0].margin, 0);
+  EXPECT_TRUE(cells[1].meets);
+  const auto recs = sweep::Recommend(cells);
+  ASSERT_EQ(recs.size(), 1u);
+  ASSERT_TRUE(recs[0].found);
+  EXPECT_EQ(recs[0].dT, 1.0);
+  EXPECT_FALSE(recs[0].censored);
+  EXPECT_EQ(recs[0].critical_dT, 1.0);
+  const auto dir = TempDir("limits");
+  fs::create_directories(dir);
+  sweep::ReportInput in{"limits", "a test", crit, cells, {}, {}, {}};
+  ASSERT_TRUE(sweep::WriteReport(in, dir.string(), plot::RenderFigure).ok());
+  const std::string md = *ReadFile((dir / "report.md").string());
+  EXPECT_NE(md.find("1 cell had runs past a datasheet limit"), std::string::npos) << md;
+  EXPECT_NE(md.find("dT 0.5 (1/2 runs)"), std::string::npos) << md;
+  fs::remove_all(dir);
+}
+
 TEST(Sweep, ARecordMadeFromOtherInputsIsNotReused) {
   // Same grid points and seeds, but the inputs changed (an edited task file): the input hash
   // differs, so every run is made again; unchanged inputs reuse every run.
