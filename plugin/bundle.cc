@@ -480,7 +480,7 @@ SmaBundle::Summary SmaBundle::Summarize(const double* s, double stretch) const {
   const int k = NumCohorts(s);
   const double* v[3] = {Field(s, kOn), Field(s, kTemp), Field(s, kXi)};
   double sum[4];
-  unit_.Observe(Field(s, kCount), v, k, stretch, false, sum);
+  unit_.SumTelemetry(Field(s, kCount), v, k, stretch, false, sum);
   if (fatigue_) sum[3] = unit_.SumTension(TensionWeights(s), Field(s, kXi), k, stretch);
   return FromSums(sum, k);
 }
@@ -494,11 +494,11 @@ SmaBundle::Summary SmaBundle::FromSums(const double* sum, int k) const {
   return r;
 }
 
-SmaBundle::Telemetry SmaBundle::Observe(const double* s, double stretch) const {
+SmaBundle::Telemetry SmaBundle::ReadTelemetry(const double* s, double stretch) const {
   const int k = NumCohorts(s);
   const double* v[3] = {Field(s, kOn), Field(s, kTemp), Field(s, kXi)};
   double sum[5];
-  unit_.Observe(Field(s, kCount), v, k, stretch, true, sum);
+  unit_.SumTelemetry(Field(s, kCount), v, k, stretch, true, sum);
   // With fatigue the peak stays that of a fresh wire at the cohort's xi (an upper bound).
   if (fatigue_) sum[3] = unit_.SumTension(TensionWeights(s), Field(s, kXi), k, stretch);
   Telemetry r;
@@ -551,11 +551,11 @@ double SmaBundle::MaxTemperature(const double* s) const {
 }
 
 double SmaBundle::MaxWireStress(const double* s, double stretch) const {
-  // The largest tension from Observe's SIMD pass (exactly the scalar maximum of
+  // The largest tension from SumTelemetry's SIMD pass (exactly the scalar maximum of
   // UnitModel::Tension: tensions are never NaN); its sums are a few loads more.
   const double* v[3] = {Field(s, kOn), Field(s, kTemp), Field(s, kXi)};
   double out[5];
-  unit_.Observe(Field(s, kCount), v, NumCohorts(s), stretch, true, out);
+  unit_.SumTelemetry(Field(s, kCount), v, NumCohorts(s), stretch, true, out);
   return unit_.WireStress(out[4]);
 }
 

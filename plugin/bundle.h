@@ -81,7 +81,7 @@ class SmaBundle {
   struct Telemetry : Summary {
     double max_temperature, max_wire_stress;
   };
-  Telemetry Observe(const double* s, double stretch) const;
+  Telemetry ReadTelemetry(const double* s, double stretch) const;
 
   // The plugin's sensor and actuator force in one mj_forward (the sensor runs first, at the
   // position stage): SummarizeAndKeep is Summarize and also keeps the tension with its extension
@@ -115,7 +115,7 @@ class SmaBundle {
   double SettledOnTension(double stretch) const;
 
  private:
-  // Summary from the sums of UnitModel::Observe (on, temperature, xi, tension) over k cohorts.
+  // Summary from the sums of UnitModel::SumTelemetry (on, temperature, xi, tension) over k cohorts.
   Summary FromSums(const double* sum, int k) const;
   // Header: magic, the random stream's 4 words as 8 exact 32-bit halves (low, high), cohort
   // count, update counter, pending time (s), the kept tension (flag 1 when kept, extension (m),

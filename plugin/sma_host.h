@@ -72,8 +72,8 @@ class SmaHost {
   // OnCount, Force, MeanTemperature, MeanXi, and the peak-relevant MaxTemperature and
   // MaxWireStress (SmaBundle) of bundle b in one pass, each bit for bit the same value: for run
   // loops that read several of them after every step.
-  SmaBundle::Telemetry Observe(const mjData* d, int b) const {
-    return bundle(b).Observe(State(d, b), Stretch(d, b));
+  SmaBundle::Telemetry ReadTelemetry(const mjData* d, int b) const {
+    return bundle(b).ReadTelemetry(State(d, b), Stretch(d, b));
   }
   double MeanTemperature(const mjData* d, int b) const {
     return bundle(b).MeanTemperature(State(d, b));

@@ -654,7 +654,7 @@ namespace {
 // the comparisons cannot change the result.
 inline Vd MaxOf(Vd a, Vd b) { return Sel(Gt(a, b), a, b); }
 
-// Observe with or without the largest tension (the sensor needs only the sums).
+// SumTelemetry with or without the largest tension (the sensor needs only the sums).
 template <bool kPeak>
 void ObservePass(const BatchParams& p, const double* count, const double* const* v, int n,
                  double stretch, double* out) {
@@ -748,8 +748,8 @@ void WeightedSums(const double* count, const double* const* v, int nf, int n, do
   for (int f = 0; f < nf; ++f) Sums<1>(count, v + f, n, out + f);
 }
 
-void Observe(const BatchParams& p, const double* count, const double* const* v, int n,
-             double stretch, bool peak, double* out) {
+void SumTelemetry(const BatchParams& p, const double* count, const double* const* v, int n,
+                  double stretch, bool peak, double* out) {
   if (peak) return ObservePass<true>(p, count, v, n, stretch, out);
   ObservePass<false>(p, count, v, n, stretch, out);
 }

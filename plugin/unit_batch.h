@@ -24,7 +24,7 @@ struct BatchCohorts {
 
 // Kernels: AdvanceCohorts and SumTension as UnitModel's; WeightedSums sets out[f] to the sum
 // over j < n of count[j] * v[f][j] for f < nf <= 3, in four partial sums (lane j mod 4) added as
-// (s0 + s1) + (s2 + s3): the same in both clones, exact for one cohort. Observe is
+// (s0 + s1) + (s2 + s3): the same in both clones, exact for one cohort. SumTelemetry is
 // WeightedSums of v[0..2] and SumTension of xi = v[2] in one pass, bit for bit, out[0..3]; with
 // `peak` also out[4] = the largest Tension(xi[j], stretch), 0 for none.
 namespace batch_base {
@@ -33,8 +33,8 @@ void AdvanceCohorts(const BatchParams& p, const BatchCohorts& c, int n, double s
 double SumTension(const BatchParams& p, const double* count, const double* xi, int n,
                   double stretch);
 void WeightedSums(const double* count, const double* const* v, int nf, int n, double* out);
-void Observe(const BatchParams& p, const double* count, const double* const* v, int n,
-             double stretch, bool peak, double* out);
+void SumTelemetry(const BatchParams& p, const double* count, const double* const* v, int n,
+                  double stretch, bool peak, double* out);
 // idx[i] = remap[idx[i]] for i < n (indices held as doubles).
 void Relabel(double* idx, int n, const int* remap);
 // UnitModel::MergeOrder; t and idx: 2 (n + 8) of scratch each.
@@ -48,8 +48,8 @@ void AdvanceCohorts(const BatchParams& p, const BatchCohorts& c, int n, double s
 double SumTension(const BatchParams& p, const double* count, const double* xi, int n,
                   double stretch);
 void WeightedSums(const double* count, const double* const* v, int nf, int n, double* out);
-void Observe(const BatchParams& p, const double* count, const double* const* v, int n,
-             double stretch, bool peak, double* out);
+void SumTelemetry(const BatchParams& p, const double* count, const double* const* v, int n,
+                  double stretch, bool peak, double* out);
 void Relabel(double* idx, int n, const int* remap);
 bool MergeOrder(const double* on, const double* temp, int n, int* order, double* t, int* idx);
 }  // namespace batch_avx2

@@ -456,8 +456,8 @@ void UnitModel::WeightedSums(const double* count, const double* const* v, int nf
   batch_base::WeightedSums(count, v, nf, n, out);
 }
 
-void UnitModel::Observe(const double* count, const double* const* v, int n, double stretch,
-                        bool peak, double* out, Isa isa) const {
+void UnitModel::SumTelemetry(const double* count, const double* const* v, int n, double stretch,
+                             bool peak, double* out, Isa isa) const {
   if (n < 4 && isa == Isa::kAuto) {  // WeightedSums' and SumTension's paths for few cohorts
     double a[4][4] = {}, top = 0;
     for (int j = 0; j < n; ++j) {
@@ -472,9 +472,9 @@ void UnitModel::Observe(const double* count, const double* const* v, int n, doub
   }
   const BatchParams& bp = batch_;
 #ifdef RECRUIT_SMA_AVX2_CLONE
-  if (UseAvx2(isa)) return batch_avx2::Observe(bp, count, v, n, stretch, peak, out);
+  if (UseAvx2(isa)) return batch_avx2::SumTelemetry(bp, count, v, n, stretch, peak, out);
 #endif
-  batch_base::Observe(bp, count, v, n, stretch, peak, out);
+  batch_base::SumTelemetry(bp, count, v, n, stretch, peak, out);
 }
 
 bool UnitModel::MergeOrder(const double* on, const double* temp, int n, int* order, double* t,

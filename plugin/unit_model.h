@@ -151,8 +151,8 @@ class UnitModel {
   // WeightedSums of v[0..2] (on, temperature, xi) and SumTension of xi = v[2] in one pass, each
   // bit for bit the value those give, in out[0..3]; with `peak` also out[4] = the largest
   // Tension(xi[j], stretch) over the cohorts (0 for none).
-  void Observe(const double* count, const double* const* v, int n, double stretch, bool peak,
-               double* out, Isa isa = Isa::kAuto) const;
+  void SumTelemetry(const double* count, const double* const* v, int n, double stretch, bool peak,
+                    double* out, Isa isa = Isa::kAuto) const;
   // The cohorts' order by (on, temperature) for the merge pass, without branches on the data:
   // when no two keys tie (and on is 0 or 1, no temperature NaN) that order is unique, so it is
   // std::sort's; order[p] = the cohort at position p. False (order unspecified) otherwise: the

@@ -1,5 +1,6 @@
-// Cost of one control instant (Observe + law + Broadcasted) per estimator, and of the mean
-// propagation the identification repeats. Run from the source tree (the identified model files).
+// Cost of one control instant (UpdateWithMeasurement + law + Broadcasted) per estimator, and of the
+// mean propagation the identification repeats. Run from the source tree (the identified model
+// files).
 #include <benchmark/benchmark.h>
 
 #include <string>

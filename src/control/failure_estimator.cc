@@ -79,7 +79,7 @@ std::optional<FailureEstimate> FailureOnCountEstimator::Failures() const {
   return f;
 }
 
-void FailureOnCountEstimator::Observe(double measured_force, double tendon_length) {
+void FailureOnCountEstimator::UpdateWithMeasurement(double measured_force, double tendon_length) {
   if (!std::isfinite(measured_force)) return;  // a lost sample: predict only
   if (output_ || relative_noise_ > 0) {
     // As KalmanOnCountEstimator: H at the measured length, R growing with the predicted force.

@@ -21,8 +21,8 @@ class FailureOnCountEstimator final : public OnCountEstimator {
       std::optional<UnitForceMap> output = std::nullopt, double relative_noise = 0);
 
   void Reset() override { filter_.Reset(); }
-  using OnCountEstimator::Observe;
-  void Observe(double measured_force, double tendon_length) override;
+  using OnCountEstimator::UpdateWithMeasurement;
+  void UpdateWithMeasurement(double measured_force, double tendon_length) override;
   void Broadcasted(const Broadcast& b) override { filter_.PredictBroadcast(b.p_on, b.p_off); }
   double EstimatedOn() const override;
   double EstimatedOnVariance() const override;

@@ -64,7 +64,7 @@ double KalmanOnCountEstimator::EstimatedOnVariance() const {
 
 void KalmanOnCountEstimator::Reset() { filter_.Reset(model_.x0, model_.P0); }
 
-void KalmanOnCountEstimator::Observe(double measured_force, double tendon_length) {
+void KalmanOnCountEstimator::UpdateWithMeasurement(double measured_force, double tendon_length) {
   if (!std::isfinite(measured_force)) return;  // a lost sample: predict only
   if (output_ || relative_noise_ > 0) {
     if (output_ && std::isfinite(tendon_length)) {

@@ -31,8 +31,8 @@ class KalmanOnCountEstimator final : public OnCountEstimator {
       std::optional<UnitForceMap> output = std::nullopt, double relative_noise = 0);
 
   void Reset() override;
-  using OnCountEstimator::Observe;
-  void Observe(double measured_force, double tendon_length) override;
+  using OnCountEstimator::UpdateWithMeasurement;
+  void UpdateWithMeasurement(double measured_force, double tendon_length) override;
   void Broadcasted(const Broadcast& b) override;
   double EstimatedOn() const override { return on_mask_.dot(filter_.estimate()); }
   double EstimatedOnVariance() const override;

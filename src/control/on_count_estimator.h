@@ -2,7 +2,8 @@
 //
 // One estimator per bundle, called once per sampling period dT, in this order at each control
 // instant k:
-//   Observe(y_k, L_k)  update with the force and the tendon length sampled at instant k (before
+//   UpdateWithMeasurement(y_k, L_k)  update with the force and the tendon length sampled at instant
+//   k (before
 //                      broadcasting); L_k NaN = not measured (the model's reference length)
 //   EstimatedOn()      the a-posteriori on-count at instant k, which the law uses
 //   Broadcasted(b_k)   the broadcast just sent: predict to instant k + 1
@@ -37,7 +38,7 @@ struct FailureEstimate {
   double working = 0, open = 0, stuck = 0;  // units (estimates; they add to N)
   double working_variance = 0;              // units^2
   int declarations = 0;                     // failures declared since Reset
-  bool declared = false;                    // the last Observe declared one
+  bool declared = false;                    // the last UpdateWithMeasurement declared one
   double force_scale = 1;                   // working units' fatigue force scale
 };
 
@@ -49,9 +50,9 @@ class OnCountEstimator {
   // The force (N) and the tendon length (m, from the joint encoder; NaN when not measured)
   // sampled at this control instant. A length-aware estimator (built with a UnitGeometry) takes
   // each state's unit force at that length; without one, at the model's reference length.
-  virtual void Observe(double measured_force, double tendon_length) = 0;
-  void Observe(double measured_force) {
-    Observe(measured_force, std::numeric_limits<double>::quiet_NaN());
+  virtual void UpdateWithMeasurement(double measured_force, double tendon_length) = 0;
+  void UpdateWithMeasurement(double measured_force) {
+    UpdateWithMeasurement(measured_force, std::numeric_limits<double>::quiet_NaN());
   }
   // The broadcast just sent at this instant: predict to the next instant (dT later).
   virtual void Broadcasted(const Broadcast& b) = 0;

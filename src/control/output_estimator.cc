@@ -12,7 +12,7 @@ OutputOnlyEstimator::OutputOnlyEstimator(int num_units, double unit_force,
 
 void OutputOnlyEstimator::Reset() { on_ = 0; }
 
-void OutputOnlyEstimator::Observe(double measured_force, double tendon_length) {
+void OutputOnlyEstimator::UpdateWithMeasurement(double measured_force, double tendon_length) {
   // Clamped to the feasible counts; a NaN force keeps the last count.
   if (measured_force != measured_force) return;
   double unit = unit_force_;

@@ -15,8 +15,8 @@ class OutputOnlyEstimator final : public OnCountEstimator {
   OutputOnlyEstimator(int num_units, double unit_force,
                       std::optional<UnitForceMap> on_force = std::nullopt);
   void Reset() override;
-  using OnCountEstimator::Observe;
-  void Observe(double measured_force, double tendon_length) override;
+  using OnCountEstimator::UpdateWithMeasurement;
+  void UpdateWithMeasurement(double measured_force, double tendon_length) override;
   void Broadcasted(const Broadcast& b) override {}
   double EstimatedOn() const override { return on_; }
   double EstimatedOnVariance() const override;

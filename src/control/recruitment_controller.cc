@@ -64,7 +64,7 @@ double RecruitmentController::OnUnitForce(double tendon_length) const {
 
 Broadcast RecruitmentController::Step(double reference_force, double measured_force,
                                       double tendon_length) {
-  estimator_->Observe(measured_force, tendon_length);
+  estimator_->UpdateWithMeasurement(measured_force, tendon_length);
   unit_force_ = OnUnitForce(tendon_length);
   // Where no on unit can pull (a slack tendon) no count reaches the reference: ask for all.
   target_on_ = unit_force_ > 0 ? reference_force / unit_force_

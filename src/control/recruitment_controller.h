@@ -39,8 +39,8 @@ class RecruitmentController {
   // Back to the initial belief (all units off).
   void Reset();
 
-  // One control instant: estimator.Observe(measured, length), target = reference / (unit force
-  // at that length), b = ExpectationLaw(target, estimated on, N, lambda),
+  // One control instant: estimator.UpdateWithMeasurement(measured, length), target = reference /
+  // (unit force at that length), b = ExpectationLaw(target, estimated on, N, lambda),
   // estimator.Broadcasted(b). tendon_length NaN: not measured (the force at ref_length).
   Broadcast Step(double reference_force, double measured_force,
                  double tendon_length = std::numeric_limits<double>::quiet_NaN());

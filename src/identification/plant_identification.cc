@@ -128,7 +128,7 @@ double NegLogLikelihood(const FilterModel& model, const control::UnitForceMap& m
           h * e.filter().covariance() * h.transpose() + r0 + rho * rho * predicted * predicted;
       const double innovation = log.force[k] - predicted;
       total += std::log(s) + innovation * innovation / s;
-      e.Observe(log.force[k], rec.lengths[k]);
+      e.UpdateWithMeasurement(log.force[k], rec.lengths[k]);
       e.Broadcasted({log.p_on[k], log.p_off[k]});
     }
   }

@@ -483,7 +483,7 @@ void Plant::Step() {
 }
 
 const sma::SmaBundle::Telemetry& Plant::ReadBundleTelemetry(int i) const {
-  telemetry_[i] = host_->Observe(data_.get(), bundles_[i]);
+  telemetry_[i] = host_->ReadTelemetry(data_.get(), bundles_[i]);
   telemetry_valid_[i] = true;
   return telemetry_[i];
 }

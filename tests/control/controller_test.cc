@@ -13,14 +13,14 @@ namespace {
 
 TEST(OutputOnlyEstimator, CountIsForceOverUnitForceClampedToFeasible) {
   OutputOnlyEstimator e(60, 0.5);
-  e.Observe(10.0);
+  e.UpdateWithMeasurement(10.0);
   EXPECT_DOUBLE_EQ(e.EstimatedOn(), 20.0);
   EXPECT_TRUE(std::isnan(e.EstimatedOnVariance()));
   EXPECT_DOUBLE_EQ(e.StateEstimate()(0), 40.0);
   EXPECT_DOUBLE_EQ(e.StateEstimate()(1), 20.0);
-  e.Observe(-1.0);
+  e.UpdateWithMeasurement(-1.0);
   EXPECT_DOUBLE_EQ(e.EstimatedOn(), 0.0);
-  e.Observe(100.0);
+  e.UpdateWithMeasurement(100.0);
   EXPECT_DOUBLE_EQ(e.EstimatedOn(), 60.0);
 }
 

@@ -19,8 +19,8 @@ class FixedEstimator final : public OnCountEstimator {
  public:
   FixedEstimator(double on, FailureEstimate f) : on_(on), f_(f) {}
   void Reset() override {}
-  using OnCountEstimator::Observe;
-  void Observe(double, double) override {}
+  using OnCountEstimator::UpdateWithMeasurement;
+  void UpdateWithMeasurement(double, double) override {}
   void Broadcasted(const Broadcast&) override {}
   double EstimatedOn() const override { return on_; }
   double EstimatedOnVariance() const override { return 1; }

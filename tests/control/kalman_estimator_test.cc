@@ -36,7 +36,7 @@ TEST(KalmanTwoState, PredictionIsTheBinomialAndUpdateTheScalarKalmanGain) {
   // y = 10 N: gain on the on-count k = v f / (f^2 v + R), estimate 18 + k (10 - 0.5 * 18),
   // variance v - k f v.
   const double v = 12.6, R = sd * sd, k = v * f / (f * f * v + R);
-  est.Observe(10.0);
+  est.UpdateWithMeasurement(10.0);
   EXPECT_NEAR(est.EstimatedOn(), 18.0 + k * (10.0 - f * 18.0), 1e-9);
   EXPECT_NEAR(est.EstimatedOnVariance(), v - k * f * v, 1e-9);
   EXPECT_NEAR(est.StateEstimate().sum(), N, 1e-9);
@@ -89,7 +89,7 @@ TEST(KalmanAugmented, SparseBroadcastPredictionEqualsTheDenseFilter) {
     const double p_on = rng.Uniform() < 0.3 ? 0.0 : 0.5 * rng.Uniform();
     const double p_off = rng.Uniform() < 0.3 ? 0.0 : 0.5 * rng.Uniform();
     y[0] = 30.0 * rng.Uniform();
-    (*e)->Observe(y[0]);
+    (*e)->UpdateWithMeasurement(y[0]);
     dense->Update(y);
     (*e)->Broadcasted({p_on, p_off});
     model.broadcast.FillMatrix(p_on, p_off, A);
@@ -102,9 +102,9 @@ TEST(KalmanAugmented, SparseBroadcastPredictionEqualsTheDenseFilter) {
   }
 }
 
-// A control instant with the Kalman estimators (Observe: SetOutput with the length-dependent H,
-// the scalar update; the law; Broadcasted: the sparse PredictBroadcast) makes no heap
-// allocation once running, with and without the tendon geometry.
+// A control instant with the Kalman estimators (UpdateWithMeasurement: SetOutput with the
+// length-dependent H, the scalar update; the law; Broadcasted: the sparse PredictBroadcast) makes
+// no heap allocation once running, with and without the tendon geometry.
 TEST(KalmanAugmented, ControlStepsDoNotAllocate) {
 #ifndef RECRUIT_COUNTS_MALLOC
   GTEST_SKIP() << "malloc is not replaceable here (sanitizer or not glibc)";

@@ -129,7 +129,7 @@ std::vector<double> MeanNees(bool length_aware) {
     EXPECT_TRUE(est.ok());
     KalmanOnCountEstimator& e = **est;
     for (int k = 0; k <= at.back(); ++k) {
-      e.Observe(run.log.force[k], run.length[k]);
+      e.UpdateWithMeasurement(run.log.force[k], run.length[k]);
       for (size_t i = 0; i < at.size(); ++i) {
         if (k != at[i]) continue;
         const double err = e.EstimatedOn() - run.true_on[k];

@@ -398,7 +398,7 @@ TEST(SmaBundle, RandomSwitchingTraceUnchangedFromScalarImplementation) {
 
 bool SameBits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
-// Observe and Summarize (one pass) give what the separate reads give, bit for bit, along a
+// ReadTelemetry and Summarize (one pass) give what the separate reads give, bit for bit, along a
 // random-switching run with merges, at a taut and a slack extension.
 TEST(SmaBundle, ObserveAndSummarizeEqualTheSeparateReads) {
   const SmaBundle b = MakeBundle(60, 0.5, 0.01);
@@ -414,7 +414,7 @@ TEST(SmaBundle, ObserveAndSummarizeEqualTheSeparateReads) {
     if (i % 37 != 0) continue;
     for (double stretch : {e, 0.8 * e, -e}) {
       const double* st = s.data();
-      const SmaBundle::Telemetry t = b.Observe(st, stretch);
+      const SmaBundle::Telemetry t = b.ReadTelemetry(st, stretch);
       EXPECT_EQ(t.on_count, b.OnCount(st));
       EXPECT_TRUE(SameBits(t.tension, b.Tension(st, stretch))) << "step " << i;
       EXPECT_TRUE(SameBits(t.mean_temperature, b.MeanTemperature(st))) << "step " << i;

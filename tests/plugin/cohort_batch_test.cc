@@ -250,7 +250,7 @@ TEST(BatchedCohortSums, SumTensionMatchesScalarSum) {
   }
 }
 
-// Observe (the sensor's and the run loop's one pass) against the separate kernels it fuses:
+// SumTelemetry (the sensor's and the run loop's one pass) against the separate kernels it fuses:
 // WeightedSums of (on, T, xi) and SumTension bit for bit, and the largest tension against a
 // plain scalar maximum of UnitModel::Tension; every cohort count around the SIMD widths, slack
 // and taut extensions, each kernel.
@@ -277,7 +277,7 @@ TEST(BatchedCohortSums, ObserveEqualsTheSeparateSumsAndTheScalarMaximum) {
         const double tension = m.SumTension(count.data(), xi.data(), n, stretch, isa);
         for (bool peak : {false, true}) {
           double out[5] = {-1, -1, -1, -1, -1};
-          m.Observe(count.data(), v, n, stretch, peak, out, isa);
+          m.SumTelemetry(count.data(), v, n, stretch, peak, out, isa);
           const std::string where = "n " + std::to_string(n) + " stretch " +
                                     std::to_string(stretch) + " isa " +
                                     std::to_string(static_cast<int>(isa));

@@ -211,7 +211,7 @@ static void kalman_update(recruit_bundle *b, recruit_work *w, const recruit_real
   recenter(b->x, m, p->N, 0);
 }
 
-/* Observe (KalmanOnCountEstimator): H and R at the measured length, then the update. */
+/* UpdateWithMeasurement (KalmanOnCountEstimator): H and R at the measured length, then the update. */
 static void kalman_observe(recruit_bundle *b, recruit_work *w, recruit_real y,
                            recruit_real length) {
   const recruit_bundle_params *p = b->params;
