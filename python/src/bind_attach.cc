@@ -54,7 +54,8 @@ std::vector<std::string> NameList(const py::object& o, const std::string& what) 
 
 py::object Attach(const py::object& model, const py::object& muscles, const py::object& output,
                   const py::object& task, const py::object& report, bool size_only,
-                  const py::object& force, bool lengthrange_from_joints, const py::object& lock) {
+                  const py::object& force, bool lengthrange_from_joints, const py::object& lock,
+                  double max_time_constant, double stroke_use, int units_per_holding_force) {
   attach::AttachOptions o;
   o.model = PathArg(model);
   o.muscles = NameList(muscles, "muscles");
@@ -74,6 +75,22 @@ py::object Attach(const py::object& model, const py::object& muscles, const py::
            "' not allowed: must be a force in N (0 < force <= 1e7)");
     }
   }
+  // The CLI's checks of the sizing options (src/cli/attach_command.cc).
+  if (!(max_time_constant > 0 && max_time_constant <= 1e3)) {
+    Fail("max_time_constant: value " + std::to_string(max_time_constant) +
+         " not allowed: must be seconds (0 < s <= 1000)");
+  }
+  if (!(stroke_use >= 0.2 && stroke_use <= 0.95)) {
+    Fail("stroke_use: value " + std::to_string(stroke_use) +
+         " not allowed: must be a fraction in 0.2..0.95");
+  }
+  if (units_per_holding_force < 0 || units_per_holding_force > 1000) {
+    Fail("units_per_holding_force: value " + std::to_string(units_per_holding_force) +
+         " not allowed: must be in 0..1000");
+  }
+  o.limits.max_time_constant = max_time_constant;
+  o.limits.stroke_use = stroke_use;
+  o.limits.units_per_holding_force = units_per_holding_force;
   o.lengthrange_from_joints = lengthrange_from_joints;
   o.lock = NameList(lock, "lock");
   std::optional<Result<attach::AttachReport>> r;
@@ -92,6 +109,9 @@ void BindAttach(py::module_& mod) {
           py::arg("task") = py::none(), py::arg("report") = py::none(),
           py::arg("size_only") = false, py::arg("force") = py::none(),
           py::arg("lengthrange_from_joints") = false, py::arg("lock") = py::none(),
+          py::arg("max_time_constant") = attach::SizingLimits{}.max_time_constant,
+          py::arg("stroke_use") = attach::SizingLimits{}.stroke_use,
+          py::arg("units_per_holding_force") = attach::SizingLimits{}.units_per_holding_force,
           R"doc(Turns a MuJoCo model's muscles into sized recruit.sma bundles, as `recruit attach`.
 
 model: the input MJCF. muscles: actuator names (a list, or one comma-separated string) or
@@ -100,6 +120,8 @@ task: also write a starter task (JSON). report: also write the report (JSON). si
 only, write nothing but the report. force: peak force of every bundle (N) instead of each
 muscle's F0. lengthrange_from_joints: set the lengthrange of other muscles whose MuJoCo
 computation fails from the joint ranges. lock: joints the starter task does not drive.
+max_time_constant, stroke_use, units_per_holding_force: the sizing options of the same names
+(`recruit attach --help`, docs/sma-units.md "Sizing a bundle").
 
 Returns the report as a dict (what `--report` writes: model, output, task, changes, warnings,
 lengthranges_from_joints, bundles). Raises ValueError for bad input and OSError when a file

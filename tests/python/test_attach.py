@@ -117,6 +117,22 @@ def test_size_only_writes_nothing_and_designs_the_same(attached, tmp_path):
         assert b["config"] == full[b["name"]]["config"]
 
 
+def test_sizing_options_are_the_clis(tmp_path):
+    """stroke_use and units_per_holding_force design what the CLI's options of the same names
+    design: the same config keys, bundle by bundle."""
+    rep = tmp_path / "cli.json"
+    subprocess.run([os.environ["RECRUIT_CLI"], "attach", ARM, "--muscles", "all", "--size-only",
+                    "--stroke-use", "0.5", "--units-per-holding-force", "0", "--report", str(rep)],
+                   check=True, capture_output=True)
+    with open(rep) as f:
+        cli = json.load(f)
+    report = recruit.attach(ARM, "all", size_only=True, stroke_use=0.5,
+                            units_per_holding_force=0)
+    assert [b["config"] for b in report["bundles"]] == [b["config"] for b in cli["bundles"]]
+    default = recruit.attach(ARM, "all", size_only=True)
+    assert [b["config"] for b in report["bundles"]] != [b["config"] for b in default["bundles"]]
+
+
 def test_bad_input_raises_naming_the_muscle_and_writes_nothing(tmp_path):
     out, task, rep = tmp_path / "out.xml", tmp_path / "task.json", tmp_path / "r.json"
     with pytest.raises(ValueError, match="'biceps' does not exist"):
@@ -129,6 +145,10 @@ def test_bad_input_raises_naming_the_muscle_and_writes_nothing(tmp_path):
         recruit.attach(ARM, "all")
     with pytest.raises(ValueError, match="force"):
         recruit.attach(ARM, "all", output=out, force=-1.0)
+    with pytest.raises(ValueError, match="stroke_use"):
+        recruit.attach(ARM, "all", output=out, stroke_use=1.5)
+    with pytest.raises(ValueError, match="units_per_holding_force"):
+        recruit.attach(ARM, "all", output=out, units_per_holding_force=-1)
     with pytest.raises(OSError, match="cannot open model"):
         recruit.attach(tmp_path / "missing.xml", "all", output=out)
     assert os.listdir(tmp_path) == []
