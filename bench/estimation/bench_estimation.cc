@@ -48,8 +48,8 @@ double Gaussian(Rng& rng) {
 
 // A chain of m states: a birth-death-like random column-stochastic A with all entries > 0, a
 // force sensor H (state i gives 0.45 i / (m - 1) N per unit), N = 60 units.
-FilterModel ChainModel(int m, double noise_std = 0.6) {
-  FilterModel f;
+estimation::FilterModel ChainModel(int m, double noise_std = 0.6) {
+  estimation::FilterModel f;
   for (int i = 0; i < m; ++i) f.state_names.push_back("s" + std::to_string(i));
   f.N = 60;
   f.H.resize(1, m);
@@ -57,7 +57,7 @@ FilterModel ChainModel(int m, double noise_std = 0.6) {
   f.R = Eigen::MatrixXd::Constant(1, 1, noise_std * noise_std);
   f.G = Eigen::MatrixXd::Zero(m, 0);
   f.Qw = Eigen::MatrixXd::Zero(0, 0);
-  f.transition = TransitionSource::kExplicit;
+  f.transition = estimation::TransitionSource::kExplicit;
   f.x0 = Eigen::VectorXd::Zero(m);
   f.x0(0) = 60;
   f.P0 = Eigen::MatrixXd::Zero(m, m);
@@ -79,7 +79,8 @@ struct Sequence {
   std::vector<Eigen::VectorXd> y, x;
 };
 
-Sequence Simulate(const FilterModel& f, int steps, uint64_t seed, bool distinct_A = true) {
+Sequence Simulate(const estimation::FilterModel& f, int steps, uint64_t seed,
+                  bool distinct_A = true) {
   Rng rng(seed);
   Sequence s;
   Eigen::VectorXd x = f.x0;
@@ -88,7 +89,7 @@ Sequence Simulate(const FilterModel& f, int steps, uint64_t seed, bool distinct_
     s.x.push_back(x);
     s.y.push_back(f.H * x + Eigen::VectorXd::Constant(1, std::sqrt(f.R(0, 0)) * Gaussian(rng)));
     s.A.push_back(distinct_A ? RandomStochastic(f.num_states(), rng) : A0);
-    x = SimulateStepAggregate(s.A.back(), x, rng);
+    x = estimation::SimulateStepAggregate(s.A.back(), x, rng);
   }
   return s;
 }
@@ -104,7 +105,7 @@ double StepFlops(int m) { return (m < 16 ? 4.0 : 3.0) * m * m * m + 11.0 * m * m
 // triangle of A B), update 4 m^2 + O(m), the projection onto 1^T P = 0 (3 m^2) every 16th step.
 double SparseStepFlops(const Eigen::SparseMatrix<double>& A) {
   const double m = static_cast<double>(A.rows());
-  const int round = std::max(2, kf_detail::kPacket);
+  const int round = std::max(2, estimation::kf_detail::kPacket);
   double second = 0.0;
   for (int l = 0; l < A.outerSize(); ++l) {
     for (Eigen::SparseMatrix<double>::InnerIterator it(A, l); it; ++it) {
@@ -118,12 +119,13 @@ double SparseStepFlops(const Eigen::SparseMatrix<double>& A) {
 
 template <int M>
 void BM_KalmanStep(benchmark::State& state) {
-  const FilterModel f = ChainModel(M);
+  const estimation::FilterModel f = ChainModel(M);
   const Sequence s = Simulate(f, kSequence, 1);
   std::vector<Eigen::Matrix<double, M, M>> A(s.A.begin(), s.A.end());
   std::vector<Eigen::Matrix<double, 1, 1>> y;
   for (const auto& v : s.y) y.emplace_back(v(0));
-  auto kf = PopulationKalmanFilterT<M, 1>::Create(f, CovarianceMode::kExtended);
+  auto kf =
+      estimation::PopulationKalmanFilterT<M, 1>::Create(f, estimation::CovarianceMode::kExtended);
   int t = 0;
   for (auto _ : state) {
     kf->Predict(A[t]);
@@ -144,12 +146,12 @@ BENCHMARK_TEMPLATE(BM_KalmanStep, 50);
 
 template <int M>
 void BM_KalmanStepLegacy(benchmark::State& state) {
-  const FilterModel f = ChainModel(M);
+  const estimation::FilterModel f = ChainModel(M);
   const Sequence s = Simulate(f, kSequence, 1);
   std::vector<Eigen::Matrix<double, M, M>> A(s.A.begin(), s.A.end());
   std::vector<Eigen::Matrix<double, 1, 1>> y;
   for (const auto& v : s.y) y.emplace_back(v(0));
-  auto kf = legacy::LegacyKalmanFilterT<M, 1>::Create(f, CovarianceMode::kExtended);
+  auto kf = legacy::LegacyKalmanFilterT<M, 1>::Create(f, estimation::CovarianceMode::kExtended);
   int t = 0;
   for (auto _ : state) {
     kf->Predict(A[t]);
@@ -170,14 +172,14 @@ BENCHMARK_TEMPLATE(BM_KalmanStepLegacy, 50);
 // measurements of a simulated run; range(0): 0 = legacy dense, 1 = dense, 2 = sparse A.
 void BM_BroadcastStep(benchmark::State& state) {
   constexpr int kM = 20;
-  auto model =
-      FilterModel::FromJson(RECRUIT_SOURCE_DIR "/models/identified/bench_n60_dt0.5_m20.json");
+  auto model = estimation::FilterModel::FromJson(RECRUIT_SOURCE_DIR
+                                                 "/models/identified/bench_n60_dt0.5_m20.json");
   if (!model.ok()) {
     state.SkipWithError(model.error().c_str());
     return;
   }
-  const FilterModel& f = *model;
-  const BroadcastTransitionModel& b = f.broadcast;
+  const estimation::FilterModel& f = *model;
+  const estimation::BroadcastTransitionModel& b = f.broadcast;
   Rng rng(7);
   std::vector<double> p_on(kSequence), p_off(kSequence);
   std::vector<Eigen::Matrix<double, 1, 1>> y(kSequence);
@@ -186,11 +188,12 @@ void BM_BroadcastStep(benchmark::State& state) {
     p_on[t] = rng.Uniform();
     p_off[t] = rng.Uniform();
     y[t] = f.H * x + Eigen::VectorXd::Constant(1, std::sqrt(f.R(0, 0)) * Gaussian(rng));
-    x = SimulateStepAggregate(b.Matrix(p_on[t], p_off[t]), x, rng);
+    x = estimation::SimulateStepAggregate(b.Matrix(p_on[t], p_off[t]), x, rng);
   }
   const int path = static_cast<int>(state.range(0));
-  auto kf = PopulationKalmanFilterT<kM, 1>::Create(f, CovarianceMode::kExtended);
-  auto old = legacy::LegacyKalmanFilterT<kM, 1>::Create(f, CovarianceMode::kExtended);
+  auto kf =
+      estimation::PopulationKalmanFilterT<kM, 1>::Create(f, estimation::CovarianceMode::kExtended);
+  auto old = legacy::LegacyKalmanFilterT<kM, 1>::Create(f, estimation::CovarianceMode::kExtended);
   Eigen::Matrix<double, kM, kM> A;
   Eigen::SparseMatrix<double> As = b.SparsePattern();
   int t = 0;
@@ -227,15 +230,15 @@ BENCHMARK(BM_BroadcastStep)->Arg(0)->Arg(1)->Arg(2);
 // that their rates compare as their times), GFLOPS achieved.
 template <int M>
 void BM_ChainStep(benchmark::State& state) {
-  FilterModel f = ChainModel(M);
-  f.transition = TransitionSource::kBroadcast;
-  f.broadcast = BroadcastTransitionModel::HeatingChain(M, 0.5);
+  estimation::FilterModel f = ChainModel(M);
+  f.transition = estimation::TransitionSource::kBroadcast;
+  f.broadcast = estimation::BroadcastTransitionModel::HeatingChain(M, 0.5);
   f.state_names = f.broadcast.state_names;
   for (int i = 0; i < M; ++i) {
     const int h = M / 2;
     f.H(0, i) = i == 0 ? 0.0 : i <= h ? 0.45 * i / h : 0.45 * (1.0 - double(i - h) / (M - h));
   }
-  const BroadcastTransitionModel& b = f.broadcast;
+  const estimation::BroadcastTransitionModel& b = f.broadcast;
   Rng rng(7);
   std::vector<double> p_on(kSequence), p_off(kSequence);
   std::vector<Eigen::Matrix<double, 1, 1>> y(kSequence);
@@ -244,10 +247,11 @@ void BM_ChainStep(benchmark::State& state) {
     p_on[t] = 0.3 * rng.Uniform();
     p_off[t] = 0.3 * rng.Uniform();
     y[t] = f.H * x + Eigen::VectorXd::Constant(1, std::sqrt(f.R(0, 0)) * Gaussian(rng));
-    x = SimulateStepAggregate(b.Matrix(p_on[t], p_off[t]), x, rng);
+    x = estimation::SimulateStepAggregate(b.Matrix(p_on[t], p_off[t]), x, rng);
   }
   const bool sparse = state.range(0) >= 1;
-  auto kf = PopulationKalmanFilterT<M, 1>::Create(f, CovarianceMode::kExtended);
+  auto kf =
+      estimation::PopulationKalmanFilterT<M, 1>::Create(f, estimation::CovarianceMode::kExtended);
   if (!kf.ok()) {
     state.SkipWithError(kf.error().c_str());
     return;
@@ -278,9 +282,9 @@ BENCHMARK_TEMPLATE(BM_ChainStep, 50)->Arg(0)->Arg(1)->Arg(2);
 
 void BM_KalmanStepDynamic(benchmark::State& state) {
   const int m = static_cast<int>(state.range(0));
-  const FilterModel f = ChainModel(m);
+  const estimation::FilterModel f = ChainModel(m);
   const Sequence s = Simulate(f, kSequence, 1);
-  auto kf = PopulationKalmanFilter::Create(f, CovarianceMode::kExtended);
+  auto kf = estimation::PopulationKalmanFilter::Create(f, estimation::CovarianceMode::kExtended);
   int t = 0;
   for (auto _ : state) {
     kf->Predict(s.A[t]);
@@ -297,10 +301,10 @@ BENCHMARK(BM_KalmanStepDynamic)->Arg(2)->Arg(5)->Arg(10)->Arg(20)->Arg(50);
 // The same with the filter of commit f33d0b3 (side-by-side baseline).
 void BM_KalmanStepDynamicLegacy(benchmark::State& state) {
   const int m = static_cast<int>(state.range(0));
-  const FilterModel f = ChainModel(m);
+  const estimation::FilterModel f = ChainModel(m);
   const Sequence s = Simulate(f, kSequence, 1);
   auto kf = legacy::LegacyKalmanFilterT<Eigen::Dynamic, Eigen::Dynamic>::Create(
-      f, CovarianceMode::kExtended);
+      f, estimation::CovarianceMode::kExtended);
   int t = 0;
   for (auto _ : state) {
     kf->Predict(s.A[t]);
@@ -328,7 +332,7 @@ BENCHMARK(BM_Gemm);
 
 // RMSE over `runs` simulated runs of `steps` steps (same runs for every estimator).
 template <class Step>
-double Rmse(const FilterModel& f, int runs, int steps, Step step) {
+double Rmse(const estimation::FilterModel& f, int runs, int steps, Step step) {
   double se = 0;
   for (int r = 0; r < runs; ++r) {
     const Sequence s = Simulate(f, steps, 100 + r);
@@ -337,8 +341,8 @@ double Rmse(const FilterModel& f, int runs, int steps, Step step) {
   return std::sqrt(se / (static_cast<double>(runs) * steps));
 }
 
-double KalmanSquaredErrors(const FilterModel& f, const Sequence& s) {
-  auto kf = PopulationKalmanFilter::Create(f, CovarianceMode::kExtended);
+double KalmanSquaredErrors(const estimation::FilterModel& f, const Sequence& s) {
+  auto kf = estimation::PopulationKalmanFilter::Create(f, estimation::CovarianceMode::kExtended);
   double se = 0;
   for (size_t t = 0; t < s.y.size(); ++t) {
     if (t > 0) kf->Predict(s.A[t - 1]);
@@ -348,9 +352,10 @@ double KalmanSquaredErrors(const FilterModel& f, const Sequence& s) {
   return se;
 }
 
-double ParticleSquaredErrors(const FilterModel& f, const Sequence& s, int particles, int run) {
+double ParticleSquaredErrors(const estimation::FilterModel& f, const Sequence& s, int particles,
+                             int run) {
   Rng rng(Rng::DeriveSeed(55, run));
-  auto pf = ParticleFilter::Create(f, {particles, 0.5}, rng);
+  auto pf = estimation::ParticleFilter::Create(f, {particles, 0.5}, rng);
   double se = 0;
   for (size_t t = 0; t < s.y.size(); ++t) {
     if (t > 0) pf->Predict(s.A[t - 1], rng);
@@ -371,7 +376,7 @@ const Calibration& Calibrate(int m, double noise_std) {
   static std::map<std::pair<int, double>, Calibration> cache;
   auto it = cache.find({m, noise_std});
   if (it != cache.end()) return it->second;
-  const FilterModel f = ChainModel(m, noise_std);
+  const estimation::FilterModel f = ChainModel(m, noise_std);
   const int runs = m <= 3 ? 200 : 50;
   Calibration c;
   c.rmse_kalman =
@@ -389,9 +394,9 @@ const Calibration& Calibrate(int m, double noise_std) {
 // 0.45 N; 100: 0.1 N, a sharp sensor that makes the particle filter degenerate).
 void BM_EstimatorKalman(benchmark::State& state) {
   const int m = static_cast<int>(state.range(0));
-  const FilterModel f = ChainModel(m, state.range(1) * 1e-3);
+  const estimation::FilterModel f = ChainModel(m, state.range(1) * 1e-3);
   const Sequence s = Simulate(f, kSequence, 1);
-  auto kf = PopulationKalmanFilter::Create(f, CovarianceMode::kExtended);
+  auto kf = estimation::PopulationKalmanFilter::Create(f, estimation::CovarianceMode::kExtended);
   int t = 0;
   for (auto _ : state) {
     kf->Predict(s.A[t]);
@@ -412,11 +417,11 @@ BENCHMARK(BM_EstimatorKalman)
 void BM_EstimatorExact(benchmark::State& state) {
   const int m = static_cast<int>(state.range(0));
   const bool distinct = state.range(1) == 1;
-  const FilterModel f = ChainModel(m);
+  const estimation::FilterModel f = ChainModel(m);
   const Sequence s = Simulate(f, kSequence, 1, distinct);
-  ExactFilterOptions o;
+  estimation::ExactFilterOptions o;
   if (distinct) o.cache_bytes = 0;
-  auto ex = ExactBayesFilter::Create(f, o);
+  auto ex = estimation::ExactBayesFilter::Create(f, o);
   ex->Predict(s.A[0]);  // outside the timing: builds the cached table for the constant A
   ex->Update(s.y[0]);
   int t = 0;
@@ -439,10 +444,10 @@ void BM_EstimatorParticle(benchmark::State& state) {
   const int m = static_cast<int>(state.range(0));
   const double noise = state.range(1) * 1e-3;
   const Calibration& c = Calibrate(m, noise);
-  const FilterModel f = ChainModel(m, noise);
+  const estimation::FilterModel f = ChainModel(m, noise);
   const Sequence s = Simulate(f, kSequence, 1);
   Rng rng(9);
-  auto pf = ParticleFilter::Create(f, {c.particles, 0.5}, rng);
+  auto pf = estimation::ParticleFilter::Create(f, {c.particles, 0.5}, rng);
   int t = 0;
   for (auto _ : state) {
     pf->Predict(s.A[t], rng);
@@ -468,7 +473,7 @@ void BM_ParseFilterModel(benchmark::State& state) {
   const std::string json = text.str();
   for (auto _ : state) {
     if (state.range(0) == 0) {
-      auto j = json_io::ParseJson(json, "model.json");
+      auto j = estimation::json_io::ParseJson(json, "model.json");
       benchmark::DoNotOptimize(j);
     } else {
       auto j = nlohmann::json::parse(json);

@@ -25,10 +25,10 @@ namespace {
 
 constexpr int kRows = 1000000;
 
-FilterModel Model(int m) {
-  if (m == 2) return FilterModel::TwoState(60, 0.5, 0.45, 0.3);
-  FilterModel f = FilterModel::TwoState(60, 0.5, 0.45, 0.3);
-  f.broadcast = BroadcastTransitionModel::HeatingChain(m, 0.5);
+estimation::FilterModel Model(int m) {
+  if (m == 2) return estimation::FilterModel::TwoState(60, 0.5, 0.45, 0.3);
+  estimation::FilterModel f = estimation::FilterModel::TwoState(60, 0.5, 0.45, 0.3);
+  f.broadcast = estimation::BroadcastTransitionModel::HeatingChain(m, 0.5);
   f.state_names = f.broadcast.state_names;
   f.H = Eigen::MatrixXd::Zero(1, m);
   const int h = m / 2;
@@ -64,13 +64,13 @@ std::string OutPath() {
 
 void BM_FilterStream(benchmark::State& state) {
   const int m = static_cast<int>(state.range(0));
-  const FilterModel model = Model(m);
+  const estimation::FilterModel model = Model(m);
   const std::string log_path = LogPath(m);
   for (auto _ : state) {
-    auto filter = MakeCountFilter(model, {});
-    auto log = FilterLogReader::OpenFile(log_path, model);
+    auto filter = estimation::MakeCountFilter(model, {});
+    auto log = estimation::FilterLogReader::OpenFile(log_path, model);
     AtomicFile out(OutPath(), std::ios::out | std::ios::binary);
-    Status s = RunFilterStream(model, **log, **filter, out.stream());
+    Status s = estimation::RunFilterStream(model, **log, **filter, out.stream());
     if (s.ok()) s = out.Commit();
     if (!s.ok()) {
       state.SkipWithError(s.error().c_str());

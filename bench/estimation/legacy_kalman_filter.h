@@ -30,10 +30,12 @@ class LegacyKalmanFilterT {
   // Validates the model and the initial belief: x0 (m entries, finite, summing to N within
   // 1e-9 N) and P0 (m x m, symmetric PSD). P0 is projected onto 1^T P0 = 0 (the total is
   // known). The model's sizes must equal M and R unless they are Eigen::Dynamic.
-  static Result<LegacyKalmanFilterT> Create(const FilterModel& model, CovarianceMode mode,
+  static Result<LegacyKalmanFilterT> Create(const estimation::FilterModel& model,
+                                            estimation::CovarianceMode mode,
                                             const Eigen::VectorXd& x0, const Eigen::MatrixXd& P0);
   // With the model's own initial belief (model.x0, model.P0).
-  static Result<LegacyKalmanFilterT> Create(const FilterModel& model, CovarianceMode mode) {
+  static Result<LegacyKalmanFilterT> Create(const estimation::FilterModel& model,
+                                            estimation::CovarianceMode mode) {
     return Create(model, mode, model.x0, model.P0);
   }
 
@@ -58,7 +60,7 @@ class LegacyKalmanFilterT {
   const Mat& covariance() const { return P_; }         // P
   const OutVec& innovation() const { return innov_; }  // y - H X^(t|t-1) of the last Update
   const GainMat& gain() const { return K_; }           // K of the last Update
-  CovarianceMode mode() const { return mode_; }
+  estimation::CovarianceMode mode() const { return mode_; }
   double population() const { return N_; }
   int num_states() const { return static_cast<int>(x_.size()); }
   int num_outputs() const { return static_cast<int>(H_.rows()); }
@@ -68,7 +70,7 @@ class LegacyKalmanFilterT {
   LegacyKalmanFilterT() = default;
   void Reproject();
 
-  CovarianceMode mode_ = CovarianceMode::kExtended;
+  estimation::CovarianceMode mode_ = estimation::CovarianceMode::kExtended;
   double N_ = 0.0;
   OutputMat H_;
   OutMat R_;
@@ -114,10 +116,9 @@ void ProjectOntoSimplexInto(const V& x, double N, V& out, V& work) {
 }  // namespace legacy_detail
 
 template <int M, int R>
-Result<LegacyKalmanFilterT<M, R>> LegacyKalmanFilterT<M, R>::Create(const FilterModel& model,
-                                                                    CovarianceMode mode,
-                                                                    const Eigen::VectorXd& x0,
-                                                                    const Eigen::MatrixXd& P0) {
+Result<LegacyKalmanFilterT<M, R>> LegacyKalmanFilterT<M, R>::Create(
+    const estimation::FilterModel& model, estimation::CovarianceMode mode,
+    const Eigen::VectorXd& x0, const Eigen::MatrixXd& P0) {
   if (Status s = model.Validate(); !s.ok()) return Error{s.error()};
   const int m = model.num_states();
   const int r = model.num_outputs();
@@ -177,19 +178,19 @@ void LegacyKalmanFilterT<M, R>::Predict(const Mat& A) {
   // A P A^T + Qz(xq) = A (P - diag xq) A^T + diag(A xq); xq is the point Qz is evaluated at.
   M_ = P_;
   switch (mode_) {
-    case CovarianceMode::kExtended:
+    case estimation::CovarianceMode::kExtended:
       legacy_detail::ProjectOntoSimplexInto(x_, N_, xq_, tmp_);
       break;
-    case CovarianceMode::kConservative:
+    case estimation::CovarianceMode::kConservative:
       xq_.setConstant(N_);
       break;
-    case CovarianceMode::kPlain:
+    case estimation::CovarianceMode::kPlain:
       break;
   }
-  if (mode_ != CovarianceMode::kPlain) M_.diagonal() -= xq_;
+  if (mode_ != estimation::CovarianceMode::kPlain) M_.diagonal() -= xq_;
   AM_.noalias() = A * M_;
   P_.noalias() = AM_ * A.transpose();
-  if (mode_ != CovarianceMode::kPlain) {
+  if (mode_ != estimation::CovarianceMode::kPlain) {
     ax_.noalias() = A * xq_;
     P_.diagonal() += ax_;
   }
@@ -239,7 +240,9 @@ void LegacyKalmanFilterT<M, R>::Reproject() {
 
 template <int M, int R>
 Status LegacyKalmanFilterT<M, R>::PredictChecked(const Eigen::MatrixXd& A) {
-  if (Status s = ValidateColumnStochastic(A, kStochasticTolerance, num_states()); !s.ok()) {
+  if (Status s =
+          estimation::ValidateColumnStochastic(A, estimation::kStochasticTolerance, num_states());
+      !s.ok()) {
     return s;
   }
   Predict(Mat(A));

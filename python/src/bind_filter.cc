@@ -13,10 +13,11 @@ namespace recruit::py_bind {
 namespace {
 
 // A model built from arrays (the plain linear case and user models without a JSON file).
-FilterModel LinearModel(const py::object& H, const py::object& R, int64_t N, const py::object& x0,
-                        const py::object& P0, const py::object& A, const py::object& G,
-                        const py::object& Qw, const py::object& state_names) {
-  FilterModel f;
+estimation::FilterModel LinearModel(const py::object& H, const py::object& R, int64_t N,
+                                    const py::object& x0, const py::object& P0, const py::object& A,
+                                    const py::object& G, const py::object& Qw,
+                                    const py::object& state_names) {
+  estimation::FilterModel f;
   f.N = N;
   f.H = ToMatrix(H, "H");
   f.R = ToMatrix(R, "R");
@@ -27,9 +28,9 @@ FilterModel LinearModel(const py::object& H, const py::object& R, int64_t N, con
     f.state_names = state_names.cast<std::vector<std::string>>();
   }
   if (A.is_none()) {
-    f.transition = TransitionSource::kExplicit;
+    f.transition = estimation::TransitionSource::kExplicit;
   } else {
-    f.transition = TransitionSource::kConstant;
+    f.transition = estimation::TransitionSource::kConstant;
     f.A = ToMatrix(A, "A");
   }
   if (!G.is_none()) {
@@ -51,18 +52,18 @@ FilterModel LinearModel(const py::object& H, const py::object& R, int64_t N, con
 
 std::string FilterLog(const std::string& model_path, const std::string& log_path,
                       const std::string& estimator, int particles, uint64_t seed) {
-  FilterModel model = Take(FilterModel::FromJson(model_path));
-  CountFilterOptions opt;
+  estimation::FilterModel model = Take(estimation::FilterModel::FromJson(model_path));
+  estimation::CountFilterOptions opt;
   opt.estimator = estimator;
   opt.particles = particles;
   opt.seed = seed;
-  auto filter = Take(MakeCountFilter(model, opt));
-  auto log = Take(FilterLogReader::OpenFile(log_path, model));
+  auto filter = Take(estimation::MakeCountFilter(model, opt));
+  auto log = Take(estimation::FilterLogReader::OpenFile(log_path, model));
   std::ostringstream out;
   Status s = Status::Ok();
   {
     py::gil_scoped_release release;
-    s = RunFilterStream(model, *log, *filter, out);
+    s = estimation::RunFilterStream(model, *log, *filter, out);
   }
   Check(s);
   return out.str();
@@ -102,14 +103,16 @@ void BindFilter(py::module_& mod) {
       .def_property_readonly(
           "num_outputs", [](const PyFilter& f) { return f.model().num_outputs(); }, "r.");
 
-  py::class_<FilterModel>(mod, "FilterModel")
+  py::class_<estimation::FilterModel>(mod, "FilterModel")
       .def_static(
-          "load", [](const std::string& path) { return Take(FilterModel::FromJson(path)); },
+          "load",
+          [](const std::string& path) { return Take(estimation::FilterModel::FromJson(path)); },
           py::arg("path"), "Reads a filter model file (docs/formats/filter.md).")
       .def_static(
           "two_state",
           [](int64_t N, double dt, double unit_force, double noise_std) {
-            FilterModel f = FilterModel::TwoState(N, dt, unit_force, noise_std);
+            estimation::FilterModel f =
+                estimation::FilterModel::TwoState(N, dt, unit_force, noise_std);
             Check(f.Validate("two_state"));
             return f;
           },
@@ -122,70 +125,82 @@ void BindFilter(py::module_& mod) {
                   "A model from arrays: y = H X + v, v ~ N(0, R); A given = constant transition, "
                   "else pass A at every predict; process noise G Qw G^T (zero column sums).")
       .def(
-          "save", [](const FilterModel& f, const std::string& path) { Check(f.Save(path)); },
+          "save",
+          [](const estimation::FilterModel& f, const std::string& path) { Check(f.Save(path)); },
           py::arg("path"), "Writes the model as a filter model file.")
       .def(
           "with_population",
-          [](const FilterModel& f, int64_t N) {
+          [](const estimation::FilterModel& f, int64_t N) {
             if (N < 1) Fail("with_population: N must be >= 1, got " + std::to_string(N));
             return f.WithPopulation(N);
           },
           py::arg("N"), "The same model for N units (x0 and P0 scaled).")
       .def(
           "broadcast_matrix",
-          [](const FilterModel& f, double p_on, double p_off) {
-            if (f.transition != TransitionSource::kBroadcast) {
+          [](const estimation::FilterModel& f, double p_on, double p_off) {
+            if (f.transition != estimation::TransitionSource::kBroadcast) {
               Fail("broadcast_matrix: the model's transition is '" + TransitionName(f.transition) +
                    "'");
             }
-            Check(BroadcastTransitionModel::ValidateInputs(p_on, p_off, "broadcast_matrix"));
+            Check(estimation::BroadcastTransitionModel::ValidateInputs(p_on, p_off,
+                                                                       "broadcast_matrix"));
             return FromMatrix(f.broadcast.Matrix(p_on, p_off));
           },
           py::arg("p_on"), py::arg("p_off"), "The dense m x m A(p_on, p_off).")
       .def_property_readonly(
-          "state_names", [](const FilterModel& f) { return f.state_names; }, "State names.")
+          "state_names", [](const estimation::FilterModel& f) { return f.state_names; },
+          "State names.")
       .def_property_readonly(
           "is_on",
-          [](const FilterModel& f) {
+          [](const estimation::FilterModel& f) {
             return std::vector<bool>(f.broadcast.is_on.begin(), f.broadcast.is_on.end());
           },
           "Per state: the heater is on (broadcast models).")
       .def_property_readonly(
-          "N", [](const FilterModel& f) { return f.N; }, "Population size.")
+          "N", [](const estimation::FilterModel& f) { return f.N; }, "Population size.")
       .def_property_readonly(
-          "H", [](const FilterModel& f) { return FromMatrix(f.H); }, "r x m output matrix.")
+          "H", [](const estimation::FilterModel& f) { return FromMatrix(f.H); },
+          "r x m output matrix.")
       .def_property_readonly(
-          "R", [](const FilterModel& f) { return FromMatrix(f.R); }, "r x r noise covariance.")
+          "R", [](const estimation::FilterModel& f) { return FromMatrix(f.R); },
+          "r x r noise covariance.")
       .def_property_readonly(
-          "G", [](const FilterModel& f) { return FromMatrix(f.G); }, "m x q noise input.")
+          "G", [](const estimation::FilterModel& f) { return FromMatrix(f.G); },
+          "m x q noise input.")
       .def_property_readonly(
-          "Qw", [](const FilterModel& f) { return FromMatrix(f.Qw); }, "q x q noise covariance.")
+          "Qw", [](const estimation::FilterModel& f) { return FromMatrix(f.Qw); },
+          "q x q noise covariance.")
       .def_property_readonly(
-          "process_noise", [](const FilterModel& f) { return FromMatrix(f.ProcessNoise()); },
+          "process_noise",
+          [](const estimation::FilterModel& f) { return FromMatrix(f.ProcessNoise()); },
           "G Qw G^T.")
       .def_property_readonly(
-          "A", [](const FilterModel& f) { return FromMatrix(f.A); },
+          "A", [](const estimation::FilterModel& f) { return FromMatrix(f.A); },
           "The constant transition (transition == 'constant').")
       .def_property_readonly(
-          "x0", [](const FilterModel& f) { return FromVector(f.x0); }, "Initial estimate.")
+          "x0", [](const estimation::FilterModel& f) { return FromVector(f.x0); },
+          "Initial estimate.")
       .def_property_readonly(
-          "P0", [](const FilterModel& f) { return FromMatrix(f.P0); }, "Initial covariance.")
+          "P0", [](const estimation::FilterModel& f) { return FromMatrix(f.P0); },
+          "Initial covariance.")
       .def_property_readonly(
-          "dt", [](const FilterModel& f) { return f.broadcast.dt; }, "Sampling period, s.")
+          "dt", [](const estimation::FilterModel& f) { return f.broadcast.dt; },
+          "Sampling period, s.")
       .def_property_readonly(
-          "transition", [](const FilterModel& f) { return TransitionName(f.transition); },
+          "transition",
+          [](const estimation::FilterModel& f) { return TransitionName(f.transition); },
           "'broadcast', 'explicit' or 'constant'.")
-      .def_property_readonly("num_states", &FilterModel::num_states, "m.")
-      .def_property_readonly("num_outputs", &FilterModel::num_outputs, "r.")
-      .def("__repr__", [](const FilterModel& f) {
+      .def_property_readonly("num_states", &estimation::FilterModel::num_states, "m.")
+      .def_property_readonly("num_outputs", &estimation::FilterModel::num_outputs, "r.")
+      .def("__repr__", [](const estimation::FilterModel& f) {
         return "<recruit.FilterModel m=" + std::to_string(f.num_states()) +
                " r=" + std::to_string(f.num_outputs()) + " N=" + std::to_string(f.N) +
                " transition=" + TransitionName(f.transition) + ">";
       });
 
   py::class_<PyKalmanFilter, PyFilter> kf(mod, "KalmanFilter");
-  kf.def(py::init<const FilterModel&, const std::string&, const py::object&, const py::object&,
-                  bool>(),
+  kf.def(py::init<const estimation::FilterModel&, const std::string&, const py::object&,
+                  const py::object&, bool>(),
          py::arg("model"), py::arg("mode") = "extended", py::arg("x0") = py::none(),
          py::arg("P0") = py::none(), py::arg("fixed_size") = true)
       .def("reset", &PyKalmanFilter::Reset, py::arg("x0") = py::none(), py::arg("P0") = py::none(),
@@ -209,9 +224,9 @@ void BindFilter(py::module_& mod) {
           "True when the fixed-size C++ filter runs (m = 2, 3 or 20 with r = 1).");
 
   py::class_<PyExactFilter, PyFilter> ex(mod, "ExactFilter");
-  ex.def(py::init<const FilterModel&, uint64_t, uint64_t>(), py::arg("model"),
-         py::arg("max_states") = ExactFilterOptions{}.max_states,
-         py::arg("cache_bytes") = ExactFilterOptions{}.cache_bytes)
+  ex.def(py::init<const estimation::FilterModel&, uint64_t, uint64_t>(), py::arg("model"),
+         py::arg("max_states") = estimation::ExactFilterOptions{}.max_states,
+         py::arg("cache_bytes") = estimation::ExactFilterOptions{}.cache_bytes)
       .def_property_readonly(
           "probabilities",
           [](const PyExactFilter& f) {
@@ -241,7 +256,7 @@ void BindFilter(py::module_& mod) {
           "S = C(N + m - 1, m - 1).");
 
   py::class_<PyParticleFilter, PyFilter> pf(mod, "ParticleFilter");
-  pf.def(py::init<const FilterModel&, int, double, uint64_t>(), py::arg("model"),
+  pf.def(py::init<const estimation::FilterModel&, int, double, uint64_t>(), py::arg("model"),
          py::arg("particles") = 1000, py::arg("resample_threshold") = 0.5, py::arg("seed") = 1)
       .def_property_readonly(
           "ess", [](const PyParticleFilter& f) { return f.filter().EffectiveSampleSize(); },

@@ -189,7 +189,7 @@ void BindPlugin(py::module_& mod) {
           [](const PyBundles& s, const py::object& data, const py::object& b, double p_on,
              double p_off) {
             const int i = s.Index(b);
-            Check(BroadcastTransitionModel::ValidateInputs(p_on, p_off, "broadcast"));
+            Check(estimation::BroadcastTransitionModel::ValidateInputs(p_on, p_off, "broadcast"));
             Check(s.host().Broadcast(s.Data(data), i, p_on, p_off));
           },
           py::arg("data"), py::arg("bundle"), py::arg("p_on"), py::arg("p_off"),

@@ -45,13 +45,13 @@ py::array_t<double> FromVector(const Eigen::VectorXd& x) {
   return out;
 }
 
-std::string TransitionName(TransitionSource t) {
+std::string TransitionName(estimation::TransitionSource t) {
   switch (t) {
-    case TransitionSource::kBroadcast:
+    case estimation::TransitionSource::kBroadcast:
       return "broadcast";
-    case TransitionSource::kExplicit:
+    case estimation::TransitionSource::kExplicit:
       return "explicit";
-    case TransitionSource::kConstant:
+    case estimation::TransitionSource::kConstant:
       return "constant";
   }
   return "?";

@@ -40,6 +40,6 @@ py::array_t<double> FromMatrix(const Eigen::MatrixXd& M);
 py::array_t<double> FromVector(const Eigen::VectorXd& x);
 
 // "broadcast", "explicit", "constant".
-std::string TransitionName(TransitionSource t);
+std::string TransitionName(estimation::TransitionSource t);
 
 }  // namespace recruit::py_bind

@@ -12,16 +12,17 @@ namespace recruit::py_bind {
 
 void PyFilter::Predict(const py::object& A) {
   const Eigen::MatrixXd M = ToMatrix(A, "A");
-  Check(ValidateColumnStochastic(M, kStochasticTolerance, model_.num_states(), "A"));
+  Check(estimation::ValidateColumnStochastic(M, estimation::kStochasticTolerance,
+                                             model_.num_states(), "A"));
   DoPredict(M);
 }
 
 void PyFilter::PredictBroadcast(double p_on, double p_off) {
-  if (model_.transition != TransitionSource::kBroadcast) {
+  if (model_.transition != estimation::TransitionSource::kBroadcast) {
     Fail("predict_broadcast: the filter model's transition is '" +
          TransitionName(model_.transition) + "', not 'broadcast' (use predict(A))");
   }
-  Check(BroadcastTransitionModel::ValidateInputs(p_on, p_off, "predict_broadcast"));
+  Check(estimation::BroadcastTransitionModel::ValidateInputs(p_on, p_off, "predict_broadcast"));
   DoPredictBroadcast(p_on, p_off);
 }
 
@@ -56,7 +57,7 @@ py::tuple PyFilter::Run(const py::object& ys, const py::object& p_on, const py::
   const bool broadcast = !p_on.is_none() || !p_off.is_none();
   if (broadcast && !As.is_none()) Fail("run: pass either p_on and p_off or A, not both");
   if (broadcast) {
-    if (model_.transition != TransitionSource::kBroadcast) {
+    if (model_.transition != estimation::TransitionSource::kBroadcast) {
       Fail("run: p_on/p_off need a broadcast filter model");
     }
     if (p_on.is_none() || p_off.is_none()) Fail("run: pass both p_on and p_off");
@@ -66,8 +67,8 @@ py::tuple PyFilter::Run(const py::object& ys, const py::object& p_on, const py::
       Fail("run: p_on and p_off need at least T - 1 = " + std::to_string(T - 1) + " entries");
     }
     for (Eigen::Index k = 0; k + 1 < T; ++k) {
-      Check(BroadcastTransitionModel::ValidateInputs(pon(k), poff(k),
-                                                     "run: step " + std::to_string(k)));
+      Check(estimation::BroadcastTransitionModel::ValidateInputs(pon(k), poff(k),
+                                                                 "run: step " + std::to_string(k)));
     }
   } else if (!As.is_none()) {
     DoubleArray a = AsArray(As, "A");
@@ -83,10 +84,10 @@ py::tuple PyFilter::Run(const py::object& ys, const py::object& p_on, const py::
       Fail("run: A must be m x m (constant) or (T - 1) x m x m");
     }
     for (size_t k = 0; k < Ak.size(); ++k) {
-      Check(ValidateColumnStochastic(Ak[k], kStochasticTolerance, m,
-                                     "run: A[" + std::to_string(k) + "]"));
+      Check(estimation::ValidateColumnStochastic(Ak[k], estimation::kStochasticTolerance, m,
+                                                 "run: A[" + std::to_string(k) + "]"));
     }
-  } else if (model_.transition == TransitionSource::kConstant) {
+  } else if (model_.transition == estimation::TransitionSource::kConstant) {
     Ak.push_back(model_.A);
   } else if (T > 1) {
     Fail("run: this model's transition is '" + TransitionName(model_.transition) +
@@ -133,7 +134,7 @@ namespace {
 template <int M, int R>
 class KalmanCoreT final : public KalmanCore {
  public:
-  using F = PopulationKalmanFilterT<M, R>;
+  using F = estimation::PopulationKalmanFilterT<M, R>;
   explicit KalmanCoreT(F f) : f_(std::move(f)) {}
   void Predict(const Eigen::MatrixXd& A) override {
     if constexpr (M == Eigen::Dynamic) {
@@ -167,17 +168,18 @@ class KalmanCoreT final : public KalmanCore {
 };
 
 template <int M, int R>
-std::unique_ptr<KalmanCore> MakeCoreT(const FilterModel& model, CovarianceMode mode,
-                                      const Eigen::VectorXd& x0, const Eigen::MatrixXd& P0) {
+std::unique_ptr<KalmanCore> MakeCoreT(const estimation::FilterModel& model,
+                                      estimation::CovarianceMode mode, const Eigen::VectorXd& x0,
+                                      const Eigen::MatrixXd& P0) {
   return std::make_unique<KalmanCoreT<M, R>>(
-      Take(PopulationKalmanFilterT<M, R>::Create(model, mode, x0, P0)));
+      Take(estimation::PopulationKalmanFilterT<M, R>::Create(model, mode, x0, P0)));
 }
 
 // The same sizes as MakeCountFilter (src/estimation/count_filter.cc), so that a fixed-size
 // filter here is the one `recruit filter` runs.
-std::unique_ptr<KalmanCore> MakeCore(const FilterModel& model, CovarianceMode mode,
-                                     const Eigen::VectorXd& x0, const Eigen::MatrixXd& P0,
-                                     bool fixed) {
+std::unique_ptr<KalmanCore> MakeCore(const estimation::FilterModel& model,
+                                     estimation::CovarianceMode mode, const Eigen::VectorXd& x0,
+                                     const Eigen::MatrixXd& P0, bool fixed) {
   if (fixed && model.num_outputs() == 1) {
     switch (model.num_states()) {
       case 2:
@@ -193,9 +195,9 @@ std::unique_ptr<KalmanCore> MakeCore(const FilterModel& model, CovarianceMode mo
 
 }  // namespace
 
-PyKalmanFilter::PyKalmanFilter(const FilterModel& model, const std::string& mode,
+PyKalmanFilter::PyKalmanFilter(const estimation::FilterModel& model, const std::string& mode,
                                const py::object& x0, const py::object& P0, bool fixed_size)
-    : PyFilter(model), mode_(Take(ParseCovarianceMode(mode))), want_fixed_(fixed_size) {
+    : PyFilter(model), mode_(Take(estimation::ParseCovarianceMode(mode))), want_fixed_(fixed_size) {
   Reset(x0, P0);
 }
 
@@ -233,30 +235,33 @@ void PyKalmanFilter::DoPredictBroadcast(double p_on, double p_off) {
 
 namespace {
 
-ExactBayesFilter MakeExact(const FilterModel& model, uint64_t max_states, uint64_t cache_bytes) {
-  ExactFilterOptions o;
+estimation::ExactBayesFilter MakeExact(const estimation::FilterModel& model, uint64_t max_states,
+                                       uint64_t cache_bytes) {
+  estimation::ExactFilterOptions o;
   o.max_states = max_states;
   o.cache_bytes = cache_bytes;
-  return Take(ExactBayesFilter::Create(model, o));
+  return Take(estimation::ExactBayesFilter::Create(model, o));
 }
 
-ParticleFilter MakeParticle(const FilterModel& model, int particles, double threshold, Rng& rng) {
+estimation::ParticleFilter MakeParticle(const estimation::FilterModel& model, int particles,
+                                        double threshold, Rng& rng) {
   if (particles < 1) Fail("particles: must be >= 1, got " + std::to_string(particles));
   if (!(threshold >= 0.0 && threshold <= 1.0)) {
     Fail("resample_threshold: must be in [0, 1], got " + std::to_string(threshold));
   }
-  ParticleFilterOptions o;
+  estimation::ParticleFilterOptions o;
   o.num_particles = particles;
   o.resample_threshold = threshold;
-  return Take(ParticleFilter::Create(model, o, rng));
+  return Take(estimation::ParticleFilter::Create(model, o, rng));
 }
 
 }  // namespace
 
-PyExactFilter::PyExactFilter(const FilterModel& model, uint64_t max_states, uint64_t cache_bytes)
+PyExactFilter::PyExactFilter(const estimation::FilterModel& model, uint64_t max_states,
+                             uint64_t cache_bytes)
     : PyFilter(model), f_(MakeExact(model, max_states, cache_bytes)) {}
 
-PyParticleFilter::PyParticleFilter(const FilterModel& model, int particles,
+PyParticleFilter::PyParticleFilter(const estimation::FilterModel& model, int particles,
                                    double resample_threshold, uint64_t seed)
     : PyFilter(model), rng_(seed), f_(MakeParticle(model, particles, resample_threshold, rng_)) {}
 

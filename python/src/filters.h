@@ -21,7 +21,7 @@ namespace py = pybind11;
 
 class PyFilter {
  public:
-  explicit PyFilter(FilterModel model) : model_(std::move(model)) {}
+  explicit PyFilter(estimation::FilterModel model) : model_(std::move(model)) {}
   virtual ~PyFilter() = default;
 
   // Time update with an m x m column-stochastic A.
@@ -37,7 +37,7 @@ class PyFilter {
 
   virtual Eigen::VectorXd Mean() const = 0;
   virtual Eigen::MatrixXd Covariance() const = 0;
-  const FilterModel& model() const { return model_; }
+  const estimation::FilterModel& model() const { return model_; }
 
  protected:
   // Inputs already checked.
@@ -51,7 +51,7 @@ class PyFilter {
     var = Covariance().diagonal();
   }
 
-  FilterModel model_;
+  estimation::FilterModel model_;
 };
 
 // The population Kalman filter of one size: fixed (PopulationKalmanFilterT<M, R>, no heap in
@@ -76,15 +76,15 @@ class PyKalmanFilter : public PyFilter {
  public:
   // fixed_size: use PopulationKalmanFilterT<m, 1> for m = 2, 3, 20 and r = 1 (the sizes
   // `recruit filter` and the controllers use), else the dynamic-size filter.
-  PyKalmanFilter(const FilterModel& model, const std::string& mode, const py::object& x0,
-                 const py::object& P0, bool fixed_size);
+  PyKalmanFilter(const estimation::FilterModel& model, const std::string& mode,
+                 const py::object& x0, const py::object& P0, bool fixed_size);
   void Reset(const py::object& x0, const py::object& P0);
   void SetOutput(const py::object& H, const py::object& R);
 
   Eigen::VectorXd Mean() const override { return core_->estimate(); }
   Eigen::MatrixXd Covariance() const override { return core_->covariance(); }
   const KalmanCore& core() const { return *core_; }
-  CovarianceMode mode() const { return mode_; }
+  estimation::CovarianceMode mode() const { return mode_; }
 
  protected:
   void DoPredict(const Eigen::MatrixXd& A) override { core_->Predict(A); }
@@ -95,36 +95,36 @@ class PyKalmanFilter : public PyFilter {
   }
 
  private:
-  CovarianceMode mode_;
+  estimation::CovarianceMode mode_;
   bool want_fixed_;
   std::unique_ptr<KalmanCore> core_;
 };
 
 class PyExactFilter : public PyFilter {
  public:
-  PyExactFilter(const FilterModel& model, uint64_t max_states, uint64_t cache_bytes);
+  PyExactFilter(const estimation::FilterModel& model, uint64_t max_states, uint64_t cache_bytes);
   Eigen::VectorXd Mean() const override { return f_.Mean(); }
   Eigen::MatrixXd Covariance() const override { return f_.Covariance(); }
-  const ExactBayesFilter& filter() const { return f_; }
-  ExactBayesFilter& filter() { return f_; }
+  const estimation::ExactBayesFilter& filter() const { return f_; }
+  estimation::ExactBayesFilter& filter() { return f_; }
 
  protected:
   void DoPredict(const Eigen::MatrixXd& A) override { f_.Predict(A); }
   void DoUpdate(const Eigen::VectorXd& y) override { f_.Update(y); }
 
  private:
-  ExactBayesFilter f_;
+  estimation::ExactBayesFilter f_;
 };
 
 class PyParticleFilter : public PyFilter {
  public:
   // As `recruit filter --estimator particle --seed seed`: one Rng(seed) draws the initial
   // particles, then every step.
-  PyParticleFilter(const FilterModel& model, int particles, double resample_threshold,
+  PyParticleFilter(const estimation::FilterModel& model, int particles, double resample_threshold,
                    uint64_t seed);
   Eigen::VectorXd Mean() const override { return f_.Mean(); }
   Eigen::MatrixXd Covariance() const override { return f_.Covariance(); }
-  const ParticleFilter& filter() const { return f_; }
+  const estimation::ParticleFilter& filter() const { return f_; }
 
  protected:
   void DoPredict(const Eigen::MatrixXd& A) override { f_.Predict(A, rng_); }
@@ -132,7 +132,7 @@ class PyParticleFilter : public PyFilter {
 
  private:
   Rng rng_;
-  ParticleFilter f_;
+  estimation::ParticleFilter f_;
 };
 
 }  // namespace recruit::py_bind

@@ -20,7 +20,7 @@ namespace {
 struct FilterArgs {
   std::string model, log, out;
   std::string plant, actuator;  // the MJCF and bundle the log was recorded on (optional)
-  CountFilterOptions options;
+  estimation::CountFilterOptions options;
 };
 
 // The output is written through a temporary file renamed onto --out, which would replace an
@@ -40,7 +40,7 @@ Status CheckOutputIsNoInput(const std::string& out, const FilterArgs& a) {
 int RunFilter(const FilterArgs& a) {
   auto fail = [](const Error& e) { return Fail("filter", e); };
   if (Status s = CheckOutputIsNoInput(a.out, a); !s.ok()) return fail(s.failure());
-  auto model = FilterModel::FromJson(a.model);
+  auto model = estimation::FilterModel::FromJson(a.model);
   if (!model.ok()) return fail(model.failure());
   // A model identified on another plant than the log's is refused (its H and chain describe
   // other units), as simulate and sweep refuse it.
@@ -49,14 +49,14 @@ int RunFilter(const FilterArgs& a) {
     if (!record.ok()) return fail(record.failure().In("--plant: "));
     if (Status s = control::CheckModelPlant(a.model, *record); !s.ok()) return fail(s.failure());
   }
-  auto filter = MakeCountFilter(*model, a.options);
+  auto filter = estimation::MakeCountFilter(*model, a.options);
   if (!filter.ok()) return fail(filter.failure());
   // Streamed: the log is read, stepped and written row by row (memory flat in its length).
-  auto log = FilterLogReader::OpenFile(a.log, *model, a.actuator);
+  auto log = estimation::FilterLogReader::OpenFile(a.log, *model, a.actuator);
   if (!log.ok()) return fail(log.failure());
   AtomicFile out(a.out, std::ios::out | std::ios::binary);
   if (!out.ok()) return fail(out.failure());
-  if (Status s = RunFilterStream(*model, **log, **filter, out.stream()); !s.ok()) {
+  if (Status s = estimation::RunFilterStream(*model, **log, **filter, out.stream()); !s.ok()) {
     return fail(s.failure());  // AtomicFile removes its temporary file: nothing is written
   }
   if (Status s = out.Commit(); !s.ok()) return fail(s.failure());
@@ -95,7 +95,7 @@ void AddFilterCommand(CLI::App& app, int& exit_code) {
       "--actuator", args->actuator,
       "--plant's bundle (default: its first), and a bench log's (default: its only one)");
   cmd->add_option("--estimator", args->options.estimator,
-                  std::string("Estimator: ") + kEstimatorNames)
+                  std::string("Estimator: ") + estimation::kEstimatorNames)
       ->check(CLI::IsMember({"extended", "conservative", "plain", "exact", "particle"}))
       ->capture_default_str();
   cmd->add_option("--particles", args->options.particles, "Particle filter: number of particles")

@@ -91,7 +91,8 @@ Result<nlohmann::json> IdentifyFromLog(const IdentifyArgs& a, const std::string&
   // the plant unknown, no force law carries H to other lengths (that needs --bench).
   TransientChain c = fit->chain;
   c.force = c.force.cwiseMax(0.0);
-  const FilterModel model = ToFilterModel(c, log->num_units, log->dT, fit->force_noise_var);
+  const estimation::FilterModel model =
+      ToFilterModel(c, log->num_units, log->dT, fit->force_noise_var);
   if (Status s = model.Validate("identified model"); !s) return Error{s.error(), s.code()};
   nlohmann::json j = model.ToJson();
   j["identification"] = {{"command", command_line},

@@ -42,7 +42,7 @@ int RunReplayCommand(const ReplayArgs& a) {
         {{"--log", a.log}, {"--task", a.task}, {"the task's model", task->model_path}});
     if (!s.ok()) return Fail(cmd, s.error(), exit_code::kUsage);
   }
-  auto log = ReadBenchLog(a.log);
+  auto log = estimation::ReadBenchLog(a.log);
   if (!log.ok()) return Fail(cmd, log.failure());
   auto result = replay::RunReplay(*task, *log, a.options);
   if (!result.ok()) return Fail(cmd, result.failure());

@@ -10,7 +10,7 @@ namespace {
 
 // One sampling period of the expected chain: the law's broadcast for `target` (a fraction of the
 // units on), then the chain's transition.
-void Advance(const BroadcastTransitionModel& chain, double target_on, double lambda,
+void Advance(const estimation::BroadcastTransitionModel& chain, double target_on, double lambda,
              Eigen::VectorXd& x) {
   double on = 0;
   for (int i = 0; i < chain.num_states(); ++i) on += chain.is_on[i] ? x[i] : 0.0;
@@ -20,7 +20,7 @@ void Advance(const BroadcastTransitionModel& chain, double target_on, double lam
 
 // Advances x under the law towards `target` until its force h'x changes by less than
 // `tolerance` in a period (or `max_periods` have passed).
-void Settle(const BroadcastTransitionModel& chain, double target, double lambda,
+void Settle(const estimation::BroadcastTransitionModel& chain, double target, double lambda,
             const Eigen::Ref<const Eigen::VectorXd>& h, double tolerance, int max_periods,
             Eigen::VectorXd& x) {
   double before = 0;
@@ -54,7 +54,7 @@ double ActuatorResponse::TimeTo(double fraction) const {
   return s.size() * dT;
 }
 
-Result<ActuatorResponse> PredictActuatorResponse(const BroadcastTransitionModel& chain,
+Result<ActuatorResponse> PredictActuatorResponse(const estimation::BroadcastTransitionModel& chain,
                                                  const std::vector<double>& force, double lambda,
                                                  double from, double to, int max_samples) {
   const int m = chain.num_states();

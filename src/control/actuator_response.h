@@ -28,7 +28,7 @@ struct ActuatorResponse {
 // on the chain's own on-fraction (a perfect estimate). `force` gives one unit's tension in each
 // state (the model's H row at the working length). Stops when the remaining error is below
 // 1e-4 of the step, or after `max_samples`.
-Result<ActuatorResponse> PredictActuatorResponse(const BroadcastTransitionModel& chain,
+Result<ActuatorResponse> PredictActuatorResponse(const estimation::BroadcastTransitionModel& chain,
                                                  const std::vector<double>& force, double lambda,
                                                  double from = 0.25, double to = 0.5,
                                                  int max_samples = 1000);

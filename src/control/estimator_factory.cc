@@ -65,7 +65,7 @@ Result<EstimatorSpec> EstimatorSpec::Parse(const std::string& kind, const std::s
   const bool failures = kind == "kalman-failures";
   auto k = ParseEstimatorKind(failures ? "kalman-augmented" : kind);
   if (!k) return Error{k.error(), k.code()};
-  auto c = ParseCovarianceMode(covariance);
+  auto c = estimation::ParseCovarianceMode(covariance);
   if (!c) {
     return Error{"estimator: covariance \"" + covariance +
                  "\" is not one of \"extended\", \"conservative\", \"plain\""};
@@ -151,8 +151,9 @@ nlohmann::json IdentificationOf(const nlohmann::json& j) {
 
 // The unit force map of an identified model: its recorded fractions, or the fractions of its H
 // at the extension it was identified at (the plant's prestretch when not recorded).
-Result<UnitForceMap> ModelForceMap(const FilterModel& model, const nlohmann::json& ident,
-                                   const UnitGeometry& g, const std::string& file) {
+Result<UnitForceMap> ModelForceMap(const estimation::FilterModel& model,
+                                   const nlohmann::json& ident, const UnitGeometry& g,
+                                   const std::string& file) {
   if (ident.contains("output_fractions")) {
     const auto& f = ident["output_fractions"];
     if (!f.is_array() || static_cast<int>(f.size()) != model.num_states()) {
@@ -202,13 +203,13 @@ Result<std::unique_ptr<OnCountEstimator>> MakeEstimator(const EstimatorSpec& spe
     return std::unique_ptr<OnCountEstimator>(
         new OutputOnlyEstimator(num_units, unit_force, std::move(on_force)));
   }
-  const CovarianceMode mode = spec.covariance;
-  FilterModel model;
+  const estimation::CovarianceMode mode = spec.covariance;
+  estimation::FilterModel model;
   std::optional<UnitForceMap> output;
   double relative_noise = 0;
   if (spec.kind == EstimatorKind::kKalman2) {
     const double sd = spec.force_noise_std > 0 ? spec.force_noise_std : unit_force;
-    model = FilterModel::TwoState(num_units, dT, unit_force, sd);
+    model = estimation::FilterModel::TwoState(num_units, dT, unit_force, sd);
     if (geometry) {
       auto map = UnitForceMap::FromForces(*geometry, geometry->unit.prestretch,
                                           Eigen::Vector2d(0.0, unit_force));
@@ -220,9 +221,10 @@ Result<std::unique_ptr<OnCountEstimator>> MakeEstimator(const EstimatorSpec& spe
         spec.model_file.empty() ? DefaultModelFile(dT, spec.num_states) : spec.model_file);
     // The file is read and parsed once, for the model, its plant and its identification record.
     auto text = ReadFile(file);
-    auto json = text.ok() ? json_io::ParseJson(*text, file) : Error{text.error(), text.code()};
-    auto loaded =
-        json.ok() ? FilterModel::FromJsonValue(*json, file) : Error{json.error(), json.code()};
+    auto json =
+        text.ok() ? estimation::json_io::ParseJson(*text, file) : Error{text.error(), text.code()};
+    auto loaded = json.ok() ? estimation::FilterModel::FromJsonValue(*json, file)
+                            : Error{json.error(), json.code()};
     if (!loaded) {
       return Error{"estimator: " + loaded.error() +
                        (spec.model_file.empty()
@@ -238,7 +240,7 @@ Result<std::unique_ptr<OnCountEstimator>> MakeEstimator(const EstimatorSpec& spe
         return Error{"estimator: " + s.error(), s.code()};
       }
     }
-    if (model.transition != TransitionSource::kBroadcast) {
+    if (model.transition != estimation::TransitionSource::kBroadcast) {
       return Error{"estimator: " + file + ": transition.type must be \"broadcast\""};
     }
     if (model.num_states() != spec.num_states) {

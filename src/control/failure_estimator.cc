@@ -8,16 +8,18 @@
 namespace recruit::control {
 
 Result<std::unique_ptr<FailureOnCountEstimator>> FailureOnCountEstimator::Create(
-    const FilterModel& model, CovarianceMode mode, const FailureFilterParams& params,
-    std::optional<UnitForceMap> output, double relative_noise) {
+    const estimation::FilterModel& model, estimation::CovarianceMode mode,
+    const estimation::FailureFilterParams& params, std::optional<UnitForceMap> output,
+    double relative_noise) {
   RECRUIT_TRY(CheckEstimatorInputs(model, output, relative_noise));
-  auto filter = FailureKalmanFilter::Create(model, mode, params);
+  auto filter = estimation::FailureKalmanFilter::Create(model, mode, params);
   if (!filter) return filter.failure();
   return std::unique_ptr<FailureOnCountEstimator>(new FailureOnCountEstimator(
       model, std::move(filter).value(), std::move(output), relative_noise));
 }
 
-FailureOnCountEstimator::FailureOnCountEstimator(FilterModel model, FailureKalmanFilter filter,
+FailureOnCountEstimator::FailureOnCountEstimator(estimation::FilterModel model,
+                                                 estimation::FailureKalmanFilter filter,
                                                  std::optional<UnitForceMap> output,
                                                  double relative_noise)
     : model_(std::move(model)),

@@ -17,7 +17,8 @@ namespace recruit::control {
 class FailureOnCountEstimator final : public OnCountEstimator {
  public:
   static Result<std::unique_ptr<FailureOnCountEstimator>> Create(
-      const FilterModel& model, CovarianceMode mode, const FailureFilterParams& params,
+      const estimation::FilterModel& model, estimation::CovarianceMode mode,
+      const estimation::FailureFilterParams& params,
       std::optional<UnitForceMap> output = std::nullopt, double relative_noise = 0);
 
   void Reset() override { filter_.Reset(); }
@@ -32,15 +33,15 @@ class FailureOnCountEstimator final : public OnCountEstimator {
   std::vector<bool> OnStates() const override;
   std::optional<FailureEstimate> Failures() const override;
 
-  const FilterModel& model() const { return model_; }
-  const FailureKalmanFilter& filter() const { return filter_; }
+  const estimation::FilterModel& model() const { return model_; }
+  const estimation::FailureKalmanFilter& filter() const { return filter_; }
 
  private:
-  FailureOnCountEstimator(FilterModel model, FailureKalmanFilter filter,
+  FailureOnCountEstimator(estimation::FilterModel model, estimation::FailureKalmanFilter filter,
                           std::optional<UnitForceMap> output, double relative_noise);
 
-  FilterModel model_;
-  FailureKalmanFilter filter_;
+  estimation::FilterModel model_;
+  estimation::FailureKalmanFilter filter_;
   Eigen::VectorXd on_mask_;    // 3m: the working heater-on states and every stuck state
   Eigen::VectorXd on_mask_w_;  // its first m entries (the working states)
   std::optional<UnitForceMap> output_;

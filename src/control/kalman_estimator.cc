@@ -4,10 +4,10 @@
 
 namespace recruit::control {
 
-Status CheckEstimatorInputs(const FilterModel& model, const std::optional<UnitForceMap>& output,
-                            double relative_noise) {
+Status CheckEstimatorInputs(const estimation::FilterModel& model,
+                            const std::optional<UnitForceMap>& output, double relative_noise) {
   if (Status s = model.Validate(); !s) return Error{s.error(), s.code()};
-  if (model.transition != TransitionSource::kBroadcast) {
+  if (model.transition != estimation::TransitionSource::kBroadcast) {
     return Error{
         "estimator: the filter model's transition must be of type \"broadcast\" (the "
         "controller drives it with p_on, p_off)"};
@@ -28,16 +28,17 @@ Status CheckEstimatorInputs(const FilterModel& model, const std::optional<UnitFo
 }
 
 Result<std::unique_ptr<KalmanOnCountEstimator>> KalmanOnCountEstimator::Create(
-    const FilterModel& model, CovarianceMode mode, std::optional<UnitForceMap> output,
-    double relative_noise) {
+    const estimation::FilterModel& model, estimation::CovarianceMode mode,
+    std::optional<UnitForceMap> output, double relative_noise) {
   RECRUIT_TRY(CheckEstimatorInputs(model, output, relative_noise));
-  auto filter = PopulationKalmanFilter::Create(model, mode);
+  auto filter = estimation::PopulationKalmanFilter::Create(model, mode);
   if (!filter) return Error{filter.error(), filter.code()};
   return std::unique_ptr<KalmanOnCountEstimator>(new KalmanOnCountEstimator(
       model, std::move(filter).value(), std::move(output), relative_noise));
 }
 
-KalmanOnCountEstimator::KalmanOnCountEstimator(FilterModel model, PopulationKalmanFilter filter,
+KalmanOnCountEstimator::KalmanOnCountEstimator(estimation::FilterModel model,
+                                               estimation::PopulationKalmanFilter filter,
                                                std::optional<UnitForceMap> output,
                                                double relative_noise)
     : model_(std::move(model)),

@@ -16,8 +16,8 @@ namespace recruit::control {
 
 // What every population-filter estimator needs of its inputs: a valid broadcast model with one
 // output, a unit force map of as many states, a finite relative noise >= 0.
-Status CheckEstimatorInputs(const FilterModel& model, const std::optional<UnitForceMap>& output,
-                            double relative_noise);
+Status CheckEstimatorInputs(const estimation::FilterModel& model,
+                            const std::optional<UnitForceMap>& output, double relative_noise);
 
 class KalmanOnCountEstimator final : public OnCountEstimator {
  public:
@@ -27,7 +27,7 @@ class KalmanOnCountEstimator final : public OnCountEstimator {
   // model's states) and R = model R + relative_noise^2 (H x^-)^2: the unit force model's error
   // (units of one state do not all sit at its fraction) grows with the force.
   static Result<std::unique_ptr<KalmanOnCountEstimator>> Create(
-      const FilterModel& model, CovarianceMode mode,
+      const estimation::FilterModel& model, estimation::CovarianceMode mode,
       std::optional<UnitForceMap> output = std::nullopt, double relative_noise = 0);
 
   void Reset() override;
@@ -40,18 +40,18 @@ class KalmanOnCountEstimator final : public OnCountEstimator {
   std::vector<std::string> StateNames() const override { return model_.state_names; }
   std::vector<bool> OnStates() const override { return model_.broadcast.is_on; }
 
-  const FilterModel& model() const { return model_; }
-  const PopulationKalmanFilter& filter() const { return filter_; }
+  const estimation::FilterModel& model() const { return model_; }
+  const estimation::PopulationKalmanFilter& filter() const { return filter_; }
   // The length-dependent output model (none: H fixed) and the relative noise of R (Create).
   const std::optional<UnitForceMap>& output() const { return output_; }
   double relative_noise() const { return relative_noise_; }
 
  private:
-  KalmanOnCountEstimator(FilterModel model, PopulationKalmanFilter filter,
+  KalmanOnCountEstimator(estimation::FilterModel model, estimation::PopulationKalmanFilter filter,
                          std::optional<UnitForceMap> output, double relative_noise);
 
-  FilterModel model_;
-  PopulationKalmanFilter filter_;
+  estimation::FilterModel model_;
+  estimation::PopulationKalmanFilter filter_;
   Eigen::VectorXd on_mask_;  // 1 for the "on" states
   Eigen::VectorXd y_;        // workspace (one output)
   std::optional<UnitForceMap> output_;

@@ -79,7 +79,7 @@ const char* EstimatorKindName(EstimatorKind kind);
 // produce (Parse / FromJson validate the names and values).
 struct EstimatorSpec {
   EstimatorKind kind = EstimatorKind::kKalmanAugmented;
-  CovarianceMode covariance = CovarianceMode::kExtended;  // Kalman kinds
+  estimation::CovarianceMode covariance = estimation::CovarianceMode::kExtended;  // Kalman kinds
   // kalman-augmented: the FilterModel file. Empty: DefaultModelFile(dT, num_states).
   std::string model_file;
   int num_states = 20;  // kalman-augmented: states of the model (checked against the file)
@@ -93,7 +93,7 @@ struct EstimatorSpec {
   // kalman-augmented with absorbing failed states (FailureKalmanFilter): the kind name
   // "kalman-failures" sets it; `failure` holds the filter's detection settings.
   bool failures = false;
-  FailureFilterParams failure;
+  estimation::FailureFilterParams failure;
   // kalman-augmented: the plant the model will run on (control/plant_record.h, PlantRecord);
   // null = unchecked. A model file recording another plant is refused (CheckModelPlant).
   nlohmann::json plant;

@@ -10,7 +10,7 @@
 #include "common/atomic_file.h"
 #include "common/short_text.h"
 
-namespace recruit {
+namespace recruit::estimation {
 namespace {
 
 constexpr std::string_view kSensed = ".sensed_force";
@@ -211,4 +211,4 @@ Result<BenchLog> ParseBenchLog(const std::string& text, const std::string& path)
   return log;
 }
 
-}  // namespace recruit
+}  // namespace recruit::estimation

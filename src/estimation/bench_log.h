@@ -17,7 +17,7 @@
 
 #include "common/result.h"
 
-namespace recruit {
+namespace recruit::estimation {
 
 // Where a bench log's columns are (indices into the header; -1 = absent).
 struct BenchLogColumns {
@@ -84,4 +84,4 @@ Result<BenchLog> ReadBenchLog(const std::string& path);
 // The same from text (`path` only names it in messages).
 Result<BenchLog> ParseBenchLog(const std::string& text, const std::string& path);
 
-}  // namespace recruit
+}  // namespace recruit::estimation

@@ -8,7 +8,7 @@
 #include "estimation/json_matrix.h"
 #include "estimation/population_chain.h"
 
-namespace recruit {
+namespace recruit::estimation {
 
 Eigen::SparseMatrix<double> BroadcastTransitionModel::SparsePattern() const {
   const int m = num_states();
@@ -197,4 +197,4 @@ nlohmann::json BroadcastTransitionModel::ToJson() const {
   return j;
 }
 
-}  // namespace recruit
+}  // namespace recruit::estimation

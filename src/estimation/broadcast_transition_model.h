@@ -10,7 +10,7 @@
 
 #include "common/result.h"
 
-namespace recruit {
+namespace recruit::estimation {
 
 // Column j (a unit in state j) of A(p_on, p_off) is
 //   (1 - p) * interior(:, j) + p * e_{target}
@@ -84,4 +84,4 @@ struct BroadcastTransitionModel {
   nlohmann::json ToJson() const;
 };
 
-}  // namespace recruit
+}  // namespace recruit::estimation

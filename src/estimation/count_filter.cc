@@ -7,7 +7,7 @@
 #include "estimation/particle_filter.h"
 #include "estimation/population_kalman_filter.h"
 
-namespace recruit {
+namespace recruit::estimation {
 namespace {
 
 // F: PopulationKalmanFilterT<M, R>; fixed sizes for the common models (no heap, unrolled).
@@ -115,4 +115,4 @@ Result<std::unique_ptr<CountFilter>> MakeCountFilter(const FilterModel& model,
   return Error{"estimator '" + ShortText(e) + "' is not one of " + kEstimatorNames};
 }
 
-}  // namespace recruit
+}  // namespace recruit::estimation

@@ -10,7 +10,7 @@
 #include "common/result.h"
 #include "estimation/filter_model.h"
 
-namespace recruit {
+namespace recruit::estimation {
 
 class CountFilter {
  public:
@@ -46,4 +46,4 @@ inline constexpr const char* kEstimatorNames = "extended, conservative, plain, e
 Result<std::unique_ptr<CountFilter>> MakeCountFilter(const FilterModel& model,
                                                      const CountFilterOptions& options);
 
-}  // namespace recruit
+}  // namespace recruit::estimation

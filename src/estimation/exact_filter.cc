@@ -6,7 +6,7 @@
 
 #include "estimation/population_chain.h"
 
-namespace recruit {
+namespace recruit::estimation {
 namespace {
 
 constexpr int64_t kMaxGrid = int64_t{1} << 24;
@@ -250,4 +250,4 @@ Eigen::MatrixXd ExactBayesFilter::Covariance() const {
   return C;
 }
 
-}  // namespace recruit
+}  // namespace recruit::estimation

@@ -16,7 +16,7 @@
 #include "common/result.h"
 #include "estimation/filter_model.h"
 
-namespace recruit {
+namespace recruit::estimation {
 
 struct ExactFilterOptions {
   uint64_t max_states = 200000;  // refuse larger count-vector spaces
@@ -76,4 +76,4 @@ class ExactBayesFilter {
   std::list<CachedTable> cache_;
 };
 
-}  // namespace recruit
+}  // namespace recruit::estimation

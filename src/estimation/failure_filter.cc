@@ -6,7 +6,7 @@
 
 #include "estimation/population_chain.h"
 
-namespace recruit {
+namespace recruit::estimation {
 
 int OpenEntry(const BroadcastTransitionModel& chain, int j) {
   return chain.is_on[j] ? chain.off_target[j] : j;  // cools from its temperature
@@ -360,4 +360,4 @@ void FailureKalmanFilter::PredictCore() {
   x_ = A_ * x_;
 }
 
-}  // namespace recruit
+}  // namespace recruit::estimation

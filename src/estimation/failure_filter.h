@@ -37,7 +37,7 @@
 #include "estimation/filter_model.h"
 #include "estimation/population_kalman_filter.h"
 
-namespace recruit {
+namespace recruit::estimation {
 
 // The augmented chain's A (3m x 3m, classes working, open, stuck) for a broadcast: heated working
 // states fail open with q_open and stuck with q_stuck per period; failed classes absorb and
@@ -188,4 +188,4 @@ class FailureKalmanFilter {
   FailureGlr::Best last_declared_;
 };
 
-}  // namespace recruit
+}  // namespace recruit::estimation

@@ -13,7 +13,7 @@
 #include "estimation/population_chain.h"
 #include "estimation/shortest_double.h"
 
-namespace recruit {
+namespace recruit::estimation {
 namespace {
 
 constexpr size_t kChunk = size_t{1} << 20;  // bytes read and written at a time
@@ -385,4 +385,4 @@ Result<std::string> RunFilterOverText(const FilterModel& model, const std::strin
   return out.str();
 }
 
-}  // namespace recruit
+}  // namespace recruit::estimation

@@ -22,7 +22,7 @@
 #include "estimation/count_filter.h"
 #include "estimation/filter_model.h"
 
-namespace recruit {
+namespace recruit::estimation {
 
 // One data row of a log, validated against the model.
 struct FilterLogRow {
@@ -99,4 +99,4 @@ Status RunFilterStream(const FilterModel& model, FilterLogReader& log, CountFilt
 Result<std::string> RunFilterOverText(const FilterModel& model, const std::string& text,
                                       const std::string& path, CountFilter& filter);
 
-}  // namespace recruit
+}  // namespace recruit::estimation

@@ -11,7 +11,7 @@
 #include "estimation/json_matrix.h"
 #include "estimation/population_chain.h"
 
-namespace recruit {
+namespace recruit::estimation {
 
 Eigen::MatrixXd FilterModel::ProcessNoise() const {
   const int m = num_states();
@@ -320,4 +320,4 @@ FilterModel FilterModel::TwoState(int64_t N, double dt, double unit_force, doubl
   return f;
 }
 
-}  // namespace recruit
+}  // namespace recruit::estimation

@@ -13,7 +13,7 @@
 #include "common/result.h"
 #include "estimation/broadcast_transition_model.h"
 
-namespace recruit {
+namespace recruit::estimation {
 
 // Where A(t) comes from.
 enum class TransitionSource {
@@ -61,4 +61,4 @@ struct FilterModel {
   static FilterModel TwoState(int64_t N, double dt, double unit_force, double noise_std);
 };
 
-}  // namespace recruit
+}  // namespace recruit::estimation

@@ -4,7 +4,7 @@
 
 #include "common/short_text.h"
 
-namespace recruit::json_io {
+namespace recruit::estimation::json_io {
 
 namespace {
 
@@ -120,4 +120,4 @@ nlohmann::json WriteVector(const Eigen::VectorXd& v) {
   return j;
 }
 
-}  // namespace recruit::json_io
+}  // namespace recruit::estimation::json_io

@@ -9,7 +9,7 @@
 #include "common/json_fields.h"
 #include "common/result.h"
 
-namespace recruit::json_io {
+namespace recruit::estimation::json_io {
 
 // json_fields::MatrixValue / VectorValue (the broadcast transition's reader calls them by these
 // names).
@@ -35,4 +35,4 @@ Result<nlohmann::json> ParseJson(const std::string& text, const std::string& pat
 nlohmann::json WriteMatrix(const Eigen::MatrixXd& M);
 nlohmann::json WriteVector(const Eigen::VectorXd& v);
 
-}  // namespace recruit::json_io
+}  // namespace recruit::estimation::json_io

@@ -6,7 +6,7 @@
 
 #include "estimation/population_chain.h"
 
-namespace recruit {
+namespace recruit::estimation {
 
 Eigen::VectorXd RoundToCounts(const Eigen::VectorXd& x, int64_t N) {
   const Eigen::VectorXd p = ProjectOntoSimplex(x, static_cast<double>(N));
@@ -156,4 +156,4 @@ Eigen::MatrixXd ParticleFilter::Covariance() const {
   return C;
 }
 
-}  // namespace recruit
+}  // namespace recruit::estimation

@@ -13,7 +13,7 @@
 #include "common/rng.h"
 #include "estimation/filter_model.h"
 
-namespace recruit {
+namespace recruit::estimation {
 
 struct ParticleFilterOptions {
   int num_particles = 1000;
@@ -57,4 +57,4 @@ class ParticleFilter {
 // remainders); negative entries are first projected away.
 Eigen::VectorXd RoundToCounts(const Eigen::VectorXd& x, int64_t N);
 
-}  // namespace recruit
+}  // namespace recruit::estimation

@@ -6,7 +6,7 @@
 #include <sstream>
 #include <vector>
 
-namespace recruit {
+namespace recruit::estimation {
 namespace {
 
 std::string Num(double v) {
@@ -257,4 +257,4 @@ uint64_t CountStateVectors(int64_t N, int m, uint64_t cap) {
   return static_cast<uint64_t>(c);
 }
 
-}  // namespace recruit
+}  // namespace recruit::estimation

@@ -10,7 +10,7 @@
 #include "common/result.h"
 #include "common/rng.h"
 
-namespace recruit {
+namespace recruit::estimation {
 
 // Default tolerance on the column sums and entries of a transition matrix.
 inline constexpr double kStochasticTolerance = 1e-9;
@@ -88,4 +88,4 @@ Result<GammaBound> ComputeGammaBound(const Eigen::MatrixXd& A, const Eigen::Matr
 // `cap` + 1 so huge spaces do not overflow.
 uint64_t CountStateVectors(int64_t N, int m, uint64_t cap = UINT64_MAX - 1);
 
-}  // namespace recruit
+}  // namespace recruit::estimation

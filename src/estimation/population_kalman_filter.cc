@@ -3,7 +3,7 @@
 #include "common/short_text.h"
 #include "estimation/json_matrix.h"
 
-namespace recruit {
+namespace recruit::estimation {
 
 const char* ToString(CovarianceMode mode) {
   switch (mode) {
@@ -31,4 +31,4 @@ template class PopulationKalmanFilterT<2, 1>;
 template class PopulationKalmanFilterT<3, 1>;
 template class PopulationKalmanFilterT<20, 1>;
 
-}  // namespace recruit
+}  // namespace recruit::estimation

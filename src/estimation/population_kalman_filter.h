@@ -53,7 +53,7 @@
 #include "estimation/filter_model.h"
 #include "estimation/population_chain.h"
 
-namespace recruit {
+namespace recruit::estimation {
 
 enum class CovarianceMode { kExtended, kConservative, kPlain };
 
@@ -663,4 +663,4 @@ extern template class PopulationKalmanFilterT<2, 1>;
 extern template class PopulationKalmanFilterT<3, 1>;
 extern template class PopulationKalmanFilterT<20, 1>;
 
-}  // namespace recruit
+}  // namespace recruit::estimation

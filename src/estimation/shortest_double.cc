@@ -9,7 +9,7 @@
 
 #include "common/decimal_digits.h"
 
-namespace recruit {
+namespace recruit::estimation {
 namespace {
 
 constexpr char kDigitPairs[] =
@@ -137,4 +137,4 @@ char* WriteShortest(char* p, double v) {
   return p;
 }
 
-}  // namespace recruit
+}  // namespace recruit::estimation

@@ -4,7 +4,7 @@
 // filter.md). For the CSV writers of large outputs (`recruit filter`).
 #pragma once
 
-namespace recruit {
+namespace recruit::estimation {
 
 // Longest output of WriteShortest ("-2.2250738585072014e-308").
 inline constexpr int kShortestDoubleMaxChars = 24;
@@ -17,4 +17,4 @@ inline constexpr int kShortestDoubleRoom = 32;
 // std::to_chars(p, p + 24, v) for every double, including zero, subnormals, infinities, NaN.
 char* WriteShortest(char* p, double v);
 
-}  // namespace recruit
+}  // namespace recruit::estimation

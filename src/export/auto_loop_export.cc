@@ -51,7 +51,7 @@ Result<std::vector<control::ActuatorResponse>> Responses(
     const double tau = plant.host().bundle(plant.bundle_index(i)).unit().time_constant();
     const auto* kalman = dynamic_cast<const control::KalmanOnCountEstimator*>(
         &controllers[i].controller.estimator());
-    FilterModel model;
+    estimation::FilterModel model;
     if (kalman != nullptr) {
       model = kalman->model();
     } else {
@@ -61,11 +61,11 @@ Result<std::vector<control::ActuatorResponse>> Responses(
         out.push_back(control::FirstOrderActuatorResponse(settings.dT, settings.lambda, tau));
         continue;
       }
-      auto loaded = FilterModel::FromJson(*file);
+      auto loaded = estimation::FilterModel::FromJson(*file);
       if (!loaded) return Error{loaded.error(), loaded.code()};
       model = std::move(loaded).value();
     }
-    if (model.transition != TransitionSource::kBroadcast || model.H.rows() < 1) {
+    if (model.transition != estimation::TransitionSource::kBroadcast || model.H.rows() < 1) {
       return Error{"bundle '" + plant.bundle_name(i) +
                    "': the self-tuned loop needs a broadcast chain model with a force row"};
     }

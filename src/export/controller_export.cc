@@ -56,7 +56,7 @@ std::vector<double> Packed(const Eigen::MatrixXd& P) {
 
 // The filter's compressed rows of the broadcast A (PopulationKalmanFilterT::Create's layout:
 // rows in order, columns ascending within a row).
-void SparseRows(const BroadcastTransitionModel& b, BundleConstants& out) {
+void SparseRows(const estimation::BroadcastTransitionModel& b, BundleConstants& out) {
   const int m = b.num_states();
   const Eigen::SparseMatrix<double> A = b.SparsePattern();
   out.ptr.assign(m + 1, 0);
@@ -105,10 +105,10 @@ Result<BundleConstants> Constants(const sim::BundleController& bc, const std::st
   if (dynamic_cast<const control::OutputOnlyEstimator*>(&c.estimator()) != nullptr) return out;
   const auto* k = dynamic_cast<const control::KalmanOnCountEstimator*>(&c.estimator());
   if (k == nullptr) return Error{where + ": this estimator cannot be exported"};
-  if (k->filter().mode() != CovarianceMode::kExtended) {
+  if (k->filter().mode() != estimation::CovarianceMode::kExtended) {
     return Error{where + ": only the extended covariance mode is exported"};
   }
-  const FilterModel& model = k->model();
+  const estimation::FilterModel& model = k->model();
   out.m = model.num_states();
   if (out.m > 255 || model.num_outputs() != 1) {
     return Error{where + ": the C package holds models of at most 255 states and one output, " +

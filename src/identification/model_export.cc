@@ -2,18 +2,18 @@
 
 namespace recruit::identification {
 
-FilterModel ToFilterModel(const TransientChain& chain, std::int64_t num_units, double dT,
-                          double force_noise_var) {
+estimation::FilterModel ToFilterModel(const TransientChain& chain, std::int64_t num_units,
+                                      double dT, double force_noise_var) {
   const int m = chain.num_states();
-  FilterModel f;
+  estimation::FilterModel f;
   f.state_names = chain.StateNames();
   f.N = num_units;
   f.H = chain.force.transpose();
   f.R = Eigen::MatrixXd::Constant(1, 1, force_noise_var);
   f.G = Eigen::MatrixXd::Zero(m, 0);
   f.Qw = Eigen::MatrixXd::Zero(0, 0);
-  f.transition = TransitionSource::kBroadcast;
-  BroadcastTransitionModel& b = f.broadcast;
+  f.transition = estimation::TransitionSource::kBroadcast;
+  estimation::BroadcastTransitionModel& b = f.broadcast;
   b.state_names = f.state_names;
   b.is_on = chain.IsOn();
   b.interior = chain.Interior();

@@ -11,7 +11,7 @@ namespace recruit::identification {
 // states = chain.StateNames(), H = chain.force^T (1 x m), R = [force_noise_var],
 // no process noise, transition "broadcast" with the chain's interior, is_on and switching
 // targets (-1 where a switch does not apply), dt = dT; x0 = N in "cold", P0 = 0.
-FilterModel ToFilterModel(const TransientChain& chain, std::int64_t num_units, double dT,
-                          double force_noise_var);
+estimation::FilterModel ToFilterModel(const TransientChain& chain, std::int64_t num_units,
+                                      double dT, double force_noise_var);
 
 }  // namespace recruit::identification

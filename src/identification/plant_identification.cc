@@ -110,13 +110,14 @@ Eigen::VectorXd RefineFractions(const TransientChain& chain, const control::Unit
 
 // Negative log-likelihood of recordings under the length-aware filter with
 // R = R0 + rho^2 (H x^-)^2, the filter driven by the broadcasts as in operation.
-double NegLogLikelihood(const FilterModel& model, const control::UnitForceMap& map,
+double NegLogLikelihood(const estimation::FilterModel& model, const control::UnitForceMap& map,
                         const std::vector<BenchRecording>& recs, double rho) {
   double total = 0;
   const double r0 = model.R(0, 0);
   Eigen::RowVectorXd h(model.num_states());
   for (const BenchRecording& rec : recs) {
-    auto est = control::KalmanOnCountEstimator::Create(model, CovarianceMode::kExtended, map, rho);
+    auto est = control::KalmanOnCountEstimator::Create(model, estimation::CovarianceMode::kExtended,
+                                                       map, rho);
     if (!est) return std::numeric_limits<double>::infinity();
     control::KalmanOnCountEstimator& e = **est;
     const SwitchingLog& log = rec.log;
@@ -137,7 +138,7 @@ double NegLogLikelihood(const FilterModel& model, const control::UnitForceMap& m
 
 // The rho in [0, 0.5] of the largest likelihood (golden section): the part of the force model's
 // error that grows with the force, seen when it is carried to other lengths.
-double FitRelativeNoise(const FilterModel& model, const control::UnitForceMap& map,
+double FitRelativeNoise(const estimation::FilterModel& model, const control::UnitForceMap& map,
                         const std::vector<BenchRecording>& recs) {
   double a = 0, b = 0.5;
   const double g = (std::sqrt(5.0) - 1) / 2;
@@ -222,7 +223,7 @@ Result<PlantIdentification> IdentifyOnPlant(const std::string& model_path,
   // The exported H: the forces of the fractions at the recorded pose (>= 0, on the force law).
   TransientChain exported = c;
   map->Forces(rec->tendon_length, exported.force);
-  const FilterModel model =
+  const estimation::FilterModel model =
       ToFilterModel(exported, rec->log.num_units, rec->log.dT, fit->force_noise_var);
   if (Status s = model.Validate("identified model"); !s) return Error{s.error(), s.code()};
   // 4. R's part that grows with the force, by maximum likelihood over every recording.

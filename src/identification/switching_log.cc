@@ -27,13 +27,13 @@ std::vector<std::string> SplitCsv(const std::string& line) {
 // A bench log's control instants, for the chosen bundle.
 Result<SwitchingLog> FromBenchLog(const std::string& path, int num_units,
                                   const std::string& bundle) {
-  auto bench = ReadBenchLog(path);
+  auto bench = estimation::ReadBenchLog(path);
   if (!bench.ok()) return bench.failure();
-  BenchLogColumns names;
+  estimation::BenchLogColumns names;
   for (const auto& b : bench->bundles) names.bundles.push_back({b.name});
-  auto i = SelectBenchBundle(names, bundle, path);
+  auto i = estimation::SelectBenchBundle(names, bundle, path);
   if (!i.ok()) return i.failure();
-  const BenchLog::Bundle& b = bench->bundles[*i];
+  const estimation::BenchLog::Bundle& b = bench->bundles[*i];
   SwitchingLog log;
   log.num_units = num_units;
   log.dT = bench->dT;
@@ -55,7 +55,7 @@ Result<SwitchingLog> SwitchingLog::FromCsv(const std::string& path, int num_unit
   if (!std::getline(in, line)) return Error{path + ": empty file (expected a CSV header)"};
   if (line.substr(0, 3) == "\xEF\xBB\xBF") line.erase(0, 3);
   const auto header = SplitCsv(line);
-  if (IsBenchLogHeader(header)) return FromBenchLog(path, num_units, bundle);
+  if (estimation::IsBenchLogHeader(header)) return FromBenchLog(path, num_units, bundle);
   int col_t = -1, col_on = -1, col_off = -1, col_f = -1, col_true = -1, col_ron = -1, col_roff = -1;
   for (int i = 0; i < static_cast<int>(header.size()); ++i) {
     if (header[i] == "time") col_t = i;

@@ -22,7 +22,7 @@ std::string Names(const std::vector<std::string>& v) {
 
 }  // namespace
 
-Result<ReplayPlan> PlanReplay(const sim::Task& task, const BenchLog& log) {
+Result<ReplayPlan> PlanReplay(const sim::Task& task, const estimation::BenchLog& log) {
   auto plant_or = sim::Plant::Create(task, /*drawn=*/false);
   if (!plant_or.ok()) return plant_or.failure();
   const sim::Plant& plant = **plant_or;
@@ -67,7 +67,8 @@ Result<ReplayPlan> PlanReplay(const sim::Task& task, const BenchLog& log) {
   return plan;
 }
 
-Result<std::vector<std::vector<double>>> ReplayOnce(const sim::Task& task, const BenchLog& log,
+Result<std::vector<std::vector<double>>> ReplayOnce(const sim::Task& task,
+                                                    const estimation::BenchLog& log,
                                                     const ReplayPlan& plan, std::uint64_t seed) {
   auto plant_or = sim::Plant::Create(task, /*drawn=*/false);
   if (!plant_or.ok()) return plant_or.failure();
@@ -91,7 +92,7 @@ Result<std::vector<std::vector<double>>> ReplayOnce(const sim::Task& task, const
       // Every load cell first, then every broadcast, as RunTask's control instant does.
       for (int i = 0; i < nb; ++i) sensed[i] = sensors[i].SampleAndHold(plant.Force(i));
       for (int i = 0; i < nb; ++i) {
-        const BenchLog::Bundle& b = log.bundles[plan.log_bundle[i]];
+        const estimation::BenchLog::Bundle& b = log.bundles[plan.log_bundle[i]];
         if (Status st = plant.Broadcast(i, b.p_on[k], b.p_off[k]); !st.ok()) {
           return st.failure().In(log.path + ":" + std::to_string(log.line[k]) + ": ");
         }

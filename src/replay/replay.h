@@ -34,12 +34,13 @@ struct ReplayPlan {
   double dT = 0;                            // the log's control period, s
   std::vector<std::string> ignored_angles;  // the log's angle columns the plant has no joint for
 };
-Result<ReplayPlan> PlanReplay(const sim::Task& task, const BenchLog& log);
+Result<ReplayPlan> PlanReplay(const sim::Task& task, const estimation::BenchLog& log);
 
 // One replay with the plant's and the load cells' streams seeded by `seed` (the streams of
 // `recruit simulate --seed`, so a log simulated with that seed is reproduced exactly): by
 // signal, the value at each control instant.
-Result<std::vector<std::vector<double>>> ReplayOnce(const sim::Task& task, const BenchLog& log,
+Result<std::vector<std::vector<double>>> ReplayOnce(const sim::Task& task,
+                                                    const estimation::BenchLog& log,
                                                     const ReplayPlan& plan, std::uint64_t seed);
 
 }  // namespace recruit::replay

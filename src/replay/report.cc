@@ -7,7 +7,7 @@
 
 namespace recruit::replay {
 
-Result<ReplayResult> RunReplay(const sim::Task& task, const BenchLog& log,
+Result<ReplayResult> RunReplay(const sim::Task& task, const estimation::BenchLog& log,
                                const ReplayOptions& options) {
   if (options.num_seeds < 3) {
     return Error{"--seeds " + std::to_string(options.num_seeds) + ": at least 3 replays"};

@@ -35,7 +35,7 @@ struct ReplayResult {
   bool flagged = false;  // any signal
 };
 
-Result<ReplayResult> RunReplay(const sim::Task& task, const BenchLog& log,
+Result<ReplayResult> RunReplay(const sim::Task& task, const estimation::BenchLog& log,
                                const ReplayOptions& options);
 
 nlohmann::json ReportJson(const ReplayResult& r);

@@ -179,7 +179,7 @@ std::vector<std::string> LoadWarnings(const Plant& plant) {
 // checked on (held-out data at the identification pose): the estimate and the self-tuned loop's
 // design rest on it.
 constexpr double kMinHoldoutR2 = 0.9;
-void IdentificationWarning(const FilterModel& model, const std::string& bundle,
+void IdentificationWarning(const estimation::FilterModel& model, const std::string& bundle,
                            std::vector<std::string>& warnings) {
   if (!(model.holdout_r2 < kMinHoldoutR2)) return;  // NaN: not recorded
   char buf[300];
@@ -244,7 +244,7 @@ Result<std::vector<control::ActuatorResponse>> ActuatorResponses(
   for (int i = 0; i < plant.num_bundles(); ++i) {
     const auto* kalman =
         dynamic_cast<const control::KalmanOnCountEstimator*>(&channels[i].controller.estimator());
-    FilterModel model;
+    estimation::FilterModel model;
     if (kalman != nullptr) {
       model = kalman->model();
     } else {
@@ -261,12 +261,12 @@ Result<std::vector<control::ActuatorResponse>> ActuatorResponses(
                            "unit's thermal lag");
         continue;
       }
-      auto loaded = FilterModel::FromJson(*file);
+      auto loaded = estimation::FilterModel::FromJson(*file);
       if (!loaded) return Error{loaded.error(), loaded.code()};
       model = std::move(loaded).value();
       IdentificationWarning(model, plant.bundle_name(i), warnings);
     }
-    if (model.transition != TransitionSource::kBroadcast || model.H.rows() < 1) {
+    if (model.transition != estimation::TransitionSource::kBroadcast || model.H.rows() < 1) {
       return Error{"bundle '" + plant.bundle_name(i) +
                    "': the self-tuned loop needs a broadcast chain model with a force row"};
     }

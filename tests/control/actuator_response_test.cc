@@ -10,7 +10,7 @@ namespace {
 // With the two-state chain (no thermal lag) the expected on-count closes lambda of its gap each
 // period, so the tension's step response is 1 - (1 - lambda)^k exactly.
 TEST(ActuatorResponse, TwoStateChainGivesTheExpectationLawsGeometricApproach) {
-  const auto chain = BroadcastTransitionModel::TwoState(0.5);
+  const auto chain = estimation::BroadcastTransitionModel::TwoState(0.5);
   for (double lambda : {0.1, 0.2, 0.5, 1.0}) {
     auto r = PredictActuatorResponse(chain, {0.0, 0.45}, lambda);
     ASSERT_TRUE(r.ok()) << r.error();
@@ -27,20 +27,21 @@ TEST(ActuatorResponse, TwoStateChainGivesTheExpectationLawsGeometricApproach) {
 }
 
 TEST(ActuatorResponse, AHeatingChainLagsTheCountAndStillSettles) {
-  const auto chain = BroadcastTransitionModel::HeatingChain(20, 1.0);
+  const auto chain = estimation::BroadcastTransitionModel::HeatingChain(20, 1.0);
   std::vector<double> force(20, 0.0);
   for (int i = 1; i <= 10; ++i) force[i] = 0.05 * i;  // rising while heating, settled at 10
   for (int i = 11; i < 20; ++i) force[i] = 0.05 * (20 - i);
   auto r = PredictActuatorResponse(chain, force, 0.2);
   ASSERT_TRUE(r.ok()) << r.error();
-  auto two = PredictActuatorResponse(BroadcastTransitionModel::TwoState(1.0), {0, 0.5}, 0.2);
+  auto two =
+      PredictActuatorResponse(estimation::BroadcastTransitionModel::TwoState(1.0), {0, 0.5}, 0.2);
   // Slower than the count alone, and settled by the end.
   EXPECT_GT(r->TimeTo(0.63), two->TimeTo(0.63) + 1.0);
   EXPECT_NEAR(r->s.back(), 1.0, 1e-3);
 }
 
 TEST(ActuatorResponse, BadInputsAreRefused) {
-  const auto chain = BroadcastTransitionModel::TwoState(0.5);
+  const auto chain = estimation::BroadcastTransitionModel::TwoState(0.5);
   EXPECT_FALSE(PredictActuatorResponse(chain, {0.0}, 0.2).ok());
   EXPECT_FALSE(PredictActuatorResponse(chain, {0.0, 0.4}, 0).ok());
   EXPECT_FALSE(PredictActuatorResponse(chain, {0.0, 0.0}, 0.2).ok());

@@ -74,7 +74,7 @@ TEST(EstimatorSpec, FromJsonNamesTheFileAndField) {
       nlohmann::json::parse(R"({"kind":"kalman2","covariance":"conservative"})"), "task.json");
   ASSERT_TRUE(ok.ok()) << ok.error();
   EXPECT_EQ(ok->kind, EstimatorKind::kKalman2);
-  EXPECT_EQ(ok->covariance, CovarianceMode::kConservative);
+  EXPECT_EQ(ok->covariance, estimation::CovarianceMode::kConservative);
   auto bad =
       EstimatorSpec::FromJson(nlohmann::json::parse(R"({"num_states":"many"})"), "task.json");
   ASSERT_FALSE(bad.ok());

@@ -78,8 +78,9 @@ TEST(KalmanAugmented, SparseBroadcastPredictionEqualsTheDenseFilter) {
   auto e = MakeEstimator(*spec, 60, 0.45, 0.5);
   ASSERT_TRUE(e.ok()) << e.error();
   const auto& est = dynamic_cast<const KalmanOnCountEstimator&>(**e);
-  FilterModel model = est.model();
-  auto dense = PopulationKalmanFilter::Create(model, CovarianceMode::kExtended);
+  estimation::FilterModel model = est.model();
+  auto dense =
+      estimation::PopulationKalmanFilter::Create(model, estimation::CovarianceMode::kExtended);
   ASSERT_TRUE(dense.ok()) << dense.error();
   const int m = model.num_states();
   Eigen::MatrixXd A(m, m);
@@ -177,9 +178,9 @@ TEST(ModelExport, FilterModelFileRoundTripsTheChain) {
   c.heat_advance << 1.0, 0.6, 0.4;
   c.force << 0.0, 0.05, 0.2, 0.35, 0.45, 0.42, 0.3, 0.12;
   c.switch_on[5] = 2;  // cool1 -> heat2
-  const FilterModel f = identification::ToFilterModel(c, 60, 0.5, 0.01);
+  const estimation::FilterModel f = identification::ToFilterModel(c, 60, 0.5, 0.01);
   ASSERT_TRUE(f.Validate().ok()) << f.Validate().error();
-  auto back = FilterModel::FromJsonValue(f.ToJson(), "round trip");
+  auto back = estimation::FilterModel::FromJsonValue(f.ToJson(), "round trip");
   ASSERT_TRUE(back.ok()) << back.error();
   for (auto [pon, poff] : {std::pair{0.0, 0.0}, {0.3, 0.6}, {1.0, 1.0}}) {
     EXPECT_LT((back->broadcast.Matrix(pon, poff) - c.Matrix(pon, poff)).norm(), 1e-12);

@@ -8,7 +8,8 @@ namespace recruit::control {
 namespace {
 
 ActuatorResponse TwoState(double dT, double lambda) {
-  return *PredictActuatorResponse(BroadcastTransitionModel::TwoState(dT), {0, 1}, lambda);
+  return *PredictActuatorResponse(estimation::BroadcastTransitionModel::TwoState(dT), {0, 1},
+                                  lambda);
 }
 
 // No gains, a joint far faster than the bundles: the limb follows the feedforward's tension,

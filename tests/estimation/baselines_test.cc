@@ -19,16 +19,17 @@ using testing_util::ThreeStateModel;
 // One prediction from a point mass: the exact belief is the convolution of the columns'
 // multinomials, whose mean is A X and covariance Qz(X) (eq. 25).
 TEST(EstimationExact, PredictionFromPointMassHasMeanAXAndCovarianceQz) {
-  FilterModel f = ThreeStateModel(20, 0.5);
+  estimation::FilterModel f = ThreeStateModel(20, 0.5);
   f.x0 = Eigen::Vector3d(8, 5, 7);
-  auto ex = ExactBayesFilter::Create(f);
+  auto ex = estimation::ExactBayesFilter::Create(f);
   ASSERT_TRUE(ex.ok()) << ex.error();
   EXPECT_EQ(ex->num_count_vectors(), 231u);  // C(22, 2)
   Eigen::Matrix3d A;
   A << 0.7, 0.2, 0.1, 0.2, 0.5, 0.3, 0.1, 0.3, 0.6;
   ex->Predict(A);
   EXPECT_LT((ex->Mean() - A * f.x0).cwiseAbs().maxCoeff(), 1e-12);
-  EXPECT_LT((ex->Covariance() - ProcessCovarianceQz(A, f.x0)).cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_LT((ex->Covariance() - estimation::ProcessCovarianceQz(A, f.x0)).cwiseAbs().maxCoeff(),
+            1e-12);
   double total = 0;
   for (double p : ex->probabilities()) total += p;
   EXPECT_NEAR(total, 1.0, 1e-12);
@@ -39,8 +40,8 @@ TEST(EstimationExact, PredictionFromPointMassHasMeanAXAndCovarianceQz) {
 TEST(EstimationExact, UpdateIsBayesRuleOnTheBinomial) {
   const int N = 30;
   const double p_on = 0.3, h = 0.45, sd = 0.5, y = 5.0;
-  const FilterModel f = FilterModel::TwoState(N, 0.5, h, sd);
-  auto ex = ExactBayesFilter::Create(f);
+  const estimation::FilterModel f = estimation::FilterModel::TwoState(N, 0.5, h, sd);
+  auto ex = estimation::ExactBayesFilter::Create(f);
   ASSERT_TRUE(ex.ok());
   ex->Predict(f.broadcast.Matrix(p_on, 0.1));
   ex->Update(Eigen::VectorXd::Constant(1, y));
@@ -61,14 +62,14 @@ TEST(EstimationExact, UpdateIsBayesRuleOnTheBinomial) {
 }
 
 TEST(EstimationExact, RefusesHugeStateSpaces) {
-  FilterModel f = ThreeStateModel(1000, 0.5);  // C(1002, 2) = 501501 count vectors
-  auto ex = ExactBayesFilter::Create(f);
+  estimation::FilterModel f = ThreeStateModel(1000, 0.5);  // C(1002, 2) = 501501 count vectors
+  auto ex = estimation::ExactBayesFilter::Create(f);
   ASSERT_FALSE(ex.ok());
   EXPECT_NE(ex.error().find("more than 200000 count vectors"), std::string::npos) << ex.error();
-  ExactFilterOptions big;
+  estimation::ExactFilterOptions big;
   big.max_states = 600000;
   big.cache_bytes = 0;  // no S x S table: rows on the fly
-  EXPECT_TRUE(ExactBayesFilter::Create(f, big).ok());
+  EXPECT_TRUE(estimation::ExactBayesFilter::Create(f, big).ok());
 }
 
 // Paired Monte Carlo comparison on N = 60: the same simulated runs filtered by the extended
@@ -78,23 +79,24 @@ struct Comparison {
   std::vector<double> rmse_particle, dist_particle;  // per particle count; dist: |PF - exact|^2
 };
 
-Comparison Compare(const FilterModel& f, int runs, int steps, const std::vector<int>& particles) {
+Comparison Compare(const estimation::FilterModel& f, int runs, int steps,
+                   const std::vector<int>& particles) {
   Comparison c;
   c.rmse_particle.assign(particles.size(), 0.0);
   c.dist_particle.assign(particles.size(), 0.0);
-  auto exact = ExactBayesFilter::Create(f);  // one filter: its tables are cached per A
+  auto exact = estimation::ExactBayesFilter::Create(f);  // one filter: its tables are cached per A
   EXPECT_TRUE(exact.ok()) << exact.error();
   const std::vector<double> prior = exact->probabilities();
   for (int run = 0; run < runs; ++run) {
     Rng rng(Rng::DeriveSeed(77, run));
-    auto kf = PopulationKalmanFilter::Create(f, CovarianceMode::kExtended);
-    ExactBayesFilter& ex = *exact;
+    auto kf = estimation::PopulationKalmanFilter::Create(f, estimation::CovarianceMode::kExtended);
+    estimation::ExactBayesFilter& ex = *exact;
     EXPECT_TRUE(ex.SetProbabilities(prior).ok());  // back to the prior, keeping the tables
-    std::vector<ParticleFilter> pfs;
+    std::vector<estimation::ParticleFilter> pfs;
     std::vector<Rng> pf_rngs;
     for (size_t k = 0; k < particles.size(); ++k) {
       pf_rngs.emplace_back(Rng::DeriveSeed(1000 + run, k));
-      pfs.push_back(*ParticleFilter::Create(f, {particles[k], 0.5}, pf_rngs.back()));
+      pfs.push_back(*estimation::ParticleFilter::Create(f, {particles[k], 0.5}, pf_rngs.back()));
     }
     Eigen::VectorXd x = f.x0;
     for (int t = 0; t < steps; ++t) {
@@ -116,7 +118,7 @@ Comparison Compare(const FilterModel& f, int runs, int steps, const std::vector<
       }
       kf->Predict(A);
       ex.Predict(A);
-      x = SimulateStepAggregate(A, x, rng);
+      x = estimation::SimulateStepAggregate(A, x, rng);
     }
   }
   const double n = static_cast<double>(runs) * steps;
@@ -133,7 +135,7 @@ Comparison Compare(const FilterModel& f, int runs, int steps, const std::vector<
 // filter's mean converges to the exact posterior mean as the particles grow (mean squared
 // distance falling roughly as 1 / particles) and its RMSE approaches the exact one.
 TEST(EstimationBaselines, TwoStatesKalmanWithinFivePercentOfExactAndParticlesConverge) {
-  const FilterModel f = FilterModel::TwoState(60, 0.5, 0.45, 0.6);
+  const estimation::FilterModel f = estimation::FilterModel::TwoState(60, 0.5, 0.45, 0.6);
   const Comparison c = Compare(f, 100, 30, {20, 200, 2000});
   std::cout << "m = 2: RMSE Kalman " << c.rmse_kalman << ", exact " << c.rmse_exact
             << ", particles 20/200/2000 " << c.rmse_particle[0] << " / " << c.rmse_particle[1]
@@ -150,7 +152,7 @@ TEST(EstimationBaselines, TwoStatesKalmanWithinFivePercentOfExactAndParticlesCon
 
 // m = 3 (off, warming, on), N = 60: 1891 count vectors.
 TEST(EstimationBaselines, ThreeStatesKalmanWithinFivePercentOfExact) {
-  const FilterModel f = ThreeStateModel(60, 0.6);
+  const estimation::FilterModel f = ThreeStateModel(60, 0.6);
   const Comparison c = Compare(f, 30, 30, {200});
   std::cout << "m = 3: RMSE Kalman " << c.rmse_kalman << ", exact " << c.rmse_exact
             << ", particles 200 " << c.rmse_particle[0] << "\n";

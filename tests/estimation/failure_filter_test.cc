@@ -19,9 +19,9 @@ namespace recruit {
 namespace {
 
 // An 8-state heating chain with a force per state (0.45 N settled on), N units, noise 0.2 N.
-FilterModel ChainModel(int N, double noise = 0.2) {
-  FilterModel f;
-  f.broadcast = BroadcastTransitionModel::HeatingChain(8, 0.5);
+estimation::FilterModel ChainModel(int N, double noise = 0.2) {
+  estimation::FilterModel f;
+  f.broadcast = estimation::BroadcastTransitionModel::HeatingChain(8, 0.5);
   f.state_names = f.broadcast.state_names;
   f.N = N;
   f.H = Eigen::MatrixXd(1, 8);
@@ -29,7 +29,7 @@ FilterModel ChainModel(int N, double noise = 0.2) {
   f.R = Eigen::MatrixXd::Constant(1, 1, noise * noise);
   f.G = Eigen::MatrixXd::Zero(8, 0);
   f.Qw = Eigen::MatrixXd::Zero(0, 0);
-  f.transition = TransitionSource::kBroadcast;
+  f.transition = estimation::TransitionSource::kBroadcast;
   f.x0 = Eigen::VectorXd::Zero(8);
   f.x0[0] = N;
   f.P0 = Eigen::MatrixXd::Zero(8, 8);
@@ -49,9 +49,11 @@ struct Drive {
 };
 
 TEST(EstimationFailureFilter, WithoutDeclarationItIsThePapersFilterBitForBit) {
-  const FilterModel model = ChainModel(60);
-  auto plain = PopulationKalmanFilter::Create(model, CovarianceMode::kExtended);
-  auto aug = FailureKalmanFilter::Create(model, CovarianceMode::kExtended, {});
+  const estimation::FilterModel model = ChainModel(60);
+  auto plain =
+      estimation::PopulationKalmanFilter::Create(model, estimation::CovarianceMode::kExtended);
+  auto aug =
+      estimation::FailureKalmanFilter::Create(model, estimation::CovarianceMode::kExtended, {});
   ASSERT_TRUE(plain.ok() && aug.ok());
   Rng rng(3);
   Eigen::VectorXd x = model.x0;
@@ -71,7 +73,7 @@ TEST(EstimationFailureFilter, WithoutDeclarationItIsThePapersFilterBitForBit) {
     drive.Next(k, on, 60, &p_on, &p_off);
     plain->PredictBroadcast(p_on, p_off);
     aug->PredictBroadcast(p_on, p_off);
-    x = SimulateStepAggregate(model.broadcast.Matrix(p_on, p_off), x, rng);
+    x = estimation::SimulateStepAggregate(model.broadcast.Matrix(p_on, p_off), x, rng);
   }
   EXPECT_FALSE(aug->augmented());
   EXPECT_EQ(aug->working(), 60);
@@ -111,10 +113,10 @@ void EnumerateMoments(const std::vector<Eigen::MatrixXd>& steps, const std::vect
 }
 
 TEST(EstimationFailureFilter, AugmentedChainMeanAndQzMatchExactEnumeration) {
-  const FilterModel model = ChainModel(3);
+  const estimation::FilterModel model = ChainModel(3);
   const std::vector<Eigen::MatrixXd> steps = {
-      AugmentedTransition(model.broadcast, 0.6, 0.0, 0.1, 0.05),
-      AugmentedTransition(model.broadcast, 0.0, 0.3, 0.1, 0.05)};
+      estimation::AugmentedTransition(model.broadcast, 0.6, 0.0, 0.1, 0.05),
+      estimation::AugmentedTransition(model.broadcast, 0.0, 0.3, 0.1, 0.05)};
   const std::vector<int> units = {0, 2, 4};  // one off, two heated
   const int n = 24;                          // working, open, stuck: 8 states each
   Eigen::VectorXd x0 = Eigen::VectorXd::Zero(n);
@@ -124,13 +126,14 @@ TEST(EstimationFailureFilter, AugmentedChainMeanAndQzMatchExactEnumeration) {
   Eigen::MatrixXd cov;
   EnumerateMoments({steps[0]}, units, n, &mean, &cov);
   EXPECT_LT((mean - steps[0] * x0).norm(), 1e-12);
-  EXPECT_LT((cov - ProcessCovarianceQz(steps[0], x0)).norm(), 1e-12);
+  EXPECT_LT((cov - estimation::ProcessCovarianceQz(steps[0], x0)).norm(), 1e-12);
   // Two steps: E = A2 A1 X, Cov = A2 Qz(X) A2^T + Qz(A1 X) (the filter's recursion from P = 0,
   // exact because Qz is linear in X).
   EnumerateMoments(steps, units, n, &mean, &cov);
   EXPECT_LT((mean - steps[1] * steps[0] * x0).norm(), 1e-12);
-  const Eigen::MatrixXd P2 = steps[1] * ProcessCovarianceQz(steps[0], x0) * steps[1].transpose() +
-                             ProcessCovarianceQz(steps[1], steps[0] * x0);
+  const Eigen::MatrixXd P2 =
+      steps[1] * estimation::ProcessCovarianceQz(steps[0], x0) * steps[1].transpose() +
+      estimation::ProcessCovarianceQz(steps[1], steps[0] * x0);
   EXPECT_LT((cov - P2).norm(), 1e-12);
   // Failed classes absorb (no way back to the working states) and ignore broadcasts (their
   // block is the chain's interior); every column is stochastic.
@@ -144,11 +147,11 @@ TEST(EstimationFailureFilter, AugmentedChainMeanAndQzMatchExactEnumeration) {
 // Prior hazards alone (no detection): with no data the filter's mean working count follows
 // the closed form of a pure-death process on the heated units.
 TEST(EstimationFailureFilter, PriorHazardDepletesTheHeatedUnitsAsExpected) {
-  FilterModel model = ChainModel(50);
-  FailureFilterParams p;
+  estimation::FilterModel model = ChainModel(50);
+  estimation::FailureFilterParams p;
   p.open_hazard = 0.01;
   p.detect = false;
-  auto f = FailureKalmanFilter::Create(model, CovarianceMode::kExtended, p);
+  auto f = estimation::FailureKalmanFilter::Create(model, estimation::CovarianceMode::kExtended, p);
   ASSERT_TRUE(f.ok());
   // Settle every unit in the hot state (state 4 of the chain) first by broadcasting p_on = 1.
   f->PredictBroadcast(1, 0);
@@ -169,9 +172,10 @@ struct LinearRun {
   std::vector<double> nu, s;
   std::vector<Eigen::VectorXd> K, prior, posterior;  // 3m (failed classes 0)
 };
-LinearRun RunLinear(const FilterModel& model, const std::vector<double>& y,
+LinearRun RunLinear(const estimation::FilterModel& model, const std::vector<double>& y,
                     const std::vector<std::pair<double, double>>& broadcasts) {
-  auto f = PopulationKalmanFilter::Create(model, CovarianceMode::kConservative);
+  auto f =
+      estimation::PopulationKalmanFilter::Create(model, estimation::CovarianceMode::kConservative);
   const int m = model.num_states();
   LinearRun r;
   auto embed = [m](const Eigen::VectorXd& x) {
@@ -196,19 +200,20 @@ LinearRun RunLinear(const FilterModel& model, const std::vector<double>& y,
 
 // One unit moved into the open class, taken from the working states in proportion to the
 // prior's (negative round-off entries count as 0).
-Eigen::VectorXd LossDirection(const Eigen::VectorXd& prior, const BroadcastTransitionModel& b) {
+Eigen::VectorXd LossDirection(const Eigen::VectorXd& prior,
+                              const estimation::BroadcastTransitionModel& b) {
   const Eigen::VectorXd w = prior.head(8).cwiseMax(0.0);
   Eigen::VectorXd delta = Eigen::VectorXd::Zero(24);
   for (int j = 0; j < 8; ++j) {
     delta[j] -= w[j] / w.sum();
-    delta[8 + OpenEntry(b, j)] += w[j] / w.sum();
+    delta[8 + estimation::OpenEntry(b, j)] += w[j] / w.sum();
   }
   return delta;
 }
 
 // A recruiting broadcast sequence and a population's noisy force under it, no failure.
 struct Scenario {
-  FilterModel model = ChainModel(60, 0.1);
+  estimation::FilterModel model = ChainModel(60, 0.1);
   std::vector<std::pair<double, double>> broadcasts;
   std::vector<double> y0;
   explicit Scenario(int T, std::uint64_t seed) {
@@ -222,11 +227,12 @@ struct Scenario {
       double p_on, p_off;
       drive.Next(t, on, 60, &p_on, &p_off);
       broadcasts.emplace_back(p_on, p_off);
-      x = SimulateStepAggregate(model.broadcast.Matrix(p_on, p_off), x, rng);
+      x = estimation::SimulateStepAggregate(model.broadcast.Matrix(p_on, p_off), x, rng);
     }
   }
   Eigen::MatrixXd A(int t) const {
-    return AugmentedTransition(model.broadcast, broadcasts[t].first, broadcasts[t].second, 0, 0);
+    return estimation::AugmentedTransition(model.broadcast, broadcasts[t].first,
+                                           broadcasts[t].second, 0, 0);
   }
   Eigen::RowVectorXd TrueRow() const {
     Eigen::RowVectorXd h(24);
@@ -247,8 +253,8 @@ struct Scenario {
 };
 
 // Feeds a filter run to a GLR bank as FailureKalmanFilter does.
-FailureGlr Bank(const Scenario& sc, const LinearRun& r, int window) {
-  FailureGlr glr(sc.model.broadcast, window);
+estimation::FailureGlr Bank(const Scenario& sc, const LinearRun& r, int window) {
+  estimation::FailureGlr glr(sc.model.broadcast, window);
   const int T = static_cast<int>(r.nu.size());
   for (int t = 0; t < T; ++t) {
     glr.Open(r.prior[t]);
@@ -278,8 +284,8 @@ TEST(EstimationFailureGlr, MatchesTheClosedFormFromReRunningTheFilter) {
     C += rho * rho / lost.s[t];
   }
   ASSERT_GT(C, 0);
-  const FailureGlr glr = Bank(sc, lost, 40);
-  const FailureGlr::Best b = glr.Hypothesis(1, T - 1 - tau);
+  const estimation::FailureGlr glr = Bank(sc, lost, 40);
+  const estimation::FailureGlr::Best b = glr.Hypothesis(1, T - 1 - tau);
   ASSERT_EQ(b.to, 1);
   EXPECT_NEAR(b.count, d / C, 1e-8 * std::abs(d / C));
   EXPECT_NEAR(b.variance, 1 / C, 1e-8 / C);
@@ -314,7 +320,7 @@ TEST(EstimationFailureGlr, RatioAndCountFollowTheirSamplingDistributions) {
   for (int i = 0; i < n; ++i) {
     for (const double k : {0.0, k0}) {
       for (int t = 0; t < T; ++t) draw.nu[t] = std::sqrt(base.s[t]) * Gauss(rng) + k * rho[t];
-      const FailureGlr::Best b = Bank(sc, draw, 40).Hypothesis(1, T - 1 - tau);
+      const estimation::FailureGlr::Best b = Bank(sc, draw, 40).Hypothesis(1, T - 1 - tau);
       ASSERT_EQ(b.to, 1);
       if (k == 0) {
         above += b.llr > c;
@@ -337,10 +343,11 @@ TEST(EstimationFailureGlr, RatioAndCountFollowTheirSamplingDistributions) {
 // working estimate within 3 of its standard deviations (+ 1 unit) of the truth, 10 steps on.
 TEST(EstimationFailureFilter, AbruptLossIsDeclaredAndPlacedWithinItsVariance) {
   const int N = 60, lost = 6, seeds = 10;
-  const FilterModel model = ChainModel(N, 0.1);
+  const estimation::FilterModel model = ChainModel(N, 0.1);
   int declared = 0, false_alarms = 0;
   for (int seed = 0; seed < seeds; ++seed) {
-    auto f = FailureKalmanFilter::Create(model, CovarianceMode::kExtended, {});
+    auto f =
+        estimation::FailureKalmanFilter::Create(model, estimation::CovarianceMode::kExtended, {});
     ASSERT_TRUE(f.ok());
     Rng rng(1000 + seed);
     Eigen::VectorXd x = Eigen::VectorXd::Zero(24);
@@ -356,7 +363,7 @@ TEST(EstimationFailureFilter, AbruptLossIsDeclaredAndPlacedWithinItsVariance) {
           int j = 0;
           while (pick >= x[j]) pick -= x[j++];
           x[j] -= 1;
-          x[8 + OpenEntry(model.broadcast, j)] += 1;
+          x[8 + estimation::OpenEntry(model.broadcast, j)] += 1;
         }
       }
       const double force = model.H.row(0).dot(x.head(8) + x.segment(8, 8) + x.tail(8));
@@ -367,7 +374,8 @@ TEST(EstimationFailureFilter, AbruptLossIsDeclaredAndPlacedWithinItsVariance) {
       double p_on, p_off;
       drive.Next(k, on, N, &p_on, &p_off);
       f->PredictBroadcast(p_on, p_off);
-      x = SimulateStepAggregate(AugmentedTransition(model.broadcast, p_on, p_off, 0, 0), x, rng);
+      x = estimation::SimulateStepAggregate(
+          estimation::AugmentedTransition(model.broadcast, p_on, p_off, 0, 0), x, rng);
     }
     if (alarm || f->declarations() == 0) continue;
     ++declared;

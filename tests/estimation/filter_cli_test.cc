@@ -109,11 +109,11 @@ TEST_F(EstimationCli, DocumentedExampleRunsAndTracksTheTruth) {
   const double rmse = std::sqrt(se / rows.size());
   EXPECT_LT(rmse, 3.0) << "count RMSE against the simulated truth";
   // Same numbers as the library run in process.
-  auto m = FilterModel::FromJson(model);
+  auto m = estimation::FilterModel::FromJson(model);
   ASSERT_TRUE(m.ok());
-  auto f = MakeCountFilter(*m, {});
+  auto f = estimation::MakeCountFilter(*m, {});
   ASSERT_TRUE(f.ok());
-  auto csv = RunFilterOverText(*m, *ReadFile(log), log, **f);
+  auto csv = estimation::RunFilterOverText(*m, *ReadFile(log), log, **f);
   ASSERT_TRUE(csv.ok()) << csv.error();
   EXPECT_EQ(*ReadFile(Out()), *csv);
 }
@@ -279,8 +279,8 @@ TEST_F(EstimationCli, LongCellIsShortenedInTheMessage) {
 // measurements; the output numbers read back exactly (to_chars shortest form).
 TEST_F(EstimationCli, StreamedRunMatchesTheDenseFilter) {
   const int m = 20;
-  FilterModel f = FilterModel::TwoState(60, 0.5, 0.45, 0.3);
-  f.broadcast = BroadcastTransitionModel::HeatingChain(m, 0.5);
+  estimation::FilterModel f = estimation::FilterModel::TwoState(60, 0.5, 0.45, 0.3);
+  f.broadcast = estimation::BroadcastTransitionModel::HeatingChain(m, 0.5);
   f.state_names = f.broadcast.state_names;
   f.H = Eigen::MatrixXd::Zero(1, m);
   for (int i = 1; i < m; ++i) f.H(0, i) = 0.45 * (i <= m / 2 ? i : m - i) / (m / 2);
@@ -306,9 +306,10 @@ TEST_F(EstimationCli, StreamedRunMatchesTheDenseFilter) {
   const RunResult r =
       RunRecruit("filter --model " + model + " --log " + Write("log.csv", log) + " --out " + Out());
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  auto loaded = FilterModel::FromJson(model);
+  auto loaded = estimation::FilterModel::FromJson(model);
   ASSERT_TRUE(loaded.ok());
-  auto kf = PopulationKalmanFilter::Create(*loaded, CovarianceMode::kExtended);
+  auto kf =
+      estimation::PopulationKalmanFilter::Create(*loaded, estimation::CovarianceMode::kExtended);
   ASSERT_TRUE(kf.ok());
   std::string header;
   const auto rows = ReadCsvNumbers(Out(), &header);

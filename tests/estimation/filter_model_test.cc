@@ -21,7 +21,7 @@ namespace recruit {
 namespace {
 
 TEST(EstimationBroadcast, TwoStateMatrixIsTheClosedForm) {
-  const auto b = BroadcastTransitionModel::TwoState(0.5);
+  const auto b = estimation::BroadcastTransitionModel::TwoState(0.5);
   ASSERT_TRUE(b.Validate().ok()) << b.Validate().error();
   const Eigen::MatrixXd A = b.Matrix(0.3, 0.1);
   Eigen::Matrix2d expected;
@@ -31,7 +31,7 @@ TEST(EstimationBroadcast, TwoStateMatrixIsTheClosedForm) {
 
 TEST(EstimationBroadcast, AugmentedModelColumns) {
   // off0 (cold) --p_on--> on0 ; on0 --interior--> on1 ; on states --p_off--> off1 (cooling).
-  BroadcastTransitionModel b;
+  estimation::BroadcastTransitionModel b;
   b.state_names = {"off0", "off1", "on0", "on1"};
   b.is_on = {false, false, true, true};
   b.interior.setZero(4, 4);
@@ -44,7 +44,7 @@ TEST(EstimationBroadcast, AugmentedModelColumns) {
   b.dt = 0.5;
   ASSERT_TRUE(b.Validate().ok()) << b.Validate().error();
   const Eigen::MatrixXd A = b.Matrix(0.2, 0.3);
-  EXPECT_TRUE(ValidateColumnStochastic(A).ok());
+  EXPECT_TRUE(estimation::ValidateColumnStochastic(A).ok());
   // Column 1 (off1): 0.8 * (0.4, 0.6, 0, 0) + 0.2 e_2.
   EXPECT_NEAR(A(0, 1), 0.32, 1e-15);
   EXPECT_NEAR(A(1, 1), 0.48, 1e-15);
@@ -60,12 +60,12 @@ TEST(EstimationBroadcast, AugmentedModelColumns) {
 }
 
 TEST(EstimationFilterModel, SaveAndLoadRoundTrip) {
-  FilterModel f = FilterModel::TwoState(60, 0.5, 0.45, 0.3);
+  estimation::FilterModel f = estimation::FilterModel::TwoState(60, 0.5, 0.45, 0.3);
   f.x0 = Eigen::Vector2d(50, 10);
   f.P0 = Eigen::Matrix2d{{4, -4}, {-4, 4}};
   const std::string path = testing::TempDir() + "/estimation_model_roundtrip.json";
   ASSERT_TRUE(f.Save(path).ok());
-  auto g = FilterModel::FromJson(path);
+  auto g = estimation::FilterModel::FromJson(path);
   ASSERT_TRUE(g.ok()) << g.error();
   EXPECT_EQ(g->state_names, f.state_names);
   EXPECT_EQ(g->N, 60);
@@ -88,7 +88,7 @@ nlohmann::json GoodJson() {
 // and sweep files do: the file and key, the value (shortened) and what is allowed; each is bad
 // input, exit code 3.
 TEST(EstimationFilterModel, ClearErrorsForBadFields) {
-  ASSERT_TRUE(FilterModel::FromJsonValue(GoodJson(), "m.json").ok());
+  ASSERT_TRUE(estimation::FilterModel::FromJsonValue(GoodJson(), "m.json").ok());
   struct Case {
     std::string pointer;  // the field replaced ("-" + pointer: removed)
     nlohmann::json value;
@@ -155,7 +155,7 @@ TEST(EstimationFilterModel, ClearErrorsForBadFields) {
     } else {
       j[nlohmann::json::json_pointer(c.pointer)] = c.value;
     }
-    auto f = FilterModel::FromJsonValue(j, "m.json");
+    auto f = estimation::FilterModel::FromJsonValue(j, "m.json");
     ASSERT_FALSE(f.ok());
     EXPECT_NE(f.error().find(c.expected), std::string::npos) << f.error();
     EXPECT_EQ(exit_code::Of(f.failure()), exit_code::kBadInput) << f.error();
@@ -163,7 +163,7 @@ TEST(EstimationFilterModel, ClearErrorsForBadFields) {
   nlohmann::json j = GoodJson();
   j["G"] = nlohmann::json::parse("[[1], [0]]");
   j["Qw"] = nlohmann::json::parse("[[0.5]]");
-  auto f = FilterModel::FromJsonValue(j, "m.json");
+  auto f = estimation::FilterModel::FromJsonValue(j, "m.json");
   ASSERT_FALSE(f.ok());
   EXPECT_NE(f.error().find("m.json.G, Qw: G Qw G^T must have zero column sums"), std::string::npos)
       << f.error();
@@ -178,22 +178,22 @@ TEST(EstimationFilterModel, OptionalFieldsAreRead) {
   j["version"] = 1;
   j["initial"] = nlohmann::json::parse(R"({"x0": [50, 10], "P0": [[1, -1], [-1, 1]]})");
   j["identification"] = nlohmann::json::parse(R"({"holdout": {"r2": 0.75}, "dT": 0.5})");
-  auto f = FilterModel::FromJsonValue(j, "m.json");
+  auto f = estimation::FilterModel::FromJsonValue(j, "m.json");
   ASSERT_TRUE(f.ok()) << f.error();
   EXPECT_EQ(f->x0, Eigen::Vector2d(50, 10));
   EXPECT_EQ(f->P0, (Eigen::Matrix2d{{1, -1}, {-1, 1}}));
   EXPECT_EQ(f->holdout_r2, 0.75);
-  EXPECT_TRUE(std::isnan(FilterModel::FromJsonValue(GoodJson(), "m.json")->holdout_r2));
+  EXPECT_TRUE(std::isnan(estimation::FilterModel::FromJsonValue(GoodJson(), "m.json")->holdout_r2));
 }
 
 TEST(EstimationFilterModel, MissingAndMalformedFiles) {
-  auto missing = FilterModel::FromJson("/nonexistent/dir/model.json");
+  auto missing = estimation::FilterModel::FromJson("/nonexistent/dir/model.json");
   ASSERT_FALSE(missing.ok());
   EXPECT_NE(missing.error().find("/nonexistent/dir/model.json"), std::string::npos);
   EXPECT_EQ(exit_code::Of(missing.failure()), exit_code::kIo);  // the file cannot be read
   const std::string path = testing::TempDir() + "/estimation_malformed.json";
   std::ofstream(path) << "{\"states\": [\"off\", ";
-  auto bad = FilterModel::FromJson(path);
+  auto bad = estimation::FilterModel::FromJson(path);
   ASSERT_FALSE(bad.ok());
   EXPECT_NE(bad.error().find("malformed JSON"), std::string::npos) << bad.error();
   EXPECT_EQ(exit_code::Of(bad.failure()), exit_code::kBadInput);
@@ -213,7 +213,7 @@ TEST(EstimationFilterModel, NumberTooLargeForADoubleNamesFileAndField) {
       WriteTemp("estimation_overflow.json",
                 R"({"states": ["off", "on"], "N": 60, "H": [[0, 1e999]], "R": [[0.09]],
           "transition": {"type": "explicit"}})");
-  auto f = FilterModel::FromJson(path);
+  auto f = estimation::FilterModel::FromJson(path);
   ASSERT_FALSE(f.ok());
   EXPECT_NE(f.error().find(path + ": field H[0][1]: number '1e999' is too large for a double"),
             std::string::npos)
@@ -227,7 +227,7 @@ TEST(EstimationFilterModel, DeepNestingIsRejectedBeforeRecursion) {
   const std::string path =
       WriteTemp("estimation_deep.json",
                 R"({"states": )" + std::string(depth, '[') + std::string(depth, ']') + "}");
-  auto f = FilterModel::FromJson(path);
+  auto f = estimation::FilterModel::FromJson(path);
   ASSERT_FALSE(f.ok());
   EXPECT_NE(f.error().find(path + ": field states[0]"), std::string::npos) << f.error();
   EXPECT_NE(f.error().find("nested deeper than 64 levels"), std::string::npos) << f.error();
@@ -251,7 +251,7 @@ TEST(EstimationFilterModel, LongValuesAreShortenedInMessages) {
   for (size_t i = 0; i < docs.size(); ++i) {
     SCOPED_TRACE(i);
     const std::string path = WriteTemp("estimation_long.json", docs[i]);
-    auto f = FilterModel::FromJson(path);
+    auto f = estimation::FilterModel::FromJson(path);
     ASSERT_FALSE(f.ok());
     EXPECT_LT(f.error().size(), 400u) << f.error().substr(0, 400);
     std::remove(path.c_str());
@@ -261,7 +261,7 @@ TEST(EstimationFilterModel, LongValuesAreShortenedInMessages) {
 // The file reader (1 MiB chunks, lines cut at chunk boundaries) gives the same output as the
 // in-memory text, for a log of about 3 MB with a byte-order mark, comments and blank lines.
 TEST(EstimationFilterLog, FileStreamMatchesInMemoryText) {
-  const FilterModel f = FilterModel::TwoState(60, 0.5, 0.45, 0.3);
+  const estimation::FilterModel f = estimation::FilterModel::TwoState(60, 0.5, 0.45, 0.3);
   std::string text = "\xEF\xBB\xBFt,p_on,p_off,y\n# a comment\n";
   for (int k = 0; k < 100000; ++k) {
     text += std::to_string(0.5 * k) + "," + std::to_string(0.001 * (k % 300)) + "," +
@@ -270,15 +270,15 @@ TEST(EstimationFilterLog, FileStreamMatchesInMemoryText) {
             (k % 1000 == 7 ? "\n\n" : "\n");
   }
   const std::string path = WriteTemp("estimation_stream_log.csv", text);
-  auto a = MakeCountFilter(f, {});
-  auto b = MakeCountFilter(f, {});
+  auto a = estimation::MakeCountFilter(f, {});
+  auto b = estimation::MakeCountFilter(f, {});
   ASSERT_TRUE(a.ok() && b.ok());
-  auto in_memory = RunFilterOverText(f, text, path, **a);
+  auto in_memory = estimation::RunFilterOverText(f, text, path, **a);
   ASSERT_TRUE(in_memory.ok()) << in_memory.error();
-  auto reader = FilterLogReader::OpenFile(path, f);
+  auto reader = estimation::FilterLogReader::OpenFile(path, f);
   ASSERT_TRUE(reader.ok()) << reader.error();
   std::ostringstream out;
-  const Status s = RunFilterStream(f, **reader, **b, out);
+  const Status s = estimation::RunFilterStream(f, **reader, **b, out);
   ASSERT_TRUE(s.ok()) << s.error();
   const std::string streamed = out.str();
   EXPECT_EQ(streamed, *in_memory);

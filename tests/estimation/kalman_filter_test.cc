@@ -9,14 +9,14 @@ namespace {
 
 // m = 2, r = 1: X^ = (6, 4), P = 2 [1 -1; -1 1], N = 10,
 // A = [0.9 0.3; 0.1 0.7], H = [0 1], R = 0.5, y = 4.
-FilterModel HandModel() {
-  FilterModel f = FilterModel::TwoState(10, 1.0, 1.0, std::sqrt(0.5));
-  f.transition = TransitionSource::kExplicit;
+estimation::FilterModel HandModel() {
+  estimation::FilterModel f = estimation::FilterModel::TwoState(10, 1.0, 1.0, std::sqrt(0.5));
+  f.transition = estimation::TransitionSource::kExplicit;
   return f;
 }
 
 struct HandCase {
-  CovarianceMode mode;
+  estimation::CovarianceMode mode;
   double qz;  // the scalar c with Qz = c [1 -1; -1 1]
 };
 
@@ -28,7 +28,8 @@ TEST_P(EstimationKalmanHandStep, MatchesEquationsWorkedByHand) {
   A << 0.9, 0.3, 0.1, 0.7;
   Eigen::Matrix2d P0;
   P0 << 2, -2, -2, 2;
-  auto f = PopulationKalmanFilter::Create(HandModel(), c.mode, Eigen::Vector2d(6, 4), P0);
+  auto f =
+      estimation::PopulationKalmanFilter::Create(HandModel(), c.mode, Eigen::Vector2d(6, 4), P0);
   ASSERT_TRUE(f.ok()) << f.error();
   f->Predict(A);
   // (16): A X^ = (0.9*6 + 0.3*4, 0.1*6 + 0.7*4) = (6.6, 3.4).
@@ -60,9 +61,9 @@ TEST_P(EstimationKalmanHandStep, MatchesEquationsWorkedByHand) {
 //   conservative at X = (10, 10): 10 * 0.09 + 10 * 0.21 = 3.0
 //   plain:                        0
 INSTANTIATE_TEST_SUITE_P(Modes, EstimationKalmanHandStep,
-                         ::testing::Values(HandCase{CovarianceMode::kExtended, 1.38},
-                                           HandCase{CovarianceMode::kConservative, 3.0},
-                                           HandCase{CovarianceMode::kPlain, 0.0}),
+                         ::testing::Values(HandCase{estimation::CovarianceMode::kExtended, 1.38},
+                                           HandCase{estimation::CovarianceMode::kConservative, 3.0},
+                                           HandCase{estimation::CovarianceMode::kPlain, 0.0}),
                          [](const auto& info) { return std::string(ToString(info.param.mode)); });
 
 // The fixed-size path gives the same numbers as the dynamic one.
@@ -71,10 +72,10 @@ TEST(EstimationKalman, FixedSizeMatchesDynamic) {
   A << 0.9, 0.3, 0.1, 0.7;
   Eigen::Matrix2d P0;
   P0 << 2, -2, -2, 2;
-  auto d = PopulationKalmanFilter::Create(HandModel(), CovarianceMode::kExtended,
-                                          Eigen::Vector2d(6, 4), P0);
-  auto s = PopulationKalmanFilterT<2, 1>::Create(HandModel(), CovarianceMode::kExtended,
-                                                 Eigen::Vector2d(6, 4), P0);
+  auto d = estimation::PopulationKalmanFilter::Create(
+      HandModel(), estimation::CovarianceMode::kExtended, Eigen::Vector2d(6, 4), P0);
+  auto s = estimation::PopulationKalmanFilterT<2, 1>::Create(
+      HandModel(), estimation::CovarianceMode::kExtended, Eigen::Vector2d(6, 4), P0);
   ASSERT_TRUE(d.ok() && s.ok());
   for (int t = 0; t < 50; ++t) {
     d->Predict(A);
@@ -91,7 +92,7 @@ TEST(EstimationKalman, FixedSizeMatchesDynamic) {
 // m = 3, r = 2, with process noise: one step against a textbook Kalman filter written with an
 // explicit inverse and the factored Joseph form.
 TEST(EstimationKalman, MatchesTextbookFilterWithTwoOutputsAndProcessNoise) {
-  FilterModel f;
+  estimation::FilterModel f;
   f.state_names = {"a", "b", "c"};
   f.N = 30;
   f.H.resize(2, 3);
@@ -101,7 +102,7 @@ TEST(EstimationKalman, MatchesTextbookFilterWithTwoOutputsAndProcessNoise) {
   f.G.resize(3, 1);
   f.G << 1.0, -1.0, 0.0;  // moves agents a <-> b: column sums of G Qw G^T are zero
   f.Qw = Eigen::MatrixXd::Constant(1, 1, 0.7);
-  f.transition = TransitionSource::kExplicit;
+  f.transition = estimation::TransitionSource::kExplicit;
   f.x0 = Eigen::Vector3d(10, 15, 5);
   f.P0 = Eigen::MatrixXd::Zero(3, 3);
   Eigen::Matrix3d A;
@@ -110,7 +111,8 @@ TEST(EstimationKalman, MatchesTextbookFilterWithTwoOutputsAndProcessNoise) {
   P0 << 2, -1, -1, -1, 1.5, -0.5, -1, -0.5, 1.5;
   const Eigen::Vector3d x0(10, 15, 5);
   const Eigen::Vector2d y(17.0, 9.0);
-  auto kf = PopulationKalmanFilter::Create(f, CovarianceMode::kExtended, x0, P0);
+  auto kf =
+      estimation::PopulationKalmanFilter::Create(f, estimation::CovarianceMode::kExtended, x0, P0);
   ASSERT_TRUE(kf.ok()) << kf.error();
   kf->Predict(A);
   kf->Update(y);
@@ -137,19 +139,20 @@ TEST(EstimationKalman, MatchesTextbookFilterWithTwoOutputsAndProcessNoise) {
 // at the projection onto {n >= 0, sum = N}, so the predicted P is A P A^T + Qz(proj X^) with a
 // PSD Qz. Reference: the free functions ProjectOntoSimplex and ProcessCovarianceQz.
 TEST(EstimationKalman, ExtendedModeProjectsNegativeEstimates) {
-  FilterModel f;
+  estimation::FilterModel f;
   f.state_names = {"a", "b", "c"};
   f.N = 10;
   f.H = Eigen::RowVector3d(1.0, 0.0, 0.0);
   f.R = Eigen::MatrixXd::Constant(1, 1, 0.01);
   f.G = Eigen::MatrixXd::Zero(3, 0);
   f.Qw = Eigen::MatrixXd::Zero(0, 0);
-  f.transition = TransitionSource::kExplicit;
+  f.transition = estimation::TransitionSource::kExplicit;
   f.x0 = Eigen::Vector3d(2, 4, 4);
   f.P0 = Eigen::Matrix3d::Zero();
   Eigen::Matrix3d P0;
   P0 << 8, -4, -4, -4, 8, -4, -4, -4, 8;
-  auto kf = PopulationKalmanFilter::Create(f, CovarianceMode::kExtended, f.x0, P0);
+  auto kf = estimation::PopulationKalmanFilter::Create(f, estimation::CovarianceMode::kExtended,
+                                                       f.x0, P0);
   ASSERT_TRUE(kf.ok());
   kf->Update(Eigen::VectorXd::Constant(1, 12.0));  // above N: pushes b and c below 0
   const Eigen::VectorXd x = kf->estimate();
@@ -158,30 +161,31 @@ TEST(EstimationKalman, ExtendedModeProjectsNegativeEstimates) {
   Eigen::Matrix3d A;
   A << 0.5, 0.2, 0.1, 0.3, 0.6, 0.2, 0.2, 0.2, 0.7;
   kf->Predict(A);
-  const Eigen::VectorXd xp = ProjectOntoSimplex(x, 10.0);
-  const Eigen::MatrixXd Qz = ProcessCovarianceQz(A, xp);
+  const Eigen::VectorXd xp = estimation::ProjectOntoSimplex(x, 10.0);
+  const Eigen::MatrixXd Qz = estimation::ProcessCovarianceQz(A, xp);
   EXPECT_GE(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(Qz).eigenvalues().minCoeff(), -1e-12);
   const Eigen::MatrixXd expected = A * P * A.transpose() + Qz;
   EXPECT_LT((kf->covariance() - expected).cwiseAbs().maxCoeff(), 1e-12);
   EXPECT_LT((kf->estimate() - A * x).cwiseAbs().maxCoeff(), 1e-12);
   // The projection mattered: Qz at the raw estimate is a different matrix.
-  EXPECT_GT((ProcessCovarianceQz(A, x) - Qz).cwiseAbs().maxCoeff(), 0.1);
+  EXPECT_GT((estimation::ProcessCovarianceQz(A, x) - Qz).cwiseAbs().maxCoeff(), 0.1);
 }
 
 TEST(EstimationKalman, RejectsBadInitialBeliefAndInputs) {
-  const FilterModel f = HandModel();
-  auto bad_sum = PopulationKalmanFilter::Create(f, CovarianceMode::kExtended, Eigen::Vector2d(6, 5),
-                                                Eigen::Matrix2d::Zero());
+  const estimation::FilterModel f = HandModel();
+  auto bad_sum = estimation::PopulationKalmanFilter::Create(
+      f, estimation::CovarianceMode::kExtended, Eigen::Vector2d(6, 5), Eigen::Matrix2d::Zero());
   ASSERT_FALSE(bad_sum.ok());
   EXPECT_NE(bad_sum.error().find("sum to N = 10"), std::string::npos) << bad_sum.error();
-  auto bad_size = PopulationKalmanFilter::Create(f, CovarianceMode::kExtended,
-                                                 Eigen::Vector3d(6, 4, 0), Eigen::Matrix2d::Zero());
+  auto bad_size = estimation::PopulationKalmanFilter::Create(
+      f, estimation::CovarianceMode::kExtended, Eigen::Vector3d(6, 4, 0), Eigen::Matrix2d::Zero());
   EXPECT_FALSE(bad_size.ok());
-  auto fixed_wrong = PopulationKalmanFilterT<3, 1>::Create(f, CovarianceMode::kExtended);
+  auto fixed_wrong =
+      estimation::PopulationKalmanFilterT<3, 1>::Create(f, estimation::CovarianceMode::kExtended);
   ASSERT_FALSE(fixed_wrong.ok());
   EXPECT_NE(fixed_wrong.error().find("m = 3"), std::string::npos);
 
-  auto kf = PopulationKalmanFilter::Create(f, CovarianceMode::kExtended);
+  auto kf = estimation::PopulationKalmanFilter::Create(f, estimation::CovarianceMode::kExtended);
   ASSERT_TRUE(kf.ok());
   Eigen::Matrix2d A;
   A << 0.9, 0.3, 0.2, 0.7;  // column 0 sums to 1.1

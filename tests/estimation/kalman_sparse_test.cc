@@ -16,8 +16,8 @@ namespace {
 
 // m states, N = 60, a force sensor (state i gives 0.45 i / (m - 1) per unit), P0 a random
 // PSD matrix (projected onto 1^T P0 = 0 by the filter), x0 a random point of the simplex.
-FilterModel RandomModel(int m, Rng& rng, bool process_noise) {
-  FilterModel f;
+estimation::FilterModel RandomModel(int m, Rng& rng, bool process_noise) {
+  estimation::FilterModel f;
   for (int i = 0; i < m; ++i) f.state_names.push_back("s" + std::to_string(i));
   f.N = 60;
   f.H.resize(1, m);
@@ -32,7 +32,7 @@ FilterModel RandomModel(int m, Rng& rng, bool process_noise) {
     f.G = Eigen::MatrixXd::Zero(m, 0);
     f.Qw = Eigen::MatrixXd::Zero(0, 0);
   }
-  f.transition = TransitionSource::kExplicit;
+  f.transition = estimation::TransitionSource::kExplicit;
   Eigen::VectorXd w(m);
   for (int i = 0; i < m; ++i) w(i) = rng.Uniform();
   f.x0 = 60.0 * w / w.sum();
@@ -43,10 +43,10 @@ FilterModel RandomModel(int m, Rng& rng, bool process_noise) {
 }
 
 // RandomModel driven by broadcasts of the m-state heating chain (p_on = 0.5).
-FilterModel HeatingChainModel(int m, Rng& rng, bool process_noise) {
-  FilterModel f = RandomModel(m, rng, process_noise);
-  f.transition = TransitionSource::kBroadcast;
-  f.broadcast = BroadcastTransitionModel::HeatingChain(m, 0.5);
+estimation::FilterModel HeatingChainModel(int m, Rng& rng, bool process_noise) {
+  estimation::FilterModel f = RandomModel(m, rng, process_noise);
+  f.transition = estimation::TransitionSource::kBroadcast;
+  f.broadcast = estimation::BroadcastTransitionModel::HeatingChain(m, 0.5);
   f.state_names = f.broadcast.state_names;
   return f;
 }
@@ -77,17 +77,18 @@ double Scale(const Eigen::MatrixXd& P) { return 1.0 + P.cwiseAbs().maxCoeff(); }
 // 40 predict + update steps with random sparse A: the sparse and the dense Predict give the
 // same estimate and covariance to 1e-12 (relative to the covariance's size) at every step.
 template <int M>
-void SparseMatchesDense(CovarianceMode mode, bool process_noise, uint64_t seed, bool avx) {
+void SparseMatchesDense(estimation::CovarianceMode mode, bool process_noise, uint64_t seed,
+                        bool avx) {
   Rng rng(seed);
   const int m = M == Eigen::Dynamic ? 20 : M;
-  const FilterModel f = RandomModel(m, rng, process_noise);
-  auto sparse = PopulationKalmanFilterT<M, 1>::Create(f, mode);
-  auto dense = PopulationKalmanFilterT<M, 1>::Create(f, mode);
+  const estimation::FilterModel f = RandomModel(m, rng, process_noise);
+  auto sparse = estimation::PopulationKalmanFilterT<M, 1>::Create(f, mode);
+  auto dense = estimation::PopulationKalmanFilterT<M, 1>::Create(f, mode);
   ASSERT_TRUE(sparse.ok()) << sparse.error();
   ASSERT_TRUE(dense.ok());
   sparse->set_avx_kernels(avx);
   if (avx && !sparse->avx_kernels()) return;  // no AVX copy in this build or on this CPU
-  using Mat = typename PopulationKalmanFilterT<M, 1>::Mat;
+  using Mat = typename estimation::PopulationKalmanFilterT<M, 1>::Mat;
   for (int t = 0; t < 40; ++t) {
     const Eigen::SparseMatrix<double> A = RandomSparseStochastic(m, rng);
     const Mat Ad = Eigen::MatrixXd(A);
@@ -105,7 +106,7 @@ void SparseMatchesDense(CovarianceMode mode, bool process_noise, uint64_t seed, 
 }
 
 template <int M>
-void SparseMatchesDense(CovarianceMode mode, bool process_noise, uint64_t seed) {
+void SparseMatchesDense(estimation::CovarianceMode mode, bool process_noise, uint64_t seed) {
   for (bool avx : {false, true}) {
     SCOPED_TRACE(avx ? "AVX kernels" : "baseline kernels");
     SparseMatchesDense<M>(mode, process_noise, seed, avx);
@@ -113,16 +114,16 @@ void SparseMatchesDense(CovarianceMode mode, bool process_noise, uint64_t seed) 
 }
 
 TEST(EstimationKalmanSparse, MatchesDensePredictFixedSize) {
-  SparseMatchesDense<20>(CovarianceMode::kExtended, false, 1);
-  SparseMatchesDense<20>(CovarianceMode::kConservative, false, 2);
-  SparseMatchesDense<20>(CovarianceMode::kPlain, false, 3);
-  SparseMatchesDense<20>(CovarianceMode::kExtended, true, 4);
-  SparseMatchesDense<3>(CovarianceMode::kExtended, false, 5);
+  SparseMatchesDense<20>(estimation::CovarianceMode::kExtended, false, 1);
+  SparseMatchesDense<20>(estimation::CovarianceMode::kConservative, false, 2);
+  SparseMatchesDense<20>(estimation::CovarianceMode::kPlain, false, 3);
+  SparseMatchesDense<20>(estimation::CovarianceMode::kExtended, true, 4);
+  SparseMatchesDense<3>(estimation::CovarianceMode::kExtended, false, 5);
 }
 
 TEST(EstimationKalmanSparse, MatchesDensePredictDynamicSize) {
-  SparseMatchesDense<Eigen::Dynamic>(CovarianceMode::kExtended, false, 6);
-  SparseMatchesDense<Eigen::Dynamic>(CovarianceMode::kConservative, true, 7);
+  SparseMatchesDense<Eigen::Dynamic>(estimation::CovarianceMode::kExtended, false, 6);
+  SparseMatchesDense<Eigen::Dynamic>(estimation::CovarianceMode::kConservative, true, 7);
 }
 
 // One prediction against the equations with dense matrices (eqs. 16, 22, 26): P' = A P A^T +
@@ -131,8 +132,8 @@ TEST(EstimationKalmanSparse, MatchesDensePredictDynamicSize) {
 TEST(EstimationKalmanSparse, MatchesPredictionEquations) {
   Rng rng(11);
   const int m = 20;
-  const FilterModel f = RandomModel(m, rng, true);
-  auto kf = PopulationKalmanFilter::Create(f, CovarianceMode::kExtended);
+  const estimation::FilterModel f = RandomModel(m, rng, true);
+  auto kf = estimation::PopulationKalmanFilter::Create(f, estimation::CovarianceMode::kExtended);
   ASSERT_TRUE(kf.ok());
   const Eigen::VectorXd x = kf->estimate();
   const Eigen::MatrixXd P = kf->covariance();
@@ -153,15 +154,17 @@ TEST(EstimationKalmanSparse, MatchesPredictionEquations) {
 TEST(EstimationKalmanSparse, IdentifiedBroadcastModels) {
   for (const char* name : {"bench_n60_dt0.5_m20.json", "bench_n60_dt2.0_m20.json"}) {
     SCOPED_TRACE(name);
-    auto model =
-        FilterModel::FromJson(std::string(RECRUIT_SOURCE_DIR) + "/models/identified/" + name);
+    auto model = estimation::FilterModel::FromJson(std::string(RECRUIT_SOURCE_DIR) +
+                                                   "/models/identified/" + name);
     ASSERT_TRUE(model.ok()) << model.error();
-    const BroadcastTransitionModel& b = model->broadcast;
+    const estimation::BroadcastTransitionModel& b = model->broadcast;
     ASSERT_EQ(b.num_states(), 20);
     Eigen::SparseMatrix<double> As = b.SparsePattern();
     for (int j = 0; j < 20; ++j) EXPECT_LE(As.col(j).nonZeros(), 3);
-    auto sparse = PopulationKalmanFilterT<20, 1>::Create(*model, CovarianceMode::kExtended);
-    auto dense = PopulationKalmanFilterT<20, 1>::Create(*model, CovarianceMode::kExtended);
+    auto sparse = estimation::PopulationKalmanFilterT<20, 1>::Create(
+        *model, estimation::CovarianceMode::kExtended);
+    auto dense = estimation::PopulationKalmanFilterT<20, 1>::Create(
+        *model, estimation::CovarianceMode::kExtended);
     ASSERT_TRUE(sparse.ok()) << sparse.error();
     ASSERT_TRUE(dense.ok());
     Rng rng(13);
@@ -178,7 +181,7 @@ TEST(EstimationKalmanSparse, IdentifiedBroadcastModels) {
       ASSERT_LT((sparse->covariance() - dense->covariance()).cwiseAbs().maxCoeff(), 1e-12 * scale)
           << "step " << t;
       ASSERT_LT((sparse->estimate() - dense->estimate()).cwiseAbs().maxCoeff(), 1e-12 * 60.0);
-      x = SimulateStepAggregate(A, x, rng);
+      x = estimation::SimulateStepAggregate(A, x, rng);
       const Eigen::Matrix<double, 1, 1> y(model->H.row(0).dot(x) + 0.3 * (rng.Uniform() - 0.5));
       sparse->Update(y);
       dense->Update(y);
@@ -197,12 +200,12 @@ namespace {
 TEST(EstimationKalmanSparse, HeatingChainIsAValidSparseBroadcastModel) {
   for (int m : {2, 3, 20, 50}) {
     SCOPED_TRACE(m);
-    const auto b = BroadcastTransitionModel::HeatingChain(m, 0.5);
+    const auto b = estimation::BroadcastTransitionModel::HeatingChain(m, 0.5);
     ASSERT_TRUE(b.Validate().ok()) << b.Validate().error();
     Eigen::SparseMatrix<double> As = b.SparsePattern();
     for (double p : {0.0, 0.37, 1.0}) {
       const Eigen::MatrixXd A = b.Matrix(p, 1.0 - p);
-      EXPECT_TRUE(ValidateColumnStochastic(A).ok());
+      EXPECT_TRUE(estimation::ValidateColumnStochastic(A).ok());
       b.FillSparse(p, 1.0 - p, As);
       EXPECT_EQ((Eigen::MatrixXd(As) - A).cwiseAbs().maxCoeff(), 0.0);
     }
@@ -219,11 +222,11 @@ TEST(EstimationKalmanSparse, HeatingChainIsAValidSparseBroadcastModel) {
 // covariance mode, m = 20 and 50 (fixed size) and the dynamic-size filter; equal to 1e-12
 // relative at every step.
 template <int M>
-void BroadcastMatchesDense(int m, CovarianceMode mode, uint64_t seed, bool avx) {
+void BroadcastMatchesDense(int m, estimation::CovarianceMode mode, uint64_t seed, bool avx) {
   Rng rng(seed);
-  const FilterModel f = HeatingChainModel(m, rng, false);
-  auto sparse = PopulationKalmanFilterT<M, 1>::Create(f, mode);
-  auto dense = PopulationKalmanFilterT<M, 1>::Create(f, mode);
+  const estimation::FilterModel f = HeatingChainModel(m, rng, false);
+  auto sparse = estimation::PopulationKalmanFilterT<M, 1>::Create(f, mode);
+  auto dense = estimation::PopulationKalmanFilterT<M, 1>::Create(f, mode);
   ASSERT_TRUE(sparse.ok()) << sparse.error();
   ASSERT_TRUE(dense.ok());
   ASSERT_TRUE(sparse->has_broadcast());
@@ -232,7 +235,8 @@ void BroadcastMatchesDense(int m, CovarianceMode mode, uint64_t seed, bool avx) 
   for (int t = 0; t < 64; ++t) {
     const double p_on = 0.3 * rng.Uniform(), p_off = 0.3 * rng.Uniform();
     sparse->PredictBroadcast(p_on, p_off);
-    dense->Predict(typename PopulationKalmanFilterT<M, 1>::Mat(f.broadcast.Matrix(p_on, p_off)));
+    dense->Predict(
+        typename estimation::PopulationKalmanFilterT<M, 1>::Mat(f.broadcast.Matrix(p_on, p_off)));
     const double scale = Scale(dense->covariance());
     ASSERT_LT((sparse->covariance() - dense->covariance()).cwiseAbs().maxCoeff(), 1e-12 * scale)
         << "step " << t;
@@ -250,8 +254,9 @@ void BroadcastMatchesDense(int m, CovarianceMode mode, uint64_t seed, bool avx) 
 }
 
 TEST(EstimationKalmanSparse, PredictBroadcastMatchesDensePredict) {
-  for (CovarianceMode mode :
-       {CovarianceMode::kExtended, CovarianceMode::kConservative, CovarianceMode::kPlain}) {
+  for (estimation::CovarianceMode mode :
+       {estimation::CovarianceMode::kExtended, estimation::CovarianceMode::kConservative,
+        estimation::CovarianceMode::kPlain}) {
     for (bool avx : {false, true}) {
       SCOPED_TRACE(std::string(ToString(mode)) + (avx ? ", AVX kernels" : ", baseline kernels"));
       BroadcastMatchesDense<20>(20, mode, 21, avx);
@@ -276,11 +281,12 @@ bool BitIdentical(const F& a, const F& b) {
 // followed by an update, one measurement in eleven far off so that the extended mode projects
 // negative estimates; bit-identical after every predict and every update.
 template <int M>
-void AvxMatchesBaselineBitwise(int m, CovarianceMode mode, bool process_noise, uint64_t seed) {
+void AvxMatchesBaselineBitwise(int m, estimation::CovarianceMode mode, bool process_noise,
+                               uint64_t seed) {
   Rng rng(seed);
-  const FilterModel f = HeatingChainModel(m, rng, process_noise);
-  auto base = PopulationKalmanFilterT<M, 1>::Create(f, mode);
-  auto avx = PopulationKalmanFilterT<M, 1>::Create(f, mode);
+  const estimation::FilterModel f = HeatingChainModel(m, rng, process_noise);
+  auto base = estimation::PopulationKalmanFilterT<M, 1>::Create(f, mode);
+  auto avx = estimation::PopulationKalmanFilterT<M, 1>::Create(f, mode);
   ASSERT_TRUE(base.ok()) << base.error();
   ASSERT_TRUE(avx.ok());
   base->set_avx_kernels(false);
@@ -308,13 +314,15 @@ void AvxMatchesBaselineBitwise(int m, CovarianceMode mode, bool process_noise, u
 
 TEST(EstimationKalmanSparse, AvxKernelsBitIdenticalToBaseline) {
   Rng rng(31);
-  auto probe = PopulationKalmanFilter::Create(RandomModel(4, rng, false), CovarianceMode::kPlain);
+  auto probe = estimation::PopulationKalmanFilter::Create(RandomModel(4, rng, false),
+                                                          estimation::CovarianceMode::kPlain);
   ASSERT_TRUE(probe.ok());
   probe->set_avx_kernels(true);
   if (!probe->avx_kernels()) GTEST_SKIP() << "no AVX copy of the kernels in this build or CPU";
   uint64_t seed = 40;
-  for (CovarianceMode mode :
-       {CovarianceMode::kExtended, CovarianceMode::kConservative, CovarianceMode::kPlain}) {
+  for (estimation::CovarianceMode mode :
+       {estimation::CovarianceMode::kExtended, estimation::CovarianceMode::kConservative,
+        estimation::CovarianceMode::kPlain}) {
     for (bool noise : {false, true}) {
       SCOPED_TRACE(std::string(ToString(mode)) + (noise ? ", process noise" : ""));
       AvxMatchesBaselineBitwise<3>(3, mode, noise, ++seed);
@@ -333,7 +341,8 @@ TEST(EstimationKalmanSparse, AvxKernelsBitIdenticalToBaseline) {
 // A filter of a non-broadcast model has no broadcast matrix.
 TEST(EstimationKalmanSparse, PredictBroadcastNeedsABroadcastModel) {
   Rng rng(3);
-  auto kf = PopulationKalmanFilter::Create(RandomModel(4, rng, false), CovarianceMode::kExtended);
+  auto kf = estimation::PopulationKalmanFilter::Create(RandomModel(4, rng, false),
+                                                       estimation::CovarianceMode::kExtended);
   ASSERT_TRUE(kf.ok());
   EXPECT_FALSE(kf->has_broadcast());
 }
@@ -342,8 +351,8 @@ TEST(EstimationKalmanSparse, PredictBroadcastNeedsABroadcastModel) {
 // and the Joseph form of (20) written out with dense matrices and a matrix inverse.
 TEST(EstimationKalmanSparse, ScalarUpdateMatchesJosephForm) {
   Rng rng(5);
-  const FilterModel f = RandomModel(7, rng, false);
-  auto kf = PopulationKalmanFilter::Create(f, CovarianceMode::kExtended);
+  const estimation::FilterModel f = RandomModel(7, rng, false);
+  auto kf = estimation::PopulationKalmanFilter::Create(f, estimation::CovarianceMode::kExtended);
   ASSERT_TRUE(kf.ok());
   const Eigen::MatrixXd P = kf->covariance();
   const Eigen::VectorXd x = kf->estimate();
@@ -364,18 +373,19 @@ TEST(EstimationKalmanSparse, ScalarUpdateMatchesJosephForm) {
 // Copies and moves of a created filter, fixed and dynamic, r = 1 and r = 2, keep working.
 TEST(EstimationKalmanSparse, CreatedFiltersCopyAndMove) {
   Rng rng(8);
-  FilterModel f = RandomModel(5, rng, false);
-  auto a = PopulationKalmanFilter::Create(f, CovarianceMode::kExtended);
+  estimation::FilterModel f = RandomModel(5, rng, false);
+  auto a = estimation::PopulationKalmanFilter::Create(f, estimation::CovarianceMode::kExtended);
   ASSERT_TRUE(a.ok());
-  PopulationKalmanFilter b = *a;
-  PopulationKalmanFilter c = std::move(*a);
+  estimation::PopulationKalmanFilter b = *a;
+  estimation::PopulationKalmanFilter c = std::move(*a);
   b.Update(Eigen::VectorXd::Constant(1, 3.0));
   c.Update(Eigen::VectorXd::Constant(1, 3.0));
   EXPECT_EQ(b.estimate(), c.estimate());
   f.H = Eigen::MatrixXd::Ones(2, 5);
   f.H(1, 0) = 0.0;
   f.R = Eigen::Matrix2d{{0.5, 0.1}, {0.1, 0.4}};
-  auto d = PopulationKalmanFilterT<5, 2>::Create(f, CovarianceMode::kConservative);
+  auto d = estimation::PopulationKalmanFilterT<5, 2>::Create(
+      f, estimation::CovarianceMode::kConservative);
   ASSERT_TRUE(d.ok()) << d.error();
   auto e = std::move(*d);
   e.Update(Eigen::Vector2d(60.0, 50.0));

@@ -20,7 +20,7 @@ constexpr int kRuns = 2000;
 constexpr int kSteps = 30;
 
 // The open-loop broadcast schedule (it does not depend on the data): recruit, hold, release.
-Eigen::MatrixXd OpenLoopA(const FilterModel& f, int t) {
+Eigen::MatrixXd OpenLoopA(const estimation::FilterModel& f, int t) {
   const double p_on = t < 10 ? 0.3 : (t < 20 ? 0.08 : 0.02);
   const double p_off = t < 10 ? 0.02 : (t < 20 ? 0.08 : 0.25);
   return f.broadcast.Matrix(p_on, p_off);
@@ -34,8 +34,8 @@ struct MonteCarlo {
   std::vector<std::vector<Eigen::MatrixXd>> P;
 };
 
-MonteCarlo RunMonteCarlo(CovarianceMode mode) {
-  const FilterModel f = ThreeStateModel(60, 0.6);
+MonteCarlo RunMonteCarlo(estimation::CovarianceMode mode) {
+  const estimation::FilterModel f = ThreeStateModel(60, 0.6);
   MonteCarlo mc;
   mc.x.resize(kRuns);
   mc.xhat.resize(kRuns);
@@ -43,7 +43,7 @@ MonteCarlo RunMonteCarlo(CovarianceMode mode) {
   mc.P.resize(kRuns);
   for (int run = 0; run < kRuns; ++run) {
     Rng rng(Rng::DeriveSeed(2024, run));
-    auto kf = PopulationKalmanFilterT<3, 1>::Create(f, mode);
+    auto kf = estimation::PopulationKalmanFilterT<3, 1>::Create(f, mode);
     EXPECT_TRUE(kf.ok());
     Eigen::VectorXd x = f.x0;
     for (int t = 0; t < kSteps; ++t) {
@@ -53,7 +53,7 @@ MonteCarlo RunMonteCarlo(CovarianceMode mode) {
       mc.xhat[run].push_back(kf->estimate());
       mc.P[run].push_back(kf->covariance());
       const Eigen::MatrixXd A = OpenLoopA(f, t);
-      const Eigen::VectorXd next = SimulateStepAggregate(A, x, rng);
+      const Eigen::VectorXd next = estimation::SimulateStepAggregate(A, x, rng);
       mc.z[run].push_back(next - A * x);
       x = next;
     }
@@ -62,7 +62,7 @@ MonteCarlo RunMonteCarlo(CovarianceMode mode) {
 }
 
 const MonteCarlo& Extended() {
-  static const MonteCarlo mc = RunMonteCarlo(CovarianceMode::kExtended);
+  static const MonteCarlo mc = RunMonteCarlo(estimation::CovarianceMode::kExtended);
   return mc;
 }
 
@@ -99,7 +99,7 @@ TEST(EstimationKalmanStatistics, TracePMatchesMonteCarloMeanSquaredError) {
 // The same check on the plain filter (no Qz) must fail: its trace P is far below the real MSE.
 // This shows the band above can tell the paper's covariance from the standard one.
 TEST(EstimationKalmanStatistics, PlainFilterUnderstatesItsError) {
-  const MonteCarlo mc = RunMonteCarlo(CovarianceMode::kPlain);
+  const MonteCarlo mc = RunMonteCarlo(estimation::CovarianceMode::kPlain);
   for (int t : {8, 22}) {
     const auto [diff, se] = MeanAndError(
         [&](int r) { return (mc.xhat[r][t] - mc.x[r][t]).squaredNorm() - mc.P[r][t].trace(); });
@@ -164,7 +164,8 @@ TEST(EstimationKalmanStatistics, NeesInsideChiSquareBand) {
   std::cout << "NEES block means outside the 95 % band: " << outside << " of 56, worst |NEES - 2| "
             << worst << "\n";
   EXPECT_LE(outside, 8) << "of 56 block means; worst |NEES - 2| = " << worst;
-  const int outside_plain = NeesBlocksOutsideBand(RunMonteCarlo(CovarianceMode::kPlain), &worst);
+  const int outside_plain =
+      NeesBlocksOutsideBand(RunMonteCarlo(estimation::CovarianceMode::kPlain), &worst);
   std::cout << "plain filter: " << outside_plain << " of 56 outside\n";
   EXPECT_GE(outside_plain, 40) << "the plain filter's NEES should be far too large";
 }
@@ -177,16 +178,17 @@ TEST(EstimationKalmanStatistics, NoDataConvergesToEquilibriumInsideGammaBound) {
   A << 0.7, 0.2, 0.0,  //
       0.3, 0.5, 0.4,   //
       0.0, 0.3, 0.6;
-  FilterModel f = ThreeStateModel(60, 0.6);
-  f.transition = TransitionSource::kConstant;
+  estimation::FilterModel f = ThreeStateModel(60, 0.6);
+  f.transition = estimation::TransitionSource::kConstant;
   f.A = A;
-  auto pi = StationaryDistribution(A);
+  auto pi = estimation::StationaryDistribution(A);
   ASSERT_TRUE(pi.ok());
-  const Eigen::MatrixXd Peq = EquilibriumCovariance(*pi, 60);
-  auto gb = ComputeGammaBound(A, ConservativeQz(A, 60));
+  const Eigen::MatrixXd Peq = estimation::EquilibriumCovariance(*pi, 60);
+  auto gb = estimation::ComputeGammaBound(A, estimation::ConservativeQz(A, 60));
   ASSERT_TRUE(gb.ok()) << gb.error();
-  for (CovarianceMode mode : {CovarianceMode::kExtended, CovarianceMode::kConservative}) {
-    auto kf = PopulationKalmanFilter::Create(f, mode);
+  for (estimation::CovarianceMode mode :
+       {estimation::CovarianceMode::kExtended, estimation::CovarianceMode::kConservative}) {
+    auto kf = estimation::PopulationKalmanFilter::Create(f, mode);
     ASSERT_TRUE(kf.ok());
     double tightest = 0.0;
     for (int t = 0; t < 300; ++t) {
@@ -202,11 +204,12 @@ TEST(EstimationKalmanStatistics, NoDataConvergesToEquilibriumInsideGammaBound) {
         }
       }
     }
-    if (mode == CovarianceMode::kExtended) {
+    if (mode == estimation::CovarianceMode::kExtended) {
       EXPECT_LT((kf->estimate() - 60.0 * *pi).cwiseAbs().maxCoeff(), 1e-9);
       EXPECT_LT((kf->covariance() - Peq).cwiseAbs().maxCoeff(), 1e-9);
       // Eq. 34 at its fixed point: Gamma_ij = e_i^T Qz(N pi) e_j / (1 - lambda_i lambda_j).
-      const Eigen::MatrixXd VQV = gb->V.transpose() * ProcessCovarianceQz(A, 60.0 * *pi) * gb->V;
+      const Eigen::MatrixXd VQV =
+          gb->V.transpose() * estimation::ProcessCovarianceQz(A, 60.0 * *pi) * gb->V;
       const Eigen::MatrixXd G = gb->Gamma(kf->covariance());
       for (int i = 1; i < 3; ++i) {
         for (int j = 1; j < 3; ++j) {
@@ -228,7 +231,7 @@ TEST(EstimationKalmanStatistics, NoDataConvergesToEquilibriumInsideGammaBound) {
 // measurement missing: the estimate keeps summing to N within 1e-9, P stays symmetric, PSD and
 // with zero column sums (1^T K = 0 keeps the total).
 TEST(EstimationKalmanStatistics, MillionStepsKeepSumSymmetryAndPsd) {
-  FilterModel f;
+  estimation::FilterModel f;
   f.state_names = {"a", "b", "c", "d"};
   f.N = 500;
   f.H.resize(2, 4);
@@ -236,7 +239,7 @@ TEST(EstimationKalmanStatistics, MillionStepsKeepSumSymmetryAndPsd) {
   f.R = Eigen::Matrix2d{{0.5, 0.1}, {0.1, 0.8}};
   f.G = Eigen::Vector4d(0.0, 1.0, -1.0, 0.0);
   f.Qw = Eigen::MatrixXd::Constant(1, 1, 0.3);
-  f.transition = TransitionSource::kExplicit;
+  f.transition = estimation::TransitionSource::kExplicit;
   f.x0 = Eigen::Vector4d(500, 0, 0, 0);
   f.P0 = Eigen::Matrix4d::Zero();
   Rng rng(99);
@@ -249,14 +252,14 @@ TEST(EstimationKalmanStatistics, MillionStepsKeepSumSymmetryAndPsd) {
     }
     pool.push_back(A);
   }
-  auto kf = PopulationKalmanFilter::Create(f, CovarianceMode::kExtended);
+  auto kf = estimation::PopulationKalmanFilter::Create(f, estimation::CovarianceMode::kExtended);
   ASSERT_TRUE(kf.ok());
   Eigen::VectorXd x = f.x0;
   double worst_sum = 0.0, worst_colsum = 0.0, worst_eig = 0.0;
   for (int t = 0; t < 1000000; ++t) {
     const Eigen::MatrixXd& A = pool[t % 16];
     kf->Predict(A);
-    x = SimulateStepAggregate(A, x, rng);
+    x = estimation::SimulateStepAggregate(A, x, rng);
     if (t % 5 != 0) kf->Update(f.H * x + Eigen::Vector2d(rng.Uniform() - 0.5, rng.Uniform() - 0.5));
     worst_sum = std::max(worst_sum, std::abs(kf->estimate().sum() - 500.0));
     if (t % 1000 == 0) {

@@ -19,7 +19,7 @@ int main(int argc, char** argv) {
   }
   const std::string dir = argv[1];
   using namespace recruit;
-  FilterModel f = testing_util::ThreeStateModel(60, 0.3);
+  estimation::FilterModel f = testing_util::ThreeStateModel(60, 0.3);
   if (Status s = f.Save(dir + "/three_state_model.json"); !s.ok()) {
     std::cerr << s.error() << "\n";
     return 1;
@@ -50,7 +50,7 @@ int main(int argc, char** argv) {
     log << buf;
     std::snprintf(buf, sizeof buf, "%d,%.1f,%g,%g,%g\n", k, t, x(0), x(1), x(2));
     truth << buf;
-    x = SimulateStepAggregate(f.broadcast.Matrix(p_on, p_off), x, rng);
+    x = estimation::SimulateStepAggregate(f.broadcast.Matrix(p_on, p_off), x, rng);
   }
   for (const auto& [name, text] :
        {std::pair<std::string, std::string>{"three_state_log.csv", log.str()},

@@ -30,8 +30,8 @@ namespace recruit {
 namespace {
 
 template <int M>
-long AllocationsPerSteps(CovarianceMode mode) {
-  FilterModel f;
+long AllocationsPerSteps(estimation::CovarianceMode mode) {
+  estimation::FilterModel f;
   for (int i = 0; i < M; ++i) f.state_names.push_back("s" + std::to_string(i));
   f.N = 60;
   f.H = Eigen::MatrixXd::Constant(1, M, 0.1);
@@ -39,11 +39,11 @@ long AllocationsPerSteps(CovarianceMode mode) {
   f.R = Eigen::MatrixXd::Constant(1, 1, 0.3);
   f.G = Eigen::MatrixXd::Zero(M, 0);
   f.Qw = Eigen::MatrixXd::Zero(0, 0);
-  f.transition = TransitionSource::kExplicit;
+  f.transition = estimation::TransitionSource::kExplicit;
   f.x0 = Eigen::VectorXd::Zero(M);
   f.x0(0) = 60;
   f.P0 = Eigen::MatrixXd::Zero(M, M);
-  auto kf = PopulationKalmanFilterT<M, 1>::Create(f, mode);
+  auto kf = estimation::PopulationKalmanFilterT<M, 1>::Create(f, mode);
   EXPECT_TRUE(kf.ok());
   Eigen::Matrix<double, M, M> A = Eigen::Matrix<double, M, M>::Constant(0.5 / M);
   A.diagonal().array() += 0.5;
@@ -60,9 +60,10 @@ long AllocationsPerSteps(CovarianceMode mode) {
 // FillSparse and Predict write in place.
 long AllocationsPerSparseSteps() {
   constexpr int M = 3;
-  const FilterModel f = testing_util::ThreeStateModel(60, std::sqrt(0.3));
-  const BroadcastTransitionModel& b = f.broadcast;
-  auto kf = PopulationKalmanFilterT<M, 1>::Create(f, CovarianceMode::kExtended);
+  const estimation::FilterModel f = testing_util::ThreeStateModel(60, std::sqrt(0.3));
+  const estimation::BroadcastTransitionModel& b = f.broadcast;
+  auto kf =
+      estimation::PopulationKalmanFilterT<M, 1>::Create(f, estimation::CovarianceMode::kExtended);
   EXPECT_TRUE(kf.ok());
   Eigen::SparseMatrix<double> A = b.SparsePattern();
   const Eigen::Matrix<double, 1, 1> y(5.0);
@@ -78,9 +79,9 @@ long AllocationsPerSparseSteps() {
 // PredictBroadcast (the filter's own sparse A, filled in place) and the scalar update, with the
 // m = 20 heating / cooling chain.
 // The m-state heating / cooling chain with a force sensor (at most 3 nonzeros per column of A).
-FilterModel ChainModel(int m) {
-  FilterModel f = testing_util::ThreeStateModel(60, std::sqrt(0.3));
-  f.broadcast = BroadcastTransitionModel::HeatingChain(m, 0.5);
+estimation::FilterModel ChainModel(int m) {
+  estimation::FilterModel f = testing_util::ThreeStateModel(60, std::sqrt(0.3));
+  f.broadcast = estimation::BroadcastTransitionModel::HeatingChain(m, 0.5);
   f.state_names = f.broadcast.state_names;
   f.H = Eigen::MatrixXd::Constant(1, m, 0.2);
   f.H(0, 0) = 0.0;
@@ -93,8 +94,9 @@ FilterModel ChainModel(int m) {
 
 long AllocationsPerBroadcastSteps() {
   constexpr int M = 20;
-  const FilterModel f = ChainModel(M);
-  auto kf = PopulationKalmanFilterT<M, 1>::Create(f, CovarianceMode::kExtended);
+  const estimation::FilterModel f = ChainModel(M);
+  auto kf =
+      estimation::PopulationKalmanFilterT<M, 1>::Create(f, estimation::CovarianceMode::kExtended);
   EXPECT_TRUE(kf.ok()) << kf.error();
   if (!kf.ok()) return -1;
   const Eigen::Matrix<double, 1, 1> y(5.0);
@@ -108,16 +110,16 @@ long AllocationsPerBroadcastSteps() {
 
 // No dynamic-size matrix in the numeric state: (X^, P) and the workspaces live in the object
 // (the broadcast pattern of PredictBroadcast is built once at Create and written in place).
-static_assert(PopulationKalmanFilterT<20, 1>::Mat::RowsAtCompileTime == 20);
-static_assert(sizeof(PopulationKalmanFilterT<20, 1>) >= 4 * 20 * 20 * sizeof(double));
+static_assert(estimation::PopulationKalmanFilterT<20, 1>::Mat::RowsAtCompileTime == 20);
+static_assert(sizeof(estimation::PopulationKalmanFilterT<20, 1>) >= 4 * 20 * 20 * sizeof(double));
 
 // malloc calls in 100 steps of the controller's sequence on the dynamic-size filter
 // (src/control/kalman_estimator.cc: SetOutput with an H that changes every step, Update,
 // PredictBroadcast), after one warm-up step. Large p_off drives counts below zero at times, so
 // the simplex projection runs too. (Unused where malloc cannot be counted: sanitizers.)
-[[maybe_unused]] long MallocsPerDynamicSteps(int m, CovarianceMode mode) {
-  const FilterModel f = ChainModel(m);
-  auto kf = PopulationKalmanFilter::Create(f, mode);
+[[maybe_unused]] long MallocsPerDynamicSteps(int m, estimation::CovarianceMode mode) {
+  const estimation::FilterModel f = ChainModel(m);
+  auto kf = estimation::PopulationKalmanFilter::Create(f, mode);
   EXPECT_TRUE(kf.ok()) << kf.error();
   if (!kf.ok()) return -1;
   Eigen::MatrixXd h = f.H, r = f.R;
@@ -137,8 +139,8 @@ static_assert(sizeof(PopulationKalmanFilterT<20, 1>) >= 4 * 20 * 20 * sizeof(dou
 // The same through MakeCountFilter's Kalman adapter (what `recruit filter` runs: fixed size for
 // m = 20, dynamic for m = 50), with MeanAndVariance as the streamed output reads it.
 [[maybe_unused]] long MallocsPerCountFilterSteps(int m) {
-  const FilterModel f = ChainModel(m);
-  auto cf = MakeCountFilter(f, CountFilterOptions{});
+  const estimation::FilterModel f = ChainModel(m);
+  auto cf = estimation::MakeCountFilter(f, estimation::CountFilterOptions{});
   EXPECT_TRUE(cf.ok()) << cf.error();
   if (!cf.ok()) return -1;
   Eigen::VectorXd y(1), mean(m), var(m);
@@ -162,19 +164,19 @@ TEST(EstimationKalmanNoAllocation, DynamicSizeAndCountFilterSteps) {
   Eigen::MatrixXd heap = Eigen::MatrixXd::Ones(30, 30);
   EXPECT_GT(testing::MallocCount(), before);
   EXPECT_EQ(heap.sum(), 900.0);
-  EXPECT_EQ(MallocsPerDynamicSteps(20, CovarianceMode::kExtended), 0);
-  EXPECT_EQ(MallocsPerDynamicSteps(50, CovarianceMode::kExtended), 0);
-  EXPECT_EQ(MallocsPerDynamicSteps(20, CovarianceMode::kConservative), 0);
+  EXPECT_EQ(MallocsPerDynamicSteps(20, estimation::CovarianceMode::kExtended), 0);
+  EXPECT_EQ(MallocsPerDynamicSteps(50, estimation::CovarianceMode::kExtended), 0);
+  EXPECT_EQ(MallocsPerDynamicSteps(20, estimation::CovarianceMode::kConservative), 0);
   EXPECT_EQ(MallocsPerCountFilterSteps(20), 0);
   EXPECT_EQ(MallocsPerCountFilterSteps(50), 0);
 #endif
 }
 
 TEST(EstimationKalmanNoAllocation, FixedSizePredictAndUpdate) {
-  EXPECT_EQ(AllocationsPerSteps<2>(CovarianceMode::kExtended), 0);
-  EXPECT_EQ(AllocationsPerSteps<3>(CovarianceMode::kConservative), 0);
-  EXPECT_EQ(AllocationsPerSteps<20>(CovarianceMode::kExtended), 0);
-  EXPECT_EQ(AllocationsPerSteps<20>(CovarianceMode::kPlain), 0);
+  EXPECT_EQ(AllocationsPerSteps<2>(estimation::CovarianceMode::kExtended), 0);
+  EXPECT_EQ(AllocationsPerSteps<3>(estimation::CovarianceMode::kConservative), 0);
+  EXPECT_EQ(AllocationsPerSteps<20>(estimation::CovarianceMode::kExtended), 0);
+  EXPECT_EQ(AllocationsPerSteps<20>(estimation::CovarianceMode::kPlain), 0);
   EXPECT_EQ(AllocationsPerSparseSteps(), 0);
   EXPECT_EQ(AllocationsPerBroadcastSteps(), 0);
   // The counter works (a std::vector allocates through operator new). Eigen's own heap

@@ -22,43 +22,43 @@ Eigen::Matrix3d A3() {
 
 TEST(EstimationChain, ValidationNamesColumnEntryAndTolerance) {
   Eigen::Matrix3d A = A3();
-  EXPECT_TRUE(ValidateColumnStochastic(A).ok());
+  EXPECT_TRUE(estimation::ValidateColumnStochastic(A).ok());
   A(1, 2) = 0.35;  // column 2 sums to 1.05
-  Status s = ValidateColumnStochastic(A);
+  Status s = estimation::ValidateColumnStochastic(A);
   ASSERT_FALSE(s.ok());
   EXPECT_NE(s.error().find("column 2 sums to 1.05"), std::string::npos) << s.error();
   EXPECT_NE(s.error().find("tolerance 1e-09"), std::string::npos) << s.error();
   A = A3();
   A(0, 1) = -0.1;
   A(1, 1) = 0.8;
-  s = ValidateColumnStochastic(A);
+  s = estimation::ValidateColumnStochastic(A);
   ASSERT_FALSE(s.ok());
   EXPECT_NE(s.error().find("entry (0, 1) = -0.1"), std::string::npos) << s.error();
   A = A3();
   A(2, 0) = NAN;
-  s = ValidateColumnStochastic(A);
+  s = estimation::ValidateColumnStochastic(A);
   ASSERT_FALSE(s.ok());
   EXPECT_NE(s.error().find("entry (2, 0) is not finite"), std::string::npos) << s.error();
-  s = ValidateColumnStochastic(Eigen::MatrixXd::Constant(2, 3, 0.5));
+  s = estimation::ValidateColumnStochastic(Eigen::MatrixXd::Constant(2, 3, 0.5));
   ASSERT_FALSE(s.ok());
   EXPECT_NE(s.error().find("must be square"), std::string::npos) << s.error();
-  s = ValidateColumnStochastic(A3(), kStochasticTolerance, 2, "m.json: A");
+  s = estimation::ValidateColumnStochastic(A3(), estimation::kStochasticTolerance, 2, "m.json: A");
   ASSERT_FALSE(s.ok());
   EXPECT_NE(s.error().find("m.json: A: must be 2 x 2"), std::string::npos) << s.error();
   // Within the tolerance is accepted.
   A = A3();
   A(0, 0) += 5e-10;
-  EXPECT_TRUE(ValidateColumnStochastic(A).ok());
+  EXPECT_TRUE(estimation::ValidateColumnStochastic(A).ok());
 }
 
 TEST(EstimationChain, CountValidation) {
-  EXPECT_TRUE(ValidateCounts(Eigen::Vector3d(20, 30, 10), 3, 60).ok());
-  Status s = ValidateCounts(Eigen::Vector3d(-2, 52, 10), 3, 60);
+  EXPECT_TRUE(estimation::ValidateCounts(Eigen::Vector3d(20, 30, 10), 3, 60).ok());
+  Status s = estimation::ValidateCounts(Eigen::Vector3d(-2, 52, 10), 3, 60);
   ASSERT_FALSE(s.ok());
   EXPECT_NE(s.error().find("entry 0 = -2 is negative"), std::string::npos) << s.error();
-  EXPECT_FALSE(ValidateCounts(Eigen::Vector3d(20.5, 29.5, 10), 3, 60).ok());
-  EXPECT_FALSE(ValidateCounts(Eigen::Vector3d(20, 30, 11), 3, 60).ok());
-  EXPECT_FALSE(ValidateCounts(Eigen::Vector2d(30, 30), 3, 60).ok());
+  EXPECT_FALSE(estimation::ValidateCounts(Eigen::Vector3d(20.5, 29.5, 10), 3, 60).ok());
+  EXPECT_FALSE(estimation::ValidateCounts(Eigen::Vector3d(20, 30, 11), 3, 60).ok());
+  EXPECT_FALSE(estimation::ValidateCounts(Eigen::Vector2d(30, 30), 3, 60).ok());
 }
 
 // Pearson chi-square of 2e5 binomial draws against the pmf, bins pooled to >= 20 expected.
@@ -73,7 +73,7 @@ TEST(EstimationChain, BinomialSamplerMatchesPmf) {
     Rng rng(1234 + c.n);
     const int draws = 200000;
     std::vector<double> hist(c.n + 1, 0.0);
-    for (int k = 0; k < draws; ++k) hist[SampleBinomial(c.n, c.p, rng)] += 1.0;
+    for (int k = 0; k < draws; ++k) hist[estimation::SampleBinomial(c.n, c.p, rng)] += 1.0;
     double chi2 = 0.0, exp_acc = 0.0, obs_acc = 0.0;
     int bins = 0;
     for (int64_t k = 0; k <= c.n; ++k) {
@@ -99,7 +99,7 @@ void CheckAgainstQz(const std::vector<Eigen::VectorXd>& next, const Eigen::Matri
   const int m = static_cast<int>(x.size());
   const double n = static_cast<double>(next.size());
   const Eigen::VectorXd mean_expected = A * x;
-  const Eigen::MatrixXd Qz = ProcessCovarianceQz(A, x);
+  const Eigen::MatrixXd Qz = estimation::ProcessCovarianceQz(A, x);
   Eigen::VectorXd mean = Eigen::VectorXd::Zero(m);
   Eigen::MatrixXd S1 = Eigen::MatrixXd::Zero(m, m), S2 = Eigen::MatrixXd::Zero(m, m);
   for (const auto& xn : next) {
@@ -130,7 +130,7 @@ TEST(EstimationChain, AggregateSamplerCovarianceIsQz) {
   Rng rng(7);
   std::vector<Eigen::VectorXd> next;
   for (int k = 0; k < 100000; ++k) {
-    next.push_back(SimulateStepAggregate(A, x, rng));
+    next.push_back(estimation::SimulateStepAggregate(A, x, rng));
     ASSERT_EQ(next.back().sum(), 60.0);
   }
   CheckAgainstQz(next, A, x);
@@ -142,12 +142,12 @@ TEST(EstimationChain, AgentSamplerCovarianceIsQz) {
   for (int i = 0; i < 20; ++i) states.push_back(0);
   for (int i = 0; i < 30; ++i) states.push_back(1);
   for (int i = 0; i < 10; ++i) states.push_back(2);
-  const Eigen::VectorXd x = CountStates(states, 3);
+  const Eigen::VectorXd x = estimation::CountStates(states, 3);
   Rng rng(8);
   std::vector<Eigen::VectorXd> next;
   for (int k = 0; k < 100000; ++k) {
     std::vector<int> s = states;
-    next.push_back(SimulateStepAgents(A, s, rng));
+    next.push_back(estimation::SimulateStepAgents(A, s, rng));
   }
   CheckAgainstQz(next, A, x);
 }
@@ -160,11 +160,11 @@ TEST(EstimationChain, AggregateSamplerCostDoesNotGrowWithN) {
   const int draws = 20000;
   double s1 = 0, s2 = 0;
   for (int k = 0; k < draws; ++k) {
-    const double v = SimulateStepAggregate(A, x, rng)(1) - (A * x)(1);
+    const double v = estimation::SimulateStepAggregate(A, x, rng)(1) - (A * x)(1);
     s1 += v;
     s2 += v * v;
   }
-  const double var = ProcessCovarianceQz(A, x)(1, 1);  // 4e6*0.09 + 6e6*0.21
+  const double var = estimation::ProcessCovarianceQz(A, x)(1, 1);  // 4e6*0.09 + 6e6*0.21
   EXPECT_LT(std::abs(s1 / draws), 5.0 * std::sqrt(var / draws));
   EXPECT_NEAR(s2 / draws, var, 5.0 * var * std::sqrt(2.0 / draws));
 }
@@ -173,25 +173,25 @@ TEST(EstimationChain, StationaryDistributionAndEquilibriumCovariance) {
   // Two-state chain: pi = (p_off, p_on) / (p_on + p_off).
   const double p_on = 0.3, p_off = 0.1;
   const Eigen::Matrix2d A{{1 - p_on, p_off}, {p_on, 1 - p_off}};
-  auto pi = StationaryDistribution(A);
+  auto pi = estimation::StationaryDistribution(A);
   ASSERT_TRUE(pi.ok()) << pi.error();
   EXPECT_NEAR((*pi)(0), 0.25, 1e-15);
   EXPECT_NEAR((*pi)(1), 0.75, 1e-15);
-  const Eigen::MatrixXd C = EquilibriumCovariance(*pi, 60);
+  const Eigen::MatrixXd C = estimation::EquilibriumCovariance(*pi, 60);
   EXPECT_NEAR(C(0, 0), 60 * 0.25 * 0.75, 1e-12);  // binomial variance
   EXPECT_NEAR(C(0, 1), -60 * 0.25 * 0.75, 1e-12);
   // Three states: A pi = pi, sum 1.
-  auto pi3 = StationaryDistribution(A3());
+  auto pi3 = estimation::StationaryDistribution(A3());
   ASSERT_TRUE(pi3.ok());
   EXPECT_LT((A3() * *pi3 - *pi3).cwiseAbs().maxCoeff(), 1e-14);
   EXPECT_NEAR(pi3->sum(), 1.0, 1e-14);
   // Reducible chain: no unique pi.
-  EXPECT_FALSE(StationaryDistribution(Eigen::Matrix2d::Identity()).ok());
+  EXPECT_FALSE(estimation::StationaryDistribution(Eigen::Matrix2d::Identity()).ok());
 }
 
 TEST(EstimationChain, ConservativeQzDominatesEveryAdmissibleQz) {
   const Eigen::Matrix3d A = A3();
-  const Eigen::MatrixXd Qc = ConservativeQz(A, 60);
+  const Eigen::MatrixXd Qc = estimation::ConservativeQz(A, 60);
   Rng rng(10);
   for (int k = 0; k < 200; ++k) {
     // Random admissible X (sum N) and box corners.
@@ -199,7 +199,7 @@ TEST(EstimationChain, ConservativeQzDominatesEveryAdmissibleQz) {
     x = (x / x.sum() * 60).array().round();
     x(2) = 60 - x(0) - x(1);
     if (x(2) < 0) continue;
-    const Eigen::MatrixXd D = Qc - ProcessCovarianceQz(A, x);
+    const Eigen::MatrixXd D = Qc - estimation::ProcessCovarianceQz(A, x);
     EXPECT_GT(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(D).eigenvalues().minCoeff(), -1e-10);
   }
 }
@@ -209,7 +209,7 @@ TEST(EstimationChain, SimplexProjectionIsTheNearestFeasiblePoint) {
   for (int k = 0; k < 100; ++k) {
     Eigen::VectorXd x(4);
     for (int i = 0; i < 4; ++i) x(i) = 30.0 * (rng.Uniform() - 0.3);
-    const Eigen::VectorXd p = ProjectOntoSimplex(x, 40.0);
+    const Eigen::VectorXd p = estimation::ProjectOntoSimplex(x, 40.0);
     ASSERT_GE(p.minCoeff(), 0.0);
     ASSERT_NEAR(p.sum(), 40.0, 1e-9);
     // No random feasible point is nearer.
@@ -223,10 +223,10 @@ TEST(EstimationChain, SimplexProjectionIsTheNearestFeasiblePoint) {
 }
 
 TEST(EstimationChain, CountStateVectors) {
-  EXPECT_EQ(CountStateVectors(60, 2), 61u);
-  EXPECT_EQ(CountStateVectors(60, 3), 1891u);                   // C(62, 2)
-  EXPECT_EQ(CountStateVectors(60, 20), 883829035553043580ull);  // C(79, 19)
-  EXPECT_EQ(CountStateVectors(1000, 10, 200000), 200001u);      // saturates
+  EXPECT_EQ(estimation::CountStateVectors(60, 2), 61u);
+  EXPECT_EQ(estimation::CountStateVectors(60, 3), 1891u);                   // C(62, 2)
+  EXPECT_EQ(estimation::CountStateVectors(60, 20), 883829035553043580ull);  // C(79, 19)
+  EXPECT_EQ(estimation::CountStateVectors(1000, 10, 200000), 200001u);      // saturates
 }
 
 }  // namespace

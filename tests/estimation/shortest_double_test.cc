@@ -22,11 +22,11 @@ std::string Reference(double v) {
 }
 
 std::string Fast(double v) {
-  char buf[kShortestDoubleRoom + 8];
+  char buf[estimation::kShortestDoubleRoom + 8];
   std::memset(buf, '#', sizeof buf);
-  char* end = WriteShortest(buf, v);
-  EXPECT_LE(end - buf, kShortestDoubleMaxChars);
-  for (int i = kShortestDoubleRoom; i < kShortestDoubleRoom + 8; ++i) {
+  char* end = estimation::WriteShortest(buf, v);
+  EXPECT_LE(end - buf, estimation::kShortestDoubleMaxChars);
+  for (int i = estimation::kShortestDoubleRoom; i < estimation::kShortestDoubleRoom + 8; ++i) {
     EXPECT_EQ(buf[i], '#') << "wrote past its room";
   }
   return std::string(buf, end);

@@ -21,7 +21,8 @@ inline double Gaussian(Rng& rng) {
 }
 
 // y = H x + v, v ~ N(0, R).
-inline Eigen::VectorXd Measure(const FilterModel& f, const Eigen::VectorXd& x, Rng& rng) {
+inline Eigen::VectorXd Measure(const estimation::FilterModel& f, const Eigen::VectorXd& x,
+                               Rng& rng) {
   const Eigen::MatrixXd L = Eigen::LLT<Eigen::MatrixXd>(f.R).matrixL();
   Eigen::VectorXd g(f.num_outputs());
   for (int i = 0; i < g.size(); ++i) g(i) = Gaussian(rng);
@@ -39,16 +40,16 @@ inline double ChiSquareQuantile(double k, double z) {
 // The three-state unit used by several tests: off, warming (heater on, partial force), on.
 // A broadcast moves off units to warming with p_on and heated units to off with p_off; a
 // warming unit that is not switched off settles to "on" with probability 0.6 per step.
-inline FilterModel ThreeStateModel(int64_t N, double noise_std) {
-  FilterModel f;
+inline estimation::FilterModel ThreeStateModel(int64_t N, double noise_std) {
+  estimation::FilterModel f;
   f.state_names = {"off", "warming", "on"};
   f.N = N;
   f.H = Eigen::RowVector3d(0.0, 0.2, 0.45);
   f.R = Eigen::MatrixXd::Constant(1, 1, noise_std * noise_std);
   f.G = Eigen::MatrixXd::Zero(3, 0);
   f.Qw = Eigen::MatrixXd::Zero(0, 0);
-  f.transition = TransitionSource::kBroadcast;
-  BroadcastTransitionModel& b = f.broadcast;
+  f.transition = estimation::TransitionSource::kBroadcast;
+  estimation::BroadcastTransitionModel& b = f.broadcast;
   b.state_names = f.state_names;
   b.is_on = {false, true, true};
   b.interior = Eigen::Matrix3d{{1, 0, 0}, {0, 0.4, 0}, {0, 0.6, 1}};

@@ -33,9 +33,9 @@ constexpr const char* kConstant = R"({
   "transition": {"type": "constant", "A": [[0.9, 0.1, 0.0], [0.1, 0.8, 0.2], [0.0, 0.1, 0.8]]},
   "initial": {"x0": [3.0, 3.0, 3.0], "P0": [[1.0, -0.5, -0.5], [-0.5, 1.0, -0.5], [-0.5, -0.5, 1.0]]}})";
 
-recruit::FilterModel Load(const char* text) {
-  auto j = recruit::json_io::ParseJson(text, "fuzz");
-  auto m = recruit::FilterModel::FromJsonValue(*j, "fuzz");
+recruit::estimation::FilterModel Load(const char* text) {
+  auto j = recruit::estimation::json_io::ParseJson(text, "fuzz");
+  auto m = recruit::estimation::FilterModel::FromJsonValue(*j, "fuzz");
   if (!m.ok()) __builtin_trap();  // the fixed models are valid
   return *m;
 }
@@ -43,20 +43,20 @@ recruit::FilterModel Load(const char* text) {
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  static const recruit::FilterModel kModels[] = {Load(kBroadcast), Load(kExplicit),
-                                                 Load(kConstant)};
+  static const recruit::estimation::FilterModel kModels[] = {Load(kBroadcast), Load(kExplicit),
+                                                             Load(kConstant)};
   static const char* const kEstimators[] = {"extended", "conservative", "plain", "exact",
                                             "particle"};
   if (size < 2) return 0;
-  const recruit::FilterModel& model = kModels[data[0] % 3];
-  recruit::CountFilterOptions options;
+  const recruit::estimation::FilterModel& model = kModels[data[0] % 3];
+  recruit::estimation::CountFilterOptions options;
   options.estimator = kEstimators[data[1] % 5];
   options.particles = 64;
   options.max_states = 100;  // the exact filter only for the small explicit model
-  auto filter = recruit::MakeCountFilter(model, options);
+  auto filter = recruit::estimation::MakeCountFilter(model, options);
   if (!filter.ok()) return 0;  // e.g. exact or particle with process noise
   const std::string log(reinterpret_cast<const char*>(data) + 2, size - 2);
-  auto out = recruit::RunFilterOverText(model, log, "fuzz_log.csv", **filter);
+  auto out = recruit::estimation::RunFilterOverText(model, log, "fuzz_log.csv", **filter);
   (void)out;
   return 0;
 }

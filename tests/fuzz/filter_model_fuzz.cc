@@ -11,22 +11,22 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);
-  auto j = recruit::json_io::ParseJson(text, "fuzz_model.json");
+  auto j = recruit::estimation::json_io::ParseJson(text, "fuzz_model.json");
   if (!j.ok()) return 0;
-  auto model = recruit::FilterModel::FromJsonValue(*j, "fuzz_model.json");
+  auto model = recruit::estimation::FilterModel::FromJsonValue(*j, "fuzz_model.json");
   if (!model.ok()) return 0;
-  const recruit::FilterModel& m = *model;
-  auto filter = recruit::MakeCountFilter(m, recruit::CountFilterOptions{});
+  const recruit::estimation::FilterModel& m = *model;
+  auto filter = recruit::estimation::MakeCountFilter(m, recruit::estimation::CountFilterOptions{});
   if (!filter.ok()) return 0;
-  recruit::CountFilter& f = **filter;
+  recruit::estimation::CountFilter& f = **filter;
   switch (m.transition) {
-    case recruit::TransitionSource::kBroadcast:
+    case recruit::estimation::TransitionSource::kBroadcast:
       f.PredictBroadcast(m.broadcast, 0.25, 0.5);
       break;
-    case recruit::TransitionSource::kConstant:
+    case recruit::estimation::TransitionSource::kConstant:
       f.Predict(m.A);
       break;
-    case recruit::TransitionSource::kExplicit:  // identity is column-stochastic
+    case recruit::estimation::TransitionSource::kExplicit:  // identity is column-stochastic
       f.Predict(Eigen::MatrixXd::Identity(m.num_states(), m.num_states()));
       break;
   }

@@ -14,8 +14,8 @@
 #include "estimation/population_chain.h"
 #include "identification/bench_recorder.h"
 #include "identification/excitation.h"
-#include "tests/plugin/mujoco_util.h"
 #include "identification/transient_chain.h"
+#include "tests/plugin/mujoco_util.h"
 
 namespace recruit::identification {
 namespace {
@@ -98,7 +98,7 @@ SwitchingLog SimulateUnits(const TransientChain& c, int units, int samples, doub
     log.true_on.push_back(on);
     log.p_on.push_back(e.p_on[k]);
     log.p_off.push_back(e.p_off[k]);
-    x = SimulateStepAggregate(c.Matrix(e.p_on[k], e.p_off[k]), x, rng);
+    x = estimation::SimulateStepAggregate(c.Matrix(e.p_on[k], e.p_off[k]), x, rng);
   }
   return log;
 }

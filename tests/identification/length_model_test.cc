@@ -75,7 +75,7 @@ SyntheticRun Simulate(const TransientChain& c, const UnitForceMap& map, int unit
     run.log.p_off.push_back(e.p_off[k]);
     run.length.push_back(L);
     run.true_on.push_back(on);
-    x = SimulateStepAggregate(c.Matrix(e.p_on[k], e.p_off[k]), x, rng);
+    x = estimation::SimulateStepAggregate(c.Matrix(e.p_on[k], e.p_off[k]), x, rng);
   }
   return run;
 }
@@ -116,7 +116,7 @@ std::vector<double> MeanNees(bool length_aware) {
   c.force.resize(8);
   map->Forces(g.ref_length, c.force);
   const double noise = 0.05;
-  const FilterModel model = ToFilterModel(c, 60, 0.5, noise * noise);
+  const estimation::FilterModel model = ToFilterModel(c, 60, 0.5, noise * noise);
   const std::vector<int> at = {400, 500, 600};
   std::vector<double> sum(at.size(), 0.0);
   const int runs = 400;
@@ -124,7 +124,7 @@ std::vector<double> MeanNees(bool length_aware) {
     auto length = [&](int k) { return g.ref_length + 0.0015 * std::sin(2 * M_PI * k / 40.0); };
     const SyntheticRun run = Simulate(c, *map, 60, at.back() + 1, noise, 1000 + r, length);
     auto est = KalmanOnCountEstimator::Create(
-        model, CovarianceMode::kExtended,
+        model, estimation::CovarianceMode::kExtended,
         length_aware ? std::optional<UnitForceMap>(*map) : std::nullopt);
     EXPECT_TRUE(est.ok());
     KalmanOnCountEstimator& e = **est;

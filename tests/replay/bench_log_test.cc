@@ -18,7 +18,7 @@ TEST(BenchLog, KeepsTheControlInstantsOfASimulatedLog) {
                            "# a comment\n"
                            "\n"
                            "0.502,0,0.3,6,0,1,0,0,1,5.5,2\n";
-  auto log = ParseBenchLog(text, "sim.csv");
+  auto log = estimation::ParseBenchLog(text, "sim.csv");
   ASSERT_TRUE(log.ok()) << log.error();
   ASSERT_EQ(log->size(), 2);
   EXPECT_DOUBLE_EQ(log->dT, 0.5);
@@ -33,7 +33,7 @@ TEST(BenchLog, KeepsTheControlInstantsOfASimulatedLog) {
 }
 
 TEST(BenchLog, WithoutControlInstantEveryRowIsOne) {
-  auto log = ParseBenchLog(
+  auto log = estimation::ParseBenchLog(
       "time,x.p_on,x.p_off,x.sensed_force\n10,0.5,0,0\n10.5,0,0,1\n11,0,0.5,2\n", "rig.csv");
   ASSERT_TRUE(log.ok()) << log.error();
   EXPECT_EQ(log->size(), 3);
@@ -61,22 +61,22 @@ TEST(BenchLog, RejectsBadLogsNamingFileLineColumnAndValue) {
       {"", "empty log"},
   };
   for (const Case& c : cases) {
-    auto log = ParseBenchLog(c.text, "log.csv");
+    auto log = estimation::ParseBenchLog(c.text, "log.csv");
     ASSERT_FALSE(log.ok()) << c.text;
     EXPECT_NE(log.error().find(c.message), std::string::npos) << log.error();
   }
 }
 
 TEST(BenchLog, SelectsABundleByName) {
-  auto cols = FindBenchLogColumns(
+  auto cols = estimation::FindBenchLogColumns(
       {"time", "a.p_on", "a.p_off", "a.sensed_force", "b.p_on", "b.p_off", "b.sensed_force"},
       "f.csv");
   ASSERT_TRUE(cols.ok());
-  EXPECT_EQ(*SelectBenchBundle(*cols, "b", "f.csv"), 1);
-  auto none = SelectBenchBundle(*cols, "", "f.csv");
+  EXPECT_EQ(*estimation::SelectBenchBundle(*cols, "b", "f.csv"), 1);
+  auto none = estimation::SelectBenchBundle(*cols, "", "f.csv");
   ASSERT_FALSE(none.ok());
   EXPECT_NE(none.error().find("several bundles (a, b)"), std::string::npos);
-  auto wrong = SelectBenchBundle(*cols, "c", "f.csv");
+  auto wrong = estimation::SelectBenchBundle(*cols, "c", "f.csv");
   ASSERT_FALSE(wrong.ok());
   EXPECT_NE(wrong.error().find("no bundle 'c' in the log; it has a, b"), std::string::npos);
 }

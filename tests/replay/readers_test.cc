@@ -39,7 +39,7 @@ std::string SimulatedCsv() {
 }
 
 // The bench log's rows in the older format: `names` are its four column names.
-std::string OlderFormat(const BenchLog& log, const char* names) {
+std::string OlderFormat(const estimation::BenchLog& log, const char* names) {
   std::string out = std::string(names) + "\n";
   const auto& b = log.bundles[0];
   for (int k = 0; k < log.size(); ++k) {
@@ -50,21 +50,22 @@ std::string OlderFormat(const BenchLog& log, const char* names) {
 
 TEST(BenchLogReaders, FilterReadsItAsItsOwnLog) {
   const std::string csv = SimulatedCsv();
-  auto log = ParseBenchLog(csv, "sim.csv");
+  auto log = estimation::ParseBenchLog(csv, "sim.csv");
   ASSERT_TRUE(log.ok()) << log.error();
   ASSERT_EQ(log->size(), 60);
-  auto model =
-      FilterModel::FromJson(kRoot + "/models/identified/bundle_903e47abb54d0604_dt1_m20.json");
+  auto model = estimation::FilterModel::FromJson(
+      kRoot + "/models/identified/bundle_903e47abb54d0604_dt1_m20.json");
   ASSERT_TRUE(model.ok()) << model.error();
-  auto f1 = MakeCountFilter(*model, {});
-  auto f2 = MakeCountFilter(*model, {});
-  auto from_bench = RunFilterOverText(*model, csv, "sim.csv", **f1);
-  auto from_older = RunFilterOverText(*model, OlderFormat(*log, "t,p_on,p_off,y"), "f.csv", **f2);
+  auto f1 = estimation::MakeCountFilter(*model, {});
+  auto f2 = estimation::MakeCountFilter(*model, {});
+  auto from_bench = estimation::RunFilterOverText(*model, csv, "sim.csv", **f1);
+  auto from_older =
+      estimation::RunFilterOverText(*model, OlderFormat(*log, "t,p_on,p_off,y"), "f.csv", **f2);
   ASSERT_TRUE(from_bench.ok()) << from_bench.error();
   ASSERT_TRUE(from_older.ok()) << from_older.error();
   EXPECT_EQ(*from_bench, *from_older);
   // A bundle the log does not have is named with the ones it has.
-  auto reader = FilterLogReader::OpenText(csv, *model, "sim.csv", "flexor");
+  auto reader = estimation::FilterLogReader::OpenText(csv, *model, "sim.csv", "flexor");
   ASSERT_FALSE(reader.ok());
   EXPECT_NE(reader.error().find("no bundle 'flexor' in the log; it has bundle"), std::string::npos)
       << reader.error();
@@ -72,7 +73,7 @@ TEST(BenchLogReaders, FilterReadsItAsItsOwnLog) {
 
 TEST(BenchLogReaders, IdentifyReadsItAsASwitchingLog) {
   const std::string csv = SimulatedCsv();
-  auto log = ParseBenchLog(csv, "sim.csv");
+  auto log = estimation::ParseBenchLog(csv, "sim.csv");
   ASSERT_TRUE(log.ok());
   const fs::path dir = fs::temp_directory_path();
   const std::string bench = (dir / "recruit_readers_bench.csv").string();

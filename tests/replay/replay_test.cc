@@ -44,7 +44,8 @@ sim::Task WithUnitParameter(sim::Task task, const std::string& key, const std::s
 }
 
 // The per-step CSV of one closed-loop run (output-only estimator: no identified model needed).
-BenchLog SimulatedLog(const sim::Task& task, std::uint64_t seed, const std::string& name) {
+estimation::BenchLog SimulatedLog(const sim::Task& task, std::uint64_t seed,
+                                  const std::string& name) {
   const std::string path =
       (fs::temp_directory_path() / ("recruit_replay_" + name + ".csv")).string();
   sim::CsvStepWriter writer(path, 50);
@@ -54,7 +55,7 @@ BenchLog SimulatedLog(const sim::Task& task, std::uint64_t seed, const std::stri
   auto run = sim::RunTask(task, o, {&writer});
   EXPECT_TRUE(run.ok()) << run.error();
   EXPECT_TRUE(writer.Commit().ok());
-  auto log = ReadBenchLog(path);
+  auto log = estimation::ReadBenchLog(path);
   EXPECT_TRUE(log.ok()) << log.error();
   fs::remove(path);
   return *log;
@@ -63,7 +64,7 @@ BenchLog SimulatedLog(const sim::Task& task, std::uint64_t seed, const std::stri
 TEST(Replay, ALogReplayedWithItsOwnSeedIsReproduced) {
   for (const char* name : {"isometric_steps", "arm_push"}) {
     const sim::Task task = LoadTask(name);
-    const BenchLog log = SimulatedLog(task, 5, name);
+    const estimation::BenchLog log = SimulatedLog(task, 5, name);
     auto plan = PlanReplay(task, log);
     ASSERT_TRUE(plan.ok()) << plan.error();
     auto same = ReplayOnce(task, log, *plan, 5);
@@ -91,7 +92,7 @@ TEST(Replay, TheSamePlantIsNotFlaggedAndLessHeatingCurrentIs) {
     const sim::Task weaker = WithUnitParameter(task, "current", "0.145");
     for (std::uint64_t seed : {31, 32}) {
       for (bool same : {true, false}) {
-        const BenchLog log = SimulatedLog(same ? task : weaker, seed, name);
+        const estimation::BenchLog log = SimulatedLog(same ? task : weaker, seed, name);
         auto r = RunReplay(task, log, ReplayOptions{});
         ASSERT_TRUE(r.ok()) << r.error();
         EXPECT_EQ(r->flagged, !same) << name << " seed " << seed << ": " << ReportJson(*r).dump();
@@ -102,8 +103,8 @@ TEST(Replay, TheSamePlantIsNotFlaggedAndLessHeatingCurrentIs) {
 
 TEST(Replay, ALogWithoutTheTasksBundlesIsRefused) {
   const sim::Task task = LoadTask("arm_push");
-  auto log = ParseBenchLog("time,flexor.p_on,flexor.p_off,flexor.sensed_force\n0,0,0,0\n1,0,0,0\n",
-                           "one.csv");
+  auto log = estimation::ParseBenchLog(
+      "time,flexor.p_on,flexor.p_off,flexor.sensed_force\n0,0,0,0\n1,0,0,0\n", "one.csv");
   ASSERT_TRUE(log.ok());
   auto plan = PlanReplay(task, *log);
   ASSERT_FALSE(plan.ok());

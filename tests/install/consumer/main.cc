@@ -12,8 +12,9 @@ int main() {
   auto unit = recruit::sma::UnitModel::Create(recruit::sma::UnitParams{});
   if (!unit.ok()) return 1;
   const double hot = unit->Tension(0.0, unit->params().prestretch);
-  const auto model = recruit::FilterModel::TwoState(60, 0.5, hot, 0.1);
-  auto kf = recruit::PopulationKalmanFilter::Create(model, recruit::CovarianceMode::kExtended);
+  const auto model = recruit::estimation::FilterModel::TwoState(60, 0.5, hot, 0.1);
+  auto kf = recruit::estimation::PopulationKalmanFilter::Create(
+      model, recruit::estimation::CovarianceMode::kExtended);
   if (!kf.ok()) return 2;
   kf->PredictBroadcast(0.3, 0.0);
   std::printf("hot unit %.4f N, on after one broadcast %.4f\n", hot, kf->estimate()[1]);
