@@ -38,7 +38,9 @@ TEST(ModelCache, ACachedModelOfAnotherIdentificationVersionIsNotUsed) {
     EXPECT_EQ(MadeByThisIdentification(file.string()), used) << version;
     auto found = FindOrIdentifyModel(r, false, nullptr);
     EXPECT_EQ(found.ok(), used) << version;
-    if (used && found.ok()) EXPECT_EQ(*found, file.string());
+    if (used && found.ok()) {
+      EXPECT_EQ(*found, file.string());
+    }
   }
   ASSERT_TRUE(WriteFileAtomically(file.string(), "{\"H\": []}").ok());  // no version: outdated
   EXPECT_FALSE(FindOrIdentifyModel(r, false, nullptr).ok());

@@ -214,7 +214,9 @@ TEST(Render, CurvesSitWhereTheirTickLabelsSayOverChangingRanges) {
       EXPECT_NEAR(text[i], grid[i], 0.3 * f.font_px) << p.y_ticks.labels[ticks.size() - 1 - i];
     }
     // Counts (>= 0) with a band reaching below zero: the axis starts at 0.
-    if (c[2] > 0) EXPECT_EQ(ticks.front(), 0.0);
+    if (c[2] > 0) {
+      EXPECT_EQ(ticks.front(), 0.0);
+    }
     // The curve at plateau columns, read through the grid rows and tick values.
     int checked = 0;
     for (int x = x0 + 5; x < x1 - 5; x += 11) {

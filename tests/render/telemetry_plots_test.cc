@@ -83,7 +83,9 @@ TEST(TelemetryPlotsTest, LegendNeverOverlapsAFigureFrom320PxTo4K) {
         // Room for a title, x tick labels, the axis label and two grid intervals of a row each.
         EXPECT_GE(boxes[p].figure.height, 6 * text.char_height);
         for (const auto& other : boxes) {
-          if (other.figure.height > 0) EXPECT_FALSE(Intersect(boxes[p].legend, other.figure));
+          if (other.figure.height > 0) {
+            EXPECT_FALSE(Intersect(boxes[p].legend, other.figure));
+          }
         }
       }
       EXPECT_GE(shown, 2);  // the tracked quantity and the counts are always shown
