@@ -8,14 +8,16 @@
 #include <stdint.h>
 
 #define RK(x) ((recruit_real)(x))
+/* clang-format off */
 #define SQRT @SQRT@
 #define SIN @SIN@
 #define FABS @FABS@
+/* clang-format on */
 
 struct recruit_bundle_params {
-  int m;                 /* model states; 0: the output estimator (force / on unit force) */
-  recruit_real N;        /* units */
-  recruit_real lambda;   /* gain of the expectation law */
+  int m;                   /* model states; 0: the output estimator (force / on unit force) */
+  recruit_real N;          /* units */
+  recruit_real lambda;     /* gain of the expectation law */
   recruit_real unit_force; /* N, settled on unit at the reference length */
   /* Unit force map (UnitForceMap): extension s = prestretch + (L - ref_length); a unit in a
    * state of fraction xi pulls max(0, k (s - c)), k its stiffness, c = xi times the recoverable
@@ -28,21 +30,23 @@ struct recruit_bundle_params {
   const uint16_t *ptr;
   const uint8_t *col, *target, *is_on;
   const recruit_real *base;
-  const recruit_real *k, *c; /* per state (length_aware) */
-  const recruit_real *h;     /* force per unit in each state at the reference length */
+  const recruit_real *k, *c;      /* per state (length_aware) */
+  const recruit_real *h;          /* force per unit in each state at the reference length */
   recruit_real R, relative_noise; /* R + (relative_noise H x)^2: the measurement variance */
   const recruit_real *x0, *P0;    /* initial belief (P0 packed; NULL = 0) */
   const recruit_real *gqg;        /* process noise G Qw G^T, packed; NULL = none */
 };
 
+/* clang-format off */
 @CONSTANTS@
+/* clang-format on */
 
 /* Upper triangle packed by columns: (i, j), i <= j. */
 #define PK(i, j) ((j) * ((j) + 1) / 2 + (i))
-/* v = a P(:, c) (first) or v += a P(:, c), P symmetric packed: column c is contiguous down to
- * the diagonal, then row c of the upper triangle (one step of l + 1 per entry). */
-static void column_axpy(recruit_real *v, const recruit_real *P, int m, int c, recruit_real a,
-                        int first) {
+    /* v = a P(:, c) (first) or v += a P(:, c), P symmetric packed: column c is contiguous down to
+     * the diagonal, then row c of the upper triangle (one step of l + 1 per entry). */
+    static void
+    column_axpy(recruit_real *v, const recruit_real *P, int m, int c, recruit_real a, int first) {
   const recruit_real *col = P + PK(0, c);
   int l, idx;
   if (first) {
@@ -193,8 +197,8 @@ void recruit_bundle_init(recruit_bundle *b, int index) {
 }
 
 /* Measurement update with the force y (PopulationKalmanFilter's scalar Joseph update). */
-static void kalman_update(recruit_bundle *b, recruit_work *w, const recruit_real *h,
-                          recruit_real R, recruit_real y) {
+static void kalman_update(recruit_bundle *b, recruit_work *w, const recruit_real *h, recruit_real R,
+                          recruit_real y) {
   const recruit_bundle_params *p = b->params;
   const int m = p->m;
   recruit_real s, innov, root;
@@ -211,7 +215,8 @@ static void kalman_update(recruit_bundle *b, recruit_work *w, const recruit_real
   recenter(b->x, m, p->N, 0);
 }
 
-/* UpdateWithMeasurement (KalmanOnCountEstimator): H and R at the measured length, then the update. */
+/* UpdateWithMeasurement (KalmanOnCountEstimator): H and R at the measured length, then the
+ * update. */
 static void kalman_observe(recruit_bundle *b, recruit_work *w, recruit_real y,
                            recruit_real length) {
   const recruit_bundle_params *p = b->params;
@@ -323,8 +328,7 @@ static void kalman_predict(recruit_bundle *b, recruit_work *w, recruit_real p_on
 
 void recruit_bundle_step(recruit_bundle *b, recruit_work *w, recruit_real force_reference,
                          recruit_real force, recruit_real length, recruit_real *p_on,
-                         recruit_real *p_off, recruit_real *estimated_on,
-                         recruit_real *variance) {
+                         recruit_real *p_off, recruit_real *estimated_on, recruit_real *variance) {
   const recruit_bundle_params *p = b->params;
   const int m = p->m;
   recruit_real unit, target, est, var = RK(0);
@@ -359,6 +363,7 @@ void recruit_bundle_step(recruit_bundle *b, recruit_work *w, recruit_real force_
   *variance = var;
 }
 
+/* clang-format off */
 void recruit_init(recruit_controller *c) {
   int i;
   for (i = 0; i < RECRUIT_NUM_BUNDLES; ++i) recruit_bundle_init(&c->bundle[i], i);
@@ -366,8 +371,10 @@ void recruit_init(recruit_controller *c) {
 }
 
 @OUTER@
+    /* clang-format on */
 
-void recruit_step(recruit_controller *c, const recruit_input *in, recruit_output *out) {
+    void
+    recruit_step(recruit_controller *c, const recruit_input *in, recruit_output *out) {
   int i;
   force_references(c, in, out->force_reference);
   for (i = 0; i < RECRUIT_NUM_BUNDLES; ++i) {

@@ -19,7 +19,7 @@ typedef @REAL@ recruit_real;
 #define RECRUIT_MAX_ENTRIES @NNZMAX@ /* largest number of nonzeros of a bundle's A */
 #define RECRUIT_PACKED (RECRUIT_MAX_STATES * (RECRUIT_MAX_STATES + 1) / 2)
 #define RECRUIT_TRACKS_ANGLE @ANGLE@ /* 1: reference and outer loop in rad; 0: force (N) */
-@LOOP_DEFINES@/* clang-format on */
+@LOOP_DEFINES@
 
 /* A bundle's constants (the identified model, unit geometry, gains): in recruit_controller.c. */
 typedef struct recruit_bundle_params recruit_bundle_params;
@@ -42,6 +42,7 @@ typedef struct {
   recruit_real xq[RECRUIT_MAX_STATES], t[RECRUIT_MAX_STATES], s[RECRUIT_MAX_STATES];
 } recruit_work;
 
+/* clang-format off */
 /* The task's controller: every bundle, the outer loop's integral (angle tasks). */
 typedef struct {
   recruit_bundle bundle[RECRUIT_NUM_BUNDLES];
@@ -55,6 +56,7 @@ typedef struct {
   recruit_real force[RECRUIT_NUM_BUNDLES];  /* N, each bundle's load cell; NaN = lost sample */
   recruit_real length[RECRUIT_NUM_BUNDLES]; /* m, each bundle's length coordinate; NaN = none */
 } recruit_input;
+/* clang-format on */
 
 /* What it decides: broadcast p_on / p_off to bundle i's units. */
 typedef struct {
