@@ -24,9 +24,33 @@ double TendonLengthNow(const mjModel* m, mjData* d, int t) {
   return d->ten_length[t];
 }
 
-// Tendon length with joint j at q, every other joint at qpos0.
-double LengthAt(const mjModel* m, mjData* d, int t, int j, double q) {
+// The joint a one-joint equality holds (MuJoCo's joint equality without joint2, active at
+// start: q = qpos0 + data[0]), or -1.
+int HeldJoint(const mjModel* m, int e) {
+  if (m->eq_type[e] != mjEQ_JOINT || !m->eq_active0[e] || m->eq_obj2id[e] >= 0) return -1;
+  return m->eq_obj1id[e];
+}
+
+// The rest pose the sweeps start from: qpos0, with the joints equalities hold where they hold
+// them (`recruit attach --lock`).
+void RestPose(const mjModel* m, mjData* d) {
   mju_copy(d->qpos, m->qpos0, m->nq);
+  for (int e = 0; e < m->neq; ++e) {
+    const int j = HeldJoint(m, e);
+    if (j >= 0) d->qpos[m->jnt_qposadr[j]] += m->eq_data[e * mjNEQDATA];
+  }
+}
+
+bool Held(const mjModel* m, int j) {
+  for (int e = 0; e < m->neq; ++e) {
+    if (HeldJoint(m, e) == j) return true;
+  }
+  return false;
+}
+
+// Tendon length with joint j at q, every other joint at the rest pose.
+double LengthAt(const mjModel* m, mjData* d, int t, int j, double q) {
+  RestPose(m, d);
   d->qpos[m->jnt_qposadr[j]] = q;
   return TendonLengthNow(m, d, t);
 }
@@ -111,7 +135,7 @@ std::pair<double, double> LengthRange(const mjModel* m, mjData* d, int t,
   const int n = static_cast<int>(joints.size());
   double lo = INFINITY, hi = -INFINITY;
   auto sample = [&](const std::vector<double>& f) {
-    mju_copy(d->qpos, m->qpos0, m->nq);
+    RestPose(m, d);
     for (int i = 0; i < n; ++i)
       d->qpos[m->jnt_qposadr[joints[i]]] = jlo[i] + f[i] * (jhi[i] - jlo[i]);
     const double l = TendonLengthNow(m, d, t);
@@ -148,19 +172,20 @@ std::pair<double, double> LengthRange(const mjModel* m, mjData* d, int t,
 }  // namespace
 
 std::vector<int> TendonJoints(const mjModel* m, mjData* d, int t) {
-  mju_copy(d->qpos, m->qpos0, m->nq);
+  RestPose(m, d);
   const double l0 = TendonLengthNow(m, d, t);
   std::vector<int> joints;
   for (int j = 0; j < m->njnt; ++j) {
     const int type = m->jnt_type[j];
-    if ((type != mjJNT_HINGE && type != mjJNT_SLIDE) || !m->jnt_limited[j]) continue;
+    if ((type != mjJNT_HINGE && type != mjJNT_SLIDE) || !m->jnt_limited[j] || Held(m, j)) continue;
     const int q = m->jnt_qposadr[j];
+    const double rest = d->qpos[q];
     bool moves = false;
     for (double f : {0.0, 0.5, 1.0}) {
       d->qpos[q] = m->jnt_range[2 * j] + f * (m->jnt_range[2 * j + 1] - m->jnt_range[2 * j]);
       moves = moves || std::abs(TendonLengthNow(m, d, t) - l0) > 1e-9;
     }
-    d->qpos[q] = m->qpos0[q];
+    d->qpos[q] = rest;
     if (moves) joints.push_back(j);
   }
   return joints;
@@ -186,7 +211,7 @@ TendonRange SampleTendonRange(const mjModel* m, mjData* d, int t) {
   if (!r.joints.empty()) {
     std::tie(r.length_min, r.length_max) = LengthRange(m, d, t, r.joints, r.usable_lo, r.usable_hi);
   } else {
-    mju_copy(d->qpos, m->qpos0, m->nq);
+    RestPose(m, d);
     r.length_min = r.length_max = TendonLengthNow(m, d, t);
   }
   return r;

@@ -30,7 +30,9 @@ struct TendonRange {
 };
 
 // Limited hinge and slide joints whose motion changes tendon t's length (probed at both limits
-// and the middle, every other joint at qpos0). d is scratch.
+// and the middle, every other joint at qpos0). A joint that an active one-joint equality holds
+// (MuJoCo's <equality><joint joint1=.../>, as `recruit attach --lock` writes) does not move: it
+// is left out, and every sweep holds it where the equality does. d is scratch.
 std::vector<int> TendonJoints(const mjModel* m, mjData* d, int t);
 
 // Tendon t's range over the usable ranges of TendonJoints(m, d, t). Jumps are found on a

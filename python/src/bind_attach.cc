@@ -119,7 +119,8 @@ model: the input MJCF. muscles: actuator names (a list, or one comma-separated s
 task: also write a starter task (JSON). report: also write the report (JSON). size_only: design
 only, write nothing but the report. force: peak force of every bundle (N) instead of each
 muscle's F0. lengthrange_from_joints: set the lengthrange of other muscles whose MuJoCo
-computation fails from the joint ranges. lock: joints the starter task does not drive.
+computation fails from the joint ranges. lock: joints held at their reference value in the written
+model (a joint equality each) and not driven by the starter task.
 max_time_constant, stroke_use, units_per_holding_force: the sizing options of the same names
 (`recruit attach --help`, docs/sma-units.md "Sizing a bundle").
 

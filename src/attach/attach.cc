@@ -75,13 +75,23 @@ Result<double> PeakForce(const mjModel* m, int a, const std::string& name, doubl
 
 // Probes the original model (compiled without lengthrange computation, which a bundle does not
 // need) for each bundle's force and tendon range.
+// The bundles' tendons, joints and loads, on a copy of the model with the locked joints held.
 Result<std::vector<BundleReport>> Probe(const mjSpec* spec, const std::vector<std::string>& names,
-                                        const AttachOptions& o) {
+                                        const AttachOptions& o, std::vector<JointLock>* locks) {
   auto copy = CopySpec(spec);
   if (!copy.ok()) return Error{copy.error(), copy.code()};
   (*copy)->compiler.LRopt.mode = mjLRMODE_NONE;
   auto m = CompileSpec(copy->get());
   if (!m.ok()) return Error{"'" + o.model + "' does not compile: " + m.error(), m.code()};
+  if (!o.lock.empty()) {
+    auto found = FindLocks(m->get(), o.lock, o.model);
+    if (!found.ok()) return found.failure();
+    *locks = std::move(found).value();
+    Status held = AddLockEqualities(copy->get(), *locks);
+    if (!held.ok()) return held.failure();
+    m = CompileSpec(copy->get());
+    if (!m.ok()) return Error{"'" + o.model + "' with the locks does not compile: " + m.error()};
+  }
   DataPtr d(mj_makeData(m->get()));
   if (!d) return Error{"cannot make data for '" + o.model + "'"};
   std::vector<BundleReport> out;
@@ -164,7 +174,8 @@ Result<AttachReport> Attach(const AttachOptions& o) {
   if (!spec.ok()) return Error{spec.error(), spec.code()};
   auto names = SelectActuators(spec->get(), o);
   if (!names.ok()) return Error{names.error(), names.code()};
-  auto bundles = Probe(spec->get(), *names, o);
+  std::vector<JointLock> locks;
+  auto bundles = Probe(spec->get(), *names, o, &locks);
   if (!bundles.ok()) return Error{bundles.error(), bundles.code()};
   Status sized = Size(*bundles, o.limits);
   if (!sized.ok()) return Error{sized.error(), sized.code()};
@@ -173,6 +184,7 @@ Result<AttachReport> Attach(const AttachOptions& o) {
   report.model = o.model;
   report.output = o.size_only ? "" : o.output;
   report.bundles = std::move(bundles).value();
+  report.locks = locks;
   for (const BundleReport& b : report.bundles) {
     for (const std::string& j : b.jumps) {
       report.warnings.push_back("'" + b.name + "': tendon path jumps at " + j +
@@ -189,6 +201,8 @@ Result<AttachReport> Attach(const AttachOptions& o) {
           s, {b.name, b.instance, b.sensor, b.design.gear, b.design.ConfigPairs()});
       if (!ok.ok()) return Error{ok.error(), ok.code()};
     }
+    Status locked = AddLockEqualities(s, report.locks);
+    if (!locked.ok()) return locked.failure();
     RebaseAssetDirs(s, o.model, o.output);
     auto fixes = CheckLengthRanges(s, o.lengthrange_from_joints);
     if (!fixes.ok()) return Error{"'" + o.model + "': " + fixes.error(), fixes.code()};

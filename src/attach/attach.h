@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "attach/holding_load.h"
+#include "attach/joint_lock.h"
 #include "attach/lengthrange.h"
 #include "attach/sizing.h"
 #include "common/result.h"
@@ -22,7 +23,8 @@ struct AttachOptions {
   bool size_only = false;            // design only: nothing written but the report
   double force = std::nan("");       // peak force for every bundle (N); NaN = the muscle's F0
   bool lengthrange_from_joints = false;
-  std::vector<std::string> lock;  // joints the starter task does not drive
+  // Joints held at their reference value in the written model (and not driven by the task).
+  std::vector<std::string> lock;
   SizingLimits limits;
 };
 
@@ -52,7 +54,8 @@ struct AttachReport {
   std::string model, output, task;
   std::vector<BundleReport> bundles;
   std::vector<LengthRangeFix> lengthranges;  // other muscles' ranges set from the joints
-  std::vector<std::string> changes;          // one line per edit
+  std::vector<JointLock> locks;
+  std::vector<std::string> changes;  // one line per edit
   std::vector<std::string> warnings;
 };
 

@@ -35,6 +35,10 @@ std::vector<std::string> ChangeLines(const AttachReport& r, const mjSpec* spec) 
   lines.push_back(std::string("default class '") + kBundleClass +
                   "' added: MuJoCo's built-in actuator defaults (dyntype none, gaintype fixed, "
                   "biastype none), so no inherited muscle default reaches the bundles");
+  for (const JointLock& l : r.locks) {
+    lines.push_back("joint '" + l.joint + "' locked at " + F("%g", l.value) +
+                    " (its reference value; a joint equality, --lock)");
+  }
   for (const LengthRangeFix& f : r.lengthranges) {
     lines.push_back("lengthrange of '" + f.actuator + "' set from the joint ranges: " +
                     F("%.4f", f.lo) + " " + F("%.4f", f.hi) + " m");

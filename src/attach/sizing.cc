@@ -45,8 +45,32 @@ Result<sma::UnitModel> DesignUnit(double d, double length, int series, const Siz
   return unit;
 }
 
-// Fewer wires per unit and more units, so that one unit is at most 1/units_per_holding_force of
-// the force that holds the limb's own weight (the wires, so the force, unchanged).
+// One wire of diameter d per segment: the unit, and how many such wires make the peak force.
+struct Wire {
+  sma::UnitParams unit;  // parallel 1, prestretch at ref_length
+  int wires = 0;
+  double time_constant = 0;  // s
+};
+
+Result<Wire> WireFor(double d, double length, int series, double gear, const SizingInput& in,
+                     const SizingLimits& limits) {
+  auto unit = DesignUnit(d, length, series, limits);
+  if (!unit.ok()) return unit.failure();
+  const double l_mid = 0.5 * (in.length_min + in.length_max);
+  const double s_mid = unit->params().prestretch - gear * (in.length_max - l_mid);
+  const double per_wire = gear * unit->Tension(0.0, s_mid);
+  Wire w;
+  w.unit = unit->params();
+  w.unit.prestretch = series * w.unit.eps_L * length - gear * (in.length_max - in.ref_length);
+  w.wires = static_cast<int>(std::ceil(in.peak_force / per_wire - 1e-9));
+  w.time_constant = unit->time_constant();
+  return w;
+}
+
+// More units for the same force, so that one unit is at most 1/units_per_holding_force of the
+// force that holds the limb's own weight: first fewer wires per unit, then, at one wire each,
+// thinner stock wire (more wires of it, the same force; they also cool faster), up to
+// max_units_resolution units.
 void RefineForResolution(const SizingInput& in, const SizingLimits& limits, BundleDesign& out) {
   if (!(in.holding_force > 0) || limits.units_per_holding_force <= 0) return;
   const double wanted =
@@ -57,6 +81,15 @@ void RefineForResolution(const SizingInput& in, const SizingLimits& limits, Bund
   if (out.units < target && parallel < out.unit.parallel) {
     out.unit.parallel = parallel;
     out.units = (wires + parallel - 1) / parallel;
+  }
+  const std::vector<double>& stock = StockDiameters();
+  for (auto d = stock.rbegin(); d != stock.rend() && out.units < target; ++d) {
+    if (*d >= out.unit.wire_diameter) continue;
+    auto wire = WireFor(*d, out.unit.wire_length, out.unit.series, out.gear, in, limits);
+    if (!wire.ok()) continue;
+    if (wire->wires > limits.max_units_resolution) break;
+    out.unit = wire->unit;
+    out.units = wire->wires;
   }
   if (out.units < wanted) {
     out.notes.push_back("resolution: " + std::to_string(out.units) + " units (at most " +
@@ -127,7 +160,6 @@ Result<BundleDesign> SizeBundle(const SizingInput& in, const SizingLimits& limit
   } else {
     out.notes.push_back("the tendon does not move over the joint ranges: default 0.1 m wire");
   }
-  const double l_mid = 0.5 * (in.length_min + in.length_max);
   // Diameter: the thinnest stock wire whose bundle needs at most 2 wires per segment within
   // max_units units (fast cooling, and enough units for the controller's resolution), unless
   // that wire cools slower than max_time_constant: then the thickest wire that does not, with up
@@ -137,20 +169,17 @@ Result<BundleDesign> SizeBundle(const SizingInput& in, const SizingLimits& limit
   sma::UnitParams fast;  // the thickest fast-enough design so far
   int fast_units = 0;
   for (std::size_t i = 0; i < stock.size(); ++i) {
-    auto unit = DesignUnit(stock[i], length, series, limits);
-    if (!unit.ok()) {
+    auto wire = WireFor(stock[i], length, series, out.gear, in, limits);
+    if (!wire.ok()) {
       if (i + 1 < stock.size() || fast_found) continue;
-      return Error{where + unit.error(), unit.code()};
+      return Error{where + wire.error(), wire.code()};
     }
-    const double s_mid = unit->params().prestretch - out.gear * (in.length_max - l_mid);
-    const double per_wire = out.gear * unit->Tension(0.0, s_mid);
-    const int wires = static_cast<int>(std::ceil(in.peak_force / per_wire - 1e-9));
+    const int wires = wire->wires;
     const int parallel = (wires + limits.max_units - 1) / limits.max_units;
-    sma::UnitParams p = unit->params();
+    sma::UnitParams p = wire->unit;
     p.parallel = parallel;
-    p.prestretch = series * eps_L * length - out.gear * (in.length_max - in.ref_length);
     const int units = (wires + parallel - 1) / parallel;
-    const bool fast_enough = unit->time_constant() <= limits.max_time_constant;
+    const bool fast_enough = wire->time_constant <= limits.max_time_constant;
     if (parallel <= 2 && (fast_enough || !fast_found)) {
       out.unit = p, out.units = units, chosen = true;
       break;
@@ -179,6 +208,7 @@ Result<BundleDesign> SizeBundle(const SizingInput& in, const SizingLimits& limit
   const sma::UnitLimits datasheet = sma::UnitLimits::ForWire(out.unit.wire_diameter);
   auto stretch = [&](double l) { return out.unit.prestretch + out.gear * (l - in.ref_length); };
   const double n = out.units;
+  const double l_mid = 0.5 * (in.length_min + in.length_max);
   out.force_mid = out.gear * n * u->Tension(0.0, stretch(l_mid));
   out.force_short = out.gear * n * u->Tension(0.0, stretch(in.length_min));
   const double long_tension = u->Tension(0.0, stretch(in.length_max));

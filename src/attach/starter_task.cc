@@ -34,13 +34,10 @@ Result<nlohmann::json> StarterTask(const AttachReport& report, const std::vector
       }
     }
   }
-  for (const std::string& l : lock) {
-    auto it =
-        std::find_if(joints.begin(), joints.end(), [&](const JointUse& j) { return j.joint == l; });
-    if (it == joints.end()) {
-      return Error{"--lock " + l + ": not a hinge the replaced muscles' tendons cross"};
-    }
-    joints.erase(it);
+  for (const std::string& l : lock) {  // held by the model: not driven
+    joints.erase(std::remove_if(joints.begin(), joints.end(),
+                                [&](const JointUse& j) { return j.joint == l; }),
+                 joints.end());
   }
   if (joints.empty()) return Error{"the starter task drives no joint (every one locked or none)"};
   nlohmann::json task;

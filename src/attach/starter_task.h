@@ -19,8 +19,8 @@ inline constexpr double kStepHold = 20;  // s per step
 inline constexpr double kStepStart = 20;
 
 // The task JSON (docs/howto-own-model.md); `task_path` is where it will be written (the model
-// path in it is relative to that folder). Error when a locked joint is not one the bundles cross
-// or every driven joint is locked.
+// path in it is relative to that folder). Error when every joint the bundles
+// cross is locked.
 Result<nlohmann::json> StarterTask(const AttachReport& report, const std::vector<std::string>& lock,
                                    const std::string& task_path);
 

@@ -89,7 +89,9 @@ void AddAttachCommand(CLI::App& app, int& exit_code) {
   sub->add_flag("--lengthrange-from-joints", args->options.lengthrange_from_joints,
                 "set the lengthrange of other muscles whose MuJoCo computation fails from the "
                 "joint ranges");
-  sub->add_option("--lock", args->lock, "joints the starter task does not drive (comma-separated)");
+  sub->add_option("--lock", args->lock,
+                  "joints held at their reference value in the written model (a joint equality "
+                  "each) and not driven by the starter task (comma-separated)");
   sub->add_option("--max-time-constant", args->options.limits.max_time_constant,
                   "slowest unit thermal time constant (s) sizing prefers a thinner wire for, with "
                   "more wires: bandwidth against heating power")

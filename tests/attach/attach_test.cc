@@ -422,10 +422,9 @@ TEST(StarterTask, LockedJointIsNotDriven) {
     auto tl = sim::Task::FromFile(a.task);
     ASSERT_TRUE(tl.ok()) << tl.error();
     EXPECT_THAT(DrivenJoints(*tl), ElementsAre(locked == "elbow" ? "shoulder" : "elbow"));
-    // Locking a joint keeps every bundle: the lock is about the task, not the model.
-    EXPECT_EQ(tl->bundles.size(), 6u);
+    EXPECT_EQ(tl->bundles.size(), 6u);  // every bundle kept
   }
-  // A joint no replaced tendon crosses, and locking everything, are refused; nothing written.
+  // A joint the model does not have, and locking everything, are refused; nothing written.
   const std::string dir = TempDir("task_lock_bad");
   AttachOptions o;
   o.model = kSrc + "/models/arm2j_muscle.xml";
@@ -603,4 +602,120 @@ TEST(StarterTask, RunsThroughTheSeveralJointLoop) {
 }
 
 }  // namespace
+// --lock holds the joint in the written model with a joint equality (MuJoCo's own loader and
+// solver keep it at its reference while the bundles pull), and the bundles are sized over the
+// joints that still move: the elbow-only tendons then have no excursion, and the biarticular
+// flexor's range is its length swept over the shoulder alone (a dense sweep with mj_tendon on
+// the original model, the elbow at its reference).
+TEST(Lock, HoldsTheJointAndSizesOverTheOthers) {
+  auto a = AttachArmWithTask("lock_model", {"elbow"});
+  ASSERT_TRUE(a.report.ok()) << a.report.error();
+  ModelPtr m = Load(a.report->output);
+  ASSERT_TRUE(m);
+  ASSERT_EQ(m->neq, 1);
+  const int elbow = mj_name2id(m.get(), mjOBJ_JOINT, "elbow");
+  EXPECT_EQ(m->eq_type[0], mjEQ_JOINT);
+  EXPECT_EQ(m->eq_obj1id[0], elbow);
+  EXPECT_EQ(m->eq_obj2id[0], -1);
+  DataPtr d(mj_makeData(m.get()));
+  for (int i = 0; i < m->nu; ++i) d->ctrl[i] = 0;
+  double worst = 0;
+  for (int k = 0; k < 500; ++k) {  // 1 s: the limb falls under gravity onto its bundles
+    mj_step(m.get(), d.get());
+    worst = std::max(worst, std::abs(d->qpos[m->jnt_qposadr[elbow]] - m->qpos0[elbow]));
+  }
+  EXPECT_LT(worst, 0.02);  // rad: held (a soft constraint)
+
+  ModelPtr plain = LoadPlain(kSrc + "/models/arm2j_muscle.xml");
+  ASSERT_TRUE(plain);
+  DataPtr pd(mj_makeData(plain.get()));
+  const int shoulder = mj_name2id(plain.get(), mjOBJ_JOINT, "shoulder");
+  for (const BundleReport& b : a.report->bundles) {
+    bool crosses_shoulder = false;
+    for (const JointUse& j : b.joints) {
+      EXPECT_NE(j.joint, "elbow") << b.name;
+      crosses_shoulder = crosses_shoulder || j.joint == "shoulder";
+    }
+    double lo = INFINITY, hi = -INFINITY;
+    for (int i = 0; i <= 2000; ++i) {
+      mju_copy(pd->qpos, plain->qpos0, plain->nq);
+      pd->qpos[plain->jnt_qposadr[shoulder]] =
+          plain->jnt_range[2 * shoulder] +
+          i / 2000.0 * (plain->jnt_range[2 * shoulder + 1] - plain->jnt_range[2 * shoulder]);
+      mj_kinematics(plain.get(), pd.get());
+      mj_comPos(plain.get(), pd.get());
+      mj_tendon(plain.get(), pd.get());
+      const double l = pd->ten_length[b.tendon_id];
+      lo = std::min(lo, l), hi = std::max(hi, l);
+    }
+    if (crosses_shoulder) {
+      EXPECT_NEAR(b.length_min, lo, 1e-5) << b.name;
+      EXPECT_NEAR(b.length_max, hi, 1e-5) << b.name;
+    } else {
+      EXPECT_EQ(b.length_max - b.length_min, 0.0) << b.name;  // EF, EE: only the elbow moved them
+      EXPECT_LT(hi - lo, 1e-9) << b.name;
+    }
+  }
+}
+
+// A held joint does not move a tendon: the sweep leaves it out and holds it where the
+// equality holds it (0.3 rad from its reference here), against the closed form of a two-link
+// arm with a straight tendon from a fixed site.
+TEST(TendonRange, AJointAnEqualityHoldsIsLeftOut) {
+  const char* xml = R"(<mujoco><worldbody>
+  <site name="s0" pos="-0.1 0 0"/>
+  <body><joint name="a" type="hinge" axis="0 1 0" range="-60 60"/>
+    <geom type="capsule" fromto="0 0 0 0.3 0 0" size="0.01"/>
+    <body pos="0.3 0 0"><joint name="b" type="hinge" axis="0 1 0" range="-60 60"/>
+      <geom type="capsule" fromto="0 0 0 0.2 0 0" size="0.01"/>
+      <site name="s1" pos="0.2 0 0"/></body></body></worldbody>
+  <tendon><spatial name="t"><site site="s0"/><site site="s1"/></spatial></tendon>
+  %s</mujoco>)";
+  auto build = [&](const std::string& eq) {
+    char buf[2000];
+    std::snprintf(buf, sizeof buf, xml, eq.c_str());
+    char error[500] = "";
+    mjSpec* s = mj_parseXMLString(buf, nullptr, error, sizeof error);
+    EXPECT_NE(s, nullptr) << error;
+    ModelPtr m(mj_compile(s, nullptr));
+    mj_deleteSpec(s);
+    return m;
+  };
+  ModelPtr free = build("");
+  ModelPtr held = build(R"(<equality><joint joint1="b" polycoef="0.3 0 0 0 0"/></equality>)");
+  ASSERT_TRUE(free && held);
+  DataPtr d(mj_makeData(held.get()));
+  const sma::TendonRange both = sma::SampleTendonRange(free.get(), d.get(), 0);
+  EXPECT_EQ(both.joints.size(), 2u);
+  const sma::TendonRange one = sma::SampleTendonRange(held.get(), d.get(), 0);
+  ASSERT_EQ(one.joints.size(), 1u);
+  EXPECT_EQ(one.joints[0], 0);
+  // Closed form: with b at 0.3 the tip is R(x) v from a's axis, v = (0.3 + 0.2 cos 0.3,
+  // 0.2 sin 0.3), and s0 is c = 0.1 behind it: l^2 = |v|^2 + 0.01 + 0.2 |v| cos(x + phi), phi the
+  // angle of v, x over +-60 deg: longest at x = -phi, shortest at the end 60 deg from it.
+  const double vx = 0.3 + 0.2 * std::cos(0.3), vy = 0.2 * std::sin(0.3);
+  const double v = std::hypot(vx, vy), phi = std::atan2(vy, vx);
+  EXPECT_NEAR(one.length_max, std::sqrt(v * v + 0.01 + 0.2 * v), 1e-7);
+  EXPECT_NEAR(one.length_min, std::sqrt(v * v + 0.01 + 0.2 * v * std::cos(M_PI / 3 + phi)), 1e-7);
+}
+
+// Resolution past one wire per unit: thinner stock wire, more units of it, the same force (the
+// bundle still meets the peak force to within one unit), and faster units.
+TEST(Sizing, ResolutionTakesThinnerWireWhenOneWirePerUnitIsNotEnough) {
+  SizingInput in{"b", 40, 0.03, 0.1, 0.13, 0.115};
+  auto coarse = SizeBundle(in);
+  ASSERT_TRUE(coarse.ok()) << coarse.error();
+  in.holding_force = 4;  // 50 units per 4 N: 500 units wanted, more than its wires
+  ASSERT_LT(coarse->units * coarse->unit.parallel, 500);
+  auto fine = SizeBundle(in);
+  ASSERT_TRUE(fine.ok()) << fine.error();
+  EXPECT_LT(fine->unit.wire_diameter, coarse->unit.wire_diameter);
+  EXPECT_GT(fine->units, coarse->units);
+  EXPECT_EQ(fine->unit.parallel, 1);
+  EXPECT_LE(fine->units, SizingLimits{}.max_units_resolution);
+  EXPECT_GE(fine->force_mid, in.peak_force);
+  EXPECT_LT(fine->force_mid, in.peak_force * (1 + 1.0 / fine->units) + 1e-9);
+  EXPECT_LT(fine->time_constant, coarse->time_constant);
+}
+
 }  // namespace recruit::attach
