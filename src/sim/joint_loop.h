@@ -82,6 +82,15 @@ class JointLoops {
   std::vector<JointDesignRecord> designs_;
 };
 
+// Each bundle's price in the torque allocation (control::AllocationProblem::price): its time to
+// 63 % over the fastest bundle's, times kCrossedJointPrice (10) for each driven joint it crosses
+// beyond the first (`arms`: joints x bundles, at the first reference pose; an arm of rounding
+// size, below 1e-9 of the largest, is not a crossing). Slow bundles take what only they can
+// give; a bundle on several joints moves one of them only where the others' bundles cannot, as
+// cancelling its torque on the other joint with bundles of another speed makes that joint jump.
+Eigen::VectorXd BundlePrices(const std::vector<control::ActuatorResponse>& responses,
+                             const Eigen::MatrixXd& arms);
+
 // The shortest time a reference holds a value over [0, duration] (its steps' holds), or the
 // duration when it never changes.
 double ShortestHold(const Reference& reference, double duration);

@@ -10,6 +10,7 @@
 #include <fstream>
 #include <regex>
 
+#include "sim/joint_loop.h"
 #include "sim/plant.h"
 #include "sim/run_task.h"
 #include "tests/plugin/mujoco_util.h"
@@ -224,4 +225,23 @@ TEST(JointLoop, TheSummaryCarriesWhatLoadingTheModelWarnedOf) {
 }
 
 }  // namespace
+// Prices: the response time ratio to the fastest, times 10 per further driven joint crossed.
+TEST(JointLoop, BundlePricesChargeSlowAndMultiJointBundles) {
+  auto response = [](double t63) {
+    control::ActuatorResponse r;
+    r.dT = 1;
+    r.s = {0, 0.63 / t63, 2 * 0.63 / t63};  // reaches 0.63 at t63 (linear between samples)
+    return r;
+  };
+  const std::vector<control::ActuatorResponse> rs = {response(1), response(2), response(1.5)};
+  Eigen::MatrixXd arms(2, 3);
+  arms << 0.02, -0.015, 0.03,  // joint 0: all three cross it
+      1e-14, 0, -0.01;         // joint 1: the third only (the first's arm is rounding)
+  const Eigen::VectorXd p = BundlePrices(rs, arms);
+  ASSERT_EQ(p.size(), 3);
+  EXPECT_NEAR(p[0], 1.0, 1e-12);
+  EXPECT_NEAR(p[1], 2.0, 1e-12);
+  EXPECT_NEAR(p[2], 1.5 * 10, 1e-12);
+}
+
 }  // namespace recruit::sim
