@@ -122,11 +122,9 @@ Result<FrozenAutoLoop> FreezeAutoLoop(const sim::Task& task, const sim::RunOptio
   FrozenAutoLoop out;
   out.dT = settings.dT;
   out.co_contraction = task.co_contraction;
-  // The allocation's prices (JointLoops::Create): each bundle's time to 63 % over the fastest's.
-  double fastest = std::numeric_limits<double>::infinity();
-  for (const control::ActuatorResponse& r : *responses) fastest = std::min(fastest, r.TimeTo(0.63));
+  const Eigen::VectorXd& price = loops->prices();  // the allocation's (sim::BundlePrices)
   for (int i = 0; i < nb; ++i) {
-    out.price.push_back((*responses)[i].TimeTo(0.63) / fastest);
+    out.price.push_back(price[i]);
     out.units.push_back(plant.num_units(i));
   }
   for (int j = 0; j < nj; ++j) {

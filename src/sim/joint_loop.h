@@ -52,6 +52,8 @@ class JointLoops {
   // The force reference (N) of every bundle at a control instant.
   void Step(double t, const Plant& plant, std::vector<double>& force_ref);
 
+  // Each bundle's price in the allocation (BundlePrices).
+  const Eigen::VectorXd& prices() const { return price_; }
   // Every design made so far, in the order made.
   const std::vector<JointDesignRecord>& designs() const { return designs_; }
   // The driven joints' references at t, kept 3 % of each limited joint's range inside it.

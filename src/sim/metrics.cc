@@ -24,6 +24,35 @@ double IntegralAbsoluteError(const std::vector<double>& t, const std::vector<dou
   return s;
 }
 
+std::vector<ReferenceStep> StepsUntilDisturbances(std::vector<ReferenceStep> steps,
+                                                  const std::vector<double>& starts) {
+  for (ReferenceStep& s : steps) {
+    for (double d : starts) {
+      if (d > s.time && d < s.end) s.end = d;
+    }
+  }
+  return steps;
+}
+
+std::vector<DisturbanceWindow> DisturbanceWindows(std::vector<double> starts,
+                                                  const std::vector<ReferenceStep>& steps,
+                                                  double duration) {
+  std::sort(starts.begin(), starts.end());
+  std::vector<DisturbanceWindow> out;
+  for (double d : starts) {
+    if (!(d < duration)) continue;
+    DisturbanceWindow w{d, duration};
+    for (double e : starts) {
+      if (e > d) w.end = std::min(w.end, e);
+    }
+    for (const ReferenceStep& s : steps) {
+      if (s.time > d) w.end = std::min(w.end, s.time);
+    }
+    out.push_back(w);
+  }
+  return out;
+}
+
 std::vector<StepResponse> StepResponses(const std::vector<double>& t, const std::vector<double>& y,
                                         const std::vector<ReferenceStep>& steps, double band) {
   std::vector<StepResponse> out;

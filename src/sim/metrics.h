@@ -23,6 +23,26 @@ struct StepResponse {
   bool settled = false;      // within the band at the end of the hold
 };
 
+// The steps scored up to the first disturbance (a push) that starts inside their hold: what
+// follows is the disturbance's response, not the step's (DisturbanceResponse).
+std::vector<ReferenceStep> StepsUntilDisturbances(std::vector<ReferenceStep> steps,
+                                                  const std::vector<double>& starts);
+
+// A disturbance's window: from its start to the next disturbance or step of the reference, or
+// the end of the run.
+struct DisturbanceWindow {
+  double start = 0, end = 0;
+};
+std::vector<DisturbanceWindow> DisturbanceWindows(std::vector<double> starts,
+                                                  const std::vector<ReferenceStep>& steps,
+                                                  double duration);
+
+struct DisturbanceResponse {
+  DisturbanceWindow window;
+  double peak_deviation = 0;   // max |y - r| in the window (the tracked unit)
+  double final_deviation = 0;  // |y - r| at the window's last sample
+};
+
 // Overshoot and settling time of y for each step of the reference.
 std::vector<StepResponse> StepResponses(const std::vector<double>& t, const std::vector<double>& y,
                                         const std::vector<ReferenceStep>& steps, double band);

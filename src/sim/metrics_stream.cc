@@ -7,8 +7,11 @@
 
 namespace recruit::sim {
 
-SignalMetrics::SignalMetrics(std::vector<ReferenceStep> steps, double band) : band_(band) {
+SignalMetrics::SignalMetrics(std::vector<ReferenceStep> steps, double band,
+                             std::vector<DisturbanceWindow> disturbances)
+    : band_(band) {
   for (const ReferenceStep& s : steps) steps_.push_back({s});
+  for (const DisturbanceWindow& w : disturbances) disturbances_.push_back({w});
 }
 
 void SignalMetrics::Add(double t, double r, double y) {
@@ -29,6 +32,11 @@ void SignalMetrics::Add(double t, double r, double y) {
     s.last_was_out = std::abs(y - s.step.to) > band_ * size;
     s.out_seen = s.out_seen || s.last_was_out;
     s.any = true;
+  }
+  for (DisturbanceResponse& d : disturbances_) {
+    if (t < d.window.start || t >= d.window.end) continue;
+    d.peak_deviation = std::max(d.peak_deviation, std::abs(y - r));
+    d.final_deviation = std::abs(y - r);
   }
 }
 
@@ -61,6 +69,10 @@ std::vector<StepResponse> SignalMetrics::StepResponses() const {
     out.push_back(resp);
   }
   return out;
+}
+
+std::vector<DisturbanceResponse> SignalMetrics::DisturbanceResponses() const {
+  return disturbances_;
 }
 
 void EstimatorScoreAccumulator::Add(double estimated, double truth, double variance) {

@@ -12,13 +12,15 @@ namespace recruit::sim {
 // Tracking RMSE, IAE, excess total variation and step responses of y against r.
 class SignalMetrics {
  public:
-  SignalMetrics(std::vector<ReferenceStep> steps, double band);
+  SignalMetrics(std::vector<ReferenceStep> steps, double band,
+                std::vector<DisturbanceWindow> disturbances = {});
   // The next sample, at time t (increasing).
   void Add(double t, double r, double y);
   double TrackingRmse() const;
   double IntegralAbsoluteError(double t_end) const;  // t_end closes the last sample
   double ExcessTotalVariation() const;
   std::vector<StepResponse> StepResponses() const;
+  std::vector<DisturbanceResponse> DisturbanceResponses() const;
 
  private:
   struct StepState {
@@ -30,6 +32,7 @@ class SignalMetrics {
     double t_after_out = 0;     // time of the sample after the latest out-of-band one
   };
   std::vector<StepState> steps_;
+  std::vector<DisturbanceResponse> disturbances_;  // accumulated as the samples come
   double band_ = 0;
   long n_ = 0;
   double sq_ = 0, iae_ = 0, tv_r_ = 0, tv_y_ = 0;

@@ -91,6 +91,16 @@ nlohmann::json RunSummary::ToJson() const {
     if (k < step_joints.size()) steps_json.back()["joint"] = step_joints[k];
   }
   j["steps"] = steps_json;
+  if (!pushes.empty()) {
+    nlohmann::json ps = nlohmann::json::array();
+    for (const DisturbanceResponse& d : pushes) {
+      ps.push_back({{"start", d.window.start},
+                    {"end", d.window.end},
+                    {"peak_deviation", d.peak_deviation},
+                    {"final_deviation", d.final_deviation}});
+    }
+    j["pushes"] = ps;
+  }
   if (!joints.empty()) {
     nlohmann::json js = nlohmann::json::array();
     for (const JointSummary& x : joints) {
@@ -409,6 +419,7 @@ void Summarize(const Task& task, const Plant& plant, const SignalMetrics& sig,
   mt.tracking_rmse = sig.TrackingRmse();
   mt.iae = sig.IntegralAbsoluteError(duration + h);
   s.steps = sig.StepResponses();
+  s.pushes = sig.DisturbanceResponses();
   mt.num_steps = static_cast<int>(s.steps.size());
   int settled = 0;
   for (const auto& st : s.steps) {
@@ -764,10 +775,15 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
     if (!loops) return Error{where + ".outer_loop: " + loops.error(), loops.code()};
     joint_loops = std::move(loops).value();
   }
+  // Steps are scored up to a push; each push's response is scored on its own.
+  std::vector<double> push_starts;
+  for (const Push& p : task.pushes) push_starts.push_back(p.start);
   // Joints after the first score against their own references (the first is `measured`).
   std::vector<SignalMetrics> more_joints;
   for (int j = 1; j < plant.num_joints(); ++j) {
-    more_joints.emplace_back(task.joints[j].reference.Steps(duration), task.settle_band);
+    more_joints.emplace_back(
+        StepsUntilDisturbances(task.joints[j].reference.Steps(duration), push_starts),
+        task.settle_band);
   }
 
   TelemetrySample sample;
@@ -785,7 +801,9 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
   const double h = plant.timestep();
   const long num_steps = std::lround(duration / h);
   // The metrics accumulate as the run goes: memory does not grow with its length.
-  SignalMetrics sig(task.reference.Steps(duration), task.settle_band);
+  SignalMetrics sig(StepsUntilDisturbances(task.reference.Steps(duration), push_starts),
+                    task.settle_band,
+                    DisturbanceWindows(push_starts, task.reference.Steps(duration), duration));
   auto measured = [&]() {
     return task.tracked == Tracked::kForce ? plant.Force(0) : plant.angle();
   };

@@ -103,8 +103,10 @@ struct RunSummary {
   std::vector<std::string> warnings;   // limits exceeded, also printed on stderr
   std::vector<StepResponse> steps;
   std::vector<std::string> step_joints;  // the joint of each step (several-joint tasks)
-  std::vector<JointSummary> joints;      // self-tuned angle tasks: per driven joint
-  nlohmann::json loop_designs;           // self-tuned angle tasks: each design made (JSON)
+  // The tracked signal's response to each push (the steps are scored up to a push).
+  std::vector<DisturbanceResponse> pushes;
+  std::vector<JointSummary> joints;  // self-tuned angle tasks: per driven joint
+  nlohmann::json loop_designs;       // self-tuned angle tasks: each design made (JSON)
 
   nlohmann::json ToJson() const;
   // True if a bundle's hottest unit or most stressed wire passed its wire's datasheet limit.

@@ -202,4 +202,40 @@ TEST(MetricsStream, AccumulatorsEqualThePureFunctionsExactly) {
 }
 
 }  // namespace
+// A push inside a step's hold ends the step's scored window there; the push is scored from its
+// start to the next event. A first-order step (tau 1 s) with a push at t = 10 that deflects it by
+// 0.3 exp(-(t - 10)) afterwards: the step settles (no overshoot, tau ln 10), and the push's peak
+// and final deviations are the deflection's closed form at the window's first and last samples.
+TEST(MetricsStream, PushesEndTheStepWindowAndAreScoredOnTheirOwn) {
+  const std::vector<ReferenceStep> steps = {{1, 0, 1, 30}};
+  const auto cut = StepsUntilDisturbances(steps, {10, 40});
+  ASSERT_EQ(cut.size(), 1u);
+  EXPECT_EQ(cut[0].end, 10);
+  const auto windows = DisturbanceWindows({25, 10}, steps, 30);
+  ASSERT_EQ(windows.size(), 2u);
+  EXPECT_EQ(windows[0].start, 10);
+  EXPECT_EQ(windows[0].end, 25);
+  EXPECT_EQ(windows[1].end, 30);
+  SignalMetrics sig(cut, 0.1, DisturbanceWindows({10}, steps, 30));
+  const double h = 0.001;
+  double last = 0;
+  for (int k = 0; k < 30000; ++k) {
+    const double t = k * h;
+    const double r = t >= 1 ? 1.0 : 0.0;
+    double y = t >= 1 ? 1 - std::exp(-(t - 1)) : 0.0;
+    if (t >= 10) y -= 0.3 * std::exp(-(t - 10));
+    sig.Add(t, r, y);
+    last = std::abs(y - r);
+  }
+  const auto st = sig.StepResponses();
+  ASSERT_EQ(st.size(), 1u);
+  EXPECT_TRUE(st[0].settled);
+  EXPECT_EQ(st[0].overshoot, 0);
+  EXPECT_NEAR(st[0].settling_time, std::log(10.0), 2 * h);
+  const auto d = sig.DisturbanceResponses();
+  ASSERT_EQ(d.size(), 1u);
+  EXPECT_NEAR(d[0].peak_deviation, 0.3 + std::exp(-9.0), 1e-12);
+  EXPECT_NEAR(d[0].final_deviation, last, 1e-15);
+}
+
 }  // namespace recruit::sim
