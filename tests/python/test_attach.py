@@ -159,3 +159,27 @@ def test_unwritable_output_is_an_os_error_and_leaves_nothing(tmp_path):
     with pytest.raises(OSError, match="cannot"):
         recruit.attach(ARM, "all", output=out, report=tmp_path / "r.json")
     assert os.listdir(tmp_path) == []
+
+
+def test_lock_holds_the_joint_in_mujocos_own_simulation(tmp_path):
+    """lock=["elbow"]: the written model holds the elbow with a joint equality, which MuJoCo's
+    own solver keeps (1 s under gravity with the bundles idle); the bundles' sizing and the
+    starter task leave the elbow out."""
+    out, task = tmp_path / "locked.xml", tmp_path / "task.json"
+    report = recruit.attach(ARM, "all", output=out, task=task, lock=["elbow"])
+    m = mujoco.MjModel.from_xml_path(str(out))
+    elbow = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, "elbow")
+    assert m.neq == 1
+    assert m.eq_type[0] == mujoco.mjtEq.mjEQ_JOINT
+    assert m.eq_obj1id[0] == elbow and m.eq_obj2id[0] == -1
+    d = mujoco.MjData(m)
+    q = m.jnt_qposadr[elbow]
+    worst = 0.0
+    for _ in range(int(1.0 / m.opt.timestep)):
+        mujoco.mj_step(m, d)
+        worst = max(worst, abs(d.qpos[q] - m.qpos0[q]))
+    assert worst < 0.02
+    for b in report["bundles"]:
+        assert all(j["joint"] != "elbow" for j in b["joints"]), b["name"]
+    with open(task) as f:
+        assert [j["joint"] for j in json.load(f)["joints"]] == ["shoulder"]
