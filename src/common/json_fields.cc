@@ -23,6 +23,21 @@ std::string Shape(int rows, int cols) {
          (cols >= 0 ? std::to_string(cols) : std::string("c"));
 }
 
+// A JSON integer lo <= n <= hi (not 2.0, not one beyond 64 bits).
+bool WholeIn(const json& v, std::int64_t lo, std::int64_t hi) {
+  if (!v.is_number_integer()) return false;
+  if (v.is_number_unsigned() && v.get<std::uint64_t>() > std::uint64_t(hi)) return false;
+  return v.get<std::int64_t>() >= lo && v.get<std::int64_t>() <= hi;
+}
+
+// An array of `size` entries (size < 0: any), else "field: must be an array of ..., got X".
+Status ArrayOf(const json& v, const std::string& field, int size, const std::string& allowed) {
+  if (!v.is_array() || (size >= 0 && static_cast<int>(v.size()) != size)) {
+    return Error{field + ": " + ShortText(v.dump()) + "; allowed: " + allowed};
+  }
+  return Status::Ok();
+}
+
 // A finite number, else "field: must be a finite number, got X".
 Status FiniteNumber(const json& v, const std::string& field, double* out) {
   if (!v.is_number() || !std::isfinite(v.get<double>())) {
@@ -71,12 +86,32 @@ Status Integer(const json& j, const std::string& key, const std::string& where, 
     return Status::Ok();
   }
   const json& v = j.at(key);
-  const bool whole = v.is_number_integer() &&
-                     (v.is_number_unsigned() ? v.get<std::uint64_t>() <= std::uint64_t(hi) : true);
-  if (!whole || v.get<std::int64_t>() < lo || v.get<std::int64_t>() > hi) {
+  if (!WholeIn(v, lo, hi)) {
     return Error{where + "." + key + ": " + ShortText(v.dump()) + "; allowed: " + allowed};
   }
   *out = v.get<std::int64_t>();
+  return Status::Ok();
+}
+
+Status Integers(const json& j, const std::string& key, const std::string& where,
+                std::vector<std::int64_t>* out, bool required, int size, std::int64_t lo,
+                std::int64_t hi, const std::string& allowed) {
+  if (!j.contains(key)) {
+    if (required) return Error{where + ": missing field '" + key + "' (" + allowed + ")"};
+    return Status::Ok();
+  }
+  const json& v = j.at(key);
+  const std::string field = where + "." + key;
+  RECRUIT_TRY(ArrayOf(v, field, size, allowed));
+  std::vector<std::int64_t> n;
+  for (size_t i = 0; i < v.size(); ++i) {
+    if (!WholeIn(v[i], lo, hi)) {
+      return Error{field + "[" + std::to_string(i) + "]: " + ShortText(v[i].dump()) +
+                   "; allowed: " + allowed};
+    }
+    n.push_back(v[i].get<std::int64_t>());
+  }
+  *out = std::move(n);
   return Status::Ok();
 }
 
@@ -239,6 +274,27 @@ Status Boolean(const json& j, const std::string& key, const std::string& where, 
   if (!j.contains(key)) return Status::Ok();
   if (!j.at(key).is_boolean()) return Error{where + "." + key + ": must be true or false"};
   *out = j.at(key).get<bool>();
+  return Status::Ok();
+}
+
+Status Booleans(const json& j, const std::string& key, const std::string& where,
+                std::vector<bool>* out, bool required, int size, const std::string& allowed) {
+  if (!j.contains(key)) {
+    if (required) return Error{where + ": missing field '" + key + "' (" + allowed + ")"};
+    return Status::Ok();
+  }
+  const json& v = j.at(key);
+  const std::string field = where + "." + key;
+  RECRUIT_TRY(ArrayOf(v, field, size, allowed));
+  std::vector<bool> b;
+  for (size_t i = 0; i < v.size(); ++i) {
+    if (!v[i].is_boolean()) {
+      return Error{field + "[" + std::to_string(i) + "]: " + ShortText(v[i].dump()) +
+                   "; allowed: true or false"};
+    }
+    b.push_back(v[i].get<bool>());
+  }
+  *out = std::move(b);
   return Status::Ok();
 }
 
