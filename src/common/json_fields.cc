@@ -30,11 +30,30 @@ bool WholeIn(const json& v, std::int64_t lo, std::int64_t hi) {
   return v.get<std::int64_t>() >= lo && v.get<std::int64_t>() <= hi;
 }
 
-// An array of `size` entries (size < 0: any), else "field: must be an array of ..., got X".
-Status ArrayOf(const json& v, const std::string& field, int size, const std::string& allowed) {
+// An array field of `size` entries (size < 0: any) of type T, each one `entry_ok` accepts
+// (else "where.key[i]: X; allowed: entry_allowed").
+template <class T, class EntryOk>
+Status ArrayField(const json& j, const std::string& key, const std::string& where,
+                  std::vector<T>* out, bool required, int size, const std::string& allowed,
+                  const std::string& entry_allowed, EntryOk entry_ok) {
+  if (!j.contains(key)) {
+    if (required) return Error{where + ": missing field '" + key + "' (" + allowed + ")"};
+    return Status::Ok();
+  }
+  const json& v = j.at(key);
+  const std::string field = where + "." + key;
   if (!v.is_array() || (size >= 0 && static_cast<int>(v.size()) != size)) {
     return Error{field + ": " + ShortText(v.dump()) + "; allowed: " + allowed};
   }
+  std::vector<T> values;
+  for (size_t i = 0; i < v.size(); ++i) {
+    if (!entry_ok(v[i])) {
+      return Error{field + "[" + std::to_string(i) + "]: " + ShortText(v[i].dump()) +
+                   "; allowed: " + entry_allowed};
+    }
+    values.push_back(v[i].get<T>());
+  }
+  *out = std::move(values);
   return Status::Ok();
 }
 
@@ -96,23 +115,8 @@ Status Integer(const json& j, const std::string& key, const std::string& where, 
 Status Integers(const json& j, const std::string& key, const std::string& where,
                 std::vector<std::int64_t>* out, bool required, int size, std::int64_t lo,
                 std::int64_t hi, const std::string& allowed) {
-  if (!j.contains(key)) {
-    if (required) return Error{where + ": missing field '" + key + "' (" + allowed + ")"};
-    return Status::Ok();
-  }
-  const json& v = j.at(key);
-  const std::string field = where + "." + key;
-  RECRUIT_TRY(ArrayOf(v, field, size, allowed));
-  std::vector<std::int64_t> n;
-  for (size_t i = 0; i < v.size(); ++i) {
-    if (!WholeIn(v[i], lo, hi)) {
-      return Error{field + "[" + std::to_string(i) + "]: " + ShortText(v[i].dump()) +
-                   "; allowed: " + allowed};
-    }
-    n.push_back(v[i].get<std::int64_t>());
-  }
-  *out = std::move(n);
-  return Status::Ok();
+  return ArrayField(j, key, where, out, required, size, allowed, allowed,
+                    [lo, hi](const json& x) { return WholeIn(x, lo, hi); });
 }
 
 Status Unsigned(const json& j, const std::string& key, const std::string& where, std::uint64_t* out,
@@ -279,23 +283,8 @@ Status Boolean(const json& j, const std::string& key, const std::string& where, 
 
 Status Booleans(const json& j, const std::string& key, const std::string& where,
                 std::vector<bool>* out, bool required, int size, const std::string& allowed) {
-  if (!j.contains(key)) {
-    if (required) return Error{where + ": missing field '" + key + "' (" + allowed + ")"};
-    return Status::Ok();
-  }
-  const json& v = j.at(key);
-  const std::string field = where + "." + key;
-  RECRUIT_TRY(ArrayOf(v, field, size, allowed));
-  std::vector<bool> b;
-  for (size_t i = 0; i < v.size(); ++i) {
-    if (!v[i].is_boolean()) {
-      return Error{field + "[" + std::to_string(i) + "]: " + ShortText(v[i].dump()) +
-                   "; allowed: true or false"};
-    }
-    b.push_back(v[i].get<bool>());
-  }
-  *out = std::move(b);
-  return Status::Ok();
+  return ArrayField(j, key, where, out, required, size, allowed, "true or false",
+                    [](const json& x) { return x.is_boolean(); });
 }
 
 Status Vec3(const json& j, const std::string& key, const std::string& where, Eigen::Vector3d* out) {
