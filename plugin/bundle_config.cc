@@ -278,8 +278,9 @@ Result<BundleConfig> BundleConfig::FromPairs(
     }
     if (key == "failures") {
       auto events = FailureConfig::ParseSchedule(value);
-      if (!events.ok())
-        return Error{where + "failures=" + ShortText(value) + " is invalid: " + events.error()};
+      if (!events.ok()) {
+        return events.failure().In(where + "failures=" + ShortText(value) + " is invalid: ");
+      }
       c.failure.schedule = std::move(events).value();
       c.failure.given = true;
       continue;
@@ -323,11 +324,10 @@ Result<BundleConfig> BundleConfig::FromPairs(
     }
     c.unit.prestretch = prestrain * c.unit.wire_length * c.unit.series;  // whole unit
   }
-  if (Status f = CheckFailures(c, given, where); !f.ok()) return Error{f.error()};
+  RECRUIT_TRY(CheckFailures(c, given, where));
   auto check = UnitModel::Create(c.unit);
-  if (!check.ok()) return Error{where + check.error(), check.code()};
-  Status domain = CheckDomain(c, given, where);
-  if (!domain.ok()) return Error{domain.error(), domain.code()};
+  if (!check.ok()) return check.failure().In(where);
+  RECRUIT_TRY(CheckDomain(c, given, where));
   return c;
 }
 

@@ -13,8 +13,8 @@
 //  - BM_ChainStep<M>/<path>: the heating / cooling chain, dense A, sparse A with the kernels
 //    the filter picks (AVX where the CPU has it), sparse A with the baseline kernels;
 //  - BM_ParseFilterModel/<path>: reading an identified model's JSON text (16 KB, what
-//    `recruit simulate` does for each bundle at start-up): 0 = json_io::ParseJson (one pass that
-//    checks and builds the tree), 1 = nlohmann::json::parse alone, the reference;
+//    `recruit simulate` does for each bundle at start-up): 0 = ParseJsonText (common/json_file.h:
+//    a depth pre-scan, then the parse), 1 = nlohmann::json::parse alone, the reference;
 //  - BM_Estimator/<kind>/m: time per step of the extended Kalman filter, the exact filter
 //    (every step a new A, and a constant, cached A) and a particle filter with the smallest
 //    particle count whose RMSE is within 5 % of the Kalman filter's (found by a calibration
@@ -28,9 +28,9 @@
 #include <sstream>
 #include <vector>
 
+#include "common/json_file.h"
 #include "common/rng.h"
 #include "estimation/exact_filter.h"
-#include "estimation/json_matrix.h"
 #include "estimation/particle_filter.h"
 #include "estimation/population_chain.h"
 #include "estimation/population_kalman_filter.h"
@@ -473,7 +473,7 @@ void BM_ParseFilterModel(benchmark::State& state) {
   const std::string json = text.str();
   for (auto _ : state) {
     if (state.range(0) == 0) {
-      auto j = estimation::json_io::ParseJson(json, "model.json");
+      auto j = ParseJsonText(json, "model.json");
       benchmark::DoNotOptimize(j);
     } else {
       auto j = nlohmann::json::parse(json);

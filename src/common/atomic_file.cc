@@ -110,8 +110,12 @@ Status WriteFileAtomically(const std::string& path, const std::string& contents)
 }
 
 Result<std::string> ReadFile(const std::string& path) {
+  errno = 0;
   std::ifstream in(path, std::ios::binary);
-  if (!in) return Error{"cannot open '" + path + "': " + std::strerror(errno), ErrorCode::kIo};
+  if (!in) {
+    const int err = errno;
+    return Error{"cannot open '" + path + "': " + std::strerror(err), CodeOfErrno(err)};
+  }
   std::ostringstream ss;
   ss << in.rdbuf();
   if (in.bad()) return Error{"cannot read '" + path + "'", ErrorCode::kIo};

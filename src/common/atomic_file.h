@@ -52,7 +52,8 @@ void UnregisterTempFile(int slot);
 // Writes `contents` to `path` atomically.
 Status WriteFileAtomically(const std::string& path, const std::string& contents);
 
-// Reads a whole file, or an error naming it.
+// Reads a whole file, or an error naming it: bad input when the path names no file, else I/O
+// (CodeOf, common/result.h).
 Result<std::string> ReadFile(const std::string& path);
 
 }  // namespace recruit

@@ -23,6 +23,40 @@ std::string Shape(int rows, int cols) {
          (cols >= 0 ? std::to_string(cols) : std::string("c"));
 }
 
+// A JSON integer lo <= n <= hi (not 2.0, not one beyond 64 bits).
+bool WholeIn(const json& v, std::int64_t lo, std::int64_t hi) {
+  if (!v.is_number_integer()) return false;
+  if (v.is_number_unsigned() && v.get<std::uint64_t>() > std::uint64_t(hi)) return false;
+  return v.get<std::int64_t>() >= lo && v.get<std::int64_t>() <= hi;
+}
+
+// An array field of `size` entries (size < 0: any) of type T, each one `entry_ok` accepts
+// (else "where.key[i]: X; allowed: entry_allowed").
+template <class T, class EntryOk>
+Status ArrayField(const json& j, const std::string& key, const std::string& where,
+                  std::vector<T>* out, bool required, int size, const std::string& allowed,
+                  const std::string& entry_allowed, EntryOk entry_ok) {
+  if (!j.contains(key)) {
+    if (required) return Error{where + ": missing field '" + key + "' (" + allowed + ")"};
+    return Status::Ok();
+  }
+  const json& v = j.at(key);
+  const std::string field = where + "." + key;
+  if (!v.is_array() || (size >= 0 && static_cast<int>(v.size()) != size)) {
+    return Error{field + ": " + ShortText(v.dump()) + "; allowed: " + allowed};
+  }
+  std::vector<T> values;
+  for (size_t i = 0; i < v.size(); ++i) {
+    if (!entry_ok(v[i])) {
+      return Error{field + "[" + std::to_string(i) + "]: " + ShortText(v[i].dump()) +
+                   "; allowed: " + entry_allowed};
+    }
+    values.push_back(v[i].get<T>());
+  }
+  *out = std::move(values);
+  return Status::Ok();
+}
+
 // A finite number, else "field: must be a finite number, got X".
 Status FiniteNumber(const json& v, const std::string& field, double* out) {
   if (!v.is_number() || !std::isfinite(v.get<double>())) {
@@ -71,13 +105,18 @@ Status Integer(const json& j, const std::string& key, const std::string& where, 
     return Status::Ok();
   }
   const json& v = j.at(key);
-  const bool whole = v.is_number_integer() &&
-                     (v.is_number_unsigned() ? v.get<std::uint64_t>() <= std::uint64_t(hi) : true);
-  if (!whole || v.get<std::int64_t>() < lo || v.get<std::int64_t>() > hi) {
+  if (!WholeIn(v, lo, hi)) {
     return Error{where + "." + key + ": " + ShortText(v.dump()) + "; allowed: " + allowed};
   }
   *out = v.get<std::int64_t>();
   return Status::Ok();
+}
+
+Status Integers(const json& j, const std::string& key, const std::string& where,
+                std::vector<std::int64_t>* out, bool required, int size, std::int64_t lo,
+                std::int64_t hi, const std::string& allowed) {
+  return ArrayField(j, key, where, out, required, size, allowed, allowed,
+                    [lo, hi](const json& x) { return WholeIn(x, lo, hi); });
 }
 
 Status Unsigned(const json& j, const std::string& key, const std::string& where, std::uint64_t* out,
@@ -240,6 +279,12 @@ Status Boolean(const json& j, const std::string& key, const std::string& where, 
   if (!j.at(key).is_boolean()) return Error{where + "." + key + ": must be true or false"};
   *out = j.at(key).get<bool>();
   return Status::Ok();
+}
+
+Status Booleans(const json& j, const std::string& key, const std::string& where,
+                std::vector<bool>* out, bool required, int size, const std::string& allowed) {
+  return ArrayField(j, key, where, out, required, size, allowed, "true or false",
+                    [](const json& x) { return x.is_boolean(); });
 }
 
 Status Vec3(const json& j, const std::string& key, const std::string& where, Eigen::Vector3d* out) {

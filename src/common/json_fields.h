@@ -28,6 +28,11 @@ Status Integer(const nlohmann::json& j, const std::string& key, const std::strin
                std::int64_t* out, bool required, std::int64_t lo, std::int64_t hi,
                const std::string& allowed);
 
+// An array of `size` whole numbers lo <= n <= hi (size < 0: any length).
+Status Integers(const nlohmann::json& j, const std::string& key, const std::string& where,
+                std::vector<std::int64_t>* out, bool required, int size, std::int64_t lo,
+                std::int64_t hi, const std::string& allowed);
+
 // A whole number >= 0 that fits 64 bits (seeds).
 Status Unsigned(const nlohmann::json& j, const std::string& key, const std::string& where,
                 std::uint64_t* out, bool required);
@@ -65,6 +70,10 @@ Status String(const nlohmann::json& j, const std::string& key, const std::string
 // true or false.
 Status Boolean(const nlohmann::json& j, const std::string& key, const std::string& where,
                bool* out);
+
+// An array of `size` booleans (size < 0: any length); `allowed` says what they mean.
+Status Booleans(const nlohmann::json& j, const std::string& key, const std::string& where,
+                std::vector<bool>* out, bool required, int size, const std::string& allowed);
 
 // [x, y, z] of finite numbers (optional).
 Status Vec3(const nlohmann::json& j, const std::string& key, const std::string& where,

@@ -63,15 +63,16 @@ Result<nlohmann::json> ParseJsonText(const std::string& text, const std::string&
 Result<nlohmann::json> LoadJsonFile(const std::string& path, const JsonLimits& limits) {
   struct stat st {};
   if (::stat(path.c_str(), &st) != 0) {
-    return Error{"cannot read '" + ShortText(path, 200) + "': " + std::strerror(errno),
-                 ErrorCode::kIo};
+    const int err = errno;
+    return Error{"cannot read '" + ShortText(path, 200) + "': " + std::strerror(err),
+                 CodeOfErrno(err)};
   }
   if (S_ISREG(st.st_mode) && static_cast<std::size_t>(st.st_size) > limits.max_bytes) {
     return Error{path + ": " + std::to_string(st.st_size) + " bytes; at most " +
                  std::to_string(limits.max_bytes) + " allowed"};
   }
   auto text = ReadFile(path);
-  if (!text.ok()) return Error{text.error(), text.code()};
+  if (!text.ok()) return text.failure();
   return ParseJsonText(*text, path, limits);
 }
 

@@ -21,7 +21,8 @@ struct JsonLimits {
 Result<nlohmann::json> ParseJsonText(const std::string& text, const std::string& source,
                                      const JsonLimits& limits = {});
 
-// Reads and parses `path` (errors: "cannot read ..." for I/O, else naming the file).
+// Reads and parses `path` (errors name the file; one that is not there is bad input, one that
+// cannot be read I/O: CodeOf, common/result.h).
 Result<nlohmann::json> LoadJsonFile(const std::string& path, const JsonLimits& limits = {});
 
 // Deepest nesting of arrays / objects in `text` (strings skipped), stopping early once it

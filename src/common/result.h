@@ -31,22 +31,26 @@ struct Error {
 
 inline Error IoError(std::string message) { return Error{std::move(message), ErrorCode::kIo}; }
 
-// The class of a failed filesystem call: denied access, a full disk, a too-large file and a
-// read-only file system are I/O failures; anything else (no such file, a name too long, ...)
-// says the input named a bad path.
+// The class of a failed filesystem call on a path an input named: a path that names no file (no
+// such file or folder, a name too long, a loop of links) is bad input; a file that is there but
+// cannot be opened, read or written (denied access, not a regular file, a full disk, an I/O
+// error, ...) is an I/O failure. ReadFile, LoadJsonFile and the locks class their errors so.
 inline ErrorCode CodeOf(const std::error_code& ec) {
-  if (ec.category() != std::generic_category() && ec.category() != std::system_category()) {
-    return ErrorCode::kBadInput;
-  }
+  const bool errno_value =
+      ec.category() == std::generic_category() || ec.category() == std::system_category();
+  if (!errno_value) return ErrorCode::kIo;
   switch (ec.value()) {
-    case EACCES:
-    case ENOSPC:
-    case EFBIG:
-    case EROFS:
-      return ErrorCode::kIo;
-    default:
+    case ENOENT:
+    case ENOTDIR:
+    case ENAMETOOLONG:
+    case ELOOP:
       return ErrorCode::kBadInput;
+    default:
+      return ErrorCode::kIo;
   }
+}
+inline ErrorCode CodeOfErrno(int err) {
+  return CodeOf(std::error_code(err, std::generic_category()));
 }
 
 template <class T>

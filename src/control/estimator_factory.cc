@@ -7,8 +7,8 @@
 #include <optional>
 #include <string>
 
-#include "common/atomic_file.h"
 #include "common/data_path.h"
+#include "common/json_file.h"
 #include "control/failure_estimator.h"
 #include "control/kalman_estimator.h"
 #include "control/model_plant.h"
@@ -16,7 +16,6 @@
 #include "control/output_estimator.h"
 #include "control/sampling_period.h"
 #include "estimation/filter_model.h"
-#include "estimation/json_matrix.h"
 #include "estimation/population_kalman_filter.h"
 
 namespace recruit::control {
@@ -220,11 +219,9 @@ Result<std::unique_ptr<OnCountEstimator>> MakeEstimator(const EstimatorSpec& spe
     const std::string file = ResolveModelPath(
         spec.model_file.empty() ? DefaultModelFile(dT, spec.num_states) : spec.model_file);
     // The file is read and parsed once, for the model, its plant and its identification record.
-    auto text = ReadFile(file);
-    auto json =
-        text.ok() ? estimation::json_io::ParseJson(*text, file) : Error{text.error(), text.code()};
+    auto json = LoadJsonFile(file);
     auto loaded = json.ok() ? estimation::FilterModel::FromJsonValue(*json, file)
-                            : Error{json.error(), json.code()};
+                            : Result<estimation::FilterModel>(json.failure());
     if (!loaded) {
       return Error{"estimator: " + loaded.error() +
                        (spec.model_file.empty()
@@ -282,7 +279,7 @@ Result<std::unique_ptr<OnCountEstimator>> MakeEstimator(const EstimatorSpec& spe
   if (spec.failures) {
     auto est = FailureOnCountEstimator::Create(model, mode, spec.failure, std::move(output),
                                                relative_noise);
-    if (!est) return Error{"estimator: " + est.error()};
+    if (!est) return est.failure().In("estimator: ");
     return std::unique_ptr<OnCountEstimator>(std::move(est).value());
   }
   auto est = KalmanOnCountEstimator::Create(model, mode, std::move(output), relative_noise);

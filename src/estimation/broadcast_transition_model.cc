@@ -2,8 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 #include <nlohmann/json.hpp>
 
+#include "common/json_fields.h"
 #include "common/short_text.h"
 #include "estimation/json_matrix.h"
 #include "estimation/population_chain.h"
@@ -119,23 +122,22 @@ Status BroadcastTransitionModel::ValidateInputs(double p_on, double p_off,
 
 namespace {
 
-Result<std::vector<int>> ReadTargets(const nlohmann::json& j, const std::string& field, int m) {
-  std::vector<int> t(m, -1);
-  if (j.is_number_integer()) {
-    t.assign(m, j.get<int>());
-    return t;
+// on_target / off_target: one state index for every state, or an array with one per state.
+Status ReadTargets(const nlohmann::json& j, const std::string& key, const std::string& where, int m,
+                   std::vector<int>* out) {
+  const std::string allowed =
+      "a state index, or an array of " + std::to_string(m) + " state indices (-1 where unused)";
+  constexpr std::int64_t lo = std::numeric_limits<int>::min(), hi = std::numeric_limits<int>::max();
+  std::vector<std::int64_t> t;
+  if (j.contains(key) && j.at(key).is_number()) {
+    std::int64_t one = 0;
+    RECRUIT_TRY(json_fields::Integer(j, key, where, &one, true, lo, hi, allowed));
+    t.assign(m, one);
+  } else {
+    RECRUIT_TRY(json_fields::Integers(j, key, where, &t, true, m, lo, hi, allowed));
   }
-  if (!j.is_array() || static_cast<int>(j.size()) != m) {
-    return Error{field + ": must be a state index or an array of " + std::to_string(m) +
-                 " state indices (-1 where unused)"};
-  }
-  for (int i = 0; i < m; ++i) {
-    if (!j[i].is_number_integer()) {
-      return Error{field + "[" + std::to_string(i) + "]: must be an integer state index"};
-    }
-    t[i] = j[i].get<int>();
-  }
-  return t;
+  out->assign(t.begin(), t.end());
+  return Status::Ok();
 }
 
 }  // namespace
@@ -146,35 +148,16 @@ Result<BroadcastTransitionModel> BroadcastTransitionModel::FromJsonValue(
   BroadcastTransitionModel b;
   b.state_names = names;
   const int m = static_cast<int>(names.size());
-  if (!j.contains("dt") || !j["dt"].is_number()) {
-    return Error{where + ".dt: required, the sampling period in seconds (number > 0)"};
-  }
-  b.dt = j["dt"].get<double>();
-  if (!j.contains("is_on") || !j["is_on"].is_array() || static_cast<int>(j["is_on"].size()) != m) {
-    return Error{where + ".is_on: required, an array of " + std::to_string(m) +
-                 " booleans (heater command per state)"};
-  }
-  for (int i = 0; i < m; ++i) {
-    if (!j["is_on"][i].is_boolean()) {
-      return Error{where + ".is_on[" + std::to_string(i) + "]: must be true or false"};
-    }
-    b.is_on.push_back(j["is_on"][i].get<bool>());
-  }
-  if (j.contains("interior")) {
-    auto I = json_io::ReadMatrix(j["interior"], where + ".interior", m, m);
-    if (!I.ok()) return Error{I.error(), I.code()};
-    b.interior = *I;
-  } else {
-    b.interior = Eigen::MatrixXd::Identity(m, m);
-  }
-  for (const char* key : {"on_target", "off_target"}) {
-    if (!j.contains(key)) {
-      return Error{where + "." + key + ": required (state index, or array with one per state)"};
-    }
-    auto t = ReadTargets(j[key], where + "." + key, m);
-    if (!t.ok()) return Error{t.error(), t.code()};
-    (std::string(key) == "on_target" ? b.on_target : b.off_target) = *t;
-  }
+  RECRUIT_TRY(json_fields::Number(j, "dt", where, &b.dt, true, 0.0,
+                                  std::numeric_limits<double>::max(), /*lo_open=*/true,
+                                  "the sampling period in seconds, a number > 0"));
+  RECRUIT_TRY(json_fields::Booleans(
+      j, "is_on", where, &b.is_on, true, m,
+      "an array of " + std::to_string(m) + " booleans (the heater command in each state)"));
+  b.interior = Eigen::MatrixXd::Identity(m, m);  // when "interior" is omitted
+  RECRUIT_TRY(json_fields::Matrix(j, "interior", where, &b.interior, false, m, m));
+  RECRUIT_TRY(ReadTargets(j, "on_target", where, m, &b.on_target));
+  RECRUIT_TRY(ReadTargets(j, "off_target", where, m, &b.off_target));
   // Entries that do not apply (on_target of an on state, ...) are normalised to -1.
   for (int i = 0; i < m; ++i) {
     if (b.is_on[i])
@@ -182,7 +165,7 @@ Result<BroadcastTransitionModel> BroadcastTransitionModel::FromJsonValue(
     else
       b.off_target[i] = -1;
   }
-  if (Status s = b.Validate(where); !s.ok()) return Error{s.error(), s.code()};
+  RECRUIT_TRY(b.Validate(where));
   return b;
 }
 

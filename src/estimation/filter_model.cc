@@ -7,6 +7,7 @@
 
 #include "common/atomic_file.h"
 #include "common/json_fields.h"
+#include "common/json_file.h"
 #include "common/short_text.h"
 #include "estimation/json_matrix.h"
 #include "estimation/population_chain.h"
@@ -131,9 +132,7 @@ FilterModel FilterModel::WithPopulation(int64_t N_new) const {
 }
 
 Result<FilterModel> FilterModel::FromJson(const std::string& path) {
-  auto text = ReadFile(path);
-  if (!text.ok()) return text.failure();
-  auto j = json_io::ParseJson(*text, path);
+  auto j = LoadJsonFile(path);
   if (!j.ok()) return j.failure();
   return FromJsonValue(*j, path);
 }

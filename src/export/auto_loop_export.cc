@@ -7,76 +7,13 @@
 #include <memory>
 
 #include "control/actuator_response.h"
-#include "control/kalman_estimator.h"
-#include "estimation/filter_model.h"
-#include "identification/model_cache.h"
-#include "identification/plant_record.h"
+#include "sim/bundle_models.h"
 #include "sim/joint_loop.h"
+#include "sim/loop_constants.h"
 #include "sim/plant.h"
 
 namespace recruit::exporter {
 namespace {
-
-// The loop's reference stays this fraction of a limited joint's range inside it
-// (sim/joint_loop.cc, kLimitMargin; FreezeAutoLoop checks the clamp against LoopReference).
-constexpr double kLimitMargin = 0.03;
-
-// Bundle i's filter model file for the response (sim/run_task.cc, BundleModelFile): the task's
-// own ("{bundle}" replaced), else the one identified for this plant and dT.
-Result<std::string> ModelFile(const sim::Task& task, const sim::ControllerSettings& settings,
-                              const sim::Plant& plant, int i, const sim::RunOptions& options) {
-  const sma::SmaHost& host = plant.host();
-  const int b = plant.bundle_index(i);
-  std::string file = settings.filter_model;
-  const std::string key = "{bundle}";
-  for (size_t at; (at = file.find(key)) != std::string::npos;) {
-    file.replace(at, key.size(), host.bundle_name(b));
-  }
-  if (!file.empty()) return file;
-  identification::ModelRequest req{task.model_path, host.bundle_name(b),
-                                   identification::PlantRecord(host, b, task.model_path),
-                                   settings.dT, 20};
-  return identification::FindOrIdentifyModel(req, options.identify_missing_models,
-                                             options.quiet ? nullptr : stderr);
-}
-
-// Each bundle's tension step response, as RunTask designs the loop on it (sim/run_task.cc,
-// ActuatorResponses): the Kalman estimator's own chain, else the identified one, else the unit's
-// thermal lag.
-Result<std::vector<control::ActuatorResponse>> Responses(
-    const sim::Task& task, const sim::ControllerSettings& settings, const sim::Plant& plant,
-    const std::vector<sim::BundleController>& controllers, const sim::RunOptions& options) {
-  std::vector<control::ActuatorResponse> out;
-  for (int i = 0; i < plant.num_bundles(); ++i) {
-    const double tau = plant.host().bundle(plant.bundle_index(i)).unit().time_constant();
-    const auto* kalman = dynamic_cast<const control::KalmanOnCountEstimator*>(
-        &controllers[i].controller.estimator());
-    estimation::FilterModel model;
-    if (kalman != nullptr) {
-      model = kalman->model();
-    } else {
-      auto file = ModelFile(task, settings, plant, i, options);
-      if (!file && options.identify_missing_models) return Error{file.error(), file.code()};
-      if (!file) {
-        out.push_back(control::FirstOrderActuatorResponse(settings.dT, settings.lambda, tau));
-        continue;
-      }
-      auto loaded = estimation::FilterModel::FromJson(*file);
-      if (!loaded) return Error{loaded.error(), loaded.code()};
-      model = std::move(loaded).value();
-    }
-    if (model.transition != estimation::TransitionSource::kBroadcast || model.H.rows() < 1) {
-      return Error{"bundle '" + plant.bundle_name(i) +
-                   "': the self-tuned loop needs a broadcast chain model with a force row"};
-    }
-    const Eigen::VectorXd h = model.H.row(0).transpose();
-    auto r = control::PredictActuatorResponse(
-        model.broadcast, std::vector<double>(h.data(), h.data() + h.size()), settings.lambda);
-    out.push_back(r ? std::move(r).value()
-                    : control::FirstOrderActuatorResponse(settings.dT, settings.lambda, tau));
-  }
-  return out;
-}
 
 std::vector<sim::UnitForce> UnitForces(const std::vector<sim::BundleController>& controllers) {
   std::vector<sim::UnitForce> out;
@@ -112,7 +49,11 @@ Result<FrozenAutoLoop> FreezeAutoLoop(const sim::Task& task, const sim::RunOptio
   if (static_cast<int>(controllers.size()) != nb) {
     return Error{where + ": one controller per bundle is needed"};
   }
-  auto responses = Responses(task, settings, plant, controllers, options);
+  // As RunTask designs the loop (sim/bundle_models.h); its warnings are the run's, not the C's.
+  double identify_s = 0;
+  std::vector<std::string> warnings;
+  auto responses =
+      sim::ActuatorResponses(task, settings, plant, controllers, options, identify_s, warnings);
   if (!responses) return Error{where + ".outer_loop: " + responses.error(), responses.code()};
   std::vector<control::ActuatorResponse> resp = *responses;
   auto loops =
@@ -131,7 +72,7 @@ Result<FrozenAutoLoop> FreezeAutoLoop(const sim::Task& task, const sim::RunOptio
     out.joints.push_back(plant.joint_name(j));
     double lo = 0, hi = 0;
     const bool limited = plant.JointRange(j, &lo, &hi);
-    const double margin = kLimitMargin * (hi - lo);
+    const double margin = sim::kLimitMargin * (hi - lo);
     out.limited.push_back(limited ? 1 : 0);
     out.lo.push_back(limited ? lo + margin : 0.0);
     out.hi.push_back(limited ? hi - margin : 0.0);
@@ -219,39 +160,12 @@ const char* const kAutoLoopC = R"RECRUIT_C(
 #define NB RECRUIT_NUM_BUNDLES
 #define ROWS (2 * NJ) /* a joint's demand, and a stiffness row per holding joint */
 #define EPS 1e-8  /* the allocation's sharing weight */
-#define STIFFNESS_MARGIN 0.5 /* sim/holding.cc, kStiffnessMargin */
 enum { FREE, LOWER, UPPER };
 
 static double clampd(double v, double lo, double hi) { return v < lo ? lo : (hi < v ? hi : v); }
 
 /* lanesum (above) in double. */
-static double lanesum_d(const double *x, int m) {
-  const int n2 = m / 4 * 4, n1 = m / 2 * 2;
-  double a0, a1, b0, b1, s;
-  int i;
-  if (n1 == 0) return m == 1 ? x[0] : 0.0;
-  a0 = x[0];
-  a1 = x[1];
-  if (n1 > 2) {
-    b0 = x[2];
-    b1 = x[3];
-    for (i = 4; i < n2; i += 4) {
-      a0 += x[i];
-      a1 += x[i + 1];
-      b0 += x[i + 2];
-      b1 += x[i + 3];
-    }
-    a0 += b0;
-    a1 += b1;
-    if (n1 > n2) {
-      a0 += x[n2];
-      a1 += x[n2 + 1];
-    }
-  }
-  s = a0 + a1;
-  if (n1 < m) s += x[n1];
-  return s;
-}
+RECRUIT_LANESUM(lanesum_d, double)
 
 typedef struct {
   int rows;
@@ -583,6 +497,8 @@ LoopCode AutoLoopCode(const FrozenAutoLoop& loop, const Writer& package) {
       "/* A reference within this of a pose's (relative) is that pose's: 0 in a double package, a\n"
       " * float's rounding in a float one. */\n";
   s += std::string("#define POSE_TOLERANCE ") + (package.is_float() ? "1.2e-7" : "0.0") + "\n";
+  s += "#define STIFFNESS_MARGIN " + w.Num(sim::kStiffnessMargin) +
+       " /* sim/loop_constants.h, kStiffnessMargin */\n";
   s += "typedef struct {\n"
        "  double reference[RECRUIT_NUM_JOINTS];   /* rad, after the limits' margin */\n"
        "  double feedforward[RECRUIT_NUM_JOINTS]; /* N m, the pose's static torque */\n"

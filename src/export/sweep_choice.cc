@@ -130,9 +130,7 @@ Result<sim::Task> PlantTask(const std::string& dir, const sim::Task& task, int k
     std::error_code ec;
     if (!fs::exists(model, ec)) {
       model = fs::temp_directory_path() / ("recruit_export_" + name);
-      if (Status s = WriteFileAtomically(model.string(), in->model_text); !s.ok()) {
-        return Error{s.error(), ErrorCode::kIo};
-      }
+      RECRUIT_TRY(WriteFileAtomically(model.string(), in->model_text));
     }
     nlohmann::json doc = nlohmann::json::parse(text);
     doc["model"] = model.string();

@@ -53,15 +53,19 @@ RunOptions RunOptionsFor(const SweepRun& run, const SweepSpec& spec) {
 }
 
 Result<std::vector<SweepRun>> ExpandGrid(const SweepSpec& spec) {
-  if (spec.dTs.empty()) return Error{"sweep: no dT values (--dT)"};
-  if (spec.lambdas.empty()) return Error{"sweep: no lambda values (--lambda)"};
-  if (spec.estimators.empty()) return Error{"sweep: no estimators (--estimator)"};
-  if (spec.seeds < 1) return Error{"sweep: --seeds must be >= 1"};
+  // The axes are the sweep's options: a bad one is a usage error.
+  const auto usage = [](std::string message) {
+    return Error{std::move(message), ErrorCode::kUsage};
+  };
+  if (spec.dTs.empty()) return usage("sweep: no dT values (--dT)");
+  if (spec.lambdas.empty()) return usage("sweep: no lambda values (--lambda)");
+  if (spec.estimators.empty()) return usage("sweep: no estimators (--estimator)");
+  if (spec.seeds < 1) return usage("sweep: --seeds must be >= 1");
   for (double x : spec.dTs) {
-    RECRUIT_TRY(control::CheckDT(x, "sweep"));
+    if (Status s = control::CheckDT(x, "sweep"); !s.ok()) return usage(s.error());
   }
   for (double x : spec.lambdas) {
-    if (!(x > 0 && x <= 1)) return Error{fmt::format("sweep: lambda {} must be in (0, 1]", x)};
+    if (!(x > 0 && x <= 1)) return usage(fmt::format("sweep: lambda {} must be in (0, 1]", x));
   }
   const std::vector<PlantPoint> plant =
       spec.plant.empty() ? std::vector<PlantPoint>{PlantPoint{}} : spec.plant;
@@ -112,10 +116,11 @@ Result<std::pair<int, int>> ParseShard(const std::string& text) {
     n = std::stoi(text.substr(slash + 1), &used);
     if (used != text.size() - slash - 1) throw std::invalid_argument("N");
   } catch (const std::exception&) {
-    return Error{"--shard '" + text + "': must be K/N with whole numbers, e.g. 3/8"};
+    return Error{"--shard '" + text + "': must be K/N with whole numbers, e.g. 3/8",
+                 ErrorCode::kUsage};
   }
   if (n < 1 || n > 100000 || k < 1 || k > n) {
-    return Error{"--shard '" + text + "': need 1 <= K <= N <= 100000"};
+    return Error{"--shard '" + text + "': need 1 <= K <= N <= 100000", ErrorCode::kUsage};
   }
   return std::make_pair(k, n);
 }

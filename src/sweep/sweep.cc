@@ -94,7 +94,7 @@ Result<PlantTask> MakePlantTask(const PreparedSweep& p, const SweepDefinition& d
   std::string label = where + ": plant point " + std::to_string(i);
   for (const auto& [name, v] : pt.values) label += fmt::format(" {}={:g}", name, v);
   auto in = ApplyPlantPoint(task_text, model_text, p.file.axes, pt, where);
-  if (!in.ok()) return Error{in.error()};
+  if (!in.ok()) return in.failure();
   PlantTask pl;
   pl.task_text = in->task_text;
   pl.model_text = in->model_text;
@@ -114,14 +114,12 @@ Result<PlantTask> MakePlantTask(const PreparedSweep& p, const SweepDefinition& d
     const fs::path file =
         fs::absolute(dir / (fs::path(p.task.model_path).stem().string() + "_" + h.Hex() + ".xml"));
     if (!fs::exists(file, ec)) {
-      if (Status s = WriteFileAtomically(file.string(), in->model_text); !s.ok()) {
-        return IoError(s.error());
-      }
+      RECRUIT_TRY(WriteFileAtomically(file.string(), in->model_text));
       auto m = LoadModel(file.string());
       if (!m.ok()) {
         std::error_code ignore;
         fs::remove(file, ignore);
-        return Error{label + ": the edited model does not load: " + m.error()};
+        return m.failure().In(label + ": the edited model does not load: ");
       }
     }
     auto doc = nlohmann::json::parse(text);
@@ -129,7 +127,7 @@ Result<PlantTask> MakePlantTask(const PreparedSweep& p, const SweepDefinition& d
     text = doc.dump(1);
   }
   auto t = sim::Task::FromJsonText(text, p.task_path);
-  if (!t.ok()) return Error{label + ": " + t.error()};
+  if (!t.ok()) return t.failure().In(label + ": ");
   pl.task = std::move(t).value();
   return pl;
 }
@@ -168,9 +166,7 @@ Status CheckOrWriteId(const PreparedSweep& p, const SweepDefinition& d, const st
     }
     return Status::Ok();
   }
-  if (Status s = WriteFileAtomically(id_path, id.dump(2) + "\n"); !s.ok())
-    return IoError(s.error());
-  return Status::Ok();
+  return WriteFileAtomically(id_path, id.dump(2) + "\n");
 }
 
 }  // namespace
@@ -187,14 +183,14 @@ Result<PreparedSweep> Prepare(const SweepDefinition& d) {
     return Error{"no task: give --task or \"task\" in the sweep file", ErrorCode::kUsage};
   }
   auto task_text = ReadFile(p.task_path);
-  if (!task_text.ok()) return IoError(task_text.error());
+  if (!task_text.ok()) return task_text.failure();
   auto task = sim::Task::FromJsonText(*task_text, p.task_path);
-  if (!task.ok()) return Error{task.error()};
+  if (!task.ok()) return task.failure();
   p.task = std::move(task).value();
   ResolveOptions(d, p);
 
   auto points = PlantPoints(p.file);
-  if (!points.ok()) return Error{points.error()};
+  if (!points.ok()) return points.failure();
   p.spec.plant = p.file.axes.empty() ? std::vector<PlantPoint>{} : *points;
 
   // Each plant point: apply it and parse the task, so a bad path or value fails now, naming the
@@ -202,7 +198,7 @@ Result<PreparedSweep> Prepare(const SweepDefinition& d) {
   std::string model_text;
   if (!p.file.axes.empty()) {
     auto m = ReadFile(p.task.model_path);
-    if (!m.ok()) return IoError(m.error());
+    if (!m.ok()) return m.failure();
     model_text = *m;
   }
   for (size_t i = 0; i < points->size(); ++i) {
@@ -219,7 +215,7 @@ Result<PreparedSweep> Prepare(const SweepDefinition& d) {
     p.plant.push_back(std::move(pl).value());
   }
   auto grid = ExpandGrid(p.spec);
-  if (!grid.ok()) return Error{grid.error(), ErrorCode::kUsage};
+  if (!grid.ok()) return grid.failure();
   p.grid = std::move(grid).value();
   std::map<std::string, std::string> contents;
   for (auto& g : p.grid) g.input_hash = RunInputHash(p.plant[g.plant], p.spec, g, contents);
@@ -242,12 +238,14 @@ Result<FileLock> OpenOutput(const PreparedSweep& p, const SweepDefinition& d) {
                                 {"--sweep", d.sweep_file},
                                 {"--filter-model", d.filter_model},
                                 {"the task's model", p.task.model_path}});
-    if (!s.ok()) return Error{s.error(), ErrorCode::kUsage};
+    RECRUIT_TRY(s);
   }
   std::error_code ec;
   fs::create_directories(d.out, ec);
   if (ec) return IoError("cannot create --out '" + ShortText(d.out) + "': " + ec.message());
   auto lock = FileLock::TryLock((fs::path(d.out) / "sweep.lock").string());
+  // A folder another sweep holds is an I/O failure (docs/reliability.md); FileLock calls it bad
+  // input, so the class is set here.
   if (!lock.ok()) return IoError(lock.error());
   return lock;
 }
@@ -255,13 +253,11 @@ Result<FileLock> OpenOutput(const PreparedSweep& p, const SweepDefinition& d) {
 Status WriteReports(const PreparedSweep& p, const std::vector<sim::RunSummary>& runs,
                     const std::string& out, const Drawing& draw) {
   const auto cells = Aggregate(p.grid, runs, p.criterion);
-  if (Status s = WriteTables(cells, p.criterion, out, p.task.name); !s.ok()) {
-    return IoError(s.error());
-  }
+  RECRUIT_TRY(WriteTables(cells, p.criterion, out, p.task.name));
   if (p.file.axes.empty()) {  // the dT x lambda map, as `recruit plot --stability-map` draws it
     const plot::PlotOptions map =
         StabilityMapOptions(out, p.task.name, static_cast<int>(p.spec.estimators.size()));
-    if (Status s = draw.stability_map(map); !s.ok()) return IoError(s.error());
+    RECRUIT_TRY(draw.stability_map(map));
   }
   ReportInput in{p.task.name, p.description, p.criterion, cells, {}, {}, {}};
   in.seed_reasons = SeedReasonsMarkdown(p.grid, runs, p.criterion);
@@ -276,8 +272,7 @@ Status WriteReports(const PreparedSweep& p, const std::vector<sim::RunSummary>& 
       if (tau.ok()) in.latency[i] = *tau;
     });
   }
-  if (Status s = WriteReport(in, out, draw.figure); !s.ok()) return IoError(s.error());
-  return Status::Ok();
+  return WriteReport(in, out, draw.figure);
 }
 
 Result<SweepOutcome> Run(const PreparedSweep& p, const SweepDefinition& d, const std::string& shard,
@@ -285,7 +280,7 @@ Result<SweepOutcome> Run(const PreparedSweep& p, const SweepDefinition& d, const
   int shard_k = 1, shard_n = 1;
   if (!shard.empty()) {
     auto s = ParseShard(shard);
-    if (!s.ok()) return Error{s.error(), ErrorCode::kUsage};
+    if (!s.ok()) return s.failure();
     std::tie(shard_k, shard_n) = *s;
   }
   const std::vector<SweepRun> todo = shard.empty() ? p.grid : ShardOf(p.grid, shard_k, shard_n);
@@ -307,9 +302,7 @@ Result<SweepOutcome> Run(const PreparedSweep& p, const SweepDefinition& d, const
     // The shard's manifest: merge checks it belongs to the same sweep.
     nlohmann::json m = {
         {"sweep_id", SweepId(p.grid)}, {"shard", shard_k}, {"of", shard_n}, {"runs", todo.size()}};
-    if (Status s = WriteFileAtomically((fs::path(d.out) / "shard.json").string(), m.dump(2) + "\n");
-        !s.ok())
-      return IoError(s.error());
+    RECRUIT_TRY(WriteFileAtomically((fs::path(d.out) / "shard.json").string(), m.dump(2) + "\n"));
     return outcome;
   }
   RECRUIT_TRY(WriteReports(p, outcome->runs, d.out, draw));
@@ -375,9 +368,8 @@ Result<MergeOutcome> Merge(const PreparedSweep& p, const SweepDefinition& d,
       continue;
     }
     auto text = ReadFile(src.string());
-    if (!text.ok()) return IoError(text.error());
-    if (Status s = WriteFileAtomically((runs_dir / (g.Key() + ".json")).string(), *text); !s.ok())
-      return IoError(s.error());
+    if (!text.ok()) return text.failure();
+    RECRUIT_TRY(WriteFileAtomically((runs_dir / (g.Key() + ".json")).string(), *text));
   }
   if (!incomplete.empty()) {
     return Error{
@@ -388,10 +380,10 @@ Result<MergeOutcome> Merge(const PreparedSweep& p, const SweepDefinition& d,
   }
   // Every run is now recorded in `d.out`: RunSweep only reads them back.
   auto none = [](const SweepRun& g) -> Result<sim::RunSummary> {
-    return Error{"run " + g.Key() + " missing after merge"};
+    return Error{"run " + g.Key() + " missing after merge", ErrorCode::kInternal};  // a bug
   };
   auto outcome = RunSweep(p.grid, d.out, none, 1);
-  if (!outcome.ok()) return Error{outcome.error(), ErrorCode::kInternal};
+  if (!outcome.ok()) return outcome.failure();
   RECRUIT_TRY(WriteReports(p, outcome->runs, d.out, draw));
   return MergeOutcome{n, std::move(outcome).value()};
 }

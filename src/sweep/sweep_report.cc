@@ -205,28 +205,32 @@ plot::Figure MarginFigure(const ReportInput& in, double c) {
   return fig;
 }
 
-// Critical dT against each plant axis (main effect: geometric mean over the other axes' values
-// at each value of this one), one series per estimator and lambda.
-plot::Figure CriticalFigure(const std::string& title, const std::vector<Recommendation>& recs) {
-  plot::Figure fig;
-  fig.title = title + ": critical dT (margin crosses 0) against each plant axis";
-  if (recs.empty()) return fig;
-  const size_t naxes = recs.front().plant_values.size();
+// One panel per plant axis: for each (estimator, lambda) of the recommendations, one series of
+// the mean of value(r) over the recommendations at each of the axis's values (the axis's main
+// effect, averaged over the other axes' values); value NaN: left out. `shown` maps the mean to
+// the plotted y (e.g. exp of a mean of logs: a geometric mean).
+template <class Value, class Shown>
+std::vector<plot::Axes> MainEffectPanels(const std::vector<Recommendation>& recs,
+                                         const std::string& y_label, Value value, Shown shown) {
+  std::vector<std::pair<std::string, double>> groups;
+  for (const auto& r : recs) {
+    auto g = std::make_pair(r.estimator, r.lambda);
+    if (std::find(groups.begin(), groups.end(), g) == groups.end()) groups.push_back(g);
+  }
+  std::vector<plot::Axes> panels;
+  const size_t naxes = recs.empty() ? 0 : recs.front().plant_values.size();
   for (size_t k = 0; k < naxes; ++k) {
     plot::Axes ax;
     ax.x_label = recs.front().plant_values[k].first;
-    ax.y_label = "critical dT (s)";
-    std::vector<std::pair<std::string, double>> groups;
-    for (const auto& r : recs) {
-      auto g = std::make_pair(r.estimator, r.lambda);
-      if (std::find(groups.begin(), groups.end(), g) == groups.end()) groups.push_back(g);
-    }
+    ax.y_label = y_label;
     for (size_t gi = 0; gi < groups.size(); ++gi) {
-      std::map<double, std::pair<double, int>> acc;  // axis value -> (sum ln dT*, count)
+      std::map<double, std::pair<double, int>> acc;  // axis value -> (sum of values, count)
       for (const auto& r : recs) {
-        if (std::make_pair(r.estimator, r.lambda) != groups[gi] || !r.found) continue;
+        if (std::make_pair(r.estimator, r.lambda) != groups[gi]) continue;
+        const double v = value(r);
+        if (std::isnan(v)) continue;
         auto& a = acc[r.plant_values[k].second];
-        a.first += std::log(r.critical_dT);
+        a.first += v;
         ++a.second;
       }
       plot::Series s;
@@ -234,19 +238,27 @@ plot::Figure CriticalFigure(const std::string& title, const std::vector<Recommen
       s.color = Palette(gi);
       for (const auto& [x, a] : acc) {
         s.x.push_back(x);
-        s.y.push_back(std::exp(a.first / a.second));
+        s.y.push_back(shown(a.first / a.second));
       }
       if (!s.x.empty()) ax.series.push_back(s);
     }
-    fig.panels.push_back(ax);
+    panels.push_back(ax);
   }
+  return panels;
+}
+
+// Critical dT against each plant axis (main effect: geometric mean over the other axes' values
+// at each value of this one), one series per estimator and lambda.
+plot::Figure CriticalFigure(const std::string& title, const std::vector<Recommendation>& recs) {
+  plot::Figure fig;
+  fig.title = title + ": critical dT (margin crosses 0) against each plant axis";
+  fig.panels = MainEffectPanels(
+      recs, "critical dT (s)",
+      [](const Recommendation& r) { return r.found ? std::log(r.critical_dT) : std::nan(""); },
+      [](double mean_log) { return std::exp(mean_log); });
   return fig;
 }
 
-// The tracking the recommended dT achieves against each plant axis: each plant point's mean
-// tracking RMSE over the seeds of its cell at the recommended dT, averaged over the other axes'
-// values at each value of this one; one series per estimator and lambda. With a failure axis
-// (docs/sweep.md) it shows what a failure rate costs in tracking.
 // The cells a run of which passed a datasheet limit (never recommended), or "".
 std::string PastLimitsText(const std::vector<CellStats>& cells) {
   std::string list;
@@ -265,10 +277,13 @@ std::string PastLimitsText(const std::vector<CellStats>& cells) {
       n, n > 1 ? "s" : "", n > 1 ? "are" : "is", list, n > 12 ? "; ..." : "");
 }
 
+// The tracking the recommended dT achieves against each plant axis: each plant point's mean
+// tracking RMSE over the seeds of its cell at the recommended dT, averaged over the other axes'
+// values at each value of this one; one series per estimator and lambda. With a failure axis
+// (docs/sweep.md) it shows what a failure rate costs in tracking.
 plot::Figure TrackingFigure(const ReportInput& in, const std::vector<Recommendation>& recs) {
   plot::Figure fig;
   fig.title = in.title + ": tracking RMSE at the recommended dT against each plant axis";
-  if (recs.empty()) return fig;
   auto rmse_at = [&](const Recommendation& r) {
     for (const auto& c : in.cells) {
       if (c.plant == r.plant && c.estimator == r.estimator && c.lambda == r.lambda &&
@@ -278,37 +293,13 @@ plot::Figure TrackingFigure(const ReportInput& in, const std::vector<Recommendat
     }
     return std::nan("");
   };
-  std::vector<std::pair<std::string, double>> groups;
-  for (const auto& r : recs) {
-    auto g = std::make_pair(r.estimator, r.lambda);
-    if (std::find(groups.begin(), groups.end(), g) == groups.end()) groups.push_back(g);
-  }
-  const size_t naxes = recs.front().plant_values.size();
-  for (size_t k = 0; k < naxes; ++k) {
-    plot::Axes ax;
-    ax.x_label = recs.front().plant_values[k].first;
-    ax.y_label = "tracking RMSE at dT" + (in.unit.empty() ? "" : " (" + in.unit + ")");
-    for (size_t gi = 0; gi < groups.size(); ++gi) {
-      std::map<double, std::pair<double, int>> acc;  // axis value -> (sum RMSE, count)
-      for (const auto& r : recs) {
-        const double e = rmse_at(r);
-        if (std::make_pair(r.estimator, r.lambda) != groups[gi] || !r.found || !std::isfinite(e))
-          continue;
-        auto& a = acc[r.plant_values[k].second];
-        a.first += e;
-        ++a.second;
-      }
-      plot::Series s;
-      s.label = fmt::format("{}, lambda {:g}", groups[gi].first, groups[gi].second);
-      s.color = Palette(gi);
-      for (const auto& [x, a] : acc) {
-        s.x.push_back(x);
-        s.y.push_back(a.first / a.second);
-      }
-      if (!s.x.empty()) ax.series.push_back(s);
-    }
-    fig.panels.push_back(ax);
-  }
+  fig.panels = MainEffectPanels(
+      recs, "tracking RMSE at dT" + (in.unit.empty() ? "" : " (" + in.unit + ")"),
+      [&](const Recommendation& r) {
+        const double e = r.found ? rmse_at(r) : std::nan("");
+        return std::isfinite(e) ? e : std::nan("");
+      },
+      [](double mean) { return mean; });
   return fig;
 }
 

@@ -454,25 +454,17 @@ Status WriteTuneReport(const PreparedSweep& p, const TuneDefinition& d, const Tu
       auto bytes = render(fig, 900, h, f);
       if (!bytes.ok()) return Error{"tune figure: " + bytes.error(), bytes.code()};
       const std::string file = f == plot::Format::kPng ? "window.png" : "window.svg";
-      if (Status s = WriteFileAtomically((dir / file).string(), *bytes); !s.ok()) {
-        return IoError(s.error());
-      }
+      RECRUIT_TRY(WriteFileAtomically((dir / file).string(), *bytes));
     }
   }
-  if (Status s = WriteFileAtomically((dir / "tune.json").string(), TuneJson(d, o).dump(1) + "\n");
-      !s.ok()) {
-    return IoError(s.error());
-  }
+  RECRUIT_TRY(WriteFileAtomically((dir / "tune.json").string(), TuneJson(d, o).dump(1) + "\n"));
   std::string md = TuneMarkdown(p, d, o);
   if (render) {
     md +=
         "\n## Figure\n\n![fraction of seeds meeting against dT, with the window's edges (dotted "
         "with an arrowhead: censored) and the recommended dT](window.png)\n";
   }
-  if (Status s = WriteFileAtomically((dir / "tune.md").string(), md); !s.ok()) {
-    return IoError(s.error());
-  }
-  return Status::Ok();
+  return WriteFileAtomically((dir / "tune.md").string(), md);
 }
 
 }  // namespace recruit::sweep

@@ -2,11 +2,17 @@
 
 #include <gtest/gtest.h>
 #include <sys/resource.h>
+#include <sys/socket.h>
+#include <sys/un.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <csignal>
+#include <cstring>
 #include <filesystem>
+
+#include "common/exit_codes.h"
 
 namespace recruit {
 namespace {
@@ -116,10 +122,35 @@ TEST(AtomicFile, AFullDiskIsAnErrorAndLeavesNoFile) {
   fs::remove_all(dir);
 }
 
-TEST(ReadFile, MissingFileErrorNamesIt) {
-  auto r = ReadFile("/no/such/file.json");
+// The class of a failed read is CodeOf's (common/result.h), as the CLI's exit codes say
+// (docs/reliability.md): a path that names no file is bad input (3), a file that is there but
+// cannot be opened is an I/O failure (4).
+TEST(ReadFile, AMissingFileIsBadInputAndAnUnopenableOneIo) {
+  for (const std::string missing : {"/no/such/file.json", "/proc/self/status/not_a_dir"}) {
+    SCOPED_TRACE(missing);
+    auto r = ReadFile(missing);
+    ASSERT_FALSE(r.ok());
+    EXPECT_NE(r.error().find(missing), std::string::npos);
+    EXPECT_EQ(exit_code::Of(r.failure()), exit_code::kBadInput);
+    EXPECT_EQ(r.code(), CodeOf(std::error_code(ENOENT, std::generic_category())));
+  }
+  // A socket is there (stat succeeds) but cannot be opened, even by root.
+  const fs::path dir = TempDir();
+  const std::string sock = (dir / "s").string();
+  const int fd = ::socket(AF_UNIX, SOCK_STREAM, 0);
+  ASSERT_GE(fd, 0);
+  sockaddr_un addr{};
+  addr.sun_family = AF_UNIX;
+  ASSERT_LT(sock.size(), sizeof(addr.sun_path));
+  std::memcpy(addr.sun_path, sock.c_str(), sock.size() + 1);
+  ASSERT_EQ(::bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof(addr)), 0);
+  auto r = ReadFile(sock);
+  ::close(fd);
   ASSERT_FALSE(r.ok());
-  EXPECT_NE(r.error().find("/no/such/file.json"), std::string::npos);
+  EXPECT_NE(r.error().find("cannot open '" + sock + "'"), std::string::npos) << r.error();
+  EXPECT_EQ(exit_code::Of(r.failure()), exit_code::kIo);
+  EXPECT_EQ(r.code(), CodeOf(std::error_code(ENXIO, std::generic_category())));
+  fs::remove_all(dir);
 }
 
 }  // namespace

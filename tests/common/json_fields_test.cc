@@ -48,6 +48,33 @@ TEST(JsonFields, IntegersRefuseFractionsAndValuesOutsideTheRange) {
   EXPECT_FALSE(Unsigned(j, "e", "w", &u, true).ok());
 }
 
+// Arrays of whole numbers and of booleans: the length, then each entry, named by its index.
+TEST(JsonFields, IntegerAndBooleanArraysNameTheEntry) {
+  const json j = json::parse(
+      R"({"t": [1, -1, 2], "f": [1, 2.0], "big": [18446744073709551615], "on": [true, false],
+          "bits": [true, 0], "short": [true]})");
+  std::vector<std::int64_t> t;
+  EXPECT_TRUE(Integers(j, "t", "w", &t, true, 3, -1, 5, "indices").ok());
+  EXPECT_EQ(t, (std::vector<std::int64_t>{1, -1, 2}));
+  EXPECT_EQ(Integers(j, "t", "w", &t, true, 2, -1, 5, "2 indices").error(),
+            "w.t: [1,-1,2]; allowed: 2 indices");
+  EXPECT_EQ(Integers(j, "t", "w", &t, true, 3, 0, 5, "indices >= 0").error(),
+            "w.t[1]: -1; allowed: indices >= 0");
+  EXPECT_EQ(Integers(j, "f", "w", &t, true, -1, 0, 5, "i").error(), "w.f[1]: 2.0; allowed: i");
+  EXPECT_FALSE(Integers(j, "big", "w", &t, true, -1, -1, 5, "i").ok());  // not wrapped to -1
+  EXPECT_EQ(Integers(j, "absent", "w", &t, true, 3, 0, 5, "indices").error(),
+            "w: missing field 'absent' (indices)");
+  EXPECT_EQ(t, (std::vector<std::int64_t>{1, -1, 2}));  // unchanged by the failures
+  std::vector<bool> b;
+  EXPECT_TRUE(Booleans(j, "on", "w", &b, true, 2, "flags").ok());
+  EXPECT_EQ(b, (std::vector<bool>{true, false}));
+  EXPECT_EQ(Booleans(j, "bits", "w", &b, true, 2, "flags").error(),
+            "w.bits[1]: 0; allowed: true or false");
+  EXPECT_EQ(Booleans(j, "short", "w", &b, true, 2, "2 flags").error(),
+            "w.short: [true]; allowed: 2 flags");
+  EXPECT_TRUE(Booleans(j, "absent", "w", &b, false, 2, "flags").ok());
+}
+
 TEST(JsonFields, UnknownKeysAreNamedWithTheAllowedOnes) {
   const json j = json::parse(R"({"kp": 1, "colour": 2})");
   Status s = CheckKeys(j, {"kp", "ki"}, "t.json.outer_loop");

@@ -50,10 +50,12 @@ TEST(JsonFile, SizeLimitAndShortenedMessages) {
   EXPECT_NE(bad.error().find("bad.json: not valid JSON"), std::string::npos) << bad.error();
 }
 
-TEST(JsonFile, MissingFileIsAnIoError) {
+// ReadFile's classes (CodeOf): a path that names no file is bad input, not I/O.
+TEST(JsonFile, AMissingFileIsBadInput) {
   auto j = LoadJsonFile("/nonexistent/dir/x.json");
   ASSERT_FALSE(j.ok());
-  EXPECT_EQ(j.error().rfind("cannot read", 0), 0u) << j.error();
+  EXPECT_EQ(j.error().rfind("cannot read '/nonexistent/dir/x.json'", 0), 0u) << j.error();
+  EXPECT_EQ(j.code(), ErrorCode::kBadInput);
 }
 
 }  // namespace

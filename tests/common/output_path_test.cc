@@ -85,10 +85,15 @@ TEST(ExitCodes, TheClassTravelsWithTheErrorNotItsWording) {
   EXPECT_EQ(outer.code, ErrorCode::kIo);
   EXPECT_EQ(exit_code::Of(ErrorCode::kUsage), exit_code::kUsage);
   EXPECT_EQ(exit_code::Of(ErrorCode::kInternal), exit_code::kInternal);
-  // Failed filesystem calls: access, space, size and read-only are I/O; a missing path is not.
-  EXPECT_EQ(CodeOf(std::error_code(EACCES, std::generic_category())), ErrorCode::kIo);
-  EXPECT_EQ(CodeOf(std::error_code(ENOSPC, std::generic_category())), ErrorCode::kIo);
-  EXPECT_EQ(CodeOf(std::error_code(ENOENT, std::generic_category())), ErrorCode::kBadInput);
+  // Failed filesystem calls: a path that names no file is bad input; a file that is there but
+  // cannot be opened, read or written (access, not a regular file, space, size, read-only, a
+  // device error) is I/O.
+  for (int err : {ENOENT, ENOTDIR, ENAMETOOLONG, ELOOP}) {
+    EXPECT_EQ(CodeOf(std::error_code(err, std::generic_category())), ErrorCode::kBadInput) << err;
+  }
+  for (int err : {EACCES, ENXIO, EISDIR, ENOSPC, EFBIG, EROFS, EIO}) {
+    EXPECT_EQ(CodeOf(std::error_code(err, std::generic_category())), ErrorCode::kIo) << err;
+  }
 }
 
 TEST(FileLock, ASecondLockOnTheSameFileFailsUntilTheFirstIsReleased) {

@@ -189,7 +189,7 @@ TEST_F(EstimationCli, BadInputGivesClearMessageNonZeroExitAndNoOutput) {
        kGoodLog, "",
        ".H[0]: must be an array of 2 numbers (row 0 of a r x 2 matrix), got [0,0.45,1]"},
       {"malformed JSON", "{\"states\": [\"off\", \"on\"], \"N\": 60,", kGoodLog, "",
-       "malformed JSON"},
+       "not valid JSON"},
       {"malformed CSV row", kTwoStateModel, "t,p_on,p_off,y\n0,0.2,0\n", "",
        ":2: has 3 cells, the header 4"},
       {"unknown CSV column", kTwoStateModel, "t,p_on,p_off,force\n0,0.2,0,1\n", "",

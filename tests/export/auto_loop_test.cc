@@ -25,13 +25,20 @@
 #include "sim/plant.h"
 #include "sim/run_task.h"
 #include "sim/task.h"
+#include "tests/export/float_bounds.h"
+#include "tests/export/m4_build.h"
 #include "tests/export/package_loader.h"
 
 namespace recruit::exporter {
 namespace {
 
+using testing::FloatDeviation;
 using testing::FreshDir;
+using testing::kFloatForceRef;
 using testing::LoadedController;
+using testing::M4Package;
+using testing::MetricMeans;
+using testing::Rel;
 
 const std::string kSrc = RECRUIT_SOURCE_DIR;
 
@@ -224,25 +231,11 @@ RecordedRun RunCase(const AutoCase& c, std::uint64_t seed, LoadedController* pac
   return {s.ok() ? *s : sim::RunSummary{}, std::move(hook.instants), hook.inexact_poses};
 }
 
-double Rel(double a, double b) {
-  if (std::isnan(a) && std::isnan(b)) return 0;
-  const double scale = std::max(std::abs(a), std::abs(b));
-  return scale == 0 ? 0 : std::abs(a - b) / scale;
-}
-
-// The float package's bound on the self-tuned tasks (docs/export.md): the measured maxima with a
-// margin. The force reference is relative to max(1 N, reference): a float rounds a bundle's
-// hundreds of newtons to 1e-5 N.
-constexpr double kFloatBroadcast = 1e-5;  // p_on, p_off (absolute)
-constexpr double kFloatEstimate = 2e-3;   // units
-constexpr double kFloatVariance = 2e-4;   // relative to max(1, variance)
-constexpr double kFloatForceRef = 2e-5;   // relative to max(1 N, reference)
-
 // Bit for bit wherever the run made the package's designs; where it did not (a design made on a
 // rounding-size moment arm's sign, FirstOtherDesign), bit for bit up to the first instant that
 // uses the other design, and each case reproduced whole on one of its seeds at least.
-struct Deviation {
-  double broadcast = 0, estimate = 0, variance = 0, force_reference = 0, relative = 0;
+// The force reference's deviation is relative to max(1 N, reference) (float_bounds.h).
+struct Deviation : FloatDeviation {
   int inexact_poses = 0;
   double first_time = INFINITY;  // s, the first instant with a relative deviation above 1e-12
   // Float: the first instant at which a bundle's force reference is another whole count of
@@ -301,15 +294,9 @@ Deviation Replay(LoadedController& c, const std::vector<Instant>& log) {
       }
       ++d.outputs;
       d.flipped += fr > kFloatForceRef ? 1 : 0;
-      d.broadcast = std::max({d.broadcast, std::abs(got[1] - want[1]), std::abs(got[2] - want[2])});
-      d.estimate = std::max(d.estimate, std::abs(got[3] - want[3]));
-      if (!(std::isnan(want[4]) && std::isnan(got[4]))) {
-        d.variance =
-            std::max(d.variance, std::abs(got[4] - want[4]) / std::max(1.0, std::abs(want[4])));
-      }
+      d.AddOutput(got, want);
       for (int f = 0; f < 5; ++f) {
         if (Rel(got[f], want[f]) > 1e-12) d.first_time = std::min(d.first_time, w.time);
-        d.relative = std::max(d.relative, Rel(got[f], want[f]));
       }
     }
   }
@@ -347,7 +334,7 @@ TEST(ExportAutoLoop, DoubleReproducesTheLoopsOnRecordedRuns) {
 }
 
 TEST(ExportAutoLoop, FloatStaysWithinItsStatedBound) {
-  Deviation worst;
+  FloatDeviation worst;
   for (const AutoCase& c : Cases()) {
     auto ctl = Load(c, Precision::kFloat, "auto_float");
     ASSERT_TRUE(ctl) << c.label;
@@ -358,15 +345,9 @@ TEST(ExportAutoLoop, FloatStaysWithinItsStatedBound) {
         "reference %.3g; variance %.3g; %d of %d outputs with another count\n",
         c.label.c_str(), d.first_flip, d.broadcast_before, d.estimate_before, d.force_reference,
         d.variance, d.flipped, d.outputs);
-    worst.broadcast = std::max(worst.broadcast, d.broadcast);
-    worst.estimate = std::max(worst.estimate, d.estimate);
-    worst.variance = std::max(worst.variance, d.variance);
-    worst.force_reference = std::max(worst.force_reference, d.force_reference);
+    worst.Widen(d);
   }
-  EXPECT_LE(worst.broadcast, kFloatBroadcast);
-  EXPECT_LE(worst.estimate, kFloatEstimate);
-  EXPECT_LE(worst.variance, kFloatVariance);
-  EXPECT_LE(worst.force_reference, kFloatForceRef);
+  worst.ExpectWithinTheFloatBound();
 }
 
 // Every metric of the run summary (the tracked joint's, each joint's and each bundle's).
@@ -432,32 +413,17 @@ TEST(ExportAutoLoop, FloatGivesTheSameMetricsOver20Seeds) {
     auto ctl = Load(shorter, Precision::kFloat, "auto_closed_float", &manifest);
     ASSERT_TRUE(ctl) << c.label;
     const sim::Task task = LoadTask(c);
-    const char* fields[] = {"tracking_rmse", "iae", "overshoot", "settled_fraction",
-                            "switching_rate"};
-    std::vector<double> ref_sum(5, 0.0), got_sum(5, 0.0);
-    int identical = 0, compared = 0;
+    MetricMeans means({"tracking_rmse", "iae", "overshoot", "settled_fraction", "switching_rate"});
     for (std::uint64_t seed = 1; seed <= 20; ++seed) {
       const RecordedRun ref = RunCase(shorter, seed, nullptr);
       ASSERT_TRUE(std::isinf(FirstOtherDesign(ref.summary, manifest, task))) << c.label;
       const RecordedRun got = RunCase(shorter, seed, ctl.get());
-      const nlohmann::json a = ref.summary.ToJson()["metrics"], b = got.summary.ToJson()["metrics"];
-      identical += a["tracking_rmse"] == b["tracking_rmse"] ? 1 : 0;
-      ++compared;
-      for (int f = 0; f < 5; ++f) {
-        ref_sum[f] += a[fields[f]].get<double>();
-        got_sum[f] += b[fields[f]].get<double>();
-      }
+      means.Add(ref.summary.ToJson()["metrics"], got.summary.ToJson()["metrics"]);
     }
-    ASSERT_EQ(compared, 20) << c.label;
+    ASSERT_EQ(means.runs(), 20) << c.label;
     std::printf("%s float: %d seeds compared, %d with the same tracking RMSE\n", c.label.c_str(),
-                compared, identical);
-    for (int f = 0; f < 5; ++f) {
-      ref_sum[f] /= compared;
-      got_sum[f] /= compared;
-      std::printf("  %-16s C++ %.6g  float %.6g\n", fields[f], ref_sum[f], got_sum[f]);
-      EXPECT_LE(std::abs(got_sum[f] - ref_sum[f]), std::max(0.05 * std::abs(ref_sum[f]), 0.02))
-          << c.label << " " << fields[f];
-    }
+                means.runs(), means.identical());
+    means.ExpectTheSame(c.label);
   }
 }
 
@@ -572,123 +538,37 @@ TEST(ExportAutoLoop, AReferenceOffTheScheduleUsesTheNearestPose) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Cortex-M4F: a self-tuned task's float package cross-compiled (the flow of export_test.cc's
-// ExportM4 test, docs/export.md), its flash and RAM, and a recorded run replayed under QEMU
-// against the host build of the same source.
-
-constexpr const char* kM4Flags =
-    "-mcpu=cortex-m4 -mthumb -mfpu=fpv4-sp-d16 -mfloat-abi=hard -std=c99 -Os -ffp-contract=off "
-    "-fno-math-errno -Wall -Wextra -Wdouble-promotion -Werror -ffunction-sections "
-    "-fdata-sections";
-
-std::string ReadText(const std::filesystem::path& p) {
-  std::ifstream in(p);
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
-
-std::string FloatHex(double v) {
-  const float f = static_cast<float>(v);
-  uint32_t u;
-  std::memcpy(&u, &f, sizeof u);
-  char buf[16];
-  std::snprintf(buf, sizeof buf, "%08lx", static_cast<unsigned long>(u));
-  return buf;
-}
-
-// replay.c's output: its rows of bit patterns, and the SysTick ticks and steps.
-struct Replayed {
-  std::vector<std::string> rows;
-  unsigned long ticks = 0;
-  int steps = 0;
-};
-
-Replayed ParseReplay(const std::string& text) {
-  Replayed r;
-  std::istringstream in(text);
-  for (std::string line; std::getline(in, line);) {
-    if (std::sscanf(line.c_str(), "ticks %lu steps %d", &r.ticks, &r.steps) == 2) continue;
-    if (!line.empty()) r.rows.push_back(line);
-  }
-  return r;
-}
+// Cortex-M4F: a self-tuned task's float package cross-compiled (as export_test.cc's ExportM4
+// test, tests/export/m4_build.h, docs/export.md), its flash and RAM, and a recorded run replayed
+// under QEMU against the host build of the same source.
 
 TEST(ExportAutoLoopM4, CrossCompilesAndReplaysUnderQemu) {
-  if (!testing::HasTool("arm-none-eabi-gcc") || !testing::HasTool("qemu-system-arm")) {
+  if (!testing::HasM4Tools()) {
     GTEST_SKIP() << "arm-none-eabi-gcc or qemu-system-arm is not installed "
                     "(scripts/install-deps.sh installs them)";
   }
-  const std::string m4 = kSrc + "/tests/export/m4/";
   for (const AutoCase& c : {Cases()[1], Cases()[2], Cases()[3]}) {
     auto pkg = ExportController(LoadTask(c), Options(c, 1), Precision::kFloat);
     ASSERT_TRUE(pkg.ok()) << pkg.error();
-    const auto dir = FreshDir("m4_auto");
-    testing::WriteFiles(pkg->files, dir);
-    const std::string d = dir.string() + "/";
-    auto sh = [&](const std::string& cmd) {
-      const int rc = testing::Shell("cd " + d + " && ( " + cmd + " ) > cmd.log 2>&1");
-      EXPECT_EQ(rc, 0) << cmd << "\n" << ReadText(dir / "cmd.log");
-      return rc == 0;
-    };
-    const std::string cc = std::string("arm-none-eabi-gcc ") + kM4Flags;
-    ASSERT_TRUE(sh(cc + " -fstack-usage -c recruit_controller.c"));
-    ASSERT_TRUE(sh(cc + " -I. -nostdlib -T " + m4 + "m4.ld -Wl,--gc-sections " + m4 + "startup.c " +
-                   m4 + "size_main.c recruit_controller.o -lm -lc -lgcc -o size.elf"));
-    ASSERT_TRUE(
-        sh("arm-none-eabi-size recruit_controller.o size.elf > size.txt && arm-none-eabi-nm -S "
-           "size.elf > nm.txt && arm-none-eabi-nm -u recruit_controller.o > undefined.txt"));
-    unsigned long otext = 0, text = 0, data = 0, ctx = 0, stack = 0;
-    {
-      std::istringstream in(ReadText(dir / "size.txt"));
-      for (std::string line; std::getline(in, line);) {
-        unsigned long t, da;
-        char name[256];
-        if (std::sscanf(line.c_str(), "%lu %lu %*u %*u %*x %255s", &t, &da, name) == 3) {
-          if (std::string(name) == "size.elf") text = t, data = da;
-          if (std::string(name) == "recruit_controller.o") otext = t;
-        }
-      }
-      std::istringstream nm(ReadText(dir / "nm.txt"));
-      for (std::string line; std::getline(nm, line);) {
-        unsigned long addr, size;
-        char type, name[256];
-        if (std::sscanf(line.c_str(), "%lx %lx %c %255s", &addr, &size, &type, name) == 4 &&
-            (type == 'b' || type == 'B') && std::string(name) == "ctl") {
-          ctx += size;
-        }
-      }
-      std::istringstream su(ReadText(dir / "recruit_controller.su"));
-      for (std::string line; std::getline(su, line);) {
-        const size_t tab = line.find('\t');
-        if (tab != std::string::npos) stack += std::strtoul(line.c_str() + tab + 1, nullptr, 10);
-      }
-    }
-    const std::string undefined = ReadText(dir / "undefined.txt");
-    for (const char* bad : {"malloc", "free", "printf", "sbrk"}) {
-      EXPECT_EQ(undefined.find(bad), std::string::npos) << undefined;
-    }
+    const M4Package m4(FreshDir("m4_auto"));
+    testing::WriteFiles(pkg->files, m4.dir());
+    ASSERT_TRUE(m4.BuildForSize("recruit_controller.c", "recruit_controller.o"));
+    const M4Package::Footprint f = m4.ReadFootprint({"ctl"});
+    m4.ExpectNoHeapOrStdio();
 
     // A recorded run, replayed on the host and on the M4.
     const RecordedRun run = RunCase(c, 3, nullptr);
     {
-      std::ofstream out(dir / "log.txt");
+      std::ofstream out(m4.dir() / "log.txt");
       out << run.instants.size() << " " << run.instants.front().decided.sensed_force.size() << "\n";
       for (const Instant& k : run.instants) {
-        for (double v : k.in) out << FloatHex(v) << " ";
+        for (double v : k.in) out << testing::FloatHex(v) << " ";
         out << "\n";
       }
     }
-    ASSERT_TRUE(sh(std::string(RECRUIT_HOST_CC) + " " + testing::HostCFlags() +
-                   " -I. recruit_controller.c " + m4 + "replay.c -lm -o replay_host && " +
-                   "./replay_host log.txt > host.txt"));
-    ASSERT_TRUE(sh(cc + " -I. -DUSE_NEWLIB -DM4_SYSTICK -nostartfiles --specs=rdimon.specs -T " +
-                   m4 + "m4.ld -Wl,--gc-sections " + m4 + "startup.c " + m4 +
-                   "replay.c recruit_controller.c -lm -o replay.elf"));
-    ASSERT_TRUE(
-        sh("timeout 120 qemu-system-arm -M mps2-an386 -nographic -no-reboot -icount shift=0 "
-           "-semihosting-config enable=on,target=native -kernel replay.elf -append log.txt > "
-           "m4.txt"));
-    const Replayed host = ParseReplay(ReadText(dir / "host.txt"));
-    const Replayed target = ParseReplay(ReadText(dir / "m4.txt"));
+    ASSERT_TRUE(m4.ReplayOnHostAndM4(120));
+    const M4Package::Replayed host = m4.ReadReplay("host.txt");
+    const M4Package::Replayed target = m4.ReadReplay("m4.txt");
     const size_t nb = run.instants.front().decided.sensed_force.size();
     ASSERT_EQ(host.rows.size(), run.instants.size() * nb);
     ASSERT_EQ(target.rows.size(), host.rows.size());
@@ -701,8 +581,9 @@ TEST(ExportAutoLoopM4, CrossCompilesAndReplaysUnderQemu) {
         "m4 %s: recruit_controller.o text %lu, program flash %lu (text %lu, data %lu), context "
         "%lu, stack frames %lu, RAM %lu; %zu outputs bit-identical to the host build of %zu; "
         "about %.0f instructions per control step (%lu ticks over %d steps)\n",
-        c.label.c_str(), otext, text + data, text, data, ctx, stack, ctx + stack, same,
-        host.rows.size(), 40.0 * target.ticks / target.steps, target.ticks, target.steps);
+        c.label.c_str(), f.object_text, f.text + f.data, f.text, f.data, f.context, f.stack,
+        f.context + f.stack, same, host.rows.size(), 40.0 * target.ticks / target.steps,
+        target.ticks, target.steps);
     EXPECT_GT(target.ticks, 0u);
   }
 }

@@ -15,13 +15,23 @@
 #include "export/controller_export.h"
 #include "sim/run_task.h"
 #include "sim/task.h"
+#include "tests/export/float_bounds.h"
+#include "tests/export/m4_build.h"
 #include "tests/export/package_loader.h"
 
 namespace recruit::exporter {
 namespace {
 
+using testing::FloatDeviation;
 using testing::FreshDir;
+using testing::kFloatBroadcast;
+using testing::kFloatEstimate;
+using testing::kFloatForceRef;
+using testing::kFloatVariance;
 using testing::LoadedController;
+using testing::M4Package;
+using testing::MetricMeans;
+using testing::Rel;
 
 // Records what the task's own controllers saw and decided at every control instant.
 class Recorder : public sim::ControlInstantHook {
@@ -94,21 +104,9 @@ std::unique_ptr<LoadedController> Load(const Case& c, Precision p, const std::st
   return loaded->error().empty() ? std::move(loaded) : nullptr;
 }
 
-// Largest deviations of the replayed outputs from the recorded ones: broadcasts (absolute),
-// estimates (units), variances (relative to max(1, |var|)), force references (N), and the
-// largest of all relative to max(|a|, |b|) (the double criterion).
-struct Deviation {
-  double broadcast = 0, estimate = 0, variance = 0, force_reference = 0, relative = 0;
-};
-
-double Rel(double a, double b) {
-  if (std::isnan(a) && std::isnan(b)) return 0;
-  const double scale = std::max(std::abs(a), std::abs(b));
-  return scale == 0 ? 0 : std::abs(a - b) / scale;
-}
-
-Deviation Replay(LoadedController& c, const std::vector<sim::ControlInstant>& log) {
-  Deviation d;
+// The replayed outputs' deviations from the recorded ones (force references in N).
+FloatDeviation Replay(LoadedController& c, const std::vector<sim::ControlInstant>& log) {
+  FloatDeviation d;
   c.Init();
   const int nb = c.bundles();
   std::vector<double> out;
@@ -122,13 +120,7 @@ Deviation Replay(LoadedController& c, const std::vector<sim::ControlInstant>& lo
                               k.estimated_on[i], k.estimated_on_variance[i]};
       const double* got = &out[5 * i];
       d.force_reference = std::max(d.force_reference, std::abs(got[0] - want[0]));
-      d.broadcast = std::max({d.broadcast, std::abs(got[1] - want[1]), std::abs(got[2] - want[2])});
-      d.estimate = std::max(d.estimate, std::abs(got[3] - want[3]));
-      if (!(std::isnan(want[4]) && std::isnan(got[4]))) {
-        d.variance =
-            std::max(d.variance, std::abs(got[4] - want[4]) / std::max(1.0, std::abs(want[4])));
-      }
-      for (int f = 0; f < 5; ++f) d.relative = std::max(d.relative, Rel(got[f], want[f]));
+      d.AddOutput(got, want);
     }
   }
   return d;
@@ -171,13 +163,6 @@ const std::vector<Case>& Cases() {
   return cases;
 }
 
-// The float package's bound against the C++ controller (double) over the recorded runs of
-// Cases(), documented in docs/export.md: measured maxima there, with a margin.
-constexpr double kFloatBroadcast = 1e-5;  // p_on, p_off (absolute)
-constexpr double kFloatEstimate = 2e-3;   // units
-constexpr double kFloatVariance = 2e-4;   // relative to max(1, variance)
-constexpr double kFloatForceRef = 2e-5;   // N
-
 TEST(ExportEquivalence, DoubleReproducesTheControllerOnRecordedRuns) {
   for (size_t n = 0; n < Cases().size(); ++n) {
     const Case& c = Cases()[n];
@@ -190,7 +175,7 @@ TEST(ExportEquivalence, DoubleReproducesTheControllerOnRecordedRuns) {
       if (!c.filter_model.empty()) {
         EXPECT_GT(log.front().estimated_on_variance[0], 0.1);
       }
-      const Deviation d = Replay(*ctl, log);
+      const FloatDeviation d = Replay(*ctl, log);
       std::printf("%s %s%s seed %d: %zu instants, largest relative deviation %.3g\n",
                   c.task.c_str(), c.estimator.c_str(), c.filter_model.empty() ? "" : " (P0 > 0)",
                   static_cast<int>(seed), log.size(), d.relative);
@@ -200,28 +185,22 @@ TEST(ExportEquivalence, DoubleReproducesTheControllerOnRecordedRuns) {
 }
 
 TEST(ExportEquivalence, FloatStaysWithinItsStatedBound) {
-  Deviation worst;
+  FloatDeviation worst;
   for (size_t n = 0; n < Cases().size(); ++n) {
     const Case& c = Cases()[n];
     auto ctl = Load(c, Precision::kFloat, "float_" + std::to_string(n));
     ASSERT_TRUE(ctl);
     for (std::uint64_t seed : {1, 7}) {
-      const Deviation d = Replay(*ctl, Record(c, seed));
+      const FloatDeviation d = Replay(*ctl, Record(c, seed));
       std::printf(
           "%s %s seed %d: broadcast %.3g, estimate %.3g units, variance %.3g, force "
           "reference %.3g N\n",
           c.task.c_str(), c.estimator.c_str(), static_cast<int>(seed), d.broadcast, d.estimate,
           d.variance, d.force_reference);
-      worst.broadcast = std::max(worst.broadcast, d.broadcast);
-      worst.estimate = std::max(worst.estimate, d.estimate);
-      worst.variance = std::max(worst.variance, d.variance);
-      worst.force_reference = std::max(worst.force_reference, d.force_reference);
+      worst.Widen(d);
     }
   }
-  EXPECT_LE(worst.broadcast, kFloatBroadcast);
-  EXPECT_LE(worst.estimate, kFloatEstimate);
-  EXPECT_LE(worst.variance, kFloatVariance);
-  EXPECT_LE(worst.force_reference, kFloatForceRef);
+  worst.ExpectWithinTheFloatBound();
   // Not trivially zero: float differs from double somewhere.
   EXPECT_GT(worst.estimate, 0.0);
 }
@@ -263,17 +242,28 @@ Result<sim::RunSummary> RunWith(const Case& c, std::uint64_t seed, sim::ControlI
   return sim::RunTask(LoadTask(c.task), o);
 }
 
+// The run summaries' "metrics" of one seed with the C++ controller and driven by the package.
+struct BothMetrics {
+  bool ok = false;
+  nlohmann::json cpp, package;
+};
+BothMetrics RunBoth(const Case& c, std::uint64_t seed, LoadedController& ctl) {
+  auto ref = RunWith(c, seed, nullptr);
+  ctl.Init();
+  ExportedDriver driver(ctl);
+  auto got = RunWith(c, seed, &driver);
+  if (!ref.ok() || !got.ok()) return {};
+  return {true, ref->ToJson()["metrics"], got->ToJson()["metrics"]};
+}
+
 TEST(ExportClosedLoop, DoubleDrivesThePlantToTheSameMetrics) {
   for (const Case& c : {Cases()[0], Cases()[1]}) {
     auto ctl = Load(c, Precision::kDouble, "closed_double_" + c.task);
     ASSERT_TRUE(ctl);
     for (std::uint64_t seed : {1, 2}) {
-      auto ref = RunWith(c, seed, nullptr);
-      ctl->Init();
-      ExportedDriver driver(*ctl);
-      auto got = RunWith(c, seed, &driver);
-      ASSERT_TRUE(ref.ok() && got.ok());
-      const nlohmann::json a = ref->ToJson()["metrics"], b = got->ToJson()["metrics"];
+      const BothMetrics m = RunBoth(c, seed, *ctl);
+      ASSERT_TRUE(m.ok);
+      const nlohmann::json &a = m.cpp, &b = m.package;
       for (auto it = a.begin(); it != a.end(); ++it) {
         const double x = it.value().is_number() ? it.value().get<double>() : NAN;
         const double y = b[it.key()].is_number() ? b[it.key()].get<double>() : NAN;
@@ -287,97 +277,51 @@ TEST(ExportClosedLoop, DoubleDrivesThePlantToTheSameMetrics) {
 }
 
 // The float package driving the plant: over 20 seeds each metric's mean is that of the C++
-// controller within kClosedLoopFloat (relative; 0.02 absolute for fractions near 0). A broadcast
-// 1e-7 off changes a unit's draw only rarely, so most runs are identical; one changed draw makes
-// the rest of that run another sample of the same process.
-constexpr double kClosedLoopFloat = 0.05;
-
+// controller within kClosedLoopFloat (float_bounds.h). A broadcast 1e-7 off changes a unit's
+// draw only rarely, so most runs are identical; one changed draw makes the rest of that run
+// another sample of the same process.
 TEST(ExportClosedLoop, FloatGivesTheSameMetricsOver20Seeds) {
   for (const Case& c :
        {Case{"isometric_steps.json", "", 60}, Case{"arm_reach_hold.json", "", 40}}) {
     auto ctl = Load(c, Precision::kFloat, "closed_float_" + c.task);
     ASSERT_TRUE(ctl);
-    const char* fields[] = {"tracking_rmse",  "iae",           "overshoot", "settled_fraction",
-                            "switching_rate", "estimator_rmse"};
-    std::vector<double> ref_sum(6, 0.0), got_sum(6, 0.0);
-    int identical = 0;
+    MetricMeans means({"tracking_rmse", "iae", "overshoot", "settled_fraction", "switching_rate",
+                       "estimator_rmse"});
     for (std::uint64_t seed = 1; seed <= 20; ++seed) {
-      auto ref = RunWith(c, seed, nullptr);
-      ctl->Init();
-      ExportedDriver driver(*ctl);
-      auto got = RunWith(c, seed, &driver);
-      ASSERT_TRUE(ref.ok() && got.ok());
-      const nlohmann::json a = ref->ToJson()["metrics"], b = got->ToJson()["metrics"];
-      identical += a["tracking_rmse"] == b["tracking_rmse"] ? 1 : 0;
-      for (int f = 0; f < 6; ++f) {
-        ref_sum[f] += a[fields[f]].get<double>() / 20;
-        got_sum[f] += b[fields[f]].get<double>() / 20;
-      }
+      const BothMetrics m = RunBoth(c, seed, *ctl);
+      ASSERT_TRUE(m.ok);
+      means.Add(m.cpp, m.package);
     }
-    std::printf("%s: %d of 20 seeds with the same tracking RMSE\n", c.task.c_str(), identical);
-    for (int f = 0; f < 6; ++f) {
-      std::printf("  %-16s C++ %.6g  float %.6g\n", fields[f], ref_sum[f], got_sum[f]);
-      EXPECT_LE(std::abs(got_sum[f] - ref_sum[f]),
-                std::max(kClosedLoopFloat * std::abs(ref_sum[f]), 0.02))
-          << c.task << " " << fields[f];
-    }
+    std::printf("%s: %d of 20 seeds with the same tracking RMSE\n", c.task.c_str(),
+                means.identical());
+    means.ExpectTheSame(c.task);
   }
 }
 
 // ---------------------------------------------------------------------------------------------
-// Cortex-M4F: the float package cross-compiled with Debian's gcc-arm-none-eabi, its flash and RAM,
-// and a recorded log replayed on QEMU's MPS2 board (mps2-an386) against the host build.
-
-constexpr const char* kM4Flags =
-    "-mcpu=cortex-m4 -mthumb -mfpu=fpv4-sp-d16 -mfloat-abi=hard -std=c99 -Os -ffp-contract=off "
-    "-fno-math-errno -Wall -Wextra -Wdouble-promotion -Werror -ffunction-sections "
-    "-fdata-sections";
-
-std::string ReadText(const std::filesystem::path& p) {
-  std::ifstream in(p);
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
-
-uint32_t FloatBits(double v) {
-  const float f = static_cast<float>(v);
-  uint32_t u;
-  std::memcpy(&u, &f, sizeof u);
-  return u;
-}
+// Cortex-M4F: the float package cross-compiled, its flash and RAM, and a recorded log replayed on
+// QEMU against the host build (tests/export/m4_build.h).
 
 float BitsFloat(unsigned long b) {
-  const uint32_t u = static_cast<uint32_t>(b);
+  const std::uint32_t u = static_cast<std::uint32_t>(b);
   float f;
   std::memcpy(&f, &u, sizeof f);
   return f;
 }
 
-// replay.c's output: per instant and bundle the five outputs; the SysTick ticks.
-struct Replayed {
-  std::vector<std::array<float, 5>> rows;
-  unsigned long ticks = 0;
-  int steps = 0;
-};
-
-Replayed ParseReplay(const std::string& text) {
-  Replayed r;
-  std::istringstream in(text);
-  for (std::string line; std::getline(in, line);) {
-    int k, i;
-    unsigned long v[5];
-    if (std::sscanf(line.c_str(), "%d %d %lx %lx %lx %lx %lx", &k, &i, &v[0], &v[1], &v[2], &v[3],
-                    &v[4]) == 7) {
-      r.rows.push_back(
-          {BitsFloat(v[0]), BitsFloat(v[1]), BitsFloat(v[2]), BitsFloat(v[3]), BitsFloat(v[4])});
-    } else {
-      std::sscanf(line.c_str(), "ticks %lu steps %d", &r.ticks, &r.steps);
-    }
-  }
-  return r;
+// A replay row's five outputs ("k i" and their float bit patterns).
+std::array<float, 5> RowFloats(const std::string& row) {
+  int k, i;
+  unsigned long v[5] = {0, 0, 0, 0, 0};
+  EXPECT_EQ(std::sscanf(row.c_str(), "%d %d %lx %lx %lx %lx %lx", &k, &i, &v[0], &v[1], &v[2],
+                        &v[3], &v[4]),
+            7)
+      << row;
+  return {BitsFloat(v[0]), BitsFloat(v[1]), BitsFloat(v[2]), BitsFloat(v[3]), BitsFloat(v[4])};
 }
 
 TEST(ExportM4, CrossCompilesWithinBudgetAndReplaysUnderQemu) {
-  if (!testing::HasTool("arm-none-eabi-gcc") || !testing::HasTool("qemu-system-arm")) {
+  if (!testing::HasM4Tools()) {
     GTEST_SKIP() << "arm-none-eabi-gcc or qemu-system-arm is not installed "
                     "(scripts/install-deps.sh installs them)";
   }
@@ -385,119 +329,56 @@ TEST(ExportM4, CrossCompilesWithinBudgetAndReplaysUnderQemu) {
   const sim::Task task = LoadTask(c.task);
   auto pkg = ExportController(task, Options(c, 1), Precision::kFloat);
   ASSERT_TRUE(pkg.ok()) << pkg.error();
-  const auto dir = FreshDir("m4");
-  testing::WriteFiles(pkg->files, dir);
-  const std::string m4 = std::string(RECRUIT_SOURCE_DIR) + "/tests/export/m4/";
-  const std::string d = dir.string() + "/";
-  auto sh = [&](const std::string& cmd) {
-    const int rc = testing::Shell("cd " + d + " && ( " + cmd + " ) > cmd.log 2>&1");
-    EXPECT_EQ(rc, 0) << cmd << "\n" << ReadText(dir / "cmd.log");
-    return rc == 0;
-  };
+  const M4Package m4(FreshDir("m4"));
+  testing::WriteFiles(pkg->files, m4.dir());
 
   // Flash and RAM: the package with the smallest caller (no stdio), libm's sinf included.
-  ASSERT_TRUE(sh(std::string("arm-none-eabi-gcc ") + kM4Flags +
-                 " -fstack-usage -c recruit_controller.c recruit_unit.c"));
-  ASSERT_TRUE(sh(std::string("arm-none-eabi-gcc ") + kM4Flags + " -I. -nostdlib -T " + m4 +
-                 "m4.ld -Wl,--gc-sections " + m4 + "startup.c " + m4 +
-                 "size_main.c recruit_controller.o -lm -lc -lgcc -o size.elf"));
-  ASSERT_TRUE(
-      sh("arm-none-eabi-size recruit_controller.o recruit_unit.o size.elf > size.txt && "
-         "arm-none-eabi-nm -S size.elf > nm.txt && arm-none-eabi-nm -u "
-         "recruit_controller.o > undefined.txt"));
-  std::printf("%s", ReadText(dir / "size.txt").c_str());
-  unsigned long text = 0, data = 0, bss = 0;
-  {
-    std::istringstream in(ReadText(dir / "size.txt"));
-    std::string line;
-    while (std::getline(in, line)) {
-      unsigned long t, da, b;
-      char name[256];
-      if (std::sscanf(line.c_str(), "%lu %lu %lu %*u %*x %255s", &t, &da, &b, name) == 4 &&
-          std::string(name) == "size.elf") {
-        text = t, data = da, bss = b;
-      }
-    }
-  }
-  // The controller's RAM: its context and in/out structs (size_main.c's statics) and every
-  // stack frame of the package added up (an upper bound of its deepest call chain).
-  unsigned long ctx = 0, stack = 0;
-  {
-    std::istringstream in(ReadText(dir / "nm.txt"));
-    for (std::string line; std::getline(in, line);) {
-      unsigned long addr, size;
-      char type, name[256];
-      if (std::sscanf(line.c_str(), "%lx %lx %c %255s", &addr, &size, &type, name) == 4 &&
-          (type == 'b' || type == 'B') &&
-          (std::string(name) == "ctl" || std::string(name) == "in" || std::string(name) == "out")) {
-        ctx += size;
-      }
-    }
-    std::istringstream su(ReadText(dir / "recruit_controller.su"));
-    for (std::string line; std::getline(su, line);) {
-      const size_t tab = line.find('\t');
-      if (tab != std::string::npos) stack += std::strtoul(line.c_str() + tab + 1, nullptr, 10);
-    }
-  }
-  const unsigned long flash = text + data, ram = ctx + stack;
+  ASSERT_TRUE(m4.BuildForSize("recruit_controller.c recruit_unit.c",
+                              "recruit_controller.o recruit_unit.o"));
+  std::printf("%s", testing::ReadText(m4.dir() / "size.txt").c_str());
+  // The controller's RAM: its context and in/out structs (size_main.c's statics) and its stack
+  // frames.
+  const M4Package::Footprint f = m4.ReadFootprint({"ctl", "in", "out"});
+  const unsigned long flash = f.text + f.data, ram = f.context + f.stack;
   std::printf(
       "m4: flash %lu bytes (text %lu, data %lu; program bss %lu), RAM %lu bytes (context "
       "and i/o %lu, stack frames %lu)\n",
-      flash, text, data, bss, ram, ctx, stack);
+      flash, f.text, f.data, f.bss, ram, f.context, f.stack);
   EXPECT_LE(flash, 16u * 1024) << "the float package for m = 20, two bundles: <= 16 KB flash";
   EXPECT_LE(ram, 4u * 1024) << "<= 4 KB RAM";
-  EXPECT_GT(ctx, 2u * 20 * 21 / 2 * 4) << "two packed 20 x 20 covariances at least";
-  // No heap, nothing but the math library: the object needs no symbol beyond libm's.
-  const std::string undefined = ReadText(dir / "undefined.txt");
-  for (const char* bad : {"malloc", "free", "printf", "sbrk"}) {
-    EXPECT_EQ(undefined.find(bad), std::string::npos) << undefined;
-  }
+  EXPECT_GT(f.context, 2u * 20 * 21 / 2 * 4) << "two packed 20 x 20 covariances at least";
+  m4.ExpectNoHeapOrStdio();
 
   // Both packages together, as firmware wires them (tests/export/m4/firmware.c): it runs.
-  ASSERT_TRUE(sh(std::string("arm-none-eabi-gcc ") + kM4Flags + " -I. -nostdlib -T " + m4 +
-                 "m4.ld -Wl,--gc-sections " + m4 + "startup.c " + m4 +
-                 "firmware.c recruit_controller.c recruit_unit.c -lm -lc -lgcc -o firmware.elf && "
-                 "timeout 60 qemu-system-arm -M mps2-an386 -nographic -no-reboot "
-                 "-semihosting-config enable=on,target=native -kernel firmware.elf"));
+  const std::string src = M4Package::Sources();
+  ASSERT_TRUE(m4.Sh(M4Package::Cc() + " -I. -nostdlib -T " + src + "m4.ld -Wl,--gc-sections " +
+                    src + "startup.c " + src +
+                    "firmware.c recruit_controller.c recruit_unit.c -lm -lc -lgcc -o "
+                    "firmware.elf && timeout 60 qemu-system-arm -M mps2-an386 -nographic "
+                    "-no-reboot -semihosting-config enable=on,target=native -kernel firmware.elf"));
 
-  // A recorded run as float bit patterns.
+  // A recorded run as float bit patterns, replayed on the host and on the M4.
   const auto log = Record(c, 3);
   ASSERT_EQ(log.size(), 110u);
   {
-    std::ofstream out(dir / "log.txt");
+    std::ofstream out(m4.dir() / "log.txt");
     out << log.size() << " 2\n";
     for (const sim::ControlInstant& k : log) {
-      char buf[32];
-      std::vector<double> v{k.reference,       k.angle,           k.angular_velocity,
-                            k.sensed_force[0], k.sensed_force[1], k.tendon_length[0],
-                            k.tendon_length[1]};
-      for (double x : v) {
-        std::snprintf(buf, sizeof buf, "%08lx ", static_cast<unsigned long>(FloatBits(x)));
-        out << buf;
+      for (double x : {k.reference, k.angle, k.angular_velocity, k.sensed_force[0],
+                       k.sensed_force[1], k.tendon_length[0], k.tendon_length[1]}) {
+        out << testing::FloatHex(x) << " ";
       }
       out << "\n";
     }
   }
-  ASSERT_TRUE(sh(std::string(RECRUIT_HOST_CC) + " " + testing::HostCFlags() +
-                 " -I. recruit_controller.c " + m4 +
-                 "replay.c -lm -o replay_host && "
-                 "./replay_host log.txt > host.txt"));
-  ASSERT_TRUE(sh(std::string("arm-none-eabi-gcc ") + kM4Flags +
-                 " -I. -DUSE_NEWLIB -DM4_SYSTICK -nostartfiles --specs=rdimon.specs -T " + m4 +
-                 "m4.ld -Wl,--gc-sections " + m4 + "startup.c " + m4 +
-                 "replay.c recruit_controller.c -lm -o replay.elf"));
-  ASSERT_TRUE(
-      sh("timeout 60 qemu-system-arm -M mps2-an386 -nographic -no-reboot -icount "
-         "shift=0 -semihosting-config enable=on,target=native -kernel replay.elf "
-         "-append log.txt > m4.txt"));
-  const Replayed host = ParseReplay(ReadText(dir / "host.txt"));
-  const Replayed target = ParseReplay(ReadText(dir / "m4.txt"));
+  ASSERT_TRUE(m4.ReplayOnHostAndM4(60));
+  const M4Package::Replayed host = m4.ReadReplay("host.txt");
+  const M4Package::Replayed target = m4.ReadReplay("m4.txt");
   ASSERT_EQ(host.rows.size(), 220u);
   ASSERT_EQ(target.rows.size(), host.rows.size());
   int identical = 0;
   for (size_t r = 0; r < host.rows.size(); ++r) {
-    const auto& a = host.rows[r];
-    const auto& b = target.rows[r];
+    const std::array<float, 5> a = RowFloats(host.rows[r]), b = RowFloats(target.rows[r]);
     identical += std::memcmp(a.data(), b.data(), sizeof(float) * 5) == 0 ? 1 : 0;
     EXPECT_LE(std::abs(a[0] - b[0]), kFloatForceRef) << "row " << r;
     EXPECT_LE(std::abs(a[1] - b[1]), kFloatBroadcast) << "row " << r;

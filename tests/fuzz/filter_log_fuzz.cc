@@ -6,10 +6,10 @@
 #include <cstdint>
 #include <string>
 
+#include "common/json_file.h"
 #include "estimation/count_filter.h"
 #include "estimation/filter_log.h"
 #include "estimation/filter_model.h"
-#include "estimation/json_matrix.h"
 
 namespace {
 
@@ -34,7 +34,7 @@ constexpr const char* kConstant = R"({
   "initial": {"x0": [3.0, 3.0, 3.0], "P0": [[1.0, -0.5, -0.5], [-0.5, 1.0, -0.5], [-0.5, -0.5, 1.0]]}})";
 
 recruit::estimation::FilterModel Load(const char* text) {
-  auto j = recruit::estimation::json_io::ParseJson(text, "fuzz");
+  auto j = recruit::ParseJsonText(text, "fuzz");
   auto m = recruit::estimation::FilterModel::FromJsonValue(*j, "fuzz");
   if (!m.ok()) __builtin_trap();  // the fixed models are valid
   return *m;

@@ -1,17 +1,18 @@
-// Fuzz target: the filter model parser (json_io::ParseJson, then FilterModel::FromJsonValue: what
-// FilterModel::FromJson does with a file's text; docs/formats/filter.md). A model that validates
-// must also give a working Kalman filter: one prediction and one update must not crash.
+// Fuzz target: the filter model parser (ParseJsonText, common/json_file.h, then
+// FilterModel::FromJsonValue: what FilterModel::FromJson does with a file's text;
+// docs/formats/filter.md). A model that validates must also give a working Kalman filter: one
+// prediction and one update must not crash.
 #include <cstddef>
 #include <cstdint>
 #include <string>
 
+#include "common/json_file.h"
 #include "estimation/count_filter.h"
 #include "estimation/filter_model.h"
-#include "estimation/json_matrix.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);
-  auto j = recruit::estimation::json_io::ParseJson(text, "fuzz_model.json");
+  auto j = recruit::ParseJsonText(text, "fuzz_model.json");
   if (!j.ok()) return 0;
   auto model = recruit::estimation::FilterModel::FromJsonValue(*j, "fuzz_model.json");
   if (!model.ok()) return 0;

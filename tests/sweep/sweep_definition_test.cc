@@ -21,11 +21,11 @@ TEST(SweepDefinition, ErrorsCarryTheirExitClass) {
   ASSERT_FALSE(none.ok());
   EXPECT_EQ(exit_code::Of(none.failure()), exit_code::kUsage);
 
-  d.task = "/no/such/task.json";  // named but unreadable: I/O
-  d.given.insert("task");
+  d.task = "/no/such/task.json";  // a path that names no file: bad input (the CLI's --task check
+  d.given.insert("task");         // says usage first)
   auto missing = Prepare(d);
   ASSERT_FALSE(missing.ok());
-  EXPECT_EQ(exit_code::Of(missing.failure()), exit_code::kIo);
+  EXPECT_EQ(exit_code::Of(missing.failure()), exit_code::kBadInput);
 
   d.task = kTask;
   d.dTs = {1.0};

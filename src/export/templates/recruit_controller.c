@@ -72,34 +72,38 @@ static recruit_real sum(const recruit_real *x, int m) {
 /* A sum in the order of the C++ build's vectorised reductions (Eigen, 2-wide SSE2 packets):
  * two packets accumulate elements 4k, 4k+1 and 4k+2, 4k+3; they are added, then the next
  * packet, then the packet's two lanes, then the last odd element. The same rounding as the
- * C++ controller's sums, so that the double package reproduces it bit for bit. */
-static recruit_real lanesum(const recruit_real *x, int m) {
-  const int n2 = m / 4 * 4, n1 = m / 2 * 2;
-  recruit_real a0, a1, b0, b1, s;
-  int i;
-  if (n1 == 0) return m == 1 ? x[0] : RK(0);
-  a0 = x[0];
-  a1 = x[1];
-  if (n1 > 2) {
-    b0 = x[2];
-    b1 = x[3];
-    for (i = 4; i < n2; i += 4) {
-      a0 += x[i];
-      a1 += x[i + 1];
-      b0 += x[i + 2];
-      b1 += x[i + 3];
-    }
-    a0 += b0;
-    a1 += b1;
-    if (n1 > n2) {
-      a0 += x[n2];
-      a1 += x[n2 + 1];
-    }
+ * C++ controller's sums, so that the double package reproduces it bit for bit. One definition
+ * for each real type that sums so: lanesum in recruit_real here, lanesum_d in double for the
+ * self-tuned loops. */
+#define RECRUIT_LANESUM(name, real)              \
+  static real name(const real *x, int m) {       \
+    const int n2 = m / 4 * 4, n1 = m / 2 * 2;    \
+    real a0, a1, b0, b1, s;                      \
+    int i;                                       \
+    if (n1 == 0) return m == 1 ? x[0] : (real)0; \
+    a0 = x[0];                                   \
+    a1 = x[1];                                   \
+    if (n1 > 2) {                                \
+      b0 = x[2];                                 \
+      b1 = x[3];                                 \
+      for (i = 4; i < n2; i += 4) {              \
+        a0 += x[i];                              \
+        a1 += x[i + 1];                          \
+        b0 += x[i + 2];                          \
+        b1 += x[i + 3];                          \
+      }                                          \
+      a0 += b0;                                  \
+      a1 += b1;                                  \
+      if (n1 > n2) {                             \
+        a0 += x[n2];                             \
+        a1 += x[n2 + 1];                         \
+      }                                          \
+    }                                            \
+    s = a0 + a1;                                 \
+    if (n1 < m) s += x[n1];                      \
+    return s;                                    \
   }
-  s = a0 + a1;
-  if (n1 < m) s += x[n1];
-  return s;
-}
+RECRUIT_LANESUM(lanesum, recruit_real)
 
 static recruit_real dot(const recruit_real *a, const recruit_real *b, int m) {
   recruit_real s = RK(0);
