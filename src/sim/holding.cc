@@ -3,17 +3,13 @@
 #include <algorithm>
 #include <cmath>
 
+#include "sim/loop_constants.h"
+
 namespace recruit::sim {
 namespace {
 
 constexpr double kStiffnessStep = 1e-3;  // rad, for d tau_static / dq and d arms / dq
 constexpr double kLengthStep = 1e-4;     // m, for a unit force map's slope
-// A joint's stiffness at constant counts is kept at least this fraction of the sum of the
-// magnitudes it is made of (the limb's and each bundle's): with less, the errors of the model
-// (force map, moment arms) can make a pose the bundles hold unstable. 0.5 settled 7/16, 6/8
-// and 3/8 steps of the development cases at dT 1 (two-joint arm, MyoSuite elbow and finger,
-// seeds 401-402) against 4/16, 4/8 and 2/8 without; 0.25 gave 7/16, 4/8, 3/8.
-constexpr double kStiffnessMargin = 0.5;
 
 }  // namespace
 

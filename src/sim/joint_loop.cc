@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "control/torque_allocation.h"
+#include "sim/loop_constants.h"
 
 namespace recruit::sim {
 namespace {
@@ -13,8 +14,7 @@ namespace {
 // unit force map's error and the estimate's bias (MyoSuite's elbow, attached with --force 150:
 // 6-25 % at the holds of seed 401).
 constexpr double kForceError = 0.15;
-constexpr double kLeastStep = 0.05;    // rad: the least step a design assumes
-constexpr double kLimitMargin = 0.03;  // of a joint's range: the loop's reference stays inside
+constexpr double kLeastStep = 0.05;  // rad: the least step a design assumes
 // The price factor of a bundle per further driven joint it crosses: moving one joint with it
 // needs the other joint's bundles to cancel its torque there, and their different speeds make
 // that joint jump in between (the two-joint arm's elbow thrown to its limits by the biarticular
