@@ -4,6 +4,7 @@
 // one unit in each state). The outer loop's design (control/loop_design.h) is made on it.
 #pragma once
 
+#include <cstddef>
 #include <vector>
 
 #include "common/result.h"
@@ -17,8 +18,18 @@ struct ActuatorResponse {
   // periods after it (s[0] = 0; tends to 1).
   std::vector<double> s;
 
-  // Linear interpolation between samples; 1 after the last.
-  double At(double t) const;
+  // Linear interpolation between samples; 1 after the last. Inline: the loop design calls it
+  // millions of times per joint (control::PredictStep), and an out-of-line call kept those
+  // calls' divisions from overlapping.
+  double At(double t) const {
+    if (s.empty()) return 1;
+    const double k = t / dT;
+    if (k <= 0) return s.front();
+    const size_t i = static_cast<size_t>(k);
+    if (i + 1 >= s.size()) return s.back();
+    const double f = k - i;
+    return s[i] + f * (s[i + 1] - s[i]);
+  }
   // The first time the response reaches `fraction` (linear between samples).
   double TimeTo(double fraction) const;
 };
