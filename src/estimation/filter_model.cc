@@ -8,6 +8,7 @@
 #include "common/atomic_file.h"
 #include "common/json_fields.h"
 #include "common/short_text.h"
+#include "estimation/filter_model_cache.h"
 #include "estimation/json_matrix.h"
 #include "estimation/population_chain.h"
 
@@ -131,11 +132,9 @@ FilterModel FilterModel::WithPopulation(int64_t N_new) const {
 }
 
 Result<FilterModel> FilterModel::FromJson(const std::string& path) {
-  auto text = ReadFile(path);
-  if (!text.ok()) return text.failure();
-  auto j = json_io::ParseJson(*text, path);
-  if (!j.ok()) return j.failure();
-  return FromJsonValue(*j, path);
+  auto parsed = ParseFilterModelFile(path);  // parsed once per process for each content
+  if (!parsed.ok()) return parsed.failure();
+  return (*parsed)->model;
 }
 
 namespace {
