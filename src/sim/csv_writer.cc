@@ -31,19 +31,21 @@ Status CsvStepWriter::OnStep(const mjModel*, const mjData*, const TelemetrySampl
     // Added after every older column, so that readers by position keep working.
     for (const auto& b : s.bundles) header += fmt::format(",{}.sensed_force", b.actuator);
     header += '\n';
+    // The longest row and the columns' texts, sized once: the row's layout is fixed.
+    row_max_ = 8 + (4 + 2 * s.joints.size() + 9 * s.bundles.size()) * kFormatGMax;
+    cache_.resize(4 + 2 * s.joints.size() + 8 * s.bundles.size());
     Reserve(header.size());
     std::memcpy(buffer_.data() + used_, header.data(), header.size());
     used_ += header.size();
     header_written_ = true;
   }
-  if (count_++ % every_ != 0 && !s.control_instant) return Status::Ok();
+  if (every_ > 1 && count_++ % every_ != 0 && !s.control_instant) return Status::Ok();
   // The row is formatted in place, with room for the longest row (FormatG: "%.9g" etc. byte
   // for byte, without fmt's format-string parsing). Most columns hold between control instants
   // (references, estimates, broadcasts): a column equal to its last value reuses its text, and
   // one equal to the number formatted just before in the row (an angle task's measured value and
   // angle, a force task's measured value and force) copies that one's.
-  Reserve(8 + (4 + 2 * s.joints.size() + 9 * s.bundles.size()) * kFormatGMax);
-  cache_.resize(4 + 2 * s.joints.size() + 8 * s.bundles.size());
+  Reserve(row_max_);
   char* p = buffer_.data() + used_;
   Column* col = cache_.data();
   const Column* last = nullptr;  // the number formatted last in this row

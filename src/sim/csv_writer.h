@@ -26,7 +26,8 @@ class CsvStepWriter : public StepObserver {
   void Flush();                 // the used bytes to the file
   AtomicFile file_;
   int every_;
-  long count_ = 0;
+  long count_ = 0;           // steps seen (only counted when every_ > 1)
+  std::size_t row_max_ = 0;  // bytes of the longest row (set with the header)
   bool header_written_ = false;
   // Rows not yet written (the first used_ bytes), flushed past kFlushBytes. Small and reserved
   // once: a 1 MB buffer grown by doubling touched ~650 more pages (a 60 s arm run: 1392 -> 732
