@@ -459,7 +459,6 @@ void Plant::Reset(std::uint64_t seed) {
   ApplyPayloads();
   host_->Reset(data_.get(), seed);
   mj_forward(m, data_.get());
-  ForgetTelemetry();
   peak_temperature_.assign(bundles_.size(), -std::numeric_limits<double>::infinity());
   peak_stress_.assign(bundles_.size(), 0.0);
   TrackPeaks();
@@ -478,7 +477,6 @@ void Plant::Step() {
     DisableForOneCall off(m, skip);
     mj_step(m, data_.get());
   }
-  ForgetTelemetry();
   TrackPeaks();
 }
 
@@ -522,7 +520,7 @@ void Plant::ApplyPushes() {
 
 void Plant::TrackPeaks() {
   for (int i = 0; i < num_bundles(); ++i) {
-    const sma::SmaBundle::Telemetry& now = BundleTelemetry(i);
+    const sma::SmaBundle::Telemetry& now = ReadBundleTelemetry(i);  // the units just changed
     peak_temperature_[i] = std::max(peak_temperature_[i], now.max_temperature);
     peak_stress_[i] = std::max(peak_stress_[i], now.max_wire_stress);
   }

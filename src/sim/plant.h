@@ -113,7 +113,7 @@ class Plant {
   Status FindJoints(const Task& task, const std::string& where);
   void ApplyPayloads();
   void ApplyPushes();
-  void TrackPeaks();
+  void TrackPeaks();  // reads every bundle's telemetry afresh (after a step or a reset)
   // Bundle i's units as they are now (force, on count, temperatures, stress): one pass over its
   // cohorts after each step or broadcast, bit for bit what the separate reads give. A run reads
   // them several times a step (measurement, telemetry, peaks): one pass, ~280 instructions for
