@@ -144,6 +144,7 @@ class Plant {
   DataPtr scratch_;          // for the inverse dynamics of StaticTorque and JointInertia
   std::vector<int> push_body_, payload_body_;
   std::vector<bool> payload_done_;
+  bool pushed_ = false;  // a push was active at the last ApplyPushes
   // The joints a step must start clear of to skip the constraint stage; none if it never does.
   std::optional<std::vector<int>> gate_;
   long skipped_ = 0;
