@@ -505,6 +505,7 @@ void Plant::ApplyPushes() {
   // Pushes act through xfrc_applied while active; several may share a body, so clear all first
   // and then add the active ones. With none active now or at the last step the pushed bodies'
   // entries are already 0 (only this writes them; mj_resetData zeroes them): nothing to do.
+  if (task_->pushes.empty()) return;
   const double t = data_->time, h = model_->opt.timestep;
   auto active = [&](const Push& p) {
     return !(t + 0.5 * h < p.start || t + 0.5 * h >= p.start + p.duration);
