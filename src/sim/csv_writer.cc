@@ -31,9 +31,6 @@ Status CsvStepWriter::OnStep(const mjModel*, const mjData*, const TelemetrySampl
     // Added after every older column, so that readers by position keep working.
     for (const auto& b : s.bundles) header += fmt::format(",{}.sensed_force", b.actuator);
     header += '\n';
-    // The longest row and the columns' texts, sized once: the row's layout is fixed.
-    row_max_ = 8 + (4 + 2 * s.joints.size() + 9 * s.bundles.size()) * kFormatGMax;
-    cache_.resize(4 + 2 * s.joints.size() + 8 * s.bundles.size());
     Reserve(header.size());
     std::memcpy(buffer_.data() + used_, header.data(), header.size());
     used_ += header.size();
@@ -45,6 +42,13 @@ Status CsvStepWriter::OnStep(const mjModel*, const mjData*, const TelemetrySampl
   // (references, estimates, broadcasts): a column equal to its last value reuses its text, and
   // one equal to the number formatted just before in the row (an angle task's measured value and
   // angle, a force task's measured value and force) copies that one's.
+  // The longest row and the columns' texts, sized when the layout is new (once in a run).
+  if (s.joints.size() != joints_ || s.bundles.size() != bundles_ || row_max_ == 0) {
+    joints_ = s.joints.size();
+    bundles_ = s.bundles.size();
+    row_max_ = 8 + (4 + 2 * joints_ + 9 * bundles_) * kFormatGMax;
+    cache_.resize(4 + 2 * joints_ + 8 * bundles_);
+  }
   Reserve(row_max_);
   char* p = buffer_.data() + used_;
   Column* col = cache_.data();
