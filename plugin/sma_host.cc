@@ -43,17 +43,6 @@ int SmaHost::BundleIndex(std::string_view actuator_name) const {
   return -1;
 }
 
-const double* SmaHost::State(const mjData* d, int b) const {
-  return Inst(b).State(d->plugin_state, m_, refs_[b].k);
-}
-double* SmaHost::State(mjData* d, int b) const {
-  return Inst(b).State(d->plugin_state, m_, refs_[b].k);
-}
-
-double SmaHost::Stretch(const mjData* d, int b) const {
-  return Inst(b).Stretch(refs_[b].k, SmaInstance::Length(m_, d, actuator_id(b)));
-}
-
 double SmaHost::Force(const mjData* d, int b) const {
   return bundle(b).Tension(State(d, b), Stretch(d, b));
 }

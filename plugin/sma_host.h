@@ -89,12 +89,17 @@ class SmaHost {
   int UnitCohort(const mjData* d, int b, int i) const {
     return bundle(b).UnitCohort(State(d, b), i);
   }
-  // Unit extension (m) of bundle b at the tendon length in d.
-  double Stretch(const mjData* d, int b) const;
+  // Unit extension (m) of bundle b at the tendon length in d. Inline, as State: a run loop
+  // reads every bundle's telemetry after every step.
+  double Stretch(const mjData* d, int b) const {
+    return Inst(b).Stretch(refs_[b].k, SmaInstance::Length(m_, d, actuator_id(b)));
+  }
 
   // Bundle b's block in plugin_state (SmaBundle layout).
-  const double* State(const mjData* d, int b) const;
-  double* State(mjData* d, int b) const;
+  const double* State(const mjData* d, int b) const {
+    return Inst(b).State(d->plugin_state, m_, refs_[b].k);
+  }
+  double* State(mjData* d, int b) const { return Inst(b).State(d->plugin_state, m_, refs_[b].k); }
 
  private:
   struct Ref {

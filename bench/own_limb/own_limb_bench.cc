@@ -25,6 +25,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -70,6 +71,31 @@ std::string MyoSimDir() {
   return dir;
 }
 
+// RECRUIT_BENCH_MERGE="T,XI" (an experiment, not the default): every bundle of the attached model
+// gets merge_temperature T and merge_xi XI (plugin/README.md), for the cost of fewer cohorts.
+Status LoosenMerge(const std::string& xml) {
+  const char* merge = std::getenv("RECRUIT_BENCH_MERGE");
+  if (merge == nullptr || *merge == 0) return Status::Ok();
+  const std::string m = merge;
+  const auto comma = m.find(',');
+  if (comma == std::string::npos) return Error{"RECRUIT_BENCH_MERGE: expected T,XI, got " + m};
+  const std::string keys = "<config key=\"merge_temperature\" value=\"" + m.substr(0, comma) +
+                           "\"/><config key=\"merge_xi\" value=\"" + m.substr(comma + 1) + "\"/>";
+  std::ifstream in(xml);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  int n = 0;
+  for (auto at = text.find("key=\"units\""); at != std::string::npos;
+       at = text.find("key=\"units\"", at + 1)) {
+    const auto end = text.find("/>", at);
+    if (end == std::string::npos) break;
+    text.insert(end + 2, keys);
+    ++n;
+  }
+  if (n == 0) return Error{"RECRUIT_BENCH_MERGE: no units config in " + xml};
+  std::ofstream(xml, std::ios::trunc) << text;
+  return Status::Ok();
+}
+
 struct Limb {
   std::string muscle_xml, attached_xml, task_json;
 };
@@ -108,6 +134,7 @@ Result<Limb> Prepare(const std::string& name) {
   o.task = std::string(tmpl) + "/steps.json";
   auto r = attach::Attach(o);
   if (!r.ok()) return made.emplace(name, Error{"attach: " + r.error()}).first->second;
+  if (Status s = LoosenMerge(o.output); !s) return made.emplace(name, s.failure()).first->second;
   limb.attached_xml = o.output;
   limb.task_json = o.task;
   return made.emplace(name, limb).first->second;

@@ -34,16 +34,6 @@ void Settle(const estimation::BroadcastTransitionModel& chain, double target, do
 
 }  // namespace
 
-double ActuatorResponse::At(double t) const {
-  if (s.empty()) return 1;
-  const double k = t / dT;
-  if (k <= 0) return s.front();
-  const size_t i = static_cast<size_t>(k);
-  if (i + 1 >= s.size()) return s.back();
-  const double f = k - i;
-  return s[i] + f * (s[i + 1] - s[i]);
-}
-
 double ActuatorResponse::TimeTo(double fraction) const {
   for (size_t i = 1; i < s.size(); ++i) {
     if (s[i] >= fraction) {

@@ -4,6 +4,9 @@
 // one unit in each state). The outer loop's design (control/loop_design.h) is made on it.
 #pragma once
 
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
 #include <vector>
 
 #include "common/result.h"
@@ -17,10 +20,39 @@ struct ActuatorResponse {
   // periods after it (s[0] = 0; tends to 1).
   std::vector<double> s;
 
-  // Linear interpolation between samples; 1 after the last.
-  double At(double t) const;
+  // Linear interpolation between samples; 1 after the last. Inline: the loop design calls it
+  // millions of times per joint (control::PredictStep), and an out-of-line call kept those
+  // calls' divisions from overlapping.
+  double At(double t) const {
+    if (s.empty()) return 1;
+    const double k = Quotient(t, dT);
+    if (k <= 0) return s.front();
+    const size_t i = static_cast<size_t>(k);
+    if (i + 1 >= s.size()) return s.back();
+    const double f = k - i;
+    return s[i] + f * (s[i + 1] - s[i]);
+  }
   // The first time the response reaches `fraction` (linear between samples).
   double TimeTo(double fraction) const;
+
+  // t / d, bit for bit. When d is a power of two (dT is 0.5, 1 or 2 s in every shipped task)
+  // its reciprocal 2^-n is exact, and t * 2^-n and t / 2^n are both the correctly rounded value
+  // of the same real number: a multiplication where a division costs several times as long.
+  static double Quotient(double t, double d) {
+    std::uint64_t bits;
+    std::memcpy(&bits, &d, sizeof bits);
+    constexpr std::uint64_t kMantissa = (std::uint64_t{1} << 52) - 1;
+    const std::uint64_t exponent = (bits >> 52) & 0x7ff;
+    // A normal power of two whose reciprocal is normal too (biased exponent 2046 - e).
+    if ((bits & kMantissa) == 0 && exponent >= 1 && exponent <= 2045) {
+      const std::uint64_t inverse_bits = (bits & (std::uint64_t{1} << 63)) | (2046 - exponent)
+                                                                                 << 52;
+      double inverse;
+      std::memcpy(&inverse, &inverse_bits, sizeof inverse);
+      return t * inverse;
+    }
+    return t / d;
+  }
 };
 
 // The chain's expected state (fractions of units per state) starts settled at `from` of the

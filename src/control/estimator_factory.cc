@@ -8,7 +8,6 @@
 #include <string>
 
 #include "common/data_path.h"
-#include "common/json_file.h"
 #include "control/failure_estimator.h"
 #include "control/kalman_estimator.h"
 #include "control/model_plant.h"
@@ -16,6 +15,8 @@
 #include "control/output_estimator.h"
 #include "control/sampling_period.h"
 #include "estimation/filter_model.h"
+#include "estimation/filter_model_cache.h"
+#include "estimation/json_matrix.h"
 #include "estimation/population_kalman_filter.h"
 
 namespace recruit::control {
@@ -218,10 +219,11 @@ Result<std::unique_ptr<OnCountEstimator>> MakeEstimator(const EstimatorSpec& spe
   } else {
     const std::string file = ResolveModelPath(
         spec.model_file.empty() ? DefaultModelFile(dT, spec.num_states) : spec.model_file);
-    // The file is read and parsed once, for the model, its plant and its identification record.
-    auto json = LoadJsonFile(file);
-    auto loaded = json.ok() ? estimation::FilterModel::FromJsonValue(*json, file)
-                            : Result<estimation::FilterModel>(json.failure());
+    // The file is read and parsed once, for the model, its plant and its identification record
+    // (and once per process for each content: a sweep's runs share the parse).
+    auto parsed = estimation::ParseFilterModelFile(file);
+    auto loaded = parsed.ok() ? Result<estimation::FilterModel>((*parsed)->model)
+                              : Result<estimation::FilterModel>(parsed.failure());
     if (!loaded) {
       return Error{"estimator: " + loaded.error() +
                        (spec.model_file.empty()
@@ -233,7 +235,7 @@ Result<std::unique_ptr<OnCountEstimator>> MakeEstimator(const EstimatorSpec& spe
     }
     model = std::move(loaded).value();
     if (!spec.plant.is_null()) {
-      if (Status s = CheckModelPlant(file, *json, spec.plant); !s) {
+      if (Status s = CheckModelPlant(file, (*parsed)->json, spec.plant); !s) {
         return Error{"estimator: " + s.error(), s.code()};
       }
     }
@@ -258,7 +260,7 @@ Result<std::unique_ptr<OnCountEstimator>> MakeEstimator(const EstimatorSpec& spe
     if (spec.force_noise_std > 0) {
       model.R = Eigen::MatrixXd::Constant(1, 1, spec.force_noise_std * spec.force_noise_std);
     }
-    const nlohmann::json ident = IdentificationOf(*json);
+    const nlohmann::json ident = IdentificationOf((*parsed)->json);
     if (geometry) {
       auto map = ModelForceMap(model, ident, *geometry, file);
       if (!map) return Error{"estimator: " + map.error(), map.code()};

@@ -7,8 +7,8 @@
 
 #include "common/atomic_file.h"
 #include "common/json_fields.h"
-#include "common/json_file.h"
 #include "common/short_text.h"
+#include "estimation/filter_model_cache.h"
 #include "estimation/json_matrix.h"
 #include "estimation/population_chain.h"
 
@@ -132,9 +132,9 @@ FilterModel FilterModel::WithPopulation(int64_t N_new) const {
 }
 
 Result<FilterModel> FilterModel::FromJson(const std::string& path) {
-  auto j = LoadJsonFile(path);
-  if (!j.ok()) return j.failure();
-  return FromJsonValue(*j, path);
+  auto parsed = ParseFilterModelFile(path);  // parsed once per process for each content
+  if (!parsed.ok()) return parsed.failure();
+  return (*parsed)->model;
 }
 
 namespace {

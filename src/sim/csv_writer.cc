@@ -36,14 +36,20 @@ Status CsvStepWriter::OnStep(const mjModel*, const mjData*, const TelemetrySampl
     used_ += header.size();
     header_written_ = true;
   }
-  if (count_++ % every_ != 0 && !s.control_instant) return Status::Ok();
+  if (every_ > 1 && count_++ % every_ != 0 && !s.control_instant) return Status::Ok();
   // The row is formatted in place, with room for the longest row (FormatG: "%.9g" etc. byte
   // for byte, without fmt's format-string parsing). Most columns hold between control instants
   // (references, estimates, broadcasts): a column equal to its last value reuses its text, and
   // one equal to the number formatted just before in the row (an angle task's measured value and
   // angle, a force task's measured value and force) copies that one's.
-  Reserve(8 + (4 + 2 * s.joints.size() + 9 * s.bundles.size()) * kFormatGMax);
-  cache_.resize(4 + 2 * s.joints.size() + 8 * s.bundles.size());
+  // The longest row and the columns' texts, sized when the layout is new (once in a run).
+  if (s.joints.size() != joints_ || s.bundles.size() != bundles_ || row_max_ == 0) {
+    joints_ = s.joints.size();
+    bundles_ = s.bundles.size();
+    row_max_ = 8 + (4 + 2 * joints_ + 9 * bundles_) * kFormatGMax;
+    cache_.resize(4 + 2 * joints_ + 8 * bundles_);
+  }
+  Reserve(row_max_);
   char* p = buffer_.data() + used_;
   Column* col = cache_.data();
   const Column* last = nullptr;  // the number formatted last in this row

@@ -26,7 +26,9 @@ class CsvStepWriter : public StepObserver {
   void Flush();                 // the used bytes to the file
   AtomicFile file_;
   int every_;
-  long count_ = 0;
+  long count_ = 0;  // steps seen (only counted when every_ > 1)
+  // The row layout the sizes below are for: joints, bundles, the longest row's bytes.
+  std::size_t joints_ = 0, bundles_ = 0, row_max_ = 0;
   bool header_written_ = false;
   // Rows not yet written (the first used_ bytes), flushed past kFlushBytes. Small and reserved
   // once: a 1 MB buffer grown by doubling touched ~650 more pages (a 60 s arm run: 1392 -> 732

@@ -456,10 +456,10 @@ void Plant::Reset(std::uint64_t seed) {
   std::copy(body_inertia0_.begin(), body_inertia0_.end(), m->body_inertia);
   payload_done_.assign(task_->payloads.size(), false);
   mj_resetData(m, data_.get());
+  pushed_ = false;  // xfrc_applied zeroed
   ApplyPayloads();
   host_->Reset(data_.get(), seed);
   mj_forward(m, data_.get());
-  ForgetTelemetry();
   peak_temperature_.assign(bundles_.size(), -std::numeric_limits<double>::infinity());
   peak_stress_.assign(bundles_.size(), 0.0);
   TrackPeaks();
@@ -478,7 +478,6 @@ void Plant::Step() {
     DisableForOneCall off(m, skip);
     mj_step(m, data_.get());
   }
-  ForgetTelemetry();
   TrackPeaks();
 }
 
@@ -504,14 +503,22 @@ void Plant::ApplyPayloads() {
 
 void Plant::ApplyPushes() {
   // Pushes act through xfrc_applied while active; several may share a body, so clear all first
-  // and then add the active ones.
+  // and then add the active ones. With none active now or at the last step the pushed bodies'
+  // entries are already 0 (only this writes them; mj_resetData zeroes them): nothing to do.
+  if (task_->pushes.empty()) return;
   const double t = data_->time, h = model_->opt.timestep;
+  auto active = [&](const Push& p) {
+    return !(t + 0.5 * h < p.start || t + 0.5 * h >= p.start + p.duration);
+  };
+  const bool any = std::any_of(task_->pushes.begin(), task_->pushes.end(), active);
+  if (!any && !pushed_) return;
+  pushed_ = any;
   for (size_t i = 0; i < task_->pushes.size(); ++i) {
     for (int k = 0; k < 6; ++k) data_->xfrc_applied[6 * push_body_[i] + k] = 0;
   }
   for (size_t i = 0; i < task_->pushes.size(); ++i) {
     const Push& p = task_->pushes[i];
-    if (t + 0.5 * h < p.start || t + 0.5 * h >= p.start + p.duration) continue;
+    if (!active(p)) continue;
     double* x = data_->xfrc_applied + 6 * push_body_[i];
     for (int k = 0; k < 3; ++k) {
       x[k] += p.force[k];
@@ -522,7 +529,7 @@ void Plant::ApplyPushes() {
 
 void Plant::TrackPeaks() {
   for (int i = 0; i < num_bundles(); ++i) {
-    const sma::SmaBundle::Telemetry& now = BundleTelemetry(i);
+    const sma::SmaBundle::Telemetry& now = ReadBundleTelemetry(i);  // the units just changed
     peak_temperature_[i] = std::max(peak_temperature_[i], now.max_temperature);
     peak_stress_[i] = std::max(peak_stress_[i], now.max_wire_stress);
   }

@@ -113,7 +113,7 @@ class Plant {
   Status FindJoints(const Task& task, const std::string& where);
   void ApplyPayloads();
   void ApplyPushes();
-  void TrackPeaks();
+  void TrackPeaks();  // reads every bundle's telemetry afresh (after a step or a reset)
   // Bundle i's units as they are now (force, on count, temperatures, stress): one pass over its
   // cohorts after each step or broadcast, bit for bit what the separate reads give. A run reads
   // them several times a step (measurement, telemetry, peaks): one pass, ~280 instructions for
@@ -144,6 +144,7 @@ class Plant {
   DataPtr scratch_;          // for the inverse dynamics of StaticTorque and JointInertia
   std::vector<int> push_body_, payload_body_;
   std::vector<bool> payload_done_;
+  bool pushed_ = false;  // a push was active at the last ApplyPushes
   // The joints a step must start clear of to skip the constraint stage; none if it never does.
   std::optional<std::vector<int>> gate_;
   long skipped_ = 0;

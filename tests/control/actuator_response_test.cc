@@ -3,6 +3,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <limits>
+#include <vector>
+
+#include "common/rng.h"
 
 namespace recruit::control {
 namespace {
@@ -38,6 +44,87 @@ TEST(ActuatorResponse, AHeatingChainLagsTheCountAndStillSettles) {
   // Slower than the count alone, and settled by the end.
   EXPECT_GT(r->TimeTo(0.63), two->TimeTo(0.63) + 1.0);
   EXPECT_NEAR(r->s.back(), 1.0, 1e-3);
+}
+
+// At divides by dT with a multiplication when dT is a power of two: the same bits as the
+// division for every t (normal, subnormal, zero, negative, huge, infinite) and every dT, a power
+// of two or not (including ones whose reciprocal would not be normal).
+TEST(ActuatorResponse, QuotientIsTheDivisionBitForBit) {
+  auto same = [](double a, double b) {
+    std::uint64_t x, y;
+    std::memcpy(&x, &a, sizeof x);
+    std::memcpy(&y, &b, sizeof y);
+    return x == y || (std::isnan(a) && std::isnan(b));
+  };
+  const double inf = std::numeric_limits<double>::infinity();
+  const double tiny = std::numeric_limits<double>::denorm_min();
+  const double big = std::numeric_limits<double>::max();
+  std::vector<double> divisors = {1,
+                                  2,
+                                  0.5,
+                                  0.25,
+                                  4,
+                                  1024,
+                                  0.3,
+                                  0.1,
+                                  1.5,
+                                  3,
+                                  0.75,
+                                  std::ldexp(1.0, -1022),
+                                  std::ldexp(1.0, -1021),
+                                  std::ldexp(1.0, 1022),
+                                  std::ldexp(1.0, 1023),
+                                  tiny,
+                                  big,
+                                  -0.5,
+                                  -1.0};
+  std::vector<double> ts = {0.0,
+                            -0.0,
+                            1.0,
+                            -1.0,
+                            0.3,
+                            1e-310,
+                            -1e-310,
+                            tiny,
+                            big,
+                            -big,
+                            inf,
+                            -inf,
+                            std::nan(""),
+                            3.0000000000000004,
+                            19.999999999999996};
+  Rng rng(7);
+  for (int i = 0; i < 20000; ++i) {
+    const double u = rng.Uniform();
+    ts.push_back(std::ldexp(u, static_cast<int>(rng.Uniform() * 2100) - 1075));
+    ts.push_back(-40 * u);
+    ts.push_back(60 * u);
+  }
+  for (double d : divisors) {
+    for (double t : ts) {
+      ASSERT_TRUE(same(ActuatorResponse::Quotient(t, d), t / d)) << t << " / " << d;
+    }
+  }
+  // And At with it, against the interpolation written with the division.
+  ActuatorResponse r;
+  r.s = {0, 0.2, 0.5, 0.7, 0.9, 1.0};
+  for (double dT : {1.0, 0.5, 2.0, 0.3}) {
+    r.dT = dT;
+    for (int i = 0; i < 2000; ++i) {
+      const double t = 8 * dT * rng.Uniform() - dT;
+      const double k = t / dT;
+      double want;
+      if (k <= 0) {
+        want = r.s.front();
+      } else if (static_cast<size_t>(k) + 1 >= r.s.size()) {
+        want = r.s.back();
+      } else {
+        const size_t j = static_cast<size_t>(k);
+        want = r.s[j] + (k - j) * (r.s[j + 1] - r.s[j]);
+      }
+      ASSERT_TRUE(same(r.At(t), want)) << t << " at dT " << dT;
+    }
+  }
 }
 
 TEST(ActuatorResponse, BadInputsAreRefused) {
