@@ -39,6 +39,24 @@ EstimatorSpec Failures() {
   return s;
 }
 
+// The controller's exploration (ControllerParams::exploration): FAILURE_EXPLORE_P (p_on, 0 =
+// off), FAILURE_EXPLORE_N (instants), FAILURE_EXPLORE_SUSPICION, FAILURE_EXPLORE_PERIOD (s),
+// FAILURE_EXPLORE_DECLARED (0/1).
+recruit::control::ExplorationParams Exploration() {
+  recruit::control::ExplorationParams e;
+  auto env = [](const char* name, double& v) {
+    if (const char* s = std::getenv(name)) v = std::atof(s);
+  };
+  env("FAILURE_EXPLORE_P", e.p_on);
+  env("FAILURE_EXPLORE_SUSPICION", e.suspicion);
+  env("FAILURE_EXPLORE_PERIOD", e.period);
+  if (const char* s = std::getenv("FAILURE_EXPLORE_N")) e.instants = std::atoi(s);
+  if (const char* s = std::getenv("FAILURE_EXPLORE_REST")) e.rest = std::atoi(s);
+  if (const char* s = std::getenv("FAILURE_EXPLORE_BALANCED")) e.balanced = std::atoi(s);
+  if (const char* s = std::getenv("FAILURE_EXPLORE_DECLARED")) e.after_declaration = std::atoi(s);
+  return e;
+}
+
 // Runs whose value lies in [lo, hi].
 int Within(const std::vector<double>& v, double lo, double hi) {
   int n = 0;
@@ -47,6 +65,7 @@ int Within(const std::vector<double>& v, double lo, double hi) {
 }
 
 std::vector<fl::Instant> MustRun(fl::Spec s) {
+  if (s.estimator.failures) s.exploration = Exploration();
   auto r = fl::Run(s);
   if (!r) {
     std::fprintf(stderr, "%s\n", r.error().c_str());
@@ -82,13 +101,20 @@ int main(int argc, char** argv) {
   // "trace CONFIG": one run of seed first_seed with the plant keys CONFIG (15 N held), every
   // control instant from 55 s printed.
   if (argc > 4 && std::string(argv[3]) == "trace") {
-    const auto run = MustRun({argv[4], Failures(), 0.5, 0.2, static_cast<std::uint64_t>(first), 100,
-                              [](double) { return 15.0; }});
-    std::printf("t force on est_on var_on working est_working var_working declared\n");
+    const auto run = MustRun({argv[4],
+                              Failures(),
+                              0.5,
+                              0.2,
+                              static_cast<std::uint64_t>(first),
+                              100,
+                              [](double) { return 15.0; },
+                              {}});
+    std::printf("t force on est_on var_on working est_working var_working declared susp expl\n");
     for (const auto& r : run) {
       if (r.t < 55) continue;
-      std::printf("%.1f %.2f %d %.2f %.2f %d %.2f %.2f %d\n", r.t, r.force, r.on, r.est_on,
-                  r.est_on_var, r.working, r.est_working, r.est_working_var, r.declared);
+      std::printf("%.1f %.2f %d %.2f %.2f %d %.2f %.2f %d %.1f %d\n", r.t, r.force, r.on, r.est_on,
+                  r.est_on_var, r.working, r.est_working, r.est_working_var, r.declared,
+                  r.suspicion, r.exploring);
     }
     return 0;
   }
@@ -101,6 +127,7 @@ int main(int argc, char** argv) {
   for (int lost : {6, 18}) {
     std::vector<double> found, nees_loss, nees_after, nees_later, error10;
     int within10 = 0, never = 0, at10 = 0;
+    std::string missed;  // seeds not within 2 units within 10 instants
     const std::string config = "failures=60:" + std::to_string(lost) + ":open";
     for (int s = first; s < first + seeds; ++s) {
       fl::Spec spec{config,
@@ -109,11 +136,13 @@ int main(int argc, char** argv) {
                     0.2,
                     static_cast<std::uint64_t>(s),
                     100,
-                    [](double) { return 15.0; }};
+                    [](double) { return 15.0; },
+                    {}};
       const auto run = MustRun(spec);
       const int k = fl::InstantsToFind(run, 60);
       found.push_back(k);
       within10 += k >= 0 && k <= 10;
+      if (!(k >= 0 && k <= 10)) missed += " " + std::to_string(s);
       never += k < 0;
       nees_loss.push_back(fl::MeanNees(run));
       nees_after.push_back(fl::MeanNees(run, 60));
@@ -129,6 +158,7 @@ int main(int argc, char** argv) {
     std::printf("detect: %d of 60 units open at 60 s, 15 N\n", lost);
     Report("instants to |working est - true| <= 2", found);
     std::printf("  within 10 instants: %d of %d runs (never: %d)\n", within10, seeds, never);
+    if (!missed.empty()) std::printf("  not within 10 instants, seeds:%s\n", missed.c_str());
     Report("|working est - true| 10 instants after (65 s)", error10);
     std::printf("  within 2 units at 10 instants after: %d of %d runs\n", at10, seeds);
     Report("mean on-count NEES per run (0-100 s)", nees_loss);
@@ -139,7 +169,7 @@ int main(int argc, char** argv) {
                 Within(nees_later, 0.3, 2), seeds);
   }
   for (int s = first; s < first + seeds; ++s) {
-    fl::Spec quiet{"", Failures(), 0.5, 0.2, static_cast<std::uint64_t>(s), 500, Steps};
+    fl::Spec quiet{"", Failures(), 0.5, 0.2, static_cast<std::uint64_t>(s), 500, Steps, {}};
     const auto q = MustRun(quiet);
     false_alarms += fl::DeclarationsBefore(q, 1e9);
     double worst = 0;
@@ -168,10 +198,17 @@ int main(int argc, char** argv) {
     for (int s = first; s < first + seeds; ++s) {
       auto ref = [](double) { return 15.0; };
       const auto f =
-          MustRun({c.config, Failures(), 0.5, 0.2, static_cast<std::uint64_t>(s), 100, ref});
-      const auto n = MustRun({"", Failures(), 0.5, 0.2, static_cast<std::uint64_t>(s), 100, ref});
-      const auto a = MustRun({c.config, *EstimatorSpec::Parse("kalman-augmented"), 0.5, 0.2,
-                              static_cast<std::uint64_t>(s), 100, ref});
+          MustRun({c.config, Failures(), 0.5, 0.2, static_cast<std::uint64_t>(s), 100, ref, {}});
+      const auto n =
+          MustRun({"", Failures(), 0.5, 0.2, static_cast<std::uint64_t>(s), 100, ref, {}});
+      const auto a = MustRun({c.config,
+                              *EstimatorSpec::Parse("kalman-augmented"),
+                              0.5,
+                              0.2,
+                              static_cast<std::uint64_t>(s),
+                              100,
+                              ref,
+                              {}});
       after.push_back(fl::MeanError(f, 80, 100));
       base.push_back(fl::MeanError(n, 80, 100));
       aug_after.push_back(fl::MeanError(a, 80, 100));
@@ -189,9 +226,15 @@ int main(int argc, char** argv) {
   for (int s = first; s < first + seeds; ++s) {
     auto ref = [](double t) { return t >= 70 && t < 130 ? 22.0 : 15.0; };
     const auto f = MustRun(
-        {"failures=60:18:open", Failures(), 0.5, 0.2, static_cast<std::uint64_t>(s), 180, ref});
-    const auto n = MustRun({"", Failures(), 0.5, 0.2, static_cast<std::uint64_t>(s), 180,
-                            [](double) { return 15.0; }});
+        {"failures=60:18:open", Failures(), 0.5, 0.2, static_cast<std::uint64_t>(s), 180, ref, {}});
+    const auto n = MustRun({"",
+                            Failures(),
+                            0.5,
+                            0.2,
+                            static_cast<std::uint64_t>(s),
+                            180,
+                            [](double) { return 15.0; },
+                            {}});
     int sat = 0, total = 0;
     for (const auto& r : f) {
       if (r.t >= 80 && r.t < 130) sat += r.saturation == 1, ++total;

@@ -78,6 +78,7 @@ std::optional<FailureEstimate> FailureOnCountEstimator::Failures() const {
   f.declarations = filter_.declarations();
   f.declared = filter_.declared_last();
   f.force_scale = filter_.force_scale();
+  f.suspicion = filter_.suspicion();
   return f;
 }
 

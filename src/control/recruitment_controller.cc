@@ -18,6 +18,22 @@ Status ControllerParams::Validate() const {
   if (!std::isfinite(lambda) || lambda <= 0 || lambda > 1) {
     return Error{"controller: lambda = " + std::to_string(lambda) + " must be in (0, 1]"};
   }
+  const ExplorationParams& e = exploration;
+  if (!std::isfinite(e.p_on) || e.p_on < 0 || e.p_on > 1) {
+    return Error{"controller: exploration.p_on = " + std::to_string(e.p_on) + " must be in [0, 1]"};
+  }
+  if (e.instants < 1) {
+    return Error{"controller: exploration.instants = " + std::to_string(e.instants) +
+                 " must be >= 1"};
+  }
+  if (!std::isfinite(e.suspicion) || e.suspicion < 0) {
+    return Error{"controller: exploration.suspicion = " + std::to_string(e.suspicion) +
+                 " must be finite and >= 0"};
+  }
+  if (!std::isfinite(e.period) || e.period < 0) {
+    return Error{"controller: exploration.period = " + std::to_string(e.period) +
+                 " s must be finite and >= 0"};
+  }
   return Status::Ok();
 }
 
@@ -54,6 +70,10 @@ void RecruitmentController::Reset() {
   estimated_on_variance_ = estimator_->EstimatedOnVariance();
   estimated_working_ = params_.num_units;
   saturation_ = 0;
+  explore_left_ = 0;
+  rest_left_ = 0;
+  since_period_ = 0;
+  exploring_ = false;
   last_ = Broadcast{};
 }
 
@@ -73,6 +93,7 @@ Broadcast RecruitmentController::Step(double reference_force, double measured_fo
   estimated_on_variance_ = estimator_->EstimatedOnVariance();
   if (const auto f = estimator_->Failures()) {
     last_ = FailureAwareLaw(*f);
+    if (params_.exploration.p_on > 0) last_ = Explore(last_, *f);
   } else {
     last_ = ExpectationLaw(target_on_, estimated_on_, params_.num_units, params_.lambda);
   }
@@ -89,6 +110,28 @@ Broadcast RecruitmentController::FailureAwareLaw(const FailureEstimate& f) {
   const double target = target_on_ - stuck;
   saturation_ = target > working ? 1 : (target < 0 ? -1 : 0);
   return ExpectationLaw(target, estimated_on_ - stuck, working, params_.lambda);
+}
+
+Broadcast RecruitmentController::Explore(const Broadcast& law, const FailureEstimate& f) {
+  const ExplorationParams& e = params_.exploration;
+  const long period = e.period > 0 ? std::max(1L, std::lround(e.period / params_.dT)) : 0;
+  const bool periodic = period > 0 && ++since_period_ >= period;
+  if (periodic) since_period_ = 0;
+  const bool triggered = (e.after_declaration && f.declared) ||
+                         (e.suspicion > 0 && f.suspicion >= e.suspicion) || periodic;
+  if (explore_left_ == 0 && rest_left_ > 0) {
+    --rest_left_;  // resting: triggers are ignored
+  } else if (triggered && explore_left_ == 0) {
+    explore_left_ = e.instants;
+  }
+  exploring_ = explore_left_ > 0;
+  if (!exploring_) return law;
+  if (--explore_left_ == 0) rest_left_ = e.rest;
+  if (!e.balanced) return Broadcast{e.p_on, e.p_on};
+  // The working units the broadcast reaches: on ones (the stuck ones ignore it) and off ones.
+  const double on = std::max(0.0, estimated_on_ - std::max(0.0, f.stuck));
+  const double off = std::max(0.0, estimated_working_ - on);
+  return ExplorationLaw(law, on, off, e.p_on);
 }
 
 }  // namespace recruit::control

@@ -185,6 +185,7 @@ void FailureKalmanFilter::Reset() {
   glr_.Clear();
   declarations_ = 0;
   declared_last_ = false;
+  suspicion_ = 0;
   last_declared_ = {};
   declared_class_[1] = declared_class_[2] = false;
   if (params_.open_hazard > 0 || params_.stuck_hazard > 0 || params_.scale_variance > 0) Augment();
@@ -292,6 +293,7 @@ void FailureKalmanFilter::UpdateCore(double y, const Eigen::MatrixXd& H, double 
 
 void FailureKalmanFilter::Update(double y) {
   declared_last_ = false;
+  suspicion_ = 0;
   const int n = 3 * m_;
   // The innovation and its variance on the filter that runs now, and the prior for the GLR.
   double nu, s;
@@ -322,8 +324,10 @@ void FailureKalmanFilter::Update(double y) {
   h << force_scale() * H_.row(0), H_.row(0), H_.row(0);
   glr_.Update(nu, s, h, K);
   const FailureGlr::Best best = glr_.Strongest(params_.glr_max_std);
+  suspicion_ = best.llr;
   if (best.to != 0 && best.llr > params_.glr_threshold && best.count >= params_.glr_min_count) {
     Declare(best);
+    suspicion_ = 0;
   }
 }
 

@@ -144,6 +144,9 @@ class FailureKalmanFilter {
   // Failures declared since Reset, and whether the last Update declared one.
   int declarations() const { return declarations_; }
   bool declared_last() const { return declared_last_; }
+  // The GLR's largest log-likelihood ratio at the last Update (that of the strongest hypothesis,
+  // declared or not; 0 after a declaration, which clears the test).
+  double suspicion() const { return suspicion_; }
   // The GLR's hypothesis at the last declaration (class, onset age, count, variance, ratio).
   const FailureGlr::Best& last_declared() const { return last_declared_; }
   // The paper's filter that runs until the augmented one takes over.
@@ -185,6 +188,7 @@ class FailureKalmanFilter {
   bool declared_class_[3] = {false, false, false};  // classes declared since Reset
   int declarations_ = 0;
   bool declared_last_ = false;
+  double suspicion_ = 0;
   FailureGlr::Best last_declared_;
 };
 

@@ -29,6 +29,7 @@ struct Spec {
   std::uint64_t seed = 1;
   double duration = 120;                    // s
   std::function<double(double)> reference;  // N, at time t
+  ExplorationParams exploration;            // the controller's (off by default)
 };
 
 struct Instant {
@@ -37,7 +38,8 @@ struct Instant {
   double est_on = 0, est_on_var = 0;
   double est_working = 0, est_working_var = 0;  // N and 0 without a failure-aware estimator
   int saturation = 0;
-  bool declared = false;
+  bool declared = false, exploring = false;
+  double suspicion = 0;  // the failure test's largest ratio
 };
 
 // The bench's MJCF with `config` (key=value tokens) added to the bundle's instance.
@@ -79,6 +81,7 @@ inline Result<std::vector<Instant>> Run(const Spec& spec) {
   params.unit_force = p.SettledUnitForce(0);
   params.dT = spec.dT;
   params.lambda = spec.lambda;
+  params.exploration = spec.exploration;
   auto c = RecruitmentController::Create(params, spec.estimator);
   if (!c) return Error{c.error()};
   const int steps = static_cast<int>(std::lround(spec.dT / m->opt.timestep));
@@ -97,11 +100,13 @@ inline Result<std::vector<Instant>> Run(const Spec& spec) {
     r.est_on = c->estimated_on();
     r.est_on_var = c->estimated_on_variance();
     r.saturation = c->saturation();
+    r.exploring = c->exploring();
     r.est_working = params.num_units;
     if (const auto fe = c->estimator().Failures()) {
       r.est_working = fe->working;
       r.est_working_var = fe->working_variance;
       r.declared = fe->declared;
+      r.suspicion = fe->suspicion;
     }
     out.push_back(r);
     if (Status s = p.Broadcast(d.get(), 0, b.p_on, b.p_off); !s) return Error{s.error()};
