@@ -106,8 +106,10 @@ Broadcast RecruitmentController::FailureAwareLaw(const FailureEstimate& f) {
   const double stuck = std::clamp(f.stuck, 0.0, n);
   const double working = std::clamp(f.working, 0.0, n - stuck);
   estimated_working_ = working;
-  // The working units must make up what the stuck ones do not.
-  const double target = target_on_ - stuck;
+  // The working units must make up what the stuck ones do not, each pulling the estimated
+  // fraction c of a fresh unit (functional fatigue; c = 1 unless estimated).
+  const double c = f.force_scale > 0 ? f.force_scale : 1.0;
+  const double target = c == 1.0 ? target_on_ - stuck : (target_on_ - stuck) / c;
   saturation_ = target > working ? 1 : (target < 0 ? -1 : 0);
   return ExpectationLaw(target, estimated_on_ - stuck, working, params_.lambda);
 }

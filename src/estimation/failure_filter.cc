@@ -143,6 +143,10 @@ Status FailureFilterParams::Validate() const {
     return Error{"failure filter: settle_hazard = " + std::to_string(settle_hazard) +
                  " must be in [0, 1]"};
   }
+  if (!(std::isfinite(scale_initial_variance) && scale_initial_variance >= 0)) {
+    return Error{"failure filter: scale_initial_variance = " +
+                 std::to_string(scale_initial_variance) + " must be finite and >= 0"};
+  }
   if (!(std::isfinite(scale_variance) && scale_variance >= 0)) {
     return Error{"failure filter: scale_variance = " + std::to_string(scale_variance) +
                  " must be finite and >= 0"};
@@ -197,6 +201,7 @@ void FailureKalmanFilter::Augment() {
   x_[3 * m_] = 1;
   P_ = Eigen::MatrixXd::Zero(3 * m_ + 1, 3 * m_ + 1);
   P_.topLeftCorner(m_, m_) = inner_.covariance();
+  if (params_.scale_variance > 0) P_(3 * m_, 3 * m_) = params_.scale_initial_variance;
   augmented_ = true;
 }
 

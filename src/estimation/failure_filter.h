@@ -111,6 +111,8 @@ struct FailureFilterParams {
   double settle_hazard = 0;
   // Random-walk variance of the working units' force scale per control period; 0 = c fixed at 1.
   double scale_variance = 0;
+  // Variance of the force scale at Reset (c = 1), when it is estimated.
+  double scale_initial_variance = 0;
 
   Status Validate() const;
 };
@@ -134,6 +136,7 @@ class FailureKalmanFilter {
   const Eigen::VectorXd& estimate() const;
   const Eigen::MatrixXd& covariance() const;
   double force_scale() const { return augmented_ ? x_[3 * m_] : 1.0; }
+  double force_scale_variance() const { return augmented_ ? P_(3 * m_, 3 * m_) : 0.0; }
   double open() const { return augmented_ ? x_.segment(m_, m_).sum() : 0.0; }
   double stuck() const { return augmented_ ? x_.segment(2 * m_, m_).sum() : 0.0; }
   double working() const { return N_ - open() - stuck(); }

@@ -111,6 +111,21 @@ TEST(Exploration, StartsOnADeclarationOrPeriodAndRests) {
   EXPECT_FALSE(p.Validate());
 }
 
+// Fatigue: with an estimated force scale c each working unit pulls c of a fresh one, so the law
+// targets (reference / unit force - stuck) / c working units.
+TEST(FailureAwareLaw, DividesTheWorkingTargetByTheForceScale) {
+  FailureEstimate f;
+  f.working = 60, f.force_scale = 0.8;
+  // 15 N = 30 fresh units = 37.5 units at 0.8; 30 on, 30 off: p_on = 0.2 (37.5 - 30) / 30.
+  RecruitmentController c = Make(30, f);
+  const Broadcast b = c.Step(15.0, 0);
+  EXPECT_DOUBLE_EQ(b.p_on, 0.2 * 7.5 / 30);
+  EXPECT_EQ(c.saturation(), 0);
+  // 25 N = 50 fresh units = 62.5 at 0.8 > 60 working: out of reach.
+  c.Step(25.0, 0);
+  EXPECT_EQ(c.saturation(), 1);
+}
+
 fl::Spec Bench(const char* config, std::uint64_t seed, double duration,
                std::function<double(double)> ref, const char* kind = "kalman-failures") {
   return {config, *EstimatorSpec::Parse(kind), 0.5, 0.2, seed, duration, std::move(ref), {}};
