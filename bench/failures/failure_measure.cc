@@ -241,89 +241,94 @@ int main(int argc, char** argv) {
     return 0;
   }
 
-  // detect: 10 % and 30 % open at 60 s, 15 N held, and the same seeds without a loss
-  std::vector<double> quiet_nees, quiet_working;
-  long quiet_instants = 0, false_alarms = 0;
-  for (int lost : {6, 18}) {
-    std::vector<double> found, nees_loss, nees_after, nees_later, error10;
-    int within10 = 0, never = 0, at10 = 0;
-    std::vector<double> blind, nees_seen;
-    int by_heated[10][2] = {};  // runs and runs within 10 instants, by heated units lost
-    std::string missed;         // seeds not within 2 units within 10 instants
-    const std::string config = "failures=60:" + std::to_string(lost) + ":open";
+  // "track": only the track and reach figures (item 3).
+  const bool track_only = argc > 3 && std::string(argv[3]) == "track";
+  if (!track_only) {
+    // detect: 10 % and 30 % open at 60 s, 15 N held, and the same seeds without a loss
+    std::vector<double> quiet_nees, quiet_working;
+    long quiet_instants = 0, false_alarms = 0;
+    for (int lost : {6, 18}) {
+      std::vector<double> found, nees_loss, nees_after, nees_later, error10;
+      int within10 = 0, never = 0, at10 = 0;
+      std::vector<double> blind, nees_seen;
+      int by_heated[10][2] = {};  // runs and runs within 10 instants, by heated units lost
+      std::string missed;         // seeds not within 2 units within 10 instants
+      const std::string config = "failures=60:" + std::to_string(lost) + ":open";
+      for (int s = first; s < first + seeds; ++s) {
+        fl::Spec spec{config,
+                      Failures(),
+                      0.5,
+                      0.2,
+                      static_cast<std::uint64_t>(s),
+                      100,
+                      [](double) { return 15.0; },
+                      {}};
+        const auto run = MustRun(spec);
+        spec.plant_config = "";  // the same seed without the loss: the same run until 60 s
+        const auto base = MustRun(spec);
+        const int k = fl::InstantsToFind(run, 60);
+        found.push_back(k);
+        within10 += k >= 0 && k <= 10;
+        const Blind b = BlindInstants(run, base, 60);
+        blind.push_back(b.instants);
+        nees_seen.push_back(b.nees_seen);
+        const int h = std::min(b.heated_lost, 9);
+        ++by_heated[h][0];
+        by_heated[h][1] += k >= 0 && k <= 10;
+        if (!(k >= 0 && k <= 10)) missed += " " + std::to_string(s);
+        never += k < 0;
+        nees_loss.push_back(fl::MeanNees(run));
+        nees_after.push_back(fl::MeanNees(run, 60));
+        nees_later.push_back(fl::MeanNees(run, 62.5));
+        for (const auto& r : run) {  // 10 instants after the first that sees the loss (60 s)
+          if (std::abs(r.t - 65) > 1e-9) continue;
+          error10.push_back(std::abs(r.est_working - r.working));
+          at10 += error10.back() <= 2;
+        }
+        false_alarms += fl::DeclarationsBefore(run, 60);
+        quiet_instants += 120;
+      }
+      std::printf("detect: %d of 60 units open at 60 s, 15 N\n", lost);
+      Report("instants to |working est - true| <= 2", found);
+      std::printf("  within 10 instants: %d of %d runs (never: %d)\n", within10, seeds, never);
+      if (!missed.empty()) std::printf("  not within 10 instants, seeds:%s\n", missed.c_str());
+      std::printf("  by heated units lost at 60 s (runs: within 10 instants / of):");
+      for (int h = 0; h < 10; ++h) {
+        if (by_heated[h][0] > 0) {
+          std::printf(" %d%s: %d/%d", h, h == 9 ? "+" : "", by_heated[h][1], by_heated[h][0]);
+        }
+      }
+      std::printf("\n");
+      Report("|working est - true| 10 instants after (65 s)", error10);
+      std::printf("  within 2 units at 10 instants after: %d of %d runs\n", at10, seeds);
+      Report("mean on-count NEES per run (0-100 s)", nees_loss);
+      std::printf("  runs with mean NEES in [0.3, 2]: %d of %d\n", Within(nees_loss, 0.3, 2),
+                  seeds);
+      Report("blind instants (force within 0.153 N of no loss)", blind);
+      Report("mean NEES per run without the blind instants", nees_seen);
+      std::printf("  runs with it in [0.3, 2]: %d of %d\n", Within(nees_seen, 0.3, 2), seeds);
+      Report("mean on-count NEES per run (60-100 s)", nees_after);
+      Report("mean on-count NEES per run (62.5-100 s)", nees_later);
+      std::printf("  runs with mean NEES (62.5-100 s) in [0.3, 2]: %d of %d\n",
+                  Within(nees_later, 0.3, 2), seeds);
+    }
     for (int s = first; s < first + seeds; ++s) {
-      fl::Spec spec{config,
-                    Failures(),
-                    0.5,
-                    0.2,
-                    static_cast<std::uint64_t>(s),
-                    100,
-                    [](double) { return 15.0; },
-                    {}};
-      const auto run = MustRun(spec);
-      spec.plant_config = "";  // the same seed without the loss: the same run until 60 s
-      const auto base = MustRun(spec);
-      const int k = fl::InstantsToFind(run, 60);
-      found.push_back(k);
-      within10 += k >= 0 && k <= 10;
-      const Blind b = BlindInstants(run, base, 60);
-      blind.push_back(b.instants);
-      nees_seen.push_back(b.nees_seen);
-      const int h = std::min(b.heated_lost, 9);
-      ++by_heated[h][0];
-      by_heated[h][1] += k >= 0 && k <= 10;
-      if (!(k >= 0 && k <= 10)) missed += " " + std::to_string(s);
-      never += k < 0;
-      nees_loss.push_back(fl::MeanNees(run));
-      nees_after.push_back(fl::MeanNees(run, 60));
-      nees_later.push_back(fl::MeanNees(run, 62.5));
-      for (const auto& r : run) {  // 10 instants after the first that sees the loss (60 s)
-        if (std::abs(r.t - 65) > 1e-9) continue;
-        error10.push_back(std::abs(r.est_working - r.working));
-        at10 += error10.back() <= 2;
-      }
-      false_alarms += fl::DeclarationsBefore(run, 60);
-      quiet_instants += 120;
+      fl::Spec quiet{"", Failures(), 0.5, 0.2, static_cast<std::uint64_t>(s), 500, Steps, {}};
+      const auto q = MustRun(quiet);
+      false_alarms += fl::DeclarationsBefore(q, 1e9);
+      double worst = 0;
+      for (const auto& r : q) worst = std::max(worst, std::abs(r.est_working - r.working));
+      quiet_working.push_back(worst);
+      quiet_instants += static_cast<long>(q.size());
+      quiet_nees.push_back(fl::MeanNees(q));
     }
-    std::printf("detect: %d of 60 units open at 60 s, 15 N\n", lost);
-    Report("instants to |working est - true| <= 2", found);
-    std::printf("  within 10 instants: %d of %d runs (never: %d)\n", within10, seeds, never);
-    if (!missed.empty()) std::printf("  not within 10 instants, seeds:%s\n", missed.c_str());
-    std::printf("  by heated units lost at 60 s (runs: within 10 instants / of):");
-    for (int h = 0; h < 10; ++h) {
-      if (by_heated[h][0] > 0) {
-        std::printf(" %d%s: %d/%d", h, h == 9 ? "+" : "", by_heated[h][1], by_heated[h][0]);
-      }
-    }
-    std::printf("\n");
-    Report("|working est - true| 10 instants after (65 s)", error10);
-    std::printf("  within 2 units at 10 instants after: %d of %d runs\n", at10, seeds);
-    Report("mean on-count NEES per run (0-100 s)", nees_loss);
-    std::printf("  runs with mean NEES in [0.3, 2]: %d of %d\n", Within(nees_loss, 0.3, 2), seeds);
-    Report("blind instants (force within 0.153 N of no loss)", blind);
-    Report("mean NEES per run without the blind instants", nees_seen);
-    std::printf("  runs with it in [0.3, 2]: %d of %d\n", Within(nees_seen, 0.3, 2), seeds);
-    Report("mean on-count NEES per run (60-100 s)", nees_after);
-    Report("mean on-count NEES per run (62.5-100 s)", nees_later);
-    std::printf("  runs with mean NEES (62.5-100 s) in [0.3, 2]: %d of %d\n",
-                Within(nees_later, 0.3, 2), seeds);
+    std::printf("quiet: no failure (500 s of 10/20/5/15 N steps, and the first 60 s above)\n");
+    std::printf("  declared failures: %ld in %ld control instants (%.2g per instant)\n",
+                false_alarms, quiet_instants, double(false_alarms) / quiet_instants);
+    Report("mean on-count NEES per run", quiet_nees);
+    std::printf("  runs with mean NEES in [0.3, 2]: %d of %d\n", Within(quiet_nees, 0.3, 2), seeds);
+    Report("largest |working est - 60| per run", quiet_working);
   }
-  for (int s = first; s < first + seeds; ++s) {
-    fl::Spec quiet{"", Failures(), 0.5, 0.2, static_cast<std::uint64_t>(s), 500, Steps, {}};
-    const auto q = MustRun(quiet);
-    false_alarms += fl::DeclarationsBefore(q, 1e9);
-    double worst = 0;
-    for (const auto& r : q) worst = std::max(worst, std::abs(r.est_working - r.working));
-    quiet_working.push_back(worst);
-    quiet_instants += static_cast<long>(q.size());
-    quiet_nees.push_back(fl::MeanNees(q));
-  }
-  std::printf("quiet: no failure (500 s of 10/20/5/15 N steps, and the first 60 s above)\n");
-  std::printf("  declared failures: %ld in %ld control instants (%.2g per instant)\n", false_alarms,
-              quiet_instants, double(false_alarms) / quiet_instants);
-  Report("mean on-count NEES per run", quiet_nees);
-  std::printf("  runs with mean NEES in [0.3, 2]: %d of %d\n", Within(quiet_nees, 0.3, 2), seeds);
-  Report("largest |working est - 60| per run", quiet_working);
   if (detect_only) return 0;
 
   // track
@@ -334,7 +339,8 @@ int main(int argc, char** argv) {
   for (const Case& c :
        {Case{"10 % open", "failures=60:6:open"}, Case{"30 % open", "failures=60:18:open"},
         Case{"10 % stuck", "failures=60:6:stuck"}}) {
-    std::vector<double> after, base, ratio, aug_after, nees;
+    std::vector<double> after, base, ratio, aug_after, nees, early, early_base;
+    std::vector<double> diff[8];  // per 5 s window after the loss: |error| with - without
     for (int s = first; s < first + seeds; ++s) {
       auto ref = [](double) { return 15.0; };
       const auto f =
@@ -349,15 +355,34 @@ int main(int argc, char** argv) {
                               100,
                               ref,
                               {}});
+      for (int w = 0; w < 8; ++w) {
+        const double t0 = 60 + 5 * w;
+        diff[w].push_back(fl::MeanError(f, t0, t0 + 5) - fl::MeanError(n, t0, t0 + 5));
+      }
+      early.push_back(fl::MeanError(f, 70, 80));
+      early_base.push_back(fl::MeanError(n, 70, 80));
       after.push_back(fl::MeanError(f, 80, 100));
       base.push_back(fl::MeanError(n, 80, 100));
       aug_after.push_back(fl::MeanError(a, 80, 100));
       nees.push_back(fl::MeanNees(f));
     }
-    std::printf("track: %s at 60 s, 15 N (mean |error| over 80-100 s, N)\n", c.name);
-    Report("kalman-failures, with the loss", after);
-    Report("kalman-failures, same seeds, no loss", base);
-    Report("kalman-augmented (unaware), with the loss", aug_after);
+    std::printf("track: %s at 60 s, 15 N (|error| in N)\n", c.name);
+    std::printf(
+        "  mean over runs of |error| with the loss - without, per 5 s window (N, +- 2 SE):\n   ");
+    for (int w = 0; w < 8; ++w) {
+      double m = 0, v = 0;
+      for (double x : diff[w]) m += x;
+      m /= diff[w].size();
+      for (double x : diff[w]) v += (x - m) * (x - m);
+      const double se = std::sqrt(v / (diff[w].size() - 1) / diff[w].size());
+      std::printf(" %d-%ds %+.3f+-%.3f", 5 * w, 5 * w + 5, m, 2 * se);
+    }
+    std::printf("\n");
+    Report("mean |error| 70-80 s, with the loss", early);
+    Report("mean |error| 70-80 s, same seeds, no loss", early_base);
+    Report("mean |error| 80-100 s, with the loss", after);
+    Report("mean |error| 80-100 s, same seeds, no loss", base);
+    Report("80-100 s, kalman-augmented (unaware), loss", aug_after);
     Report("mean on-count NEES per run (kalman-failures)", nees);
   }
 
