@@ -54,6 +54,7 @@ recruit::control::ExplorationParams Exploration() {
   env("FAILURE_EXPLORE_PERIOD", e.period);
   if (const char* s = std::getenv("FAILURE_EXPLORE_N")) e.instants = std::atoi(s);
   if (const char* s = std::getenv("FAILURE_EXPLORE_REST")) e.rest = std::atoi(s);
+  if (const char* s = std::getenv("FAILURE_EXPLORE_UNMEASURED")) e.unmeasured = std::atoi(s);
   if (const char* s = std::getenv("FAILURE_EXPLORE_BALANCED")) e.balanced = std::atoi(s);
   if (const char* s = std::getenv("FAILURE_EXPLORE_DECLARED")) e.after_declaration = std::atoi(s);
   return e;
@@ -245,7 +246,7 @@ int main(int argc, char** argv) {
   const bool track_only = argc > 3 && std::string(argv[3]) == "track";
   if (!track_only) {
     // detect: 10 % and 30 % open at 60 s, 15 N held, and the same seeds without a loss
-    std::vector<double> quiet_nees, quiet_working;
+    std::vector<double> quiet_nees, quiet_working, quiet_suspicion;
     long quiet_instants = 0, false_alarms = 0;
     for (int lost : {6, 18}) {
       std::vector<double> found, nees_loss, nees_after, nees_later, error10;
@@ -321,6 +322,9 @@ int main(int argc, char** argv) {
       quiet_working.push_back(worst);
       quiet_instants += static_cast<long>(q.size());
       quiet_nees.push_back(fl::MeanNees(q));
+      double top = 0;
+      for (const auto& r : q) top = std::max(top, r.suspicion);
+      quiet_suspicion.push_back(top);
     }
     std::printf("quiet: no failure (500 s of 10/20/5/15 N steps, and the first 60 s above)\n");
     std::printf("  declared failures: %ld in %ld control instants (%.2g per instant)\n",
@@ -328,6 +332,7 @@ int main(int argc, char** argv) {
     Report("mean on-count NEES per run", quiet_nees);
     std::printf("  runs with mean NEES in [0.3, 2]: %d of %d\n", Within(quiet_nees, 0.3, 2), seeds);
     Report("largest |working est - 60| per run", quiet_working);
+    Report("largest failure-test ratio per run (suspicion)", quiet_suspicion);
   }
   if (detect_only) return 0;
 

@@ -83,7 +83,10 @@ std::optional<FailureEstimate> FailureOnCountEstimator::Failures() const {
 }
 
 void FailureOnCountEstimator::UpdateWithMeasurement(double measured_force, double tendon_length) {
-  if (!std::isfinite(measured_force)) return;  // a lost sample: predict only
+  if (!std::isfinite(measured_force)) {  // a lost sample: predict only
+    filter_.NoMeasurement();
+    return;
+  }
   if (output_ || relative_noise_ > 0) {
     // As KalmanOnCountEstimator: H at the measured length, R growing with the predicted force.
     if (output_ && std::isfinite(tendon_length)) {

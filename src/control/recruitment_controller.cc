@@ -22,6 +22,10 @@ Status ControllerParams::Validate() const {
   if (!std::isfinite(e.p_on) || e.p_on < 0 || e.p_on > 1) {
     return Error{"controller: exploration.p_on = " + std::to_string(e.p_on) + " must be in [0, 1]"};
   }
+  if (e.unmeasured < 0 || e.unmeasured > e.instants) {
+    return Error{"controller: exploration.unmeasured = " + std::to_string(e.unmeasured) +
+                 " must be in [0, instants]"};
+  }
   if (e.instants < 1) {
     return Error{"controller: exploration.instants = " + std::to_string(e.instants) +
                  " must be >= 1"};
@@ -72,6 +76,7 @@ void RecruitmentController::Reset() {
   saturation_ = 0;
   explore_left_ = 0;
   rest_left_ = 0;
+  unmeasured_left_ = 0;
   since_period_ = 0;
   exploring_ = false;
   last_ = Broadcast{};
@@ -84,7 +89,12 @@ double RecruitmentController::OnUnitForce(double tendon_length) const {
 
 Broadcast RecruitmentController::Step(double reference_force, double measured_force,
                                       double tendon_length) {
-  estimator_->UpdateWithMeasurement(measured_force, tendon_length);
+  // While an exploration's switched units are in transient (ExplorationParams::unmeasured) the
+  // estimator predicts through it without the force.
+  const bool skip = unmeasured_left_ > 0;
+  if (skip) --unmeasured_left_;
+  estimator_->UpdateWithMeasurement(
+      skip ? std::numeric_limits<double>::quiet_NaN() : measured_force, tendon_length);
   unit_force_ = OnUnitForce(tendon_length);
   // Where no on unit can pull (a slack tendon) no count reaches the reference: ask for all.
   target_on_ = unit_force_ > 0 ? reference_force / unit_force_
@@ -128,8 +138,12 @@ Broadcast RecruitmentController::Explore(const Broadcast& law, const FailureEsti
   }
   exploring_ = explore_left_ > 0;
   if (!exploring_) return law;
+  const bool first = explore_left_ == e.instants;
+  if (first) unmeasured_left_ = e.unmeasured;
   if (--explore_left_ == 0) rest_left_ = e.rest;
-  if (!e.balanced) return Broadcast{e.p_on, e.p_on};
+  // Toggle: every unit switches with p_on at the first instant, then nothing switches so the
+  // switched units settle (the chain's transients are least exact for a synchronised cohort).
+  if (!e.balanced) return first ? Broadcast{e.p_on, e.p_on} : Broadcast{};
   // The working units the broadcast reaches: on ones (the stuck ones ignore it) and off ones.
   const double on = std::max(0.0, estimated_on_ - std::max(0.0, f.stuck));
   const double off = std::max(0.0, estimated_working_ - on);

@@ -18,8 +18,10 @@ namespace recruit::control {
 // `instants` control instants after a trigger the broadcast switches units both ways so that
 // units lost while off (invisible until recruited) show up. `balanced`: at least `p_on` of the
 // off units are recruited and as many more on units released as keeps the expected count
-// (ExplorationLaw); otherwise every unit toggles with probability p_on (p_on = p_off; with 1, a
-// deterministic swap of the on and off units). Triggers: a declared failure
+// (ExplorationLaw); otherwise ("toggle") every unit switches with probability p_on at the first
+// instant (p_on = p_off; with 1, a deterministic swap of the on and off units) and none for the
+// other instants-1, so that the switched units settle before the law resumes. Triggers: a declared
+// failure
 // (`after_declaration`), the estimator's suspicion (FailureEstimate::suspicion, the failure
 // test's largest ratio) reaching `suspicion` (> 0), and every `period` seconds (> 0); none within
 // `rest` instants of the end of the last exploration. The default (p_on = 0) never explores: the
@@ -28,6 +30,9 @@ struct ExplorationParams {
   double p_on = 0;  // in [0, 1]; 0: off
   bool balanced = true;
   int instants = 10;
+  // The control instants after the exploration's first whose force the estimator does not use
+  // (it predicts through the switched units' transient, which its chain models least exactly).
+  int unmeasured = 0;
   int rest = 0;
   bool after_declaration = true;
   double suspicion = 0;  // log-likelihood ratio; 0: not a trigger
@@ -106,9 +111,10 @@ class RecruitmentController {
   double estimated_on_variance_ = 0;
   double estimated_working_ = 0;
   int saturation_ = 0;
-  int explore_left_ = 0;   // instants of exploration still to broadcast
-  int rest_left_ = 0;      // instants before a trigger may start another
-  long since_period_ = 0;  // instants since the last periodic exploration began
+  int explore_left_ = 0;     // instants of exploration still to broadcast
+  int rest_left_ = 0;        // instants before a trigger may start another
+  int unmeasured_left_ = 0;  // instants whose force the estimator is not given
+  long since_period_ = 0;    // instants since the last periodic exploration began
   bool exploring_ = false;
   Broadcast last_;
 };

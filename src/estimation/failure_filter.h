@@ -128,6 +128,8 @@ class FailureKalmanFilter {
   void SetOutput(const Eigen::MatrixXd& H, const Eigen::MatrixXd& R);
   // Measurement update with the force y; runs the GLR (and a declaration).
   void Update(double y);
+  // A control instant without a measurement (a lost sample): nothing is declared or suspected.
+  void NoMeasurement() { declared_last_ = false, suspicion_ = 0; }
   // Time update with the broadcast just sent.
   void PredictBroadcast(double p_on, double p_off);
 

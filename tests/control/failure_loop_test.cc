@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <memory>
 #include <vector>
 
@@ -21,7 +22,7 @@ class FixedEstimator final : public OnCountEstimator {
   FixedEstimator(double on, FailureEstimate f) : f(f), on_(on) {}
   void Reset() override {}
   using OnCountEstimator::UpdateWithMeasurement;
-  void UpdateWithMeasurement(double, double) override {}
+  void UpdateWithMeasurement(double y, double) override { measured.push_back(y); }
   void Broadcasted(const Broadcast&) override {}
   double EstimatedOn() const override { return on_; }
   double EstimatedOnVariance() const override { return 1; }
@@ -29,7 +30,8 @@ class FixedEstimator final : public OnCountEstimator {
   std::vector<std::string> StateNames() const override { return {"x"}; }
   std::vector<bool> OnStates() const override { return {true}; }
   std::optional<FailureEstimate> Failures() const override { return f; }
-  FailureEstimate f;  // what Failures() answers (a test may change it between steps)
+  FailureEstimate f;             // what Failures() answers (a test may change it between steps)
+  std::vector<double> measured;  // the forces it was given
 
  private:
   double on_;
@@ -107,6 +109,28 @@ TEST(Exploration, StartsOnADeclarationOrPeriodAndRests) {
     }
   }
   EXPECT_EQ(explored, (std::vector<int>{0, 0, 0, 1, 0, 0, 0, 1, 0}));
+  // Toggle for 3 instants: switch all at the first, hold (nothing switches) at the other two, and
+  // the estimator is not given the force at the 2 instants after the first.
+  p.exploration = {};
+  p.exploration.p_on = 1, p.exploration.balanced = false, p.exploration.instants = 3;
+  p.exploration.unmeasured = 2;
+  auto held = std::make_unique<FixedEstimator>(30, f);
+  FixedEstimator* h = held.get();
+  RecruitmentController u = RecruitmentController::Create(p, std::move(held)).value();
+  h->f.declared = true;
+  std::vector<Broadcast> sent;
+  for (int k = 0; k < 4; ++k) sent.push_back(u.Step(15.0, 1.0 + k));
+  EXPECT_EQ(sent[0].p_on, 1.0);
+  EXPECT_EQ(sent[0].p_off, 1.0);
+  for (int k : {1, 2}) {
+    EXPECT_EQ(sent[k].p_on, 0.0);
+    EXPECT_EQ(sent[k].p_off, 0.0);
+    EXPECT_TRUE(std::isnan(h->measured[k]));
+  }
+  EXPECT_EQ(h->measured[0], 1.0);
+  EXPECT_EQ(h->measured[3], 4.0);
+  p.exploration.unmeasured = 4;  // more than its instants
+  EXPECT_FALSE(p.Validate());
   p.exploration.instants = 0;
   EXPECT_FALSE(p.Validate());
 }
