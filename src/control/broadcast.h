@@ -25,4 +25,12 @@ struct Broadcast {
 // or N <= 0 broadcasts no transition (p_on = p_off = 0).
 Broadcast ExpectationLaw(double target_on, double estimated_on, double num_units, double lambda);
 
+// Exploration: the broadcast `law` with at least `p_explore` of the off units recruited and as
+// many more on units released as keeps the expected on count after the instant that of `law`:
+//   p_on' = max(p_on, p_explore),  p_off' = (on p_off + off (p_on' - p_on)) / on
+// (on, off: the estimated on and off units of those the broadcast reaches). Units switched in
+// both directions show units that no longer respond (lost while off) without moving the expected
+// force. p_off' is capped at 1; with no on unit to release (on <= 0) `law` is returned as it is.
+Broadcast ExplorationLaw(const Broadcast& law, double on, double off, double p_explore);
+
 }  // namespace recruit::control

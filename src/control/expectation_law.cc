@@ -26,4 +26,12 @@ Broadcast ExpectationLaw(double target_on, double estimated_on, double num_units
   return b;
 }
 
+Broadcast ExplorationLaw(const Broadcast& law, double on, double off, double p_explore) {
+  if (!(on > 0) || !(off > 0) || !(p_explore > law.p_on)) return law;
+  Broadcast b;
+  b.p_on = std::min(1.0, p_explore);
+  b.p_off = std::min(1.0, (on * law.p_off + off * (b.p_on - law.p_on)) / on);
+  return b;
+}
+
 }  // namespace recruit::control

@@ -78,11 +78,15 @@ std::optional<FailureEstimate> FailureOnCountEstimator::Failures() const {
   f.declarations = filter_.declarations();
   f.declared = filter_.declared_last();
   f.force_scale = filter_.force_scale();
+  f.suspicion = filter_.suspicion();
   return f;
 }
 
 void FailureOnCountEstimator::UpdateWithMeasurement(double measured_force, double tendon_length) {
-  if (!std::isfinite(measured_force)) return;  // a lost sample: predict only
+  if (!std::isfinite(measured_force)) {  // a lost sample: predict only
+    filter_.NoMeasurement();
+    return;
+  }
   if (output_ || relative_noise_ > 0) {
     // As KalmanOnCountEstimator: H at the measured length, R growing with the predicted force.
     if (output_ && std::isfinite(tendon_length)) {

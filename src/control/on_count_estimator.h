@@ -40,6 +40,9 @@ struct FailureEstimate {
   int declarations = 0;                     // failures declared since Reset
   bool declared = false;                    // the last UpdateWithMeasurement declared one
   double force_scale = 1;                   // working units' fatigue force scale
+  // How strongly the innovations suggest an undeclared loss: the failure test's largest
+  // log-likelihood ratio at the last update (0 when none, and right after a declaration).
+  double suspicion = 0;
 };
 
 class OnCountEstimator {

@@ -18,6 +18,26 @@ Status ControllerParams::Validate() const {
   if (!std::isfinite(lambda) || lambda <= 0 || lambda > 1) {
     return Error{"controller: lambda = " + std::to_string(lambda) + " must be in (0, 1]"};
   }
+  const ExplorationParams& e = exploration;
+  if (!std::isfinite(e.p_on) || e.p_on < 0 || e.p_on > 1) {
+    return Error{"controller: exploration.p_on = " + std::to_string(e.p_on) + " must be in [0, 1]"};
+  }
+  if (e.unmeasured < 0 || e.unmeasured > e.instants) {
+    return Error{"controller: exploration.unmeasured = " + std::to_string(e.unmeasured) +
+                 " must be in [0, instants]"};
+  }
+  if (e.instants < 1) {
+    return Error{"controller: exploration.instants = " + std::to_string(e.instants) +
+                 " must be >= 1"};
+  }
+  if (!std::isfinite(e.suspicion) || e.suspicion < 0) {
+    return Error{"controller: exploration.suspicion = " + std::to_string(e.suspicion) +
+                 " must be finite and >= 0"};
+  }
+  if (!std::isfinite(e.period) || e.period < 0) {
+    return Error{"controller: exploration.period = " + std::to_string(e.period) +
+                 " s must be finite and >= 0"};
+  }
   return Status::Ok();
 }
 
@@ -54,6 +74,11 @@ void RecruitmentController::Reset() {
   estimated_on_variance_ = estimator_->EstimatedOnVariance();
   estimated_working_ = params_.num_units;
   saturation_ = 0;
+  explore_left_ = 0;
+  rest_left_ = 0;
+  unmeasured_left_ = 0;
+  since_period_ = 0;
+  exploring_ = false;
   last_ = Broadcast{};
 }
 
@@ -64,7 +89,12 @@ double RecruitmentController::OnUnitForce(double tendon_length) const {
 
 Broadcast RecruitmentController::Step(double reference_force, double measured_force,
                                       double tendon_length) {
-  estimator_->UpdateWithMeasurement(measured_force, tendon_length);
+  // While an exploration's switched units are in transient (ExplorationParams::unmeasured) the
+  // estimator predicts through it without the force.
+  const bool skip = unmeasured_left_ > 0;
+  if (skip) --unmeasured_left_;
+  estimator_->UpdateWithMeasurement(
+      skip ? std::numeric_limits<double>::quiet_NaN() : measured_force, tendon_length);
   unit_force_ = OnUnitForce(tendon_length);
   // Where no on unit can pull (a slack tendon) no count reaches the reference: ask for all.
   target_on_ = unit_force_ > 0 ? reference_force / unit_force_
@@ -73,6 +103,7 @@ Broadcast RecruitmentController::Step(double reference_force, double measured_fo
   estimated_on_variance_ = estimator_->EstimatedOnVariance();
   if (const auto f = estimator_->Failures()) {
     last_ = FailureAwareLaw(*f);
+    if (params_.exploration.p_on > 0) last_ = Explore(last_, *f);
   } else {
     last_ = ExpectationLaw(target_on_, estimated_on_, params_.num_units, params_.lambda);
   }
@@ -85,10 +116,38 @@ Broadcast RecruitmentController::FailureAwareLaw(const FailureEstimate& f) {
   const double stuck = std::clamp(f.stuck, 0.0, n);
   const double working = std::clamp(f.working, 0.0, n - stuck);
   estimated_working_ = working;
-  // The working units must make up what the stuck ones do not.
-  const double target = target_on_ - stuck;
+  // The working units must make up what the stuck ones do not, each pulling the estimated
+  // fraction c of a fresh unit (functional fatigue; c = 1 unless estimated).
+  const double c = f.force_scale > 0 ? f.force_scale : 1.0;
+  const double target = c == 1.0 ? target_on_ - stuck : (target_on_ - stuck) / c;
   saturation_ = target > working ? 1 : (target < 0 ? -1 : 0);
   return ExpectationLaw(target, estimated_on_ - stuck, working, params_.lambda);
+}
+
+Broadcast RecruitmentController::Explore(const Broadcast& law, const FailureEstimate& f) {
+  const ExplorationParams& e = params_.exploration;
+  const long period = e.period > 0 ? std::max(1L, std::lround(e.period / params_.dT)) : 0;
+  const bool periodic = period > 0 && ++since_period_ >= period;
+  if (periodic) since_period_ = 0;
+  const bool triggered = (e.after_declaration && f.declared) ||
+                         (e.suspicion > 0 && f.suspicion >= e.suspicion) || periodic;
+  if (explore_left_ == 0 && rest_left_ > 0) {
+    --rest_left_;  // resting: triggers are ignored
+  } else if (triggered && explore_left_ == 0) {
+    explore_left_ = e.instants;
+  }
+  exploring_ = explore_left_ > 0;
+  if (!exploring_) return law;
+  const bool first = explore_left_ == e.instants;
+  if (first) unmeasured_left_ = e.unmeasured;
+  if (--explore_left_ == 0) rest_left_ = e.rest;
+  // Toggle: every unit switches with p_on at the first instant, then nothing switches so the
+  // switched units settle (the chain's transients are least exact for a synchronised cohort).
+  if (!e.balanced) return first ? Broadcast{e.p_on, e.p_on} : Broadcast{};
+  // The working units the broadcast reaches: on ones (the stuck ones ignore it) and off ones.
+  const double on = std::max(0.0, estimated_on_ - std::max(0.0, f.stuck));
+  const double off = std::max(0.0, estimated_working_ - on);
+  return ExplorationLaw(law, on, off, e.p_on);
 }
 
 }  // namespace recruit::control

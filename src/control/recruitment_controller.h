@@ -14,6 +14,31 @@
 
 namespace recruit::control {
 
+// Exploration (docs/failures.md "Exploration"), with a failure-aware estimator only: for
+// `instants` control instants after a trigger the broadcast switches units both ways so that
+// units lost while off (invisible until recruited) show up. `balanced`: at least `p_on` of the
+// off units are recruited and as many more on units released as keeps the expected count
+// (ExplorationLaw); otherwise ("toggle") every unit switches with probability p_on at the first
+// instant (p_on = p_off; with 1, a deterministic swap of the on and off units) and none for the
+// other instants-1, so that the switched units settle before the law resumes. Triggers: a declared
+// failure
+// (`after_declaration`), the estimator's suspicion (FailureEstimate::suspicion, the failure
+// test's largest ratio) reaching `suspicion` (> 0), and every `period` seconds (> 0); none within
+// `rest` instants of the end of the last exploration. The default (p_on = 0) never explores: the
+// broadcasts are the law's.
+struct ExplorationParams {
+  double p_on = 0;  // in [0, 1]; 0: off
+  bool balanced = true;
+  int instants = 10;
+  // The control instants after the exploration's first whose force the estimator does not use
+  // (it predicts through the switched units' transient, which its chain models least exactly).
+  int unmeasured = 0;
+  int rest = 0;
+  bool after_declaration = true;
+  double suspicion = 0;  // log-likelihood ratio; 0: not a trigger
+  double period = 0;     // s; 0: not a trigger
+};
+
 struct ControllerParams {
   int num_units = 60;      // N, units in the bundle
   double unit_force = 0;   // N, settled force of one unit whose heater is on
@@ -22,6 +47,7 @@ struct ControllerParams {
   // The bundle's unit and tendon geometry: when set, the target count and the estimator use the
   // settled on unit's force at the measured tendon length (UnitForceMap), not at ref_length.
   std::optional<UnitGeometry> geometry;
+  ExplorationParams exploration;
 
   // Checks N >= 1, unit_force > 0, dT (CheckDT), 0 < lambda <= 1 (finite); the message names the
   // field.
@@ -61,6 +87,8 @@ class RecruitmentController {
   // stuck units alone exceed it, 0 otherwise (and always 0 without failures).
   int saturation() const { return saturation_; }
   double estimated_working() const { return estimated_working_; }
+  // Whether the last Step's broadcast explored (ControllerParams::exploration).
+  bool exploring() const { return exploring_; }
   double estimated_on_variance() const { return estimated_on_variance_; }
   const Broadcast& last_broadcast() const { return last_; }
 
@@ -71,6 +99,8 @@ class RecruitmentController {
 
   // The expectation law on the working units (a failure-aware estimator).
   Broadcast FailureAwareLaw(const FailureEstimate& f);
+  // Counts the exploration's triggers and, while one runs, widens the law's broadcast.
+  Broadcast Explore(const Broadcast& law, const FailureEstimate& f);
 
   ControllerParams params_;
   std::unique_ptr<OnCountEstimator> estimator_;
@@ -81,6 +111,11 @@ class RecruitmentController {
   double estimated_on_variance_ = 0;
   double estimated_working_ = 0;
   int saturation_ = 0;
+  int explore_left_ = 0;     // instants of exploration still to broadcast
+  int rest_left_ = 0;        // instants before a trigger may start another
+  int unmeasured_left_ = 0;  // instants whose force the estimator is not given
+  long since_period_ = 0;    // instants since the last periodic exploration began
+  bool exploring_ = false;
   Broadcast last_;
 };
 

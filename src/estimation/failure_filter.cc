@@ -143,6 +143,10 @@ Status FailureFilterParams::Validate() const {
     return Error{"failure filter: settle_hazard = " + std::to_string(settle_hazard) +
                  " must be in [0, 1]"};
   }
+  if (!(std::isfinite(scale_initial_variance) && scale_initial_variance >= 0)) {
+    return Error{"failure filter: scale_initial_variance = " +
+                 std::to_string(scale_initial_variance) + " must be finite and >= 0"};
+  }
   if (!(std::isfinite(scale_variance) && scale_variance >= 0)) {
     return Error{"failure filter: scale_variance = " + std::to_string(scale_variance) +
                  " must be finite and >= 0"};
@@ -185,6 +189,7 @@ void FailureKalmanFilter::Reset() {
   glr_.Clear();
   declarations_ = 0;
   declared_last_ = false;
+  suspicion_ = 0;
   last_declared_ = {};
   declared_class_[1] = declared_class_[2] = false;
   if (params_.open_hazard > 0 || params_.stuck_hazard > 0 || params_.scale_variance > 0) Augment();
@@ -196,6 +201,7 @@ void FailureKalmanFilter::Augment() {
   x_[3 * m_] = 1;
   P_ = Eigen::MatrixXd::Zero(3 * m_ + 1, 3 * m_ + 1);
   P_.topLeftCorner(m_, m_) = inner_.covariance();
+  if (params_.scale_variance > 0) P_(3 * m_, 3 * m_) = params_.scale_initial_variance;
   augmented_ = true;
 }
 
@@ -292,6 +298,7 @@ void FailureKalmanFilter::UpdateCore(double y, const Eigen::MatrixXd& H, double 
 
 void FailureKalmanFilter::Update(double y) {
   declared_last_ = false;
+  suspicion_ = 0;
   const int n = 3 * m_;
   // The innovation and its variance on the filter that runs now, and the prior for the GLR.
   double nu, s;
@@ -322,8 +329,10 @@ void FailureKalmanFilter::Update(double y) {
   h << force_scale() * H_.row(0), H_.row(0), H_.row(0);
   glr_.Update(nu, s, h, K);
   const FailureGlr::Best best = glr_.Strongest(params_.glr_max_std);
+  suspicion_ = best.llr;
   if (best.to != 0 && best.llr > params_.glr_threshold && best.count >= params_.glr_min_count) {
     Declare(best);
+    suspicion_ = 0;
   }
 }
 

@@ -111,6 +111,8 @@ struct FailureFilterParams {
   double settle_hazard = 0;
   // Random-walk variance of the working units' force scale per control period; 0 = c fixed at 1.
   double scale_variance = 0;
+  // Variance of the force scale at Reset (c = 1), when it is estimated.
+  double scale_initial_variance = 0;
 
   Status Validate() const;
 };
@@ -126,6 +128,8 @@ class FailureKalmanFilter {
   void SetOutput(const Eigen::MatrixXd& H, const Eigen::MatrixXd& R);
   // Measurement update with the force y; runs the GLR (and a declaration).
   void Update(double y);
+  // A control instant without a measurement (a lost sample): nothing is declared or suspected.
+  void NoMeasurement() { declared_last_ = false, suspicion_ = 0; }
   // Time update with the broadcast just sent.
   void PredictBroadcast(double p_on, double p_off);
 
@@ -134,6 +138,7 @@ class FailureKalmanFilter {
   const Eigen::VectorXd& estimate() const;
   const Eigen::MatrixXd& covariance() const;
   double force_scale() const { return augmented_ ? x_[3 * m_] : 1.0; }
+  double force_scale_variance() const { return augmented_ ? P_(3 * m_, 3 * m_) : 0.0; }
   double open() const { return augmented_ ? x_.segment(m_, m_).sum() : 0.0; }
   double stuck() const { return augmented_ ? x_.segment(2 * m_, m_).sum() : 0.0; }
   double working() const { return N_ - open() - stuck(); }
@@ -144,6 +149,9 @@ class FailureKalmanFilter {
   // Failures declared since Reset, and whether the last Update declared one.
   int declarations() const { return declarations_; }
   bool declared_last() const { return declared_last_; }
+  // The GLR's largest log-likelihood ratio at the last Update (that of the strongest hypothesis,
+  // declared or not; 0 after a declaration, which clears the test).
+  double suspicion() const { return suspicion_; }
   // The GLR's hypothesis at the last declaration (class, onset age, count, variance, ratio).
   const FailureGlr::Best& last_declared() const { return last_declared_; }
   // The paper's filter that runs until the augmented one takes over.
@@ -185,6 +193,7 @@ class FailureKalmanFilter {
   bool declared_class_[3] = {false, false, false};  // classes declared since Reset
   int declarations_ = 0;
   bool declared_last_ = false;
+  double suspicion_ = 0;
   FailureGlr::Best last_declared_;
 };
 

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <limits>
+#include <random>
 
 #include "control/broadcast.h"
 
@@ -103,6 +104,45 @@ TEST(ExpectationLaw, ExpectedCountContractsByOneMinusLambda) {
       const double next = n + b.p_on * (60 - n) - b.p_off * n;
       EXPECT_NEAR(next - target, (1 - lambda) * (n - target), 1e-12) << lambda << " " << n;
     }
+  }
+}
+
+// Exploration keeps the law's expected on count: on (1 - p_off') + off p_on' = on (1 - p_off) +
+// off p_on, by hand and over binomial draws (4 standard errors).
+TEST(ExplorationLaw, RecruitsAndReleasesAtTheLawsExpectedCount) {
+  // 30 on, 20 off, the law idle: p_on 0.3, p_off = 20 x 0.3 / 30 = 0.2.
+  Broadcast b = ExplorationLaw({}, 30, 20, 0.3);
+  EXPECT_DOUBLE_EQ(b.p_on, 0.3);
+  EXPECT_DOUBLE_EQ(b.p_off, 0.2);
+  // The law recruits 0.05 of 20 (one unit): p_off = 20 (0.3 - 0.05) / 30.
+  b = ExplorationLaw({0.05, 0}, 30, 20, 0.3);
+  EXPECT_DOUBLE_EQ(b.p_off, 20 * 0.25 / 30);
+  EXPECT_NEAR(30 * (1 - b.p_off) + 20 * b.p_on, 30 + 20 * 0.05, 1e-12);
+  // The law releases: the extra release adds to it.
+  b = ExplorationLaw({0, 0.1}, 30, 20, 0.3);
+  EXPECT_NEAR(30 * (1 - b.p_off) + 20 * b.p_on, 30 * 0.9, 1e-12);
+  std::mt19937_64 rng(7);
+  std::binomial_distribution<int> up(20, b.p_on), down(30, b.p_off);
+  const int draws = 20000;
+  double sum = 0, sum2 = 0;
+  for (int i = 0; i < draws; ++i) {
+    const double on = 30 - down(rng) + up(rng);
+    sum += on, sum2 += on * on;
+  }
+  const double mean = sum / draws, var = sum2 / draws - mean * mean;
+  EXPECT_NEAR(mean, 27.0, 4 * std::sqrt(var / draws));
+  EXPECT_NEAR(var, 20 * b.p_on * (1 - b.p_on) + 30 * b.p_off * (1 - b.p_off), 0.05 * var);
+}
+
+TEST(ExplorationLaw, CapsAndGuards) {
+  // 10 on, 50 off, p 0.5: p_off would be 2.5, capped at 1.
+  EXPECT_DOUBLE_EQ(ExplorationLaw({}, 10, 50, 0.5).p_off, 1.0);
+  // No on unit to release, no off unit, or a law already above p: the law as it is.
+  const Broadcast law{0.4, 0};
+  for (const Broadcast& b : {ExplorationLaw(law, 0, 60, 0.5), ExplorationLaw(law, 60, 0, 0.5),
+                             ExplorationLaw(law, 30, 30, 0.3)}) {
+    EXPECT_EQ(b.p_on, law.p_on);
+    EXPECT_EQ(b.p_off, law.p_off);
   }
 }
 

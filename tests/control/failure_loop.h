@@ -29,6 +29,7 @@ struct Spec {
   std::uint64_t seed = 1;
   double duration = 120;                    // s
   std::function<double(double)> reference;  // N, at time t
+  ExplorationParams exploration;            // the controller's (off by default)
 };
 
 struct Instant {
@@ -37,8 +38,25 @@ struct Instant {
   double est_on = 0, est_on_var = 0;
   double est_working = 0, est_working_var = 0;  // N and 0 without a failure-aware estimator
   int saturation = 0;
-  bool declared = false;
+  bool declared = false, exploring = false;
+  double suspicion = 0;  // the failure test's largest ratio
+  // Fatigue: the plant's mean force scale over its heated working units (1 without fatigue or
+  // with none heated) and the estimator's (FailureEstimate::force_scale).
+  double scale = 1, est_scale = 1;
 };
+
+// The mean fatigue force scale (SmaBundle::UnitForceScale) of bundle b's heated working units.
+inline double HeatedWorkingScale(const sma::SmaHost& p, const mjData* d, int b) {
+  const double* s = p.State(d, b);
+  double sum = 0;
+  int n = 0;
+  for (int i = 0; i < p.num_units(b); ++i) {
+    if (p.bundle(b).UnitFailure(s, i) != 0 || !p.UnitOn(d, b, i)) continue;
+    sum += p.bundle(b).UnitForceScale(s, i);
+    ++n;
+  }
+  return n > 0 ? sum / n : 1.0;
+}
 
 // The bench's MJCF with `config` (key=value tokens) added to the bundle's instance.
 inline Result<std::string> BenchXml(const std::string& config) {
@@ -79,6 +97,7 @@ inline Result<std::vector<Instant>> Run(const Spec& spec) {
   params.unit_force = p.SettledUnitForce(0);
   params.dT = spec.dT;
   params.lambda = spec.lambda;
+  params.exploration = spec.exploration;
   auto c = RecruitmentController::Create(params, spec.estimator);
   if (!c) return Error{c.error()};
   const int steps = static_cast<int>(std::lround(spec.dT / m->opt.timestep));
@@ -93,15 +112,19 @@ inline Result<std::vector<Instant>> Run(const Spec& spec) {
     r.on = p.OnCount(d.get(), 0);
     const auto f = p.Failures(d.get(), 0);
     r.working = f.working, r.open = f.open, r.stuck = f.stuck;
+    r.scale = HeatedWorkingScale(p, d.get(), 0);
     const Broadcast b = c->Step(r.reference, r.force);
     r.est_on = c->estimated_on();
     r.est_on_var = c->estimated_on_variance();
     r.saturation = c->saturation();
+    r.exploring = c->exploring();
     r.est_working = params.num_units;
     if (const auto fe = c->estimator().Failures()) {
       r.est_working = fe->working;
       r.est_working_var = fe->working_variance;
       r.declared = fe->declared;
+      r.suspicion = fe->suspicion;
+      r.est_scale = fe->force_scale;
     }
     out.push_back(r);
     if (Status s = p.Broadcast(d.get(), 0, b.p_on, b.p_off); !s) return Error{s.error()};

@@ -5,7 +5,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <memory>
+#include <vector>
 
 #include "control/recruitment_controller.h"
 
@@ -17,21 +19,22 @@ namespace fl = failure_loop;
 // An estimator with fixed counts, to check the law.
 class FixedEstimator final : public OnCountEstimator {
  public:
-  FixedEstimator(double on, FailureEstimate f) : on_(on), f_(f) {}
+  FixedEstimator(double on, FailureEstimate f) : f(f), on_(on) {}
   void Reset() override {}
   using OnCountEstimator::UpdateWithMeasurement;
-  void UpdateWithMeasurement(double, double) override {}
+  void UpdateWithMeasurement(double y, double) override { measured.push_back(y); }
   void Broadcasted(const Broadcast&) override {}
   double EstimatedOn() const override { return on_; }
   double EstimatedOnVariance() const override { return 1; }
   Eigen::VectorXd StateEstimate() const override { return Eigen::VectorXd::Zero(1); }
   std::vector<std::string> StateNames() const override { return {"x"}; }
   std::vector<bool> OnStates() const override { return {true}; }
-  std::optional<FailureEstimate> Failures() const override { return f_; }
+  std::optional<FailureEstimate> Failures() const override { return f; }
+  FailureEstimate f;             // what Failures() answers (a test may change it between steps)
+  std::vector<double> measured;  // the forces it was given
 
  private:
   double on_;
-  FailureEstimate f_;
 };
 
 RecruitmentController Make(double on, FailureEstimate f) {
@@ -63,9 +66,93 @@ TEST(FailureAwareLaw, ActsOnTheWorkingUnitsAndCountsTheStuckOnes) {
   EXPECT_DOUBLE_EQ(b.p_off, 0.2);
 }
 
+// Exploration: a declaration starts `instants` instants of the exploration broadcast, then none
+// may start for `rest` instants; the periodic trigger fires every period / dT instants.
+TEST(Exploration, StartsOnADeclarationOrPeriodAndRests) {
+  FailureEstimate f;
+  f.working = 60;
+  auto est = std::make_unique<FixedEstimator>(30, f);
+  FixedEstimator* e = est.get();
+  ControllerParams p;
+  p.num_units = 60, p.unit_force = 0.5, p.lambda = 0.2, p.dT = 0.5;
+  p.exploration.p_on = 0.3, p.exploration.instants = 2, p.exploration.rest = 3;
+  RecruitmentController c = RecruitmentController::Create(p, std::move(est)).value();
+  // On target (15 N = 30 units): the law is idle.
+  Broadcast b = c.Step(15.0, 0);
+  EXPECT_FALSE(c.exploring());
+  EXPECT_EQ(b.p_on, 0);
+  e->f.declared = true;  // declared: 2 instants of p_on 0.3, p_off 30 x 0.3 / 30
+  std::vector<int> explored;
+  for (int k = 0; k < 8; ++k) {
+    b = c.Step(15.0, 0);
+    explored.push_back(c.exploring());
+    if (c.exploring()) {
+      EXPECT_DOUBLE_EQ(b.p_on, 0.3);
+      EXPECT_DOUBLE_EQ(b.p_off, 0.3);
+    }
+  }
+  // Declared at every instant: 2 on, 3 at rest, 2 on, ...
+  EXPECT_EQ(explored, (std::vector<int>{1, 1, 0, 0, 0, 1, 1, 0}));
+  // Periodic (every 2 s = 4 instants), toggling (not balanced): p_on = p_off = 1.
+  e->f.declared = false;
+  p.exploration = {};
+  p.exploration.p_on = 1, p.exploration.balanced = false, p.exploration.instants = 1;
+  p.exploration.period = 2;
+  RecruitmentController t =
+      RecruitmentController::Create(p, std::make_unique<FixedEstimator>(30, f)).value();
+  explored.clear();
+  for (int k = 0; k < 9; ++k) {
+    b = t.Step(15.0, 0);
+    explored.push_back(t.exploring());
+    if (t.exploring()) {
+      EXPECT_EQ(b.p_off, 1.0);
+    }
+  }
+  EXPECT_EQ(explored, (std::vector<int>{0, 0, 0, 1, 0, 0, 0, 1, 0}));
+  // Toggle for 3 instants: switch all at the first, hold (nothing switches) at the other two, and
+  // the estimator is not given the force at the 2 instants after the first.
+  p.exploration = {};
+  p.exploration.p_on = 1, p.exploration.balanced = false, p.exploration.instants = 3;
+  p.exploration.unmeasured = 2;
+  auto held = std::make_unique<FixedEstimator>(30, f);
+  FixedEstimator* h = held.get();
+  RecruitmentController u = RecruitmentController::Create(p, std::move(held)).value();
+  h->f.declared = true;
+  std::vector<Broadcast> sent;
+  for (int k = 0; k < 4; ++k) sent.push_back(u.Step(15.0, 1.0 + k));
+  EXPECT_EQ(sent[0].p_on, 1.0);
+  EXPECT_EQ(sent[0].p_off, 1.0);
+  for (int k : {1, 2}) {
+    EXPECT_EQ(sent[k].p_on, 0.0);
+    EXPECT_EQ(sent[k].p_off, 0.0);
+    EXPECT_TRUE(std::isnan(h->measured[k]));
+  }
+  EXPECT_EQ(h->measured[0], 1.0);
+  EXPECT_EQ(h->measured[3], 4.0);
+  p.exploration.unmeasured = 4;  // more than its instants
+  EXPECT_FALSE(p.Validate());
+  p.exploration.instants = 0;
+  EXPECT_FALSE(p.Validate());
+}
+
+// Fatigue: with an estimated force scale c each working unit pulls c of a fresh one, so the law
+// targets (reference / unit force - stuck) / c working units.
+TEST(FailureAwareLaw, DividesTheWorkingTargetByTheForceScale) {
+  FailureEstimate f;
+  f.working = 60, f.force_scale = 0.8;
+  // 15 N = 30 fresh units = 37.5 units at 0.8; 30 on, 30 off: p_on = 0.2 (37.5 - 30) / 30.
+  RecruitmentController c = Make(30, f);
+  const Broadcast b = c.Step(15.0, 0);
+  EXPECT_DOUBLE_EQ(b.p_on, 0.2 * 7.5 / 30);
+  EXPECT_EQ(c.saturation(), 0);
+  // 25 N = 50 fresh units = 62.5 at 0.8 > 60 working: out of reach.
+  c.Step(25.0, 0);
+  EXPECT_EQ(c.saturation(), 1);
+}
+
 fl::Spec Bench(const char* config, std::uint64_t seed, double duration,
                std::function<double(double)> ref, const char* kind = "kalman-failures") {
-  return {config, *EstimatorSpec::Parse(kind), 0.5, 0.2, seed, duration, std::move(ref)};
+  return {config, *EstimatorSpec::Parse(kind), 0.5, 0.2, seed, duration, std::move(ref), {}};
 }
 
 // Losing 10 % or 30 % of the units at 60 s with 15 N held (reachable by the rest): 20-40 s
