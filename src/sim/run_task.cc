@@ -166,6 +166,13 @@ Result<std::vector<Channel>> MakeChannels(const Task& task, const ControllerSett
   auto spec = control::EstimatorSpec::Parse(settings.estimator, "extended", settings.filter_model,
                                             20, settings.force_noise_std);
   if (!spec.ok()) return Error{where + ".controller.estimator: " + spec.error(), spec.code()};
+  if (settings.force_scale_variance > 0 && !spec->failures) {
+    return Error{where + ".controller.force_scale_variance: " +
+                 std::to_string(settings.force_scale_variance) +
+                 "; allowed: 0 unless the estimator is kalman-failures (the one that estimates "
+                 "the working units' force scale)"};
+  }
+  spec->failure.scale_variance = settings.force_scale_variance;
   const sma::SmaHost& host = plant.host();
   std::vector<Channel> channels;
   for (int i = 0; i < plant.num_bundles(); ++i) {

@@ -278,8 +278,9 @@ Result<Task> Task::FromJsonText(const std::string& text, const std::string& sour
     const json& c = j["controller"];
     const std::string where = file + ".controller";
     if (!c.is_object()) return Error{where + ": must be an object"};
-    RECRUIT_TRY(
-        CheckKeys(c, {"estimator", "filter_model", "dT", "lambda", "force_noise_std"}, where));
+    RECRUIT_TRY(CheckKeys(
+        c, {"estimator", "filter_model", "dT", "lambda", "force_noise_std", "force_scale_variance"},
+        where));
     RECRUIT_TRY(String(c, "estimator", where, &task.controller.estimator, false));
     RECRUIT_TRY(String(c, "filter_model", where, &task.controller.filter_model, false));
     task.controller.filter_model = Resolve(task.controller.filter_model, source);
@@ -287,6 +288,11 @@ Result<Task> Task::FromJsonText(const std::string& text, const std::string& sour
                        control::kDTAllowed));
     RECRUIT_TRY(
         Number(c, "lambda", where, &task.controller.lambda, false, 0, 1, true, "0 < lambda <= 1"));
+    RECRUIT_TRY(Number(c, "force_noise_std", where, &task.controller.force_noise_std, false, 0, 1e6,
+                       false, "0 <= force_noise_std <= 1e6 N (0: the estimator's default)"));
+    RECRUIT_TRY(Number(c, "force_scale_variance", where, &task.controller.force_scale_variance,
+                       false, 0, 1, false,
+                       "0 <= force_scale_variance <= 1 per control period (0: the scale fixed)"));
   }
 
   if (j.contains("sensor")) {

@@ -27,6 +27,9 @@ struct ControllerSettings {
   // Kalman estimators: force measurement noise std, N (0 = the estimator's default: the model
   // file's R for kalman-augmented, one settled unit's force for kalman2).
   double force_noise_std = 0;
+  // kalman-failures: random-walk variance per control period of the working units' fatigue
+  // force scale, estimated online (docs/failures.md); 0 = the scale fixed at 1.
+  double force_scale_variance = 0;
 };
 
 // Outer loop of arm tasks: PI(D) on the joint angle error gives a net tendon force; positive

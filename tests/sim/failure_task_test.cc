@@ -83,6 +83,45 @@ TEST(FailureTask, ZeroUnitsScheduledIsTheTaskWithoutFailures) {
   EXPECT_EQ(zero->bundles[0].estimator_rmse, none->bundles[0].estimator_rmse);
 }
 
+// A bundle that tires (its units' force falls 30 % within about 5 cycles, docs/failures.md):
+// with the scale fixed at 1 the filter reads the weaker units as fewer units and its on-count
+// NEES leaves the band; with "force_scale_variance" it estimates the scale and stays
+// consistent. Any other estimator refuses the key.
+TEST(FailureTask, ForceScaleVarianceEstimatesATiringBundlesScale) {
+  const std::string model = kRoot + "/models/isometric_bench.xml";
+  // 200 s of steps between 4 and 20 N every 10 s: every unit goes through many cycles.
+  auto task = [&](const std::string& estimator, const std::string& controller_extra) {
+    std::string times, values;
+    for (int k = 0; k < 20; ++k) {
+      times += (k ? ", " : "") + std::to_string(5 + 10 * k);
+      values += (k ? ", " : "") + std::string(k % 2 ? "4" : "20");
+    }
+    return R"({"name": "tires", "model": ")" + model + R"(", "tracked": "force",
+      "agonist": "bundle", "duration": 200,
+      "reference": {"type": "steps", "times": [)" +
+           times + R"(], "values": [)" + values +
+           R"(], "unit": "N"},
+      "controller": {"estimator": ")" +
+           estimator + R"(", "dT": 0.5, "lambda": 0.2)" + controller_extra + R"(},
+      "failures": {"bundle": {"fatigue_loss": 0.3, "fatigue_cycles": 5, "fatigue_exponent": 0}}})";
+  };
+  auto fixed = RunText(task("kalman-failures", ""), "f.json");
+  auto scaled = RunText(task("kalman-failures", R"(, "force_scale_variance": 1e-4)"), "s.json");
+  ASSERT_TRUE(fixed.ok()) << fixed.error();
+  ASSERT_TRUE(scaled.ok()) << scaled.error();
+  EXPECT_GT(fixed->bundles[0].mean_nees, 2.0);
+  EXPECT_GE(scaled->bundles[0].mean_nees, 0.3);
+  EXPECT_LE(scaled->bundles[0].mean_nees, 2.0);
+  EXPECT_LT(scaled->bundles[0].estimator_rmse, fixed->bundles[0].estimator_rmse);
+  auto refused = RunText(task("kalman-augmented", R"(, "force_scale_variance": 1e-4)"), "r.json");
+  ASSERT_FALSE(refused.ok());
+  EXPECT_NE(refused.error().find("force_scale_variance"), std::string::npos) << refused.error();
+  auto negative = RunText(task("kalman-failures", R"(, "force_scale_variance": -1)"), "n.json");
+  ASSERT_FALSE(negative.ok());
+  EXPECT_NE(negative.error().find("force_scale_variance: -1"), std::string::npos)
+      << negative.error();
+}
+
 TEST(FailureTask, BadKeysAreNamedWithTheirValueAndWhatIsAllowed) {
   const std::string model = kRoot + "/models/isometric_bench.xml";
   struct Case {
