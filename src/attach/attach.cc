@@ -27,7 +27,7 @@ Status CheckPaths(const AttachOptions& o) {
   if (o.model.empty()) return Error{"no model given"};
   std::error_code ec;
   if (!fs::is_regular_file(o.model, ec))
-    return Error{"cannot open model '" + o.model + "': no such file", ErrorCode::kIo};
+    return Error{"cannot open model '" + o.model + "': no such file"};  // bad input (CodeOf)
   if (o.muscles.empty()) return Error{"no muscle given (--muscles NAME[,NAME...] or all)"};
   if (!o.size_only && o.output.empty()) return Error{"no output model given (-o OUT.xml)"};
   for (const std::string* p : {&o.output, &o.task, &o.report}) {

@@ -22,8 +22,9 @@ Result<FileLock> FileLock::TryLock(const std::string& path) {
       std::string holder = n > 0 ? std::string(pid, static_cast<size_t>(n)) : "unknown";
       while (!holder.empty() && (holder.back() == '\n' || holder.back() == ' ')) holder.pop_back();
       return Error{"'" + path + "' is locked by another process (pid " + holder +
-                   "): another sweep is writing into this folder; wait for it or use another "
-                   "--out"};
+                       "): another sweep is writing into this folder; wait for it or use another "
+                       "--out",
+                   ErrorCode::kIo};
     }
     return Error{"cannot lock '" + path + "': " + std::strerror(err),
                  CodeOf(std::error_code(err, std::generic_category()))};

@@ -157,13 +157,13 @@ Status FailureFilterParams::Validate() const {
 Result<FailureKalmanFilter> FailureKalmanFilter::Create(const FilterModel& model,
                                                         CovarianceMode mode,
                                                         const FailureFilterParams& params) {
-  if (Status s = params.Validate(); !s) return Error{s.error()};
-  if (Status s = model.Validate(); !s) return Error{s.error()};
+  if (Status s = params.Validate(); !s) return s.failure();
+  if (Status s = model.Validate(); !s) return s.failure();
   if (model.transition != TransitionSource::kBroadcast || model.num_outputs() != 1) {
     return Error{"failure filter: the model must be a broadcast chain with one output"};
   }
   auto inner = PopulationKalmanFilter::Create(model, mode);
-  if (!inner) return Error{inner.error()};
+  if (!inner) return inner.failure();
   FailureKalmanFilter f(model, mode, params, std::move(inner).value());
   f.Reset();
   return f;

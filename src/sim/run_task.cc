@@ -529,7 +529,7 @@ Result<std::unique_ptr<Plant>> CreatePlant(const Task& task, bool drawn, Task& h
   auto text = ReadFile(task.model_path);
   if (!text.ok()) return Error{where + ": " + text.error(), text.code()};
   auto model = LoadModel(task.model_path);
-  if (!model.ok()) return Error{where + ": " + model.error()};
+  if (!model.ok()) return model.failure().In(where + ": ");
   const mjModel* m = model->get();
   std::string xml = std::move(text).value();
   std::vector<std::string> instances;  // of the bundles given failures, in the task's order
@@ -557,7 +557,7 @@ Result<std::unique_ptr<Plant>> CreatePlant(const Task& task, bool drawn, Task& h
     instances.push_back(instance);
     for (const auto& [key, value] : f.keys) {
       auto edited = SetPluginConfig(xml, instance, key, value);
-      if (!edited.ok()) return Error{where + "." + f.actuator + ": " + edited.error()};
+      if (!edited.ok()) return edited.failure().In(where + "." + f.actuator + ": ");
       xml = std::move(edited).value();
     }
   }

