@@ -48,6 +48,20 @@ struct Drive {
   }
 };
 
+// One control period of the closed loop on the filter's own chain (8 working states, then open,
+// then stuck): the drive on the filter's on-count, the filter's prediction, the plant's draw.
+void DriveOnePeriod(estimation::FailureKalmanFilter& f, const estimation::FilterModel& model,
+                    Drive& drive, int k, int N, Eigen::VectorXd& x, Rng& rng) {
+  double on = 0;
+  const Eigen::VectorXd e = f.estimate();
+  for (int j = 0; j < 8; ++j) on += model.broadcast.is_on[j] ? e[j] : 0;
+  double p_on, p_off;
+  drive.Next(k, on, N, &p_on, &p_off);
+  f.PredictBroadcast(p_on, p_off);
+  x = estimation::SimulateStepAggregate(
+      estimation::AugmentedTransition(model.broadcast, p_on, p_off, 0, 0), x, rng);
+}
+
 TEST(EstimationFailureFilter, WithoutDeclarationItIsThePapersFilterBitForBit) {
   const estimation::FilterModel model = ChainModel(60);
   auto plain =
@@ -368,14 +382,7 @@ TEST(EstimationFailureFilter, AbruptLossIsDeclaredAndPlacedWithinItsVariance) {
       }
       const double force = model.H.row(0).dot(x.head(8) + x.segment(8, 8) + x.tail(8));
       f->Update(force + 0.1 * Gauss(rng));
-      double on = 0;
-      const Eigen::VectorXd e = f->estimate();
-      for (int j = 0; j < 8; ++j) on += model.broadcast.is_on[j] ? e[j] : 0;
-      double p_on, p_off;
-      drive.Next(k, on, N, &p_on, &p_off);
-      f->PredictBroadcast(p_on, p_off);
-      x = estimation::SimulateStepAggregate(
-          estimation::AugmentedTransition(model.broadcast, p_on, p_off, 0, 0), x, rng);
+      DriveOnePeriod(*f, model, drive, k, N, x, rng);
     }
     if (alarm || f->declarations() == 0) continue;
     ++declared;
@@ -413,14 +420,7 @@ TEST(EstimationFailureFilter, ForceScaleEstimateIsUnbiasedAndHonest) {
     Drive drive;
     for (int k = 0; k < steps; ++k) {
       f->Update(c * model.H.row(0).dot(x.head(8)) + noise * Gauss(rng));
-      double on = 0;
-      const Eigen::VectorXd e = f->estimate();
-      for (int j = 0; j < 8; ++j) on += model.broadcast.is_on[j] ? e[j] : 0;
-      double p_on, p_off;
-      drive.Next(k, on, N, &p_on, &p_off);
-      f->PredictBroadcast(p_on, p_off);
-      x = estimation::SimulateStepAggregate(
-          estimation::AugmentedTransition(model.broadcast, p_on, p_off, 0, 0), x, rng);
+      DriveOnePeriod(*f, model, drive, k, N, x, rng);
     }
     const double z = (f->force_scale() - c) / std::sqrt(f->force_scale_variance());
     sum_z += z, sum_z2 += z * z;
