@@ -102,16 +102,17 @@ double SwitchingRate(const std::vector<int>& on_count, int num_units, double dur
 }
 
 EstimatorScore ScoreEstimator(const std::vector<double>& estimated,
-                              const std::vector<double>& truth,
-                              const std::vector<double>& variance) {
+                              const std::vector<double>& truth, const std::vector<double>& variance,
+                              double band) {
   EstimatorScore s;
   double se = 0, nees = 0;
-  int nees_n = 0, within = 0;
+  int nees_n = 0, within = 0, within_band = 0;
   for (size_t k = 0; k < estimated.size(); ++k) {
     if (!std::isfinite(estimated[k])) continue;
     const double e = estimated[k] - truth[k];
     se += e * e;
     if (std::abs(e) <= 3) ++within;
+    if (std::abs(e) <= band) ++within_band;
     if (k < variance.size() && variance[k] > 0 && std::isfinite(variance[k])) {
       nees += e * e / variance[k];
       ++nees_n;
@@ -121,6 +122,7 @@ EstimatorScore ScoreEstimator(const std::vector<double>& estimated,
   if (s.samples > 0) {
     s.rmse = std::sqrt(se / s.samples);
     s.within3 = static_cast<double>(within) / s.samples;
+    s.within_band = static_cast<double>(within_band) / s.samples;
   }
   s.mean_nees = nees_n > 0 ? nees / nees_n : std::numeric_limits<double>::quiet_NaN();
   return s;

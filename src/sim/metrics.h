@@ -58,13 +58,14 @@ double SwitchingRate(const std::vector<int>& on_count, int num_units, double dur
 
 // Estimator accuracy at the control instants.
 struct EstimatorScore {
-  double rmse = 0;       // sqrt(mean (n^ - n)^2), units
-  double mean_nees = 0;  // mean of (n^ - n)^2 / var(n^) over samples with var > 0
-  double within3 = 0;    // fraction of samples with |n^ - n| <= 3
+  double rmse = 0;         // sqrt(mean (n^ - n)^2), units
+  double mean_nees = 0;    // mean of (n^ - n)^2 / var(n^) over samples with var > 0
+  double within3 = 0;      // fraction of samples with |n^ - n| <= 3
+  double within_band = 0;  // fraction with |n^ - n| <= band (ScoreEstimator's; default 3)
   int samples = 0;
 };
 EstimatorScore ScoreEstimator(const std::vector<double>& estimated,
-                              const std::vector<double>& truth,
-                              const std::vector<double>& variance);
+                              const std::vector<double>& truth, const std::vector<double>& variance,
+                              double band = 3);
 
 }  // namespace recruit::sim

@@ -80,6 +80,7 @@ void EstimatorScoreAccumulator::Add(double estimated, double truth, double varia
   const double e = estimated - truth;
   se_ += e * e;
   if (std::abs(e) <= 3) ++within_;
+  if (std::abs(e) <= band_) ++within_band_;
   if (variance > 0 && std::isfinite(variance)) {
     nees_ += e * e / variance;
     ++nees_n_;
@@ -93,6 +94,7 @@ EstimatorScore EstimatorScoreAccumulator::Score() const {
   if (samples_ > 0) {
     s.rmse = std::sqrt(se_ / samples_);
     s.within3 = static_cast<double>(within_) / samples_;
+    s.within_band = static_cast<double>(within_band_) / samples_;
   }
   s.mean_nees = nees_n_ > 0 ? nees_ / nees_n_ : std::numeric_limits<double>::quiet_NaN();
   return s;

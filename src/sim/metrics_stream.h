@@ -39,15 +39,17 @@ class SignalMetrics {
   double prev_t_ = 0, prev_r_ = 0, prev_y_ = 0, prev_abs_ = 0;
 };
 
-// ScoreEstimator, one control instant at a time.
+// ScoreEstimator, one control instant at a time; `band` (units) is EstimatorScore's within_band.
 class EstimatorScoreAccumulator {
  public:
+  explicit EstimatorScoreAccumulator(double band = 3) : band_(band) {}
   void Add(double estimated, double truth, double variance);
   EstimatorScore Score() const;
 
  private:
+  double band_ = 3;
   double se_ = 0, nees_ = 0;
-  int nees_n_ = 0, within_ = 0, samples_ = 0;
+  int nees_n_ = 0, within_ = 0, within_band_ = 0, samples_ = 0;
 };
 
 // SwitchingRate, from the on-count after each control instant.

@@ -121,6 +121,8 @@ nlohmann::json RunSummary::ToJson() const {
                             {"estimator_rmse", b.estimator_rmse},
                             {"mean_nees", b.mean_nees},
                             {"estimator_within3", b.estimator_within3},
+                            {"estimator_band", b.estimator_band},
+                            {"estimator_within_band", b.estimator_within_band},
                             {"peak_temperature", b.peak_temperature},
                             {"peak_wire_stress", b.peak_wire_stress},
                             {"max_temperature", b.max_temperature},
@@ -133,6 +135,9 @@ nlohmann::json RunSummary::ToJson() const {
 }
 
 namespace {
+
+// A count estimate's band for a bundle of n units: 3 units, or 5 % of n for a bundle of many.
+double EstimatorBand(int n) { return std::max(3.0, 0.05 * n); }
 
 // One bundle's controller side: its load cell and its recruitment controller (which owns the
 // on-count estimator), and what it did at the control instants, for the scores.
@@ -204,7 +209,10 @@ Result<std::vector<Channel>> MakeChannels(const Task& task, const ControllerSett
     auto sensor =
         ForceSensor::Create(task.sensor, Rng::DeriveSeed(options.seed, kSensorStream + i));
     if (!sensor.ok()) return Error{where + ".sensor: " + sensor.error(), sensor.code()};
-    channels.push_back({std::move(sensor).value(), std::move(c).value(), {}, {}});
+    channels.push_back({std::move(sensor).value(),
+                        std::move(c).value(),
+                        EstimatorScoreAccumulator(EstimatorBand(p.num_units)),
+                        {}});
     channels.back().switches.Add(plant.OnCount(i));
   }
   return channels;
@@ -362,6 +370,8 @@ void Summarize(const Task& task, const Plant& plant, const SignalMetrics& sig,
     bs.estimator_rmse = es.rmse;
     bs.mean_nees = es.mean_nees;
     bs.estimator_within3 = es.within3;
+    bs.estimator_band = EstimatorBand(plant.num_units(i));
+    bs.estimator_within_band = es.within_band;
     bs.peak_temperature = plant.peak_temperature(i);
     bs.peak_wire_stress = plant.peak_wire_stress(i);
     bs.max_temperature = lim.max_temperature;

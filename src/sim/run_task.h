@@ -70,10 +70,14 @@ struct BundleSummary {
   double estimator_rmse = 0;     // units
   double mean_nees = 0;          // NaN: the estimator gives no variance
   double estimator_within3 = 0;  // fraction of control instants with |n^ - n| <= 3
-  double peak_temperature = 0;   // C, hottest unit over the run
-  double peak_wire_stress = 0;   // Pa, most stressed wire over the run
-  double max_temperature = 0;    // C, the limit
-  double max_wire_stress = 0;    // Pa, the limit
+  // The same within max(3, 5 % of the bundle's units): "within 3 units, or 5 % of N for a bundle
+  // of many units".
+  double estimator_band = 3;         // units
+  double estimator_within_band = 0;  // fraction of control instants
+  double peak_temperature = 0;       // C, hottest unit over the run
+  double peak_wire_stress = 0;       // Pa, most stressed wire over the run
+  double max_temperature = 0;        // C, the limit
+  double max_wire_stress = 0;        // Pa, the limit
 };
 
 // One driven joint's scores (self-tuned angle tasks).

@@ -118,6 +118,9 @@ TEST(Metrics, EstimatorScoreRmseNeesAndWithinThree) {
   // NEES over samples with var > 0: 0/1, 4/4, 16/4 -> mean 5/3.
   EXPECT_DOUBLE_EQ(s.mean_nees, (0 + 1 + 4) / 3.0);
   EXPECT_DOUBLE_EQ(s.within3, 3.0 / 4.0);
+  EXPECT_DOUBLE_EQ(s.within_band, 3.0 / 4.0);  // the default band is 3 units
+  // A band of 5 % of 100 units: the error of 4 is inside it too.
+  EXPECT_DOUBLE_EQ(ScoreEstimator(est, truth, var, 5).within_band, 1.0);
 }
 
 TEST(Metrics, NeesOfGaussianErrorsWithTrueVarianceIsNearOne) {
@@ -181,7 +184,7 @@ TEST(MetricsStream, AccumulatorsEqualThePureFunctionsExactly) {
       EXPECT_EQ(a[i].step.time, b[i].step.time);
     }
   }
-  EstimatorScoreAccumulator acc;
+  EstimatorScoreAccumulator acc(1.5);
   SwitchingCounter sw;
   std::vector<double> est, truth, var;
   std::vector<int> on;
@@ -193,10 +196,11 @@ TEST(MetricsStream, AccumulatorsEqualThePureFunctionsExactly) {
     acc.Add(e, n, v);
     sw.Add(static_cast<int>(n));
   }
-  const EstimatorScore a = acc.Score(), b = ScoreEstimator(est, truth, var);
+  const EstimatorScore a = acc.Score(), b = ScoreEstimator(est, truth, var, 1.5);
   EXPECT_EQ(a.rmse, b.rmse);
   EXPECT_EQ(a.mean_nees, b.mean_nees);
   EXPECT_EQ(a.within3, b.within3);
+  EXPECT_EQ(a.within_band, b.within_band);
   EXPECT_EQ(a.samples, b.samples);
   EXPECT_EQ(sw.Rate(60, 250.0), SwitchingRate(on, 60, 250.0));
 }
