@@ -2,8 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <limits>
+#include <map>
+#include <mutex>
 #include <unsupported/Eigen/MatrixFunctions>
+#include <vector>
 
 namespace recruit::control {
 namespace {
@@ -56,6 +61,30 @@ double Penalty(const LoopDesign& d, const LoopTarget& target) {
   return one(d.nominal, target.overshoot) + 0.25 * one(d.robust, 0.25) + 0.25 * one(d.offset, 0.25);
 }
 
+// Designs already made in this process, keyed by the exact bits of every input: a sweep's runs
+// of one task design the same loops again (the design is a sixth of a short auto-loop run), and
+// a design is a pure function of its inputs, so a stored one is the one a new search would make.
+constexpr std::size_t kDesignMemoEntries = 512;
+
+std::vector<std::uint64_t> DesignKey(const JointDynamics& j, const ActuatorResponse& act, double dT,
+                                     const LoopTarget& t) {
+  const double head[] = {j.inertia,   j.damping, j.stiffness, act.dT,        dT,
+                         t.overshoot, t.band,    t.hold,      t.torque_error};
+  std::vector<std::uint64_t> key(std::size(head) + act.s.size());
+  std::memcpy(key.data(), head, sizeof head);
+  std::memcpy(key.data() + std::size(head), act.s.data(), act.s.size() * sizeof(double));
+  return key;
+}
+
+std::mutex design_memo_mutex;
+std::map<std::vector<std::uint64_t>, LoopDesign>& DesignMemo() {
+  static auto* memo = new std::map<std::vector<std::uint64_t>, LoopDesign>();
+  return *memo;
+}
+
+LoopDesign SearchGrid(const JointDynamics& joint, const ActuatorResponse& act, double dT,
+                      const LoopTarget& target);
+
 }  // namespace
 
 PredictedStep PredictStep(const JointDynamics& joint, const ActuatorResponse& act, double dT,
@@ -102,6 +131,23 @@ Result<LoopDesign> DesignJointLoop(const JointDynamics& joint, const ActuatorRes
   if (act.s.size() < 2 || !(dT > 0) || !(target.hold > dT)) {
     return Error{"loop design: needs an actuator response, dT > 0 and a hold longer than dT"};
   }
+  const std::vector<std::uint64_t> key = DesignKey(joint, act, dT, target);
+  {
+    std::lock_guard<std::mutex> lock(design_memo_mutex);
+    auto it = DesignMemo().find(key);
+    if (it != DesignMemo().end()) return it->second;
+  }
+  LoopDesign design = SearchGrid(joint, act, dT, target);
+  std::lock_guard<std::mutex> lock(design_memo_mutex);
+  if (DesignMemo().size() < kDesignMemoEntries) DesignMemo().emplace(key, design);
+  return design;
+}
+
+namespace {
+
+// The grid search of DesignJointLoop (inputs checked).
+LoopDesign SearchGrid(const JointDynamics& joint, const ActuatorResponse& act, double dT,
+                      const LoopTarget& target) {
   // Scales: the actuator's time to 63 % and a stiffness the loop must at least match.
   const double t63 = std::max(act.TimeTo(0.63), dT);
   const double k_ref = std::max({std::abs(joint.stiffness), joint.damping / t63,
@@ -131,5 +177,7 @@ Result<LoopDesign> DesignJointLoop(const JointDynamics& joint, const ActuatorRes
       best.meets ? "meets the target" : "no gain on the grid meets the target: the closest is used";
   return best;
 }
+
+}  // namespace
 
 }  // namespace recruit::control

@@ -92,6 +92,32 @@ TEST(LoopDesign, AnUnstableStaticPoseStillGetsAStabilisingDesign) {
   EXPECT_FALSE(PredictStep(joint, act, 0.5, LoopGains{}, target).settled);
 }
 
+// Designs are kept per process by their exact inputs: asked again, a design is the one made the
+// first time, and two actuators that differ only in their response (not in dT or the joint) get
+// their own designs, whatever the order they are asked in.
+TEST(LoopDesign, AKeptDesignIsTheOneItsOwnInputsMade) {
+  const ActuatorResponse slow = TwoState(1.0, 0.2), fast = TwoState(1.0, 0.6);
+  ASSERT_EQ(slow.dT, fast.dT);
+  const JointDynamics joint{0.003, 0.02, 0.1};
+  LoopTarget target;
+  target.hold = 20;
+  auto a1 = DesignJointLoop(joint, slow, 1.0, target);
+  auto b1 = DesignJointLoop(joint, fast, 1.0, target);
+  auto a2 = DesignJointLoop(joint, slow, 1.0, target);
+  auto b2 = DesignJointLoop(joint, fast, 1.0, target);
+  ASSERT_TRUE(a1.ok() && b1.ok() && a2.ok() && b2.ok());
+  EXPECT_NE(a1->gains.kp, b1->gains.kp);
+  EXPECT_EQ(a1->gains.kp, a2->gains.kp);
+  EXPECT_EQ(a1->gains.ki, a2->gains.ki);
+  EXPECT_EQ(a1->gains.kd, a2->gains.kd);
+  EXPECT_EQ(a1->nominal.angle, a2->nominal.angle);
+  EXPECT_EQ(b1->gains.kp, b2->gains.kp);
+  EXPECT_EQ(b1->nominal.angle, b2->nominal.angle);
+  // The prediction of the kept design is the one its gains give now.
+  const PredictedStep again = PredictStep(joint, fast, 1.0, b2->gains, target);
+  EXPECT_EQ(again.angle, b2->nominal.angle);
+}
+
 TEST(LoopDesign, BadInputsAreRefused) {
   const ActuatorResponse act = TwoState(1.0, 0.2);
   LoopTarget target;
