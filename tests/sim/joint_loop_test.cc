@@ -2,6 +2,8 @@
 // gravity summed by hand, the moment arms against finite differences of the tendons' lengths,
 // the one-joint form with "outer_loop": "auto", the several-joint form on a two-joint arm, and
 // the load-time warnings in the run's summary.
+#include "sim/joint_loop.h"
+
 #include <gtest/gtest.h>
 #include <mujoco/mujoco.h>
 
@@ -10,7 +12,6 @@
 #include <fstream>
 #include <regex>
 
-#include "sim/joint_loop.h"
 #include "sim/plant.h"
 #include "sim/run_task.h"
 #include "tests/plugin/mujoco_util.h"
