@@ -119,7 +119,7 @@ Broadcast RecruitmentController::FailureAwareLaw(const FailureEstimate& f) {
   // The working units must make up what the stuck ones do not, each pulling the estimated
   // fraction c of a fresh unit (functional fatigue; c = 1 unless estimated).
   const double c = f.force_scale > 0 ? f.force_scale : 1.0;
-  const double target = c == 1.0 ? target_on_ - stuck : (target_on_ - stuck) / c;
+  const double target = (target_on_ - stuck) / c;  // exact for c = 1 (IEEE division by 1)
   saturation_ = target > working ? 1 : (target < 0 ? -1 : 0);
   return ExpectationLaw(target, estimated_on_ - stuck, working, params_.lambda);
 }

@@ -20,12 +20,11 @@ namespace recruit::control {
 // off units are recruited and as many more on units released as keeps the expected count
 // (ExplorationLaw); otherwise ("toggle") every unit switches with probability p_on at the first
 // instant (p_on = p_off; with 1, a deterministic swap of the on and off units) and none for the
-// other instants-1, so that the switched units settle before the law resumes. Triggers: a declared
-// failure
-// (`after_declaration`), the estimator's suspicion (FailureEstimate::suspicion, the failure
-// test's largest ratio) reaching `suspicion` (> 0), and every `period` seconds (> 0); none within
-// `rest` instants of the end of the last exploration. The default (p_on = 0) never explores: the
-// broadcasts are the law's.
+// other instants-1, so that the switched units settle before the law resumes. Triggers: a
+// declared failure (`after_declaration`), the estimator's suspicion (FailureEstimate::suspicion,
+// the failure test's largest ratio) reaching `suspicion` (> 0), and every `period` seconds (> 0);
+// none within `rest` instants of the end of the last exploration. The default (p_on = 0) never
+// explores: the broadcasts are the law's.
 struct ExplorationParams {
   double p_on = 0;  // in [0, 1]; 0: off
   bool balanced = true;

@@ -45,6 +45,7 @@ class EstimatorScoreAccumulator {
   explicit EstimatorScoreAccumulator(double band = 3) : band_(band) {}
   void Add(double estimated, double truth, double variance);
   EstimatorScore Score() const;
+  double band() const { return band_; }
 
  private:
   double band_ = 3;

@@ -370,7 +370,7 @@ void Summarize(const Task& task, const Plant& plant, const SignalMetrics& sig,
     bs.estimator_rmse = es.rmse;
     bs.mean_nees = es.mean_nees;
     bs.estimator_within3 = es.within3;
-    bs.estimator_band = EstimatorBand(plant.num_units(i));
+    bs.estimator_band = ch.score.band();
     bs.estimator_within_band = es.within_band;
     bs.peak_temperature = plant.peak_temperature(i);
     bs.peak_wire_stress = plant.peak_wire_stress(i);
@@ -724,9 +724,9 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
   const double h = plant.timestep();
   const long num_steps = std::lround(duration / h);
   // The metrics accumulate as the run goes: memory does not grow with its length.
-  SignalMetrics sig(StepsUntilDisturbances(task.reference.Steps(duration), push_starts),
-                    task.settle_band,
-                    DisturbanceWindows(push_starts, task.reference.Steps(duration), duration));
+  const std::vector<ReferenceStep> steps = task.reference.Steps(duration);
+  SignalMetrics sig(StepsUntilDisturbances(steps, push_starts), task.settle_band,
+                    DisturbanceWindows(push_starts, steps, duration));
   auto measured = [&]() {
     return task.tracked == Tracked::kForce ? plant.Force(0) : plant.angle();
   };
