@@ -403,8 +403,8 @@ static void force_references(recruit_controller *c, const recruit_input *in, rec
   p.rows = NJ;
   for (j = 0; j < NJ; ++j) {
     const double e = r[j] - (double)in->angle[j];
-    trial[j] = c->integral[j] + e * dT;
-    p.torque[j] = pose->feedforward[j] + pose->kp[j] * e + pose->ki[j] * trial[j] -
+    trial[j] = c->integral[j] + pose->ki[j] * e * dT;
+    p.torque[j] = pose->feedforward[j] + pose->kp[j] * e + trial[j] -
                   pose->kd[j] * (double)in->angular_velocity[j];
     for (b = 0; b < NB; ++b) p.arms[j][b] = pose->arms[j][b];
   }
@@ -479,7 +479,7 @@ LoopCode AutoLoopCode(const FrozenAutoLoop& loop, const Writer& package) {
   code.defines += " */\n#define RECRUIT_NUM_POSES " + std::to_string(np) +
                   " /* reference poses of the task's schedule */\n";
   code.state =
-      "  double integral[RECRUIT_NUM_JOINTS]; /* rad s, per driven joint */\n"
+      "  double integral[RECRUIT_NUM_JOINTS]; /* N m, per driven joint: the sum of ki e dT */\n"
       "  int pose;       /* the reference pose of the last step (index into the .c's table) */\n"
       "  int pose_exact; /* 1: the references were that pose's; 0: the nearest pose was used */";
   code.input =

@@ -165,9 +165,11 @@ void JointLoops::Step(double t, const Plant& plant, std::vector<double>& force_r
   Eigen::VectorXd trial(nj);
   for (int j = 0; j < nj; ++j) {
     const double e = r[j] - plant.JointAngle(j);
-    trial[j] = integral_[j] + e * dT_;
-    p.torque[j] = feedforward[j] + gains[j].kp * e + gains[j].ki * trial[j] -
-                  gains[j].kd * plant.JointVelocity(j);
+    // The integral is kept as torque, so a new design's ki takes over what the last one
+    // integrated without a jump (bumpless).
+    trial[j] = integral_[j] + gains[j].ki * e * dT_;
+    p.torque[j] =
+        feedforward[j] + gains[j].kp * e + trial[j] - gains[j].kd * plant.JointVelocity(j);
   }
   p.cap.resize(nb);
   p.floor.resize(nb);

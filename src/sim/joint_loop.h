@@ -54,6 +54,9 @@ class JointLoops {
 
   // Each bundle's price in the allocation (BundlePrices).
   const Eigen::VectorXd& prices() const { return price_; }
+  // Per joint, the PID's integral term (N m): the sum of ki e dT over the instants the bundles
+  // could deliver it, each with the gain of its own design.
+  const std::vector<double>& integral() const { return integral_; }
   // Every design made so far, in the order made.
   const std::vector<JointDesignRecord>& designs() const { return designs_; }
   // The driven joints' references at t, kept 3 % of each limited joint's range inside it.
@@ -78,7 +81,7 @@ class JointLoops {
   };
   std::vector<std::map<double, Setting>> settings_;
 
-  std::vector<double> integral_;     // rad s, per joint
+  std::vector<double> integral_;     // N m, per joint: the sum of ki e dT
   std::vector<double> last_target_;  // rad, per joint: NaN before the first instant
   Eigen::VectorXd price_;            // per bundle: its time to 63 % over the fastest bundle's
   std::vector<JointDesignRecord> designs_;

@@ -197,6 +197,42 @@ TEST(JointLoop, OneJointRunTracksAndReportsItsDesigns) {
   EXPECT_GE(settled, 5);
 }
 
+// The integral term is kept as torque: when a new reference value brings a new design with
+// another ki, the torque integrated so far carries over unchanged and only the new error is
+// integrated with the new gain (summed by hand here, the limb held still).
+TEST(JointLoop, ANewDesignTakesOverTheIntegratedTorqueWithoutAJump) {
+  std::string text = ArmTask("\"auto\"");
+  text = std::regex_replace(text, std::regex(R"("times": \[5\], "values": \[40\])"),
+                            R"("initial": 4, "times": [5], "values": [7])");
+  auto t = TaskFromText(text, kRoot + "/models/tasks");
+  ASSERT_TRUE(t.ok()) << t.error();
+  auto plant = Plant::Create(*t, /*drawn=*/false);
+  ASSERT_TRUE(plant.ok()) << plant.error();
+  Plant& pl = **plant;
+  pl.Reset(1);
+  const double dT = 1.0;
+  std::vector<control::ActuatorResponse> responses(
+      pl.num_bundles(), control::FirstOrderActuatorResponse(dT, 0.2, 0.3));
+  std::vector<UnitForce> unit_force(pl.num_bundles(), [](double) { return 0.5; });
+  auto loops = JointLoops::Create(*t, pl, responses, unit_force, dT);
+  ASSERT_TRUE(loops.ok()) << loops.error();
+  std::vector<double> force_ref(pl.num_bundles());
+  const double q = pl.JointAngle(0);
+  double sum = 0;
+  // The reference steps from 4 to 7 deg at 5 s; the limb is held hanging (0 deg), near enough
+  // for the bundles not to saturate, which would hold the integral.
+  for (int k = 0; k < 6; ++k) {
+    loops->Step(k * dT, pl, force_ref);
+    const double e = loops->LoopReference(pl, k * dT)[0] - q;
+    ASSERT_FALSE(loops->designs().empty());
+    sum += loops->designs().back().design.gains.ki * e * dT;
+    EXPECT_NEAR(loops->integral()[0], sum, 1e-12 * (1 + std::abs(sum))) << "instant " << k;
+  }
+  ASSERT_EQ(loops->designs().size(), 2u);
+  const double ki0 = loops->designs()[0].design.gains.ki, ki1 = loops->designs()[1].design.gains.ki;
+  EXPECT_GT(std::abs(ki1 - ki0), 0.01 * std::max(ki0, ki1));  // the two designs differ
+}
+
 // A bundle designed past the wire's long-life temperature: the warning loading printed is in
 // the run's summary too.
 TEST(JointLoop, TheSummaryCarriesWhatLoadingTheModelWarnedOf) {
