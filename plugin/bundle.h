@@ -162,6 +162,11 @@ class SmaBundle {
   // Sum over cohorts of count * field f, in four partial sums.
   double CountWeightedSum(const double* s, int f) const;
   void Merge(double* s) const;
+  // unit_model=binned, after Merge: merges neighbours in (on, temperature) order with the same
+  // on/off state and failure mode, in rounds, the nearest first (largest difference of
+  // temperature, xi, branch constants and force scale in units of the merge tolerances), until at
+  // most config().bins cohorts remain (or one per on/off state and failure mode).
+  void Bin(double* s) const;
   // Forgets a kept tension (SummarizeAndKeep): the units are about to change.
   static void DropKept(double* s) {
     s[kKeptSlot] = 0, s[kKeptStretchSlot] = 0, s[kKeptTensionSlot] = 0;
