@@ -85,19 +85,90 @@ const char kElbowUnit[] =
     "units=366 wire_diameter=0.000127 wire_length=0.25 series=4 parallel=3 series_spring=182.687 "
     "prestretch=0.00604701 current=0.2331";
 
+// Figures for docs/sma-units.md: RECRUIT_PRINT_ACCURACY=1 RECRUIT_ACCURACY_MODELS='k=v ...|...'
+// prints each model's errors on both bundles.
 TEST(UnitModelAccuracy, Explore) {
   if (std::getenv("RECRUIT_PRINT_ACCURACY") == nullptr) GTEST_SKIP();
   const char* env = std::getenv("RECRUIT_ACCURACY_MODELS");
   std::vector<std::string> models;
-  for (std::string all = env ? env : "", item; !all.empty();) {
+  for (std::string all = env ? env : ""; !all.empty();) {
     const auto bar = all.find('|');
     models.push_back(all.substr(0, bar));
     all = bar == std::string::npos ? "" : all.substr(bar + 1);
   }
   for (const std::string& model : models) {
-    Compare(std::string("units=60 ") + model, 300, Regime::kRandomSwitching);
+    Compare("units=60 " + model, 300, Regime::kRandomSwitching);
     Compare(std::string(kElbowUnit) + " " + model, 100, Regime::kRandomSwitching);
   }
+}
+
+// The bands: each model's measured worst error on these runs (docs/sma-units.md), rounded up
+// by about half, so that a change that makes a model markedly less accurate fails. The runs
+// are deterministic (one seed), so the figures do not scatter.
+TEST(UnitModelAccuracy, ExactModelFollowsEveryUnit) {
+  const Errors small = Compare("units=60", 300, Regime::kRandomSwitching);
+  EXPECT_LE(small.force_units, 0.03);   // measured 0.020
+  EXPECT_LE(small.mean_temp_k, 0.015);  // 0.0095
+  const Errors elbow = Compare(kElbowUnit, 100, Regime::kRandomSwitching);
+  EXPECT_LE(elbow.force_units, 0.5);   // 0.306
+  EXPECT_LE(elbow.mean_temp_k, 0.01);  // 0.0055
+}
+
+TEST(UnitModelAccuracy, BinnedModelStaysWithinItsBand) {
+  const Errors small = Compare("units=60 unit_model=binned bins=16", 300, Regime::kRandomSwitching);
+  EXPECT_LE(small.force_units, 1.1);  // measured 0.74
+  EXPECT_LE(small.mean_temp_k, 0.5);  // 0.33
+  EXPECT_LE(small.cohorts, 16);
+  const Errors elbow = Compare(std::string(kElbowUnit) + " unit_model=binned bins=48", 100,
+                               Regime::kRandomSwitching);
+  EXPECT_LE(elbow.force_units, 8.5);   // 5.6
+  EXPECT_LE(elbow.mean_temp_k, 0.13);  // 0.087
+  EXPECT_LE(elbow.cohorts, 48);
+}
+
+// All units switch together: one cohort, which both models advance by the scalar exact update,
+// so the bundle is the reference but for the order of the force's sum.
+TEST(UnitModelAccuracy, Fig4StepIsExactInBothModels) {
+  for (const std::string model : {"", " unit_model=binned bins=2"}) {
+    for (const std::string units : {std::string("units=60"), std::string(kElbowUnit)}) {
+      const Errors e = Compare(units + model, 32, Regime::kFig4Step);
+      EXPECT_LE(e.force_units, 1e-9) << units << model;
+      EXPECT_LE(e.mean_temp_k, 1e-9) << units << model;
+      EXPECT_LE(e.max_temp_k, 1e-9) << units << model;
+      EXPECT_EQ(e.cohorts, 1) << units << model;
+    }
+  }
+}
+
+// After each merge pass at most `bins` cohorts; with room for every cohort, binning never merges
+// and the bundle is the exact model's, bit for bit.
+TEST(UnitModelAccuracy, BinnedBoundsTheCohortsAndIsExactWithRoom) {
+  auto run = [](const std::string& text, std::vector<double>* s, int* most_before_broadcast) {
+    auto c = BundleConfig::FromText("t", text);
+    ASSERT_TRUE(c.ok()) << c.error();
+    auto b = SmaBundle::Create(*c, 1e-3);
+    ASSERT_TRUE(b.ok());
+    s->assign(b->state_size(), 0);
+    const double x = c->unit.prestretch;
+    b->Reset(s->data(), 11, x);
+    *most_before_broadcast = 0;
+    for (long i = 0; i < 60000; ++i) {
+      if (i % 500 == 0) ASSERT_TRUE(b->Broadcast(s->data(), 0.1, 0.1, x).ok());
+      b->Advance(s->data(), x, 1e-3);
+      if (i % 500 == 499) {
+        *most_before_broadcast = std::max(*most_before_broadcast, b->NumCohorts(s->data()));
+      }
+    }
+  };
+  std::vector<double> exact, roomy, binned;
+  int k_exact, k_roomy, k_binned;
+  run("units=200", &exact, &k_exact);
+  run("units=200 unit_model=binned bins=1000000", &roomy, &k_roomy);
+  run("units=200 unit_model=binned bins=10", &binned, &k_binned);
+  EXPECT_GT(k_exact, 10);
+  EXPECT_EQ(k_roomy, k_exact);
+  EXPECT_EQ(roomy, exact);  // every double of the block
+  EXPECT_EQ(k_binned, 10);
 }
 
 }  // namespace
