@@ -96,6 +96,34 @@ Status LoosenMerge(const std::string& xml) {
   return Status::Ok();
 }
 
+// RECRUIT_BENCH_UNIT_MODEL="binned,BINS" (an experiment, not the default): every bundle of the
+// attached model gets unit_model=binned with BINS bins (plugin/README.md "Unit models").
+Status BinUnits(const std::string& xml) {
+  const char* model = std::getenv("RECRUIT_BENCH_UNIT_MODEL");
+  if (model == nullptr || *model == 0) return Status::Ok();
+  const std::string m = model;
+  if (m.rfind("binned,", 0) != 0) {
+    return Error{"RECRUIT_BENCH_UNIT_MODEL: expected binned,BINS, got " + m};
+  }
+  const std::string keys =
+      "<config key=\"unit_model\" value=\"binned\"/><config key=\"bins\" "
+      "value=\"" +
+      m.substr(7) + "\"/>";
+  std::ifstream in(xml);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  int n = 0;
+  for (auto at = text.find("key=\"units\""); at != std::string::npos;
+       at = text.find("key=\"units\"", at + 1)) {
+    const auto end = text.find("/>", at);
+    if (end == std::string::npos) break;
+    text.insert(end + 2, keys);
+    ++n;
+  }
+  if (n == 0) return Error{"RECRUIT_BENCH_UNIT_MODEL: no units config in " + xml};
+  std::ofstream(xml, std::ios::trunc) << text;
+  return Status::Ok();
+}
+
 struct Limb {
   std::string muscle_xml, attached_xml, task_json;
 };
@@ -135,6 +163,7 @@ Result<Limb> Prepare(const std::string& name) {
   auto r = attach::Attach(o);
   if (!r.ok()) return made.emplace(name, Error{"attach: " + r.error()}).first->second;
   if (Status s = LoosenMerge(o.output); !s) return made.emplace(name, s.failure()).first->second;
+  if (Status s = BinUnits(o.output); !s) return made.emplace(name, s.failure()).first->second;
   limb.attached_xml = o.output;
   limb.task_json = o.task;
   return made.emplace(name, limb).first->second;
