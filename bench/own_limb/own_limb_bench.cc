@@ -29,6 +29,7 @@
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -96,19 +97,21 @@ Status LoosenMerge(const std::string& xml) {
   return Status::Ok();
 }
 
-// RECRUIT_BENCH_UNIT_MODEL="binned,BINS" (an experiment, not the default): every bundle of the
-// attached model gets unit_model=binned with BINS bins (plugin/README.md "Unit models").
-Status BinUnits(const std::string& xml) {
-  const char* model = std::getenv("RECRUIT_BENCH_UNIT_MODEL");
-  if (model == nullptr || *model == 0) return Status::Ok();
-  const std::string m = model;
-  if (m.rfind("binned,", 0) != 0) {
-    return Error{"RECRUIT_BENCH_UNIT_MODEL: expected binned,BINS, got " + m};
+// RECRUIT_BENCH_KEYS="key=value ..." (an experiment, not the default): every bundle of the
+// attached model gets those config keys, e.g. "unit_model=binned bins=16" or
+// "update_period=0.01" (plugin/README.md).
+Status AddKeys(const std::string& xml) {
+  const char* given = std::getenv("RECRUIT_BENCH_KEYS");
+  if (given == nullptr || *given == 0) return Status::Ok();
+  std::istringstream pairs(given);
+  std::string keys;
+  for (std::string pair; pairs >> pair;) {
+    const auto eq = pair.find('=');
+    if (eq == std::string::npos || eq == 0) {
+      return Error{"RECRUIT_BENCH_KEYS: expected key=value pairs, got " + pair};
+    }
+    keys += "<config key=\"" + pair.substr(0, eq) + "\" value=\"" + pair.substr(eq + 1) + "\"/>";
   }
-  const std::string keys =
-      "<config key=\"unit_model\" value=\"binned\"/><config key=\"bins\" "
-      "value=\"" +
-      m.substr(7) + "\"/>";
   std::ifstream in(xml);
   std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   int n = 0;
@@ -119,7 +122,7 @@ Status BinUnits(const std::string& xml) {
     text.insert(end + 2, keys);
     ++n;
   }
-  if (n == 0) return Error{"RECRUIT_BENCH_UNIT_MODEL: no units config in " + xml};
+  if (n == 0) return Error{"RECRUIT_BENCH_KEYS: no units config in " + xml};
   std::ofstream(xml, std::ios::trunc) << text;
   return Status::Ok();
 }
@@ -163,7 +166,7 @@ Result<Limb> Prepare(const std::string& name) {
   auto r = attach::Attach(o);
   if (!r.ok()) return made.emplace(name, Error{"attach: " + r.error()}).first->second;
   if (Status s = LoosenMerge(o.output); !s) return made.emplace(name, s.failure()).first->second;
-  if (Status s = BinUnits(o.output); !s) return made.emplace(name, s.failure()).first->second;
+  if (Status s = AddKeys(o.output); !s) return made.emplace(name, s.failure()).first->second;
   limb.attached_xml = o.output;
   limb.task_json = o.task;
   return made.emplace(name, limb).first->second;
