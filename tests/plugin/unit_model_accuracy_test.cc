@@ -171,5 +171,46 @@ TEST(UnitModelAccuracy, BinnedBoundsTheCohortsAndIsExactWithRoom) {
   EXPECT_EQ(k_binned, 10);
 }
 
+// Binning never merges units of different failure modes: after every step each unit's mode is
+// the one it failed into (open units never turn on, stuck units stay on) and the counts by mode
+// add up, with fatigue's force scales averaged like the rest of the state.
+TEST(UnitModelAccuracy, BinnedKeepsFailureModesApart) {
+  auto c = BundleConfig::FromText(
+      "t",
+      "units=80 unit_model=binned bins=4 open_per_cycle=0.05 stuck_per_cycle=0.05 "
+      "fatigue_loss=0.2 fatigue_cycles=5");
+  ASSERT_TRUE(c.ok()) << c.error();
+  auto b = SmaBundle::Create(*c, 1e-3);
+  ASSERT_TRUE(b.ok());
+  std::vector<double> s(b->state_size());
+  const double x = c->unit.prestretch;
+  b->Reset(s.data(), 5, x);
+  std::vector<int> mode(80, 0);
+  for (long i = 0; i < 30000; ++i) {
+    if (i % 500 == 0) ASSERT_TRUE(b->Broadcast(s.data(), 0.3, 0.3, x).ok());
+    b->Advance(s.data(), x, 1e-3);
+    int open = 0, stuck = 0;
+    for (int u = 0; u < 80; ++u) {
+      const int now = b->UnitFailure(s.data(), u);
+      ASSERT_TRUE(mode[u] == 0 || now == mode[u]) << "unit " << u << " step " << i;
+      mode[u] = now;
+      open += now == 1;
+      stuck += now == 2;
+      if (now == 1) ASSERT_FALSE(b->UnitOn(s.data(), u));
+      if (now == 2) ASSERT_TRUE(b->UnitOn(s.data(), u));
+      const double scale = b->UnitForceScale(s.data(), u);
+      ASSERT_TRUE(scale >= 0.8 && scale <= 1) << scale;
+    }
+    const auto f = b->Failures(s.data());
+    ASSERT_EQ(f.open, open);
+    ASSERT_EQ(f.stuck, stuck);
+    ASSERT_EQ(f.working + f.open + f.stuck, 80);
+  }
+  const auto f = b->Failures(s.data());
+  EXPECT_GT(f.open, 0);
+  EXPECT_GT(f.stuck, 0);
+  EXPECT_GT(f.working, 0);
+}
+
 }  // namespace
 }  // namespace recruit::sma
