@@ -4,7 +4,8 @@
 //
 // Units with identical state form a cohort (count + state); per-step cost scales with the number
 // of cohorts, not units. A broadcast splits a cohort when some of its units switch; cohorts whose
-// states coincide within (merge_temperature, merge_xi) are merged again.
+// states coincide within (merge_temperature, merge_xi) are merged again, and with
+// unit_model=binned the nearest are merged further until at most `bins` remain (Bin).
 #pragma once
 
 #include <cstdint>
