@@ -333,7 +333,91 @@ void SmaBundle::Integrate(double* s, double stretch, double dt) const {
   unit_.AdvanceCohorts(c, k, stretch, decay);
   s[kCounterSlot] += 1;
   // The counter is a whole number: integer modulo instead of a libm fmod call.
-  if (k > 1 && static_cast<long long>(s[kCounterSlot]) % kMergeEvery == 0) Merge(s);
+  if (k > 1 && static_cast<long long>(s[kCounterSlot]) % kMergeEvery == 0) {
+    Merge(s);
+    if (config_.unit_model == UnitModelKind::kBinned && NumCohorts(s) > config_.bins) Bin(s);
+  }
+}
+
+void SmaBundle::Bin(double* s) const {
+  struct Scratch {
+    std::vector<int> seq, pairs, forward, remap;
+    std::vector<double> cost;
+    std::vector<char> used;
+  };
+  static thread_local Scratch w;  // bundles may step in parallel on their own mjData
+  const int k = NumCohorts(s);
+  double* count = Field(s, kCount);
+  double* f[kFields];
+  for (int i = 0; i < kFields; ++i) f[i] = Field(s, i);
+  const double *on = f[kOn], *temp = f[kTemp];
+  w.seq.resize(k);
+  std::iota(w.seq.begin(), w.seq.end(), 0);
+  std::sort(w.seq.begin(), w.seq.end(), [&](int a, int b) {
+    if (on[a] != on[b]) return on[a] < on[b];
+    if (temp[a] != temp[b]) return temp[a] < temp[b];
+    return a < b;
+  });
+  w.forward.assign(k, -1);
+  // A pair's distance: its largest difference in units of the merge tolerances (the defaults'
+  // where one is 0), so the pass widens Merge's box evenly, the nearest pairs first.
+  const double per_kelvin = 1 / (config_.merge_temperature > 0 ? config_.merge_temperature : 0.5);
+  const double per_xi = 1 / (config_.merge_xi > 0 ? config_.merge_xi : 0.01);
+  auto distance = [&](int a, int b) {
+    double d = std::max({per_kelvin * std::abs(temp[a] - temp[b]),
+                         per_xi * std::abs(f[kXi][a] - f[kXi][b]),
+                         per_xi * std::abs(f[kHeatScale][a] - f[kHeatScale][b]),
+                         per_xi * std::abs(f[kCoolScale][a] - f[kCoolScale][b])});
+    if (fatigue_) {
+      d = std::max(d, per_xi * std::abs(ForceScale(Damage(s)[a]) - ForceScale(Damage(s)[b])));
+    }
+    return d;
+  };
+  auto compatible = [&](int a, int b) {
+    return on[a] == on[b] && (!failures_ || Mode(s)[a] == Mode(s)[b]);
+  };
+  int alive = k;
+  // Rounds: the cheapest neighbours first, each cohort in at most one merge per round.
+  while (alive > config_.bins) {
+    const int m = static_cast<int>(w.seq.size());
+    w.pairs.clear();
+    w.cost.resize(m);
+    for (int i = 0; i + 1 < m; ++i) {
+      if (!compatible(w.seq[i], w.seq[i + 1])) continue;
+      w.cost[i] = distance(w.seq[i], w.seq[i + 1]);
+      w.pairs.push_back(i);
+    }
+    if (w.pairs.empty()) break;  // one cohort per on/off state and failure mode
+    std::sort(w.pairs.begin(), w.pairs.end(),
+              [&](int a, int b) { return w.cost[a] != w.cost[b] ? w.cost[a] < w.cost[b] : a < b; });
+    w.used.assign(m, 0);
+    for (int i : w.pairs) {
+      if (alive <= config_.bins) break;
+      if (w.used[i] || w.used[i + 1]) continue;
+      w.used[i] = w.used[i + 1] = 1;
+      const int r = w.seq[i], c = w.seq[i + 1];
+      // Count-weighted mean, as Merge: the bundle's mean temperature and fraction are kept.
+      const double n = count[r] + count[c];
+      for (int fi : {kTemp, kXi, kTeff, kHeatScale, kCoolScale}) {
+        f[fi][r] = (f[fi][r] * count[r] + f[fi][c] * count[c]) / n;
+      }
+      if (fatigue_) Damage(s)[r] = (Damage(s)[r] * count[r] + Damage(s)[c] * count[c]) / n;
+      count[r] = n;
+      count[c] = 0;
+      w.forward[c] = r;
+      --alive;
+    }
+    w.seq.erase(std::remove_if(w.seq.begin(), w.seq.end(), [&](int j) { return count[j] == 0; }),
+                w.seq.end());
+  }
+  // A cohort merged into one merged later forwards to where its chain ends.
+  for (int j = 0; j < k; ++j) {
+    int t = w.forward[j];
+    while (t >= 0 && w.forward[t] >= 0) t = w.forward[t];
+    w.forward[j] = t;
+  }
+  w.remap.resize(k);
+  Compact(s, w.forward.data(), w.remap.data());
 }
 
 void SmaBundle::Merge(double* s) const {

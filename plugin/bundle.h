@@ -4,7 +4,8 @@
 //
 // Units with identical state form a cohort (count + state); per-step cost scales with the number
 // of cohorts, not units. A broadcast splits a cohort when some of its units switch; cohorts whose
-// states coincide within (merge_temperature, merge_xi) are merged again.
+// states coincide within (merge_temperature, merge_xi) are merged again, and with
+// unit_model=binned the nearest are merged further until at most `bins` remain (Bin).
 #pragma once
 
 #include <cstdint>
@@ -162,6 +163,11 @@ class SmaBundle {
   // Sum over cohorts of count * field f, in four partial sums.
   double CountWeightedSum(const double* s, int f) const;
   void Merge(double* s) const;
+  // unit_model=binned, after Merge: merges neighbours in (on, temperature) order with the same
+  // on/off state and failure mode, in rounds, the nearest first (largest difference of
+  // temperature, xi, branch constants and force scale in units of the merge tolerances), until at
+  // most config().bins cohorts remain (or one per on/off state and failure mode).
+  void Bin(double* s) const;
   // Forgets a kept tension (SummarizeAndKeep): the units are about to change.
   static void DropKept(double* s) {
     s[kKeptSlot] = 0, s[kKeptStretchSlot] = 0, s[kKeptTensionSlot] = 0;

@@ -78,6 +78,8 @@ const std::vector<Key>& NumericKeys() {
       {"fatigue_stress", 0, 2e9, true, "Pa", FAILURE_FIELD(fatigue_stress)},
       {"fatigue_exponent", 0, 10, false, "", FAILURE_FIELD(fatigue_exponent)},
 #undef FAILURE_FIELD
+      {"bins", 2, 1e6, false, "cohorts (unit_model=binned)",
+       [](BundleConfig& c, double v) { c.bins = int(v); }},
   };
   return keys;
 }
@@ -199,8 +201,12 @@ Status CheckFailures(const BundleConfig& c, const std::map<std::string, std::str
 
 std::vector<std::string> BundleConfig::Keys() {
   std::vector<std::string> k = {"law"};
-  for (const Key& key : NumericKeys()) k.push_back(key.name);
+  for (const Key& key : NumericKeys()) {
+    if (std::string(key.name) != "bins") k.push_back(key.name);
+  }
   k.push_back("failures");
+  k.push_back("unit_model");  // the unit model's keys last (the older keys keep their places)
+  k.push_back("bins");
   return k;
 }
 
@@ -276,6 +282,17 @@ Result<BundleConfig> BundleConfig::FromPairs(
       }
       continue;
     }
+    if (key == "unit_model") {
+      if (value == "exact") {
+        c.unit_model = UnitModelKind::kExact;
+      } else if (value == "binned") {
+        c.unit_model = UnitModelKind::kBinned;
+      } else {
+        return Error{where + "unit_model=" + ShortText(value) +
+                     " is invalid: allowed values are exact, binned"};
+      }
+      continue;
+    }
     if (key == "failures") {
       auto events = FailureConfig::ParseSchedule(value);
       if (!events.ok()) {
@@ -306,7 +323,8 @@ Result<BundleConfig> BundleConfig::FromPairs(
                    (spec->lo_open ? "(" : "[") + GText(spec->lo) + ", " + GText(spec->hi) + "]" +
                    (spec->unit[0] ? std::string(" ") + spec->unit : std::string())};
     }
-    if ((key == "units" || key == "series" || key == "parallel") && v != std::floor(v)) {
+    if ((key == "units" || key == "series" || key == "parallel" || key == "bins") &&
+        v != std::floor(v)) {
       return Error{where + key + "=" + ShortText(value) + " must be a whole number"};
     }
     if (key == "prestrain") {
@@ -323,6 +341,11 @@ Result<BundleConfig> BundleConfig::FromPairs(
       return Error{where + "prestrain is for law=wire; use prestretch (m) with law=spring"};
     }
     c.unit.prestretch = prestrain * c.unit.wire_length * c.unit.series;  // whole unit
+  }
+  if (given.count("bins") && c.unit_model != UnitModelKind::kBinned) {
+    return Error{where + "bins=" + ShortText(given["bins"]) +
+                 " is for unit_model=binned (unit_model=exact keeps every cohort the merge "
+                 "tolerances allow): give unit_model=binned, or leave bins out"};
   }
   RECRUIT_TRY(CheckFailures(c, given, where));
   auto check = UnitModel::Create(c.unit);

@@ -45,6 +45,13 @@ struct FailureConfig {
   static Result<std::vector<Event>> ParseSchedule(const std::string& text);
 };
 
+// How a bundle's cohorts are kept (plugin/README.md "Unit models"). kExact: cohorts merge only
+// within merge_temperature and merge_xi, so the bundle follows every unit's exact update to ~1e-4
+// of one unit's force. kBinned: after each merge pass the cohorts are merged further, the closest
+// pairs first, until at most `bins` remain: the per-step cost is bounded by `bins` cohorts, at
+// the accuracy docs/sma-units.md states.
+enum class UnitModelKind { kExact, kBinned };
+
 struct BundleConfig {
   std::string actuator;  // actuator name in the model
   int units = 60;        // N, units in the bundle
@@ -64,6 +71,8 @@ struct BundleConfig {
   // every step; 0 = every step. For long sweeps: the thermal time constant is about 1 s, so a
   // few ms keeps the force within a fraction of a percent at a fraction of the cost.
   double update_period = 0;
+  UnitModelKind unit_model = UnitModelKind::kExact;
+  int bins = 16;  // kBinned: the most cohorts a merge pass leaves
   FailureConfig failure;
 
   // Parses key/value pairs; an empty value keeps the default (MuJoCo gives "" for a declared key

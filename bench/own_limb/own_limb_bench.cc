@@ -29,6 +29,7 @@
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -96,6 +97,36 @@ Status LoosenMerge(const std::string& xml) {
   return Status::Ok();
 }
 
+// RECRUIT_BENCH_KEYS="key=value ..." (an experiment, not the default): every bundle of the
+// attached model gets those config keys, e.g. "unit_model=binned bins=16" or
+// "update_period=0.01" (plugin/README.md).
+Status AddKeys(const std::string& xml) {
+  const char* given = std::getenv("RECRUIT_BENCH_KEYS");
+  if (given == nullptr || *given == 0) return Status::Ok();
+  std::istringstream pairs(given);
+  std::string keys;
+  for (std::string pair; pairs >> pair;) {
+    const auto eq = pair.find('=');
+    if (eq == std::string::npos || eq == 0) {
+      return Error{"RECRUIT_BENCH_KEYS: expected key=value pairs, got " + pair};
+    }
+    keys += "<config key=\"" + pair.substr(0, eq) + "\" value=\"" + pair.substr(eq + 1) + "\"/>";
+  }
+  std::ifstream in(xml);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  int n = 0;
+  for (auto at = text.find("key=\"units\""); at != std::string::npos;
+       at = text.find("key=\"units\"", at + 1)) {
+    const auto end = text.find("/>", at);
+    if (end == std::string::npos) break;
+    text.insert(end + 2, keys);
+    ++n;
+  }
+  if (n == 0) return Error{"RECRUIT_BENCH_KEYS: no units config in " + xml};
+  std::ofstream(xml, std::ios::trunc) << text;
+  return Status::Ok();
+}
+
 struct Limb {
   std::string muscle_xml, attached_xml, task_json;
 };
@@ -135,6 +166,7 @@ Result<Limb> Prepare(const std::string& name) {
   auto r = attach::Attach(o);
   if (!r.ok()) return made.emplace(name, Error{"attach: " + r.error()}).first->second;
   if (Status s = LoosenMerge(o.output); !s) return made.emplace(name, s.failure()).first->second;
+  if (Status s = AddKeys(o.output); !s) return made.emplace(name, s.failure()).first->second;
   limb.attached_xml = o.output;
   limb.task_json = o.task;
   return made.emplace(name, limb).first->second;

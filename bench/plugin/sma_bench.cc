@@ -35,11 +35,12 @@ std::string ModelPath(const char* file) {
 }
 
 // The bench with `units` units and the update period; without `truth`, minus the plugin's
-// ground-truth sensor (the muscle bench has none: like for like).
-std::string BenchWithUnits(int units, int update_ms, bool truth = true) {
+// ground-truth sensor (the muscle bench has none: like for like); bins > 0: unit_model=binned
+// with that many bins (plugin/README.md "Unit models"), else the exact model.
+std::string BenchWithUnits(int units, int update_ms, bool truth = true, int bins = 0) {
   char buf[256];
-  std::snprintf(buf, sizeof buf, "/tmp/recruit_sma_bench_%d_%d%s.xml", units, update_ms,
-                truth ? "" : "_notruth");
+  std::snprintf(buf, sizeof buf, "/tmp/recruit_sma_bench_%d_%d%s_%d.xml", units, update_ms,
+                truth ? "" : "_notruth", bins);
   std::FILE* in = std::fopen(ModelPath("isometric_bench.xml").c_str(), "r");
   std::string xml;
   char chunk[4096];
@@ -52,7 +53,12 @@ std::string BenchWithUnits(int units, int update_ms, bool truth = true) {
   replace("<config key=\"units\" value=\"60\"/>", "<config key=\"units\" value=\"" +
                                                       std::to_string(units) +
                                                       "\"/><config key=\"update_period\" value=\"" +
-                                                      std::to_string(update_ms * 1e-3) + "\"/>");
+                                                      std::to_string(update_ms * 1e-3) + "\"/>" +
+                                                      (bins > 0 ? "<config key=\"unit_model\" "
+                                                                  "value=\"binned\"/><config "
+                                                                  "key=\"bins\" value=\"" +
+                                                                      std::to_string(bins) + "\"/>"
+                                                                : std::string()));
   if (!truth) replace("<plugin name=\"bundle_truth\" instance=\"bundle_units\"/>", "");
   std::FILE* out = std::fopen(buf, "w");
   std::fwrite(xml.data(), 1, xml.size(), out);
@@ -132,19 +138,20 @@ double ThreadCpuSeconds() {
 
 // Interleaved blocks of 1000 steps of each model; counter "ratio" = SMA CPU time / muscle CPU
 // time. truth 0: without the plugin's ground-truth sensor, which the muscle bench has no
-// counterpart of (the bench's other three sensors are in both).
+// counterpart of (the bench's other three sensors are in both). bins > 0: unit_model=binned.
 void BM_SmaOverMuscle(benchmark::State& state) {
   const auto regime = static_cast<Regime>(state.range(0));
   const int update_ms = static_cast<int>(state.range(1));
   const bool truth = state.range(2) != 0;
+  const int bins = static_cast<int>(state.range(3));
   mjModel* mm = Load(ModelPath("isometric_bench_muscle.xml"));
-  mjModel* ms = Load(BenchWithUnits(60, update_ms, truth));
+  mjModel* ms = Load(BenchWithUnits(60, update_ms, truth, bins));
   auto p = SmaHost::Create(ms);
   mjData* dm = mj_makeData(mm);
   mjData* ds = mj_makeData(ms);
   dm->ctrl[0] = 1;
   (*p)->Reset(ds, 1);
-  double t_muscle = 0, t_sma = 0;
+  double t_muscle = 0, t_sma = 0, cohorts = 0;
   long i = 0;
   for (auto _ : state) {
     const double t0 = ThreadCpuSeconds();
@@ -154,11 +161,13 @@ void BM_SmaOverMuscle(benchmark::State& state) {
       Control(**p, ds, regime, i++);
       mj_step(ms, ds);
     }
+    cohorts += (*p)->NumCohorts(ds, 0);
     const double t2 = ThreadCpuSeconds();
     t_muscle += t1 - t0;
     t_sma += t2 - t1;
   }
   state.counters["ratio"] = t_sma / t_muscle;
+  state.counters["cohorts"] = cohorts / state.iterations();  // at the end of each block
   state.counters["muscle_steps_per_s"] = 1000.0 * state.iterations() / t_muscle;
   state.counters["sma_steps_per_s"] = 1000.0 * state.iterations() / t_sma;
   state.SetLabel(regime == Regime::kFig4Step ? "fig4_step" : "random_switching");
@@ -169,13 +178,16 @@ void BM_SmaOverMuscle(benchmark::State& state) {
   mj_deleteModel(ms);
 }
 BENCHMARK(BM_SmaOverMuscle)
-    ->ArgNames({"regime", "update_ms", "truth"})
-    ->Args({0, 0, 1})
-    ->Args({1, 0, 1})
-    ->Args({1, 10, 1})
-    ->Args({0, 0, 0})
-    ->Args({1, 0, 0})
-    ->Args({1, 10, 0})
+    ->ArgNames({"regime", "update_ms", "truth", "bins"})
+    ->Args({0, 0, 1, 0})
+    ->Args({1, 0, 1, 0})
+    ->Args({1, 10, 1, 0})
+    ->Args({0, 0, 0, 0})
+    ->Args({1, 0, 0, 0})
+    ->Args({1, 10, 0, 0})
+    ->Args({1, 0, 1, 8})
+    ->Args({1, 0, 1, 12})
+    ->Args({1, 0, 1, 16})
     ->Iterations(48);
 
 // The cohort update's kernels side by side on n cohorts that transform at every step (each

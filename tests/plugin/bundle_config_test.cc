@@ -95,7 +95,27 @@ INSTANTIATE_TEST_SUITE_P(
         BadCase{"parallel=2.25", "parallel=2.25 must be a whole number"},
         BadCase{"series=two", "series=two is not a finite number"},
         BadCase{"parallel=5000", "parallel=5000 is out of range"},
-        BadCase{"series_spring=-3", "series_spring=-3 is out of range: must be in [0"}));
+        BadCase{"series_spring=-3", "series_spring=-3 is out of range: must be in [0"},
+        BadCase{"unit_model=tabulated",
+                "unit_model=tabulated is invalid: allowed values are "
+                "exact, binned"},
+        BadCase{"unit_model=binned bins=1", "bins=1 is out of range: must be in [2, 1e+06]"},
+        BadCase{"unit_model=binned bins=12.5", "bins=12.5 must be a whole number"},
+        BadCase{"bins=16", "bins=16 is for unit_model=binned"},
+        BadCase{"unit_model=exact bins=16", "bins=16 is for unit_model=binned"}));
+
+TEST(BundleConfig, UnitModelDefaultsToExact) {
+  auto c = BundleConfig::FromText("m", "");
+  ASSERT_TRUE(c.ok()) << c.error();
+  EXPECT_EQ(c->unit_model, UnitModelKind::kExact);
+  auto b = BundleConfig::FromText("m", "unit_model=binned");
+  ASSERT_TRUE(b.ok()) << b.error();
+  EXPECT_EQ(b->unit_model, UnitModelKind::kBinned);
+  EXPECT_EQ(b->bins, 16);
+  auto n = BundleConfig::FromText("m", "bins=40 unit_model=binned");
+  ASSERT_TRUE(n.ok()) << n.error();
+  EXPECT_EQ(n->bins, 40);
+}
 
 TEST(BundleConfig, EveryNumericKeyRejectsNonFiniteAndOutOfRangeValues) {
   for (const std::string& key : BundleConfig::Keys()) {
@@ -121,7 +141,8 @@ TEST(BundleConfig, KeysListsEveryDocumentedKey) {
                         "G_A",           "eps_L",
                         "ref_length",    "merge_temperature",
                         "series",        "parallel",
-                        "series_spring"}) {
+                        "series_spring", "unit_model",
+                        "bins"}) {
     EXPECT_NE(std::find(keys.begin(), keys.end(), k), keys.end()) << k;
   }
 }

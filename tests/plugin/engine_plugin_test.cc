@@ -246,6 +246,12 @@ TEST(EnginePlugin, CompileErrorNamesActuatorKeyAndValue) {
        bench("", "joint=\"load_cell\""),
        {"biceps", "joint='load_cell'", "must act on a tendon"}},
       {"gear", bench("", "tendon=\"bundle\"", "gear=\"-2\""), {"biceps", "gear=-2", "must be > 0"}},
+      {"bad unit model",
+       bench(ConfigXml("unit_model", "tabulated")),
+       {"biceps", "unit_model=tabulated", "exact, binned"}},
+      {"bins without binned",
+       bench(ConfigXml("bins", "8")),
+       {"biceps", "bins=8", "is for unit_model=binned"}},
   };
   for (const BadCase& c : cases) {
     SCOPED_TRACE(c.label);
@@ -306,6 +312,31 @@ std::string SwitchingBench() {
   return BenchXml(
       {ConfigXml("units", "60") + ConfigXml("seed", "11") + ConfigXml("broadcast_period", "0.01"),
        "bundle", "tendon=\"bundle\"", "", "Euler", false});
+}
+
+// unit_model=binned from MJCF: the plugin reads both keys, and after the bundle's merge passes
+// (every 8 steps) at most `bins` cohorts remain under switching in both directions, where the
+// exact model keeps more.
+TEST(EnginePlugin, BinnedUnitModelFromMjcfBoundsTheCohorts) {
+  auto most_cohorts = [](const std::string& keys) {
+    ModelPtr m = MustLoad(BenchXml({ConfigXml("units", "60") + ConfigXml("seed", "11") +
+                                        ConfigXml("broadcast_period", "0.01") + keys,
+                                    "bundle", "tendon=\"bundle\"", "", "Euler", false}));
+    if (m == nullptr) return -1;
+    DataPtr d(mj_makeData(m.get()));
+    const int block = SmaBundle::StateSize(60);
+    int most = 0;
+    for (int i = 0; i < 3000; ++i) {
+      d->ctrl[0] = Schedule(d->time, 0);
+      mj_step(m.get(), d.get());
+      if (i % 8 == 7) {  // just after a merge pass (the bundle's 8th, 16th, ... update)
+        most = std::max(most, static_cast<int>(Block(m.get(), d.get(), 0, 0, block)[9]));
+      }
+    }
+    return most;
+  };
+  EXPECT_GT(most_cohorts(""), 6);
+  EXPECT_EQ(most_cohorts(ConfigXml("unit_model", "binned") + ConfigXml("bins", "6")), 6);
 }
 
 // (c) mj_copyData mid-run forks the run: both continuations are bit-identical, including a
