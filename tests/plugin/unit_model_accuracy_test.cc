@@ -130,7 +130,7 @@ TEST(UnitModelAccuracy, BinnedModelStaysWithinItsBand) {
 // so the bundle is the reference but for the order of the force's sum.
 TEST(UnitModelAccuracy, Fig4StepIsExactInBothModels) {
   for (const std::string model : {"", " unit_model=binned bins=2"}) {
-    for (const std::string units : {std::string("units=60"), std::string(kElbowUnit)}) {
+    for (const std::string& units : {std::string("units=60"), std::string(kElbowUnit)}) {
       const Errors e = Compare(units + model, 32, Regime::kFig4Step);
       EXPECT_LE(e.force_units, 1e-9) << units << model;
       EXPECT_LE(e.mean_temp_k, 1e-9) << units << model;
@@ -153,7 +153,9 @@ TEST(UnitModelAccuracy, BinnedBoundsTheCohortsAndIsExactWithRoom) {
     b->Reset(s->data(), 11, x);
     *most_before_broadcast = 0;
     for (long i = 0; i < 60000; ++i) {
-      if (i % 500 == 0) ASSERT_TRUE(b->Broadcast(s->data(), 0.1, 0.1, x).ok());
+      if (i % 500 == 0) {
+        ASSERT_TRUE(b->Broadcast(s->data(), 0.1, 0.1, x).ok());
+      }
       b->Advance(s->data(), x, 1e-3);
       if (i % 500 == 499) {
         *most_before_broadcast = std::max(*most_before_broadcast, b->NumCohorts(s->data()));
@@ -187,7 +189,9 @@ TEST(UnitModelAccuracy, BinnedKeepsFailureModesApart) {
   b->Reset(s.data(), 5, x);
   std::vector<int> mode(80, 0);
   for (long i = 0; i < 30000; ++i) {
-    if (i % 500 == 0) ASSERT_TRUE(b->Broadcast(s.data(), 0.3, 0.3, x).ok());
+    if (i % 500 == 0) {
+      ASSERT_TRUE(b->Broadcast(s.data(), 0.3, 0.3, x).ok());
+    }
     b->Advance(s.data(), x, 1e-3);
     int open = 0, stuck = 0;
     for (int u = 0; u < 80; ++u) {
@@ -196,8 +200,12 @@ TEST(UnitModelAccuracy, BinnedKeepsFailureModesApart) {
       mode[u] = now;
       open += now == 1;
       stuck += now == 2;
-      if (now == 1) ASSERT_FALSE(b->UnitOn(s.data(), u));
-      if (now == 2) ASSERT_TRUE(b->UnitOn(s.data(), u));
+      if (now == 1) {
+        ASSERT_FALSE(b->UnitOn(s.data(), u));
+      }
+      if (now == 2) {
+        ASSERT_TRUE(b->UnitOn(s.data(), u));
+      }
       const double scale = b->UnitForceScale(s.data(), u);
       ASSERT_TRUE(scale >= 0.8 && scale <= 1) << scale;
     }
