@@ -101,15 +101,16 @@ PredictedStep PredictStep(const JointDynamics& joint, const ActuatorResponse& ac
   PredictedStep out;
   std::vector<double> t_fine, y_fine;
   // The step response m sampling periods and s + 1/2 substeps after a change of the demand
-  // (at [s * instants + m]), tabulated once: the convolution below reads it (n + 1) times per
-  // substep.
+  // (at [m * kSubsteps + s]), tabulated once, and each instant's tensions over its substeps
+  // summed change by change (the same terms in the same order for every substep).
   std::vector<double> response(static_cast<size_t>(instants) * kSubsteps);
   for (int m = 0; m < instants; ++m) {
     for (int s = 0; s < kSubsteps; ++s) {
-      response[s * instants + m] = act.At((m * dT + (s + 0.5) * h) / actuator_slowdown);
+      response[m * kSubsteps + s] = act.At((m * dT + (s + 0.5) * h) / actuator_slowdown);
     }
   }
   std::vector<double> change;  // u[i] - u[i - 1], i >= 1
+  double tau[kSubsteps];
   for (int n = 0; n < instants; ++n) {
     const double e = -z[0];
     integral += e * dT;
@@ -118,12 +119,15 @@ PredictedStep PredictStep(const JointDynamics& joint, const ActuatorResponse& ac
     change.push_back(u[n + 1] - u[n]);
     out.time.push_back(n * dT);
     out.angle.push_back(z[0] + 1);
+    // Each change of the demand moves the tension along the bundle's step response.
+    std::fill(tau, tau + kSubsteps, u[0]);
+    for (int i = 1; i <= n + 1; ++i) {
+      const double c = change[i - 1];
+      const double* r = &response[static_cast<size_t>(n + 1 - i) * kSubsteps];
+      for (int s = 0; s < kSubsteps; ++s) tau[s] += c * r[s];
+    }
     for (int s = 0; s < kSubsteps; ++s) {
-      // Each change of the demand moves the tension along the bundle's step response.
-      const double* r = &response[static_cast<size_t>(s) * instants];
-      double tau = u[0];
-      for (int i = 1; i <= n + 1; ++i) tau += change[i - 1] * r[n + 1 - i];
-      z = dis.phi * z + dis.gam * tau;
+      z = dis.phi * z + dis.gam * tau[s];
       t_fine.push_back(n * dT + (s + 1) * h);
       y_fine.push_back(z[0] + 1);
     }
