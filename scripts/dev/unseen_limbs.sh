@@ -6,16 +6,22 @@
 # kept and tabled (settled steps, worst overshoot, NEES, count within band, warnings, datasheet
 # limits, run and identification time).
 # Usage: scripts/dev/unseen_limbs.sh OUT_DIR [SEEDS] [CASE...]   (SEEDS like 601-603)
-# Cases: arm26_elbow arm26_all myoelbow2_all myolegs_ankle (default: all four).
+# Cases (default: all): arm26_elbow (EF, EE; shoulder locked), arm26_all (six bundles, both
+# joints), arm26_all_f150 (the same at --force 150: every bundle of 0.127 mm wire, none of the
+# 0.51 mm wire F0 gives SF and BF), myoelbow2_all (MyoSuite's 2-dof elbow, six bundles, shoulder
+# and elbow driven), myoelbow2_elbow (the same, shoulder locked), myolegs_ankle (OSL legs model,
+# left ankle: soleus and tibialis anterior, subtalar locked), myolegs_ankle_pinned (the same with
+# the pelvis held by a hand edit).
 # arm26.xml is taken from the mujoco-mjx wheel on PyPI (mujoco/mjx/test_data/actuator/arm26.xml;
 # the mujoco wheel has no model/ folder), downloaded to a temporary folder; ARM26=PATH skips that.
 # MyoSuite's models are used where myo-sim 0.2.3 installed them (.venv), never copied.
+# About 15 min on one core (the legs model's two identifications take 7-8 min of it).
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 OUT=$(mkdir -p "$1" && cd "$1" && pwd)
 SEEDS=${2:-601-603}
 shift $(($# < 2 ? $# : 2))
-CASES=${*:-arm26_elbow arm26_all myoelbow2_all myolegs_ankle}
+CASES=${*:-arm26_elbow arm26_all arm26_all_f150 myoelbow2_all myoelbow2_elbow myolegs_ankle myolegs_ankle_pinned}
 ROOT=$PWD
 R=$ROOT/build/src/cli/recruit
 PY=$ROOT/.venv/bin/python
@@ -28,6 +34,10 @@ if [ -z "${ARM26:-}" ]; then
   unzip -q -o -j "$TMP"/mujoco_mjx-3.17.0-*.whl mujoco/mjx/test_data/actuator/arm26.xml -d "$OUT"
   ARM26=$OUT/arm26.xml
 fi
+
+# Identified filter models go to OUT (RECRUIT_MODEL_CACHE), so that the first run of each case
+# and dT identifies them, as a new user's does, and the table's identification time is real.
+export RECRUIT_MODEL_CACHE=${RECRUIT_MODEL_CACHE:-$OUT/identified}
 
 # A stand-in for `recruit` that eval_tasks.py runs: it runs the real one and keeps each run's
 # summary, stderr and wall time (identification included) under OUT/runs/.
@@ -68,13 +78,38 @@ for c in $CASES; do
       attach arm26_elbow_nolr "$ARM26" --muscles EF,EE --lock shoulder || true
       attach arm26_elbow "$ARM26" --muscles EF,EE --lock shoulder --lengthrange-from-joints ;;
     arm26_all) attach arm26_all "$ARM26" --muscles all ;;
+    arm26_all_f150) attach arm26_all_f150 "$ARM26" --muscles all --force 150 ;;
     myoelbow2_all)
       attach myoelbow2_all "$M/legacy/elbow/myoelbow_2dof6muscles.xml" --muscles all ;;
+    myoelbow2_elbow)
+      attach myoelbow2_elbow "$M/legacy/elbow/myoelbow_2dof6muscles.xml" --muscles all \
+        --lock r_shoulder_elev ;;
     myolegs_ankle)
       # The left (biological) ankle of the OSL legs model: soleus and tibialis anterior, the
       # subtalar joint they also cross held.
       attach myolegs_ankle "$M/legacy/osl/myolegs_osl.xml" --muscles soleus_l,tibant_l \
         --lock subtalar_angle_l ;;
+    myolegs_ankle_pinned)
+      # The same with the pelvis held (a hand edit attach cannot make: --lock takes hinges and
+      # slides only): the root free joint and the keyframes deleted through mjSpec, else the
+      # body falls and the ankle is stepped lying on the floor.
+      attach myolegs_ankle "$M/legacy/osl/myolegs_osl.xml" --muscles soleus_l,tibant_l \
+        --lock subtalar_angle_l
+      (cd "$OUT" && $PY - "$ROOT/build/plugin/librecruit_sma.so" <<'PIN'
+import json, sys
+import mujoco
+mujoco.mj_loadPluginLibrary(sys.argv[1])
+s = mujoco.MjSpec.from_file("myolegs_ankle.xml")
+s.delete(s.joint("root"))
+for k in list(s.keys):
+    s.delete(k)
+s.compile()
+open("myolegs_ankle_pinned.xml", "w").write(s.to_xml())
+t = json.load(open("myolegs_ankle_task.json"))
+t["model"], t["name"] = "myolegs_ankle_pinned.xml", "myolegs_ankle_pinned_steps"
+json.dump(t, open("myolegs_ankle_pinned_task.json", "w"), indent=2)
+PIN
+      ) ;;
     *) echo "unknown case $c" >&2; exit 2 ;;
   esac
   python3 scripts/dev/eval_tasks.py --recruit "$OUT/runs/recruit_keep.sh" --seeds "$SEEDS" \
@@ -88,7 +123,7 @@ out, seeds, cases = sys.argv[1], sys.argv[2], sys.argv[3:]
 lo, hi = (int(x) for x in seeds.split("-"))
 print("| case | bundles | dT (s) | settled | worst overshoot | NEES | count within band (min) "
       "| within 3 units (min) | peak T (C) / stress (MPa) | limits exceeded | summary warnings "
-      "| run s (sim) | identification s |")
+      "| run s (sim) | identification s (first run) |")
 print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
 for c in cases:
     for dT in ("1", "0.5"):
@@ -130,8 +165,28 @@ for c in cases:
             f'{a} {min(x["mean_nees"] for x in v):.2f}..{max(x["mean_nees"] for x in v):.2f}'
             f'/{min(x["estimator_within_band"] for x in v):.3f}' for a, v in per.items()))
 print()
+print("Per joint (settled steps, worst overshoot, tracking RMSE range):")
+for c in cases:
+    for dT in ("1", "0.5"):
+        per = {}
+        for f in sorted(glob.glob(os.path.join(out, "runs", f"{c}_task_dT{dT}_s*.json"))):
+            for j in json.load(open(f))["joints"]:
+                per.setdefault(j["joint"], []).append(j)
+        print(f"  {c} dT {dT}: " + ", ".join(
+            f'{n} {round(sum(j["settled_fraction"] * j["num_steps"] for j in v))}/'
+            f'{sum(j["num_steps"] for j in v)} {100*max(j["max_overshoot"] for j in v):.0f} % '
+            f'{min(j["tracking_rmse"] for j in v)*57.2958:.1f}..'
+            f'{max(j["tracking_rmse"] for j in v)*57.2958:.1f} deg' for n, v in per.items()))
+times = sorted(glob.glob(os.path.join(out, "runs", "*.time")))
+if times:
+    print()
+    print("Wall time per run, identification included (s): " + ", ".join(
+        f'{os.path.basename(t)[:-5]} {float(open(t).read()):.1f}' for t in times))
+print()
 print("Designs (recruit attach --report):")
 for c in cases:
+    if not os.path.exists(os.path.join(out, f"{c}_report.json")):
+        continue
     rep = json.load(open(os.path.join(out, f"{c}_report.json")))
     for x in rep["bundles"]:
         k = {key: float(v) for key, v in x["config"].items()}  # MJCF config values: text
