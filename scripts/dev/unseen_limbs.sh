@@ -15,7 +15,7 @@
 # arm26.xml is taken from the mujoco-mjx wheel on PyPI (mujoco/mjx/test_data/actuator/arm26.xml;
 # the mujoco wheel has no model/ folder), downloaded to a temporary folder; ARM26=PATH skips that.
 # MyoSuite's models are used where myo-sim 0.2.3 installed them (.venv), never copied.
-# About 15 min on one core (the legs model's two identifications take 7-8 min of it).
+# About 15 min on one core (the legs model's two identifications take 6.5 min of it).
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 OUT=$(mkdir -p "$1" && cd "$1" && pwd)
