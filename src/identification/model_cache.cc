@@ -12,12 +12,13 @@
 namespace recruit::identification {
 namespace fs = std::filesystem;
 
-std::string ModelFileName(const nlohmann::json& plant, double dT, int num_states) {
+std::string ModelFileName(const nlohmann::json& plant, double dT, int num_states, bool limb) {
   char dt[32];
   std::snprintf(dt, sizeof dt, "%g", dT);
+  const std::string limb_hash = limb ? plant.value("limb", std::string()) : std::string();
   return plant.value("actuator", std::string("bundle")) + "_" +
-         plant.value("hash", std::string("unknown")) + "_dt" + dt + "_m" +
-         std::to_string(num_states) + ".json";
+         plant.value("hash", std::string("unknown")) + (limb_hash.empty() ? "" : "_" + limb_hash) +
+         "_dt" + dt + "_m" + std::to_string(num_states) + ".json";
 }
 
 std::vector<std::string> ModelSearchPath() {
@@ -60,10 +61,17 @@ Result<std::string> FindOrIdentifyModel(const ModelRequest& r, bool identify, st
   std::error_code ec;
   // The folders before the cache hold models put there on purpose: taken as they are. The
   // cache's were made on demand: only one this build would make is used.
+  // Those folders may also hold a model named without the limb (made for the bundle's units on
+  // any limb): in each, taken when none of this limb's is there. The cache's are this limb's.
+  const std::string any_limb = ModelFileName(r.plant, r.dT, r.num_states, /*limb=*/false);
   for (size_t i = 0; i < dirs.size(); ++i) {
-    const fs::path f = fs::path(dirs[i]) / name;
-    if (!fs::exists(f, ec)) continue;
-    if (i + 1 < dirs.size() || MadeByThisIdentification(f.string())) return f.string();
+    const bool cache = i + 1 == dirs.size();
+    for (const std::string& n : {name, any_limb}) {
+      const fs::path f = fs::path(dirs[i]) / n;
+      if (!fs::exists(f, ec)) continue;
+      if (!cache) return f.string();
+      if (n == name && MadeByThisIdentification(f.string())) return f.string();
+    }
   }
   if (!identify) {
     return Error{"no identified model " + name + " on the model search path (" + dirs.front() +

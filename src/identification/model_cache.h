@@ -1,6 +1,7 @@
 // Where the estimator's identified models are found, and made when missing: a model is keyed
-// by the plant it describes (its unit's hash), the bundle's actuator, dT and its number of states,
-// e.g. "flexor_3f2a9c0d12ab45ef_dt0.5_m20.json". Looked up, in order, in the folders of
+// by the plant it describes (its unit's hash and the limb it is identified on, PlantRecord's
+// "limb"), the bundle's actuator, dT and its number of states, e.g.
+// "flexor_3f2a9c0d12ab45ef_0c1d2e3f4a5b6c7d_dt0.5_m20.json". Looked up, in order, in the folders of
 // RECRUIT_MODEL_PATH (colon-separated), the shipped models/identified/ (under the data folder
 // the program set, common/data_path.h; none when it set none) and the user's cache
 // (RECRUIT_MODEL_CACHE, else $XDG_CACHE_HOME/recruit/models, else ~/.cache/recruit/models).
@@ -20,8 +21,11 @@
 
 namespace recruit::identification {
 
-// "<actuator>_<hash>_dt<dT>_m<states>.json" for a PlantRecord `plant`.
-std::string ModelFileName(const nlohmann::json& plant, double dT, int num_states);
+// "<actuator>_<hash>_<limb>_dt<dT>_m<states>.json" for a PlantRecord `plant`; without the limb
+// part when `limb` is false or the record has none. The folders before the cache may hold a
+// model named without it (one made for the bundle's units on any limb): used when none of this
+// limb's is there. The cache's are always the limb's.
+std::string ModelFileName(const nlohmann::json& plant, double dT, int num_states, bool limb = true);
 
 // The folders searched, in order; the last is the cache.
 std::vector<std::string> ModelSearchPath();

@@ -4,8 +4,18 @@
 
 #include <cstdio>
 #include <fstream>
+#include <iterator>
+
+#include "common/content_hash.h"
 
 namespace recruit::identification {
+
+std::string LimbHash(const std::string& model_path) {
+  std::ifstream in(model_path, std::ios::binary);
+  if (!in) return "";
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  return ContentHash().Add(bytes).Hex();
+}
 
 nlohmann::json PlantRecord(const sma::SmaHost& host, int b, const std::string& model_path) {
   const nlohmann::json unit = control::UnitRecord(host.bundle(b).config().unit);
@@ -18,7 +28,8 @@ nlohmann::json PlantRecord(const sma::SmaHost& host, int b, const std::string& m
           {"num_units", host.num_units(b)},
           {"settled_unit_force_N", host.SettledUnitForce(b)},
           {"unit", unit},
-          {"hash", control::PlantHash(unit)}};
+          {"hash", control::PlantHash(unit)},
+          {"limb", LimbHash(model_path)}};
 }
 
 Result<LoadedBundle> LoadBundle(const std::string& model_path, const std::string& actuator) {

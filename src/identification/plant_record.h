@@ -17,8 +17,14 @@
 namespace recruit::identification {
 
 // {"model": ..., "actuator": ..., "tendon": ..., "num_units": N, "settled_unit_force_N": f,
-//  "unit": {key: value, ...}, "hash": "16 hex digits"}.
+//  "unit": {key: value, ...}, "hash": "16 hex digits", "limb": "16 hex digits"}. "limb" is
+// LimbHash(model_path): identification runs on the limb (its tendon's lengths and poses), so the
+// model cache keys its files by it too.
 nlohmann::json PlantRecord(const sma::SmaHost& host, int bundle, const std::string& model_path);
+
+// FNV-1a 64 (common/content_hash.h) of the MJCF file's bytes (not of the files it includes or
+// the meshes it names), "" when it cannot be read.
+std::string LimbHash(const std::string& model_path);
 
 // An MJCF model loaded with MuJoCo, its SMA host and the index of one of its bundles.
 struct LoadedBundle {
