@@ -120,12 +120,13 @@ task: also write a starter task (JSON). report: also write the report (JSON). si
 only, write nothing but the report. force: peak force of every bundle (N) instead of each
 muscle's F0. lengthrange_from_joints: set the lengthrange of other muscles whose MuJoCo
 computation fails from the joint ranges. lock: joints held at their reference value in the written
-model (a joint equality each) and not driven by the starter task.
+model (a joint equality each) and not driven by the starter task; the muscles kept beside the
+bundles then get the lengthrange MuJoCo computes on the free limb, written explicitly.
 max_time_constant, stroke_use, units_per_holding_force: the sizing options of the same names
 (`recruit attach --help`, docs/sma-units.md "Sizing a bundle").
 
 Returns the report as a dict (what `--report` writes: model, output, task, changes, warnings,
-lengthranges_from_joints, bundles). Raises ValueError for bad input and OSError when a file
+lengthranges_from_joints, lengthranges_without_locks, bundles). Raises ValueError for bad input and OSError when a file
 cannot be read or written, with the CLI's message; nothing is written on error.
 docs/howto-own-model.md has the guide. The GIL is released meanwhile.)doc");
 }

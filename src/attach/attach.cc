@@ -201,12 +201,17 @@ Result<AttachReport> Attach(const AttachOptions& o) {
           s, {b.name, b.instance, b.sensor, b.design.gear, b.design.ConfigPairs()});
       if (!ok.ok()) return Error{ok.error(), ok.code()};
     }
-    Status locked = AddLockEqualities(s, report.locks);
-    if (!locked.ok()) return locked.failure();
     RebaseAssetDirs(s, o.model, o.output);
     auto fixes = CheckLengthRanges(s, o.lengthrange_from_joints);
     if (!fixes.ok()) return Error{"'" + o.model + "': " + fixes.error(), fixes.code()};
     report.lengthranges = std::move(fixes).value();
+    if (!report.locks.empty()) {  // the kept muscles' ranges are the free limb's, not the locked
+      auto frozen = FreezeLengthRanges(s);
+      if (!frozen.ok()) return Error{"'" + o.model + "': " + frozen.error(), frozen.code()};
+      report.lengthranges_unlocked = std::move(frozen).value();
+    }
+    Status locked = AddLockEqualities(s, report.locks);
+    if (!locked.ok()) return locked.failure();
     auto compiled = CompileSpec(s);
     if (!compiled.ok())
       return Error{"the edited model does not compile: " + compiled.error(), compiled.code()};

@@ -54,6 +54,9 @@ struct AttachReport {
   std::string model, output, task;
   std::vector<BundleReport> bundles;
   std::vector<LengthRangeFix> lengthranges;  // other muscles' ranges set from the joints
+  // With --lock: the other muscles' ranges as MuJoCo computes them on the free limb, written
+  // before the locks (lengthrange.h, FreezeLengthRanges).
+  std::vector<LengthRangeFix> lengthranges_unlocked;
   std::vector<JointLock> locks;
   std::vector<std::string> changes;  // one line per edit
   std::vector<std::string> warnings;

@@ -87,4 +87,22 @@ Result<std::vector<LengthRangeFix>> CheckLengthRanges(mjSpec* spec, bool apply) 
   return fixes;
 }
 
+Result<std::vector<LengthRangeFix>> FreezeLengthRanges(mjSpec* spec) {
+  auto copy = CopySpec(spec);
+  if (!copy.ok()) return Error{copy.error(), copy.code()};
+  auto m = CompileSpec(copy->get());
+  if (!m.ok()) return Error{m.error(), m.code()};
+  const std::vector<std::string> names = ActuatorNames(spec);
+  std::vector<LengthRangeFix> frozen;
+  for (int a = 0; a < static_cast<int>(names.size()); ++a) {
+    mjsActuator* act = FindActuator(spec, names[a]);
+    const double lo = (*m)->actuator_lengthrange[2 * a], hi = (*m)->actuator_lengthrange[2 * a + 1];
+    if (act == nullptr || act->lengthrange[0] < act->lengthrange[1] || !(hi > lo)) continue;
+    act->lengthrange[0] = lo;
+    act->lengthrange[1] = hi;
+    frozen.push_back({names[a], lo, hi});
+  }
+  return frozen;
+}
+
 }  // namespace recruit::attach

@@ -23,4 +23,11 @@ struct LengthRangeFix {
 // errors are returned as they are.
 Result<std::vector<LengthRangeFix>> CheckLengthRanges(mjSpec* spec, bool apply);
 
+// Writes into `spec` the lengthrange MuJoCo computes for each actuator that has none set (the
+// muscles), from a compiled copy of `spec` as it is, and returns them. Called before joints
+// are locked: MuJoCo would otherwise compute them on the locked limb at every load (a kept
+// muscle's range a fraction of a millimetre wide, its passive force kilonewtons at a small
+// drift, and wrong once the lock is removed).
+Result<std::vector<LengthRangeFix>> FreezeLengthRanges(mjSpec* spec);
+
 }  // namespace recruit::attach

@@ -43,6 +43,12 @@ std::vector<std::string> ChangeLines(const AttachReport& r, const mjSpec* spec) 
     lines.push_back("lengthrange of '" + f.actuator + "' set from the joint ranges: " +
                     F("%.4f", f.lo) + " " + F("%.4f", f.hi) + " m");
   }
+  for (const LengthRangeFix& f : r.lengthranges_unlocked) {
+    lines.push_back("lengthrange of '" + f.actuator +
+                    "' written as MuJoCo computes it without the "
+                    "locks: " +
+                    F("%.4f", f.lo) + " " + F("%.4f", f.hi) + " m");
+  }
   const char* meshdir = mjs_getString(spec->compiler.meshdir);
   if (meshdir != nullptr && meshdir[0] != '\0') {
     lines.push_back(std::string("compiler meshdir/texturedir now relative to the output: ") +
@@ -99,6 +105,10 @@ nlohmann::json ReportJson(const AttachReport& r) {
   j["lengthranges_from_joints"] = nlohmann::json::array();
   for (const LengthRangeFix& f : r.lengthranges) {
     j["lengthranges_from_joints"].push_back({{"actuator", f.actuator}, {"range", {f.lo, f.hi}}});
+  }
+  j["lengthranges_without_locks"] = nlohmann::json::array();
+  for (const LengthRangeFix& f : r.lengthranges_unlocked) {
+    j["lengthranges_without_locks"].push_back({{"actuator", f.actuator}, {"range", {f.lo, f.hi}}});
   }
   j["bundles"] = nlohmann::json::array();
   for (const BundleReport& b : r.bundles) {

@@ -607,6 +607,38 @@ TEST(StarterTask, RunsThroughTheSeveralJointLoop) {
 // joints that still move: the elbow-only tendons then have no excursion, and the biarticular
 // flexor's range is its length swept over the shoulder alone (a dense sweep with mj_tendon on
 // the original model, the elbow at its reference).
+// A muscle kept beside the bundles keeps the lengthrange of the free limb: MuJoCo computing it at
+// load with the lock active would make it a fraction of a millimetre wide. Reference: MuJoCo's
+// own computation on the original model (the bundles' passive pull moves it a little).
+TEST(Lock, KeptMusclesKeepTheFreeLimbsLengthRange) {
+  const std::string dir = TempDir("lock_kept_muscles");
+  AttachOptions o;
+  o.model = kSrc + "/models/arm2j_muscle.xml";
+  o.muscles = {"EF", "EE"};
+  o.output = dir + "/out.xml";
+  o.lock = {"shoulder"};
+  auto r = Attach(o);
+  ASSERT_TRUE(r.ok()) << r.error();
+  ModelPtr original = Load(o.model);
+  ModelPtr written = Load(o.output);
+  ASSERT_TRUE(original && written);
+  int kept = 0;
+  for (const char* name : {"SF", "SE", "BF", "BE"}) {
+    const int a0 = mj_name2id(original.get(), mjOBJ_ACTUATOR, name);
+    const int a1 = mj_name2id(written.get(), mjOBJ_ACTUATOR, name);
+    ASSERT_GE(a0, 0);
+    ASSERT_GE(a1, 0);
+    const double lo = original->actuator_lengthrange[2 * a0];
+    const double hi = original->actuator_lengthrange[2 * a0 + 1];
+    ASSERT_GT(hi - lo, 0.01) << name;  // m: the free limb's
+    EXPECT_NEAR(written->actuator_lengthrange[2 * a1], lo, 0.02 * (hi - lo)) << name;
+    EXPECT_NEAR(written->actuator_lengthrange[2 * a1 + 1], hi, 0.02 * (hi - lo)) << name;
+    ++kept;
+  }
+  EXPECT_EQ(kept, 4);
+  EXPECT_EQ(r->lengthranges_unlocked.size(), 4u);
+}
+
 TEST(Lock, HoldsTheJointAndSizesOverTheOthers) {
   auto a = AttachArmWithTask("lock_model", {"elbow"});
   ASSERT_TRUE(a.report.ok()) << a.report.error();
