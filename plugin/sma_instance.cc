@@ -323,6 +323,16 @@ std::vector<TendonFit> SmaInstance::Fit(const mjModel* m) const {
   return fits;
 }
 
+std::string ClipEntries(const std::string& s, size_t max) {
+  if (s.size() <= max) return s;
+  size_t cut = std::string::npos;
+  for (const char* sep : {"; ", ", "}) {
+    const size_t at = s.rfind(sep, max);
+    if (at != std::string::npos && at > 0 && (cut == std::string::npos || at > cut)) cut = at;
+  }
+  return cut == std::string::npos ? s.substr(0, max) + "..." : s.substr(0, cut + 2) + "...";
+}
+
 std::string SmaInstance::FitWarning(const mjModel* m, int k, const TendonFit& f) const {
   if (f.fits() && f.num_jumps == 0) return "";
   const SmaActuator& a = actuators_[k];
@@ -330,12 +340,12 @@ std::string SmaInstance::FitWarning(const mjModel* m, int k, const TendonFit& f)
   // Short: mj_loadXML keeps about 500 characters of warnings for all bundles together.
   std::string w = "recruit.sma actuator '" + ActuatorName(m, a.actuator) + "': ";
   if (f.num_jumps > 0) {
-    w += "tendon path jumps at " + f.jumps.substr(0, 60) + ": usable " +
-         f.joint_ranges.substr(0, 40) + ";";
+    w += "tendon path jumps at " + ClipEntries(f.jumps, 60) + ": usable " +
+         ClipEntries(f.joint_ranges, 48) + ";";
     if (f.fits()) return w;
     w += " ";
   }
-  w += "tendon excursion " + mm(f.excursion()) + " mm over " + f.joint_ranges.substr(0, 40) +
+  w += "tendon excursion " + mm(f.excursion()) + " mm over " + ClipEntries(f.joint_ranges, 48) +
        (f.gear != 1 ? " (gear " + Fmt("%g", f.gear) + ")" : "") + ", unit stroke " + mm(f.stroke) +
        " mm, extension " + mm(f.stretch_min) + ".." + mm(f.stretch_max) + " mm:";
   if (f.blocks()) {

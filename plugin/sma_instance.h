@@ -155,4 +155,9 @@ int SmaPluginSlot();
 // True when instance `instance` of `m` is a recruit.sma instance.
 bool IsSmaInstance(const mjModel* m, int instance);
 
+// `s` cut to at most `max` characters at its last "; " or ", " (whole entries, then "..."), so a
+// warning never cuts a joint's range inside its number or unit; cut at `max` only when no
+// separator comes before it.
+std::string ClipEntries(const std::string& s, size_t max);
+
 }  // namespace recruit::sma

@@ -13,6 +13,7 @@
 
 #include "common/rng.h"
 #include "plugin/sma_host.h"
+#include "plugin/sma_instance.h"
 #include "tests/plugin/mujoco_util.h"
 
 namespace recruit::sma {
@@ -374,4 +375,14 @@ TEST(FitCheck, FindsAnExtremeInsideTheRangeOfOneJoint) {
 }
 
 }  // namespace
+// The fit warning's lists are cut between entries, never inside a joint's range.
+TEST(FitCheck, WarningListsAreCutBetweenEntries) {
+  const std::string ranges = "shoulder 0..111.8 deg, elbow 0..114.4 deg, wrist -70..70 deg";
+  EXPECT_EQ(ClipEntries(ranges, 100), ranges);
+  EXPECT_EQ(ClipEntries(ranges, 48), "shoulder 0..111.8 deg, elbow 0..114.4 deg, ...");
+  EXPECT_EQ(ClipEntries(ranges, 30), "shoulder 0..111.8 deg, ...");
+  EXPECT_EQ(ClipEntries("shoulder at 1.2 deg; elbow at 114.4 deg", 25), "shoulder at 1.2 deg; ...");
+  EXPECT_EQ(ClipEntries("averyveryverylongjointname", 10), "averyveryv...");
+}
+
 }  // namespace recruit::sma
