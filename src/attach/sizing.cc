@@ -165,9 +165,13 @@ Result<BundleDesign> SizeBundle(const SizingInput& in, const SizingLimits& limit
   // that wire cools slower than max_time_constant: then the thickest wire that does not, with up
   // to max_parallel wires per segment and max_units_fast units (more wires, the bandwidth kept).
   const std::vector<double>& stock = StockDiameters();
-  bool chosen = false, fast_found = false;
+  bool chosen = false, fast_found = false, many_found = false;
   sma::UnitParams fast;  // the thickest fast-enough design so far
   int fast_units = 0;
+  // The same within max_units_resolution units, for a force no design of max_units_fast units
+  // makes fast enough (a slow bundle is the last resort).
+  sma::UnitParams many;
+  int many_units = 0;
   for (std::size_t i = 0; i < stock.size(); ++i) {
     auto wire = WireFor(stock[i], length, series, out.gear, in, limits);
     if (!wire.ok()) {
@@ -191,9 +195,19 @@ Result<BundleDesign> SizeBundle(const SizingInput& in, const SizingLimits& limit
       fast_units = (wires + parallel_fast - 1) / parallel_fast;
       fast_found = true;
     }
+    const int parallel_many =
+        (wires + limits.max_units_resolution - 1) / limits.max_units_resolution;
+    if (parallel_many <= limits.max_parallel && fast_enough) {
+      many = p;
+      many.parallel = parallel_many;
+      many_units = (wires + parallel_many - 1) / parallel_many;
+      many_found = true;
+    }
     if (parallel <= 2 || i + 1 == stock.size()) {
       if (fast_found) {
         out.unit = fast, out.units = fast_units;
+      } else if (many_found) {
+        out.unit = many, out.units = many_units;
       } else {
         out.unit = p, out.units = units;
       }
@@ -227,6 +241,14 @@ Result<BundleDesign> SizeBundle(const SizingInput& in, const SizingLimits& limit
   out.power = wires * u->HeatingPower(true, 0.0);
   out.time_constant = u->time_constant();
   out.cooling_time = datasheet.cooling_time;
+  if (out.time_constant > limits.max_time_constant) {
+    out.notes.push_back("thermal time constant " + Num(out.time_constant) + " s, above " +
+                        Num(limits.max_time_constant) +
+                        " s (--max-time-constant): no stock wire that cools fast enough makes " +
+                        Num(in.peak_force) + " N within " + std::to_string(limits.max_parallel) +
+                        " wires per unit and " + std::to_string(limits.max_units_resolution) +
+                        " units; the loop will be slow (a lower --force, or a larger gear)");
+  }
   return out;
 }
 

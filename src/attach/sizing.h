@@ -29,7 +29,9 @@ struct SizingLimits {
   // s: the slowest unit thermal time constant chosen when a thinner wire can meet the force with
   // at most max_parallel wires per segment (0.15 mm wire: 2.0 s; the bundle's bandwidth).
   double max_time_constant = 2.0;
-  int max_units_fast = 300;          // units a bundle of such thinner wires may have
+  // Units a bundle of such thinner wires may have; when none within it is fast enough, up to
+  // max_units_resolution before a slower wire is taken (and said in the design's notes).
+  int max_units_fast = 300;
   double min_segment_length = 0.03;  // m
   // Resolution: at least this many units' force in the load the bundle holds
   // (SizingInput::holding_force), up to max_units_resolution units.
