@@ -202,7 +202,12 @@ Result<AttachReport> Attach(const AttachOptions& o) {
       if (!ok.ok()) return Error{ok.error(), ok.code()};
     }
     RebaseAssetDirs(s, o.model, o.output);
-    auto fixes = CheckLengthRanges(s, o.lengthrange_from_joints);
+    // Compiled before the locks: what the fit check says then is not the written model's (which
+    // is compiled and checked at the end, warnings and all).
+    auto fixes = [&] {
+      QuietMujocoWarnings quiet;
+      return CheckLengthRanges(s, o.lengthrange_from_joints);
+    }();
     if (!fixes.ok()) return Error{"'" + o.model + "': " + fixes.error(), fixes.code()};
     report.lengthranges = std::move(fixes).value();
     if (!report.locks.empty()) {  // the kept muscles' ranges are the free limb's, not the locked

@@ -90,6 +90,8 @@ Result<std::vector<LengthRangeFix>> CheckLengthRanges(mjSpec* spec, bool apply) 
 Result<std::vector<LengthRangeFix>> FreezeLengthRanges(mjSpec* spec) {
   auto copy = CopySpec(spec);
   if (!copy.ok()) return Error{copy.error(), copy.code()};
+  // Without the locks the bundles' fit check (plugin) warns of the joints they will hold.
+  QuietMujocoWarnings quiet;
   auto m = CompileSpec(copy->get());
   if (!m.ok()) return Error{m.error(), m.code()};
   const std::vector<std::string> names = ActuatorNames(spec);

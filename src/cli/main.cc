@@ -5,7 +5,9 @@
 
 #include <exception>
 #include <iostream>
+#include <mutex>
 #include <new>
+#include <set>
 #include <sstream>
 #include <string>
 
@@ -28,11 +30,23 @@ std::string VersionText() {
   return s.str();
 }
 
+// MuJoCo's warnings (the plugin's design and fit checks among them) on stderr, each text once
+// per process (a model compiled several times warns as often), and never into MUJOCO_LOG.TXT in
+// the working folder, which MuJoCo's default handler appends to: a command writes only its
+// outputs.
+void WarnOnce(const char* message) {
+  static std::mutex mutex;
+  static std::set<std::string> said;
+  std::lock_guard<std::mutex> lock(mutex);
+  if (said.insert(message).second) std::cerr << "WARNING: " << message << "\n";
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   using namespace recruit;
   InstallTempFileCleanupOnSignals();
+  mju_user_warning = WarnOnce;
   SetDataDir(RECRUIT_DATA_DIR_DEFAULT);  // models/identified/ of the tree it was built from
   CLI::App app{
       "Recruit: stochastic recruitment control of SMA muscle bundles in MuJoCo, with the "

@@ -241,6 +241,33 @@ TEST(Sizing, TheBandwidthRuleTradesHeatingPowerForTheTimeConstant) {
   EXPECT_GE(slow->force_mid, 900);
 }
 
+// A force no fast-enough wire makes within max_units_fast units takes up to max_units_resolution
+// of them before a slow wire; past that the slow design says so in its notes.
+TEST(Sizing, TheBandwidthRuleTakesMoreUnitsBeforeASlowWireAndSaysWhenItCannot) {
+  const SizingLimits limits;
+  auto slow_note = [](const BundleDesign& d) {
+    for (const std::string& n : d.notes) {
+      if (n.find("thermal time constant") != std::string::npos) return true;
+    }
+    return false;
+  };
+  SizingInput big{"b", 4000, 0.04, 0.1, 0.14, 0.12};
+  auto many = SizeBundle(big);
+  ASSERT_TRUE(many.ok()) << many.error();
+  EXPECT_LE(many->time_constant, limits.max_time_constant);
+  EXPECT_GT(many->units, limits.max_units_fast);
+  EXPECT_LE(many->units, limits.max_units_resolution);
+  EXPECT_LE(many->unit.parallel, limits.max_parallel);
+  EXPECT_GE(many->force_mid, 4000);
+  EXPECT_FALSE(slow_note(*many));
+  SizingInput huge{"b", 8000, 0.04, 0.1, 0.14, 0.12};
+  auto slow = SizeBundle(huge);
+  ASSERT_TRUE(slow.ok()) << slow.error();
+  EXPECT_GT(slow->time_constant, limits.max_time_constant);
+  EXPECT_GE(slow->force_mid, 8000);
+  EXPECT_TRUE(slow_note(*slow));
+}
+
 TEST(Sizing, MatchesForceWithinLimitsAndCoversTheStroke) {
   for (double force : {5.0, 40.0, 600.0}) {
     for (double excursion : {0.01, 0.03, 0.08}) {
@@ -611,6 +638,7 @@ TEST(StarterTask, RunsThroughTheSeveralJointLoop) {
 // load with the lock active would make it a fraction of a millimetre wide. Reference: MuJoCo's
 // own computation on the original model (the bundles' passive pull moves it a little).
 TEST(Lock, KeptMusclesKeepTheFreeLimbsLengthRange) {
+  sma::testing::WarningCapture quiet;  // the fit check may warn: not into MUJOCO_LOG.TXT
   const std::string dir = TempDir("lock_kept_muscles");
   AttachOptions o;
   o.model = kSrc + "/models/arm2j_muscle.xml";
