@@ -200,6 +200,14 @@ replay_errors)  # replay: bad log content 3, outputs that would replace an input
   expect 0 "$RECRUIT" replay --log r_replay.csv --task "$TASK" --seeds 3 --out o
   [ "$(ls o | wc -l)" -eq 3 ] || fail "outputs: $(ls o)"
   ;;
+mujoco_warnings)  # MuJoCo's warnings on stderr, each once, never into MUJOCO_LOG.TXT here
+  mkdir written
+  expect 0 "$RECRUIT" attach "$SRC/tests/attach/data/jump_arm.xml" --muscles all -o written/m.xml
+  [ "$(grep -c "^WARNING: recruit.sma actuator 'ext': tendon path jumps" err)" -eq 1 ] ||
+    fail "the fit warning not printed exactly once"
+  [ ! -e MUJOCO_LOG.TXT ] || fail "MUJOCO_LOG.TXT written in the working folder"
+  [ "$(ls | tr '\n' ' ')" = "err out written " ] || fail "files left: $(ls | tr '\n' ' ')"
+  ;;
 *)
   echo "unknown case $CASE"; exit 1 ;;
 esac
