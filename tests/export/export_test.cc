@@ -82,6 +82,7 @@ sim::Task LoadTask(const std::string& path) {
 const std::string kSteps = "models/tasks/isometric_steps.json";
 const std::string kArmHand = "tests/export/data/arm_reach_hold_hand.json";
 const std::string kPushHand = "tests/export/data/arm_push_hand.json";
+const std::string kLiftHand = "tests/export/data/arm_lift_hand.json";
 
 struct Case {
   std::string task;       // relative to the source tree
@@ -167,6 +168,7 @@ const std::vector<Case>& Cases() {
                                           {kSteps, "", 60},
                                           {kArmHand, "", 60},
                                           {kPushHand, "", 40},
+                                          {kLiftHand, "", 40},  // the payload changes at 20 s
                                           {kArmHand, "output", 40},
                                           {kArmHand, "kalman2", 40}};
   return cases;
