@@ -5,9 +5,16 @@
 #   2. 20 seeds of each at lambda = 0.2 (recruit sweep), and the claims checked on them;
 #   3. a dT x lambda sweep of output only and of the filter: stability map docs/img/sweep_*.png;
 #   4. the three arm tasks (seed 1): docs/img/repro_arm_*.png.
-# Usage: scripts/reproduce_paper.sh [OUT_DIR]   (default renders/out/repro; resumable)
+# Usage: scripts/reproduce_paper.sh [--arm] [OUT_DIR]   (default renders/out/repro; resumable)
+#   --arm: step 4 only (the arm tasks' figures, about 10 s; remake them after a change to the arm
+#   tasks or their loop).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+ARM_ONLY=0
+if [ "${1:-}" = --arm ]; then
+  ARM_ONLY=1
+  shift
+fi
 RECRUIT=${RECRUIT:-./build/src/cli/recruit}
 OUT=${1:-renders/out/repro}
 TASK=models/tasks/isometric_paper.json
@@ -17,6 +24,20 @@ FM=()
 [ -n "${FILTER_MODEL:-}" ] && FM=(--filter-model "$FILTER_MODEL")
 mkdir -p "$OUT" docs/img
 [ -x "$RECRUIT" ] || { echo "build first: bash scripts/build.sh" >&2; exit 1; }
+
+arm_figures() {
+  echo "== arm tasks (seed 1, the tasks' Kalman filter and self-tuned loop)"
+  for t in arm_reach_hold arm_lift arm_push; do
+    "$RECRUIT" simulate --task "models/tasks/$t.json" --seed 1 --out "$OUT" --csv-every 5
+    "$RECRUIT" plot --csv "$OUT/${t}_steps.csv" --summary "$OUT/${t}_summary.json" --out docs/img \
+      --name "repro_$t" --figure all --width 900 --height 640
+  done
+}
+if [ "$ARM_ONLY" = 1 ]; then
+  arm_figures
+  echo "done: $OUT, docs/img/repro_arm_*.png"
+  exit 0
+fi
 
 run() {  # run NAME ESTIMATOR DT
   local fm=()
@@ -72,10 +93,5 @@ echo "== dT x lambda sweeps (stability maps)"
 "$RECRUIT" plot --stability-map "$OUT/map_kalman/stability.dat" --out docs/img \
   --name sweep_stability_kalman --width 920 --height 420 \
   --title "isometric_paper, Kalman filter: mean step overshoot (%), ring = meets criterion"
-echo "== arm tasks (seed 1, the tasks' Kalman filter)"
-for t in arm_reach_hold arm_lift arm_push; do
-  "$RECRUIT" simulate --task "models/tasks/$t.json" --seed 1 --out "$OUT" --csv-every 5
-  "$RECRUIT" plot --csv "$OUT/${t}_steps.csv" --summary "$OUT/${t}_summary.json" --out docs/img \
-    --name "repro_$t" --figure all --width 900 --height 640
-done
+arm_figures
 echo "done: $OUT, docs/img/repro_*.png, docs/img/sweep_*.png"

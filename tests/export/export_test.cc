@@ -1,7 +1,8 @@
 // The exported C controller against the C++ controller it was generated from: fed the control
 // instants recorded from RunTask it gives the same broadcasts and estimates (double: to 1e-12
 // relative; float: within the bound docs/export.md states), and driving the simulated plant in
-// its place (RunTask's ControlInstantHook) it gives the same metrics.
+// its place (RunTask's ControlInstantHook) it gives the same metrics. Tasks: the bench's and the
+// elbow arm's with hand-set gains; the self-tuned loop's package: auto_loop_test.cc.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -9,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -68,14 +70,22 @@ class ExportedDriver : public sim::ControlInstantHook {
   LoadedController& c_;
 };
 
-sim::Task LoadTask(const std::string& name) {
-  auto t = sim::Task::FromFile(std::string(RECRUIT_SOURCE_DIR) + "/models/tasks/" + name);
+// `path`: relative to the source tree. The shipped arm tasks run the self-tuned loop
+// (auto_loop_test.cc); the hand-set form's package is tested here on tests/export/data's copies
+// of them with hand-set gains.
+sim::Task LoadTask(const std::string& path) {
+  auto t = sim::Task::FromFile(std::string(RECRUIT_SOURCE_DIR) + "/" + path);
   EXPECT_TRUE(t.ok()) << t.error();
   return *t;
 }
 
+const std::string kSteps = "models/tasks/isometric_steps.json";
+const std::string kArmHand = "tests/export/data/arm_reach_hold_hand.json";
+const std::string kPushHand = "tests/export/data/arm_push_hand.json";
+const std::string kLiftHand = "tests/export/data/arm_lift_hand.json";
+
 struct Case {
-  std::string task;
+  std::string task;       // relative to the source tree
   std::string estimator;  // "" = the task's
   double duration;
   std::string filter_model = "";  // "" = the task's
@@ -154,12 +164,13 @@ std::string UncertainStartModel() {
 }
 
 const std::vector<Case>& Cases() {
-  static const std::vector<Case> cases = {{"isometric_steps.json", "", 40, UncertainStartModel()},
-                                          {"isometric_steps.json", "", 60},
-                                          {"arm_reach_hold.json", "", 60},
-                                          {"arm_push.json", "", 40},
-                                          {"arm_reach_hold.json", "output", 40},
-                                          {"arm_reach_hold.json", "kalman2", 40}};
+  static const std::vector<Case> cases = {{kSteps, "", 40, UncertainStartModel()},
+                                          {kSteps, "", 60},
+                                          {kArmHand, "", 60},
+                                          {kPushHand, "", 40},
+                                          {kLiftHand, "", 40},  // the payload changes at 20 s
+                                          {kArmHand, "output", 40},
+                                          {kArmHand, "kalman2", 40}};
   return cases;
 }
 
@@ -210,7 +221,7 @@ TEST(ExportEquivalence, FloatStaysWithinItsStatedBound) {
 // package alike, on a force task's recorded instants.
 TEST(ExportEquivalence, DoubleHandlesLostSamplesAsTheController) {
   for (const std::string estimator : {"kalman-augmented", "output"}) {
-    const Case c{"isometric_steps.json", estimator, 60};
+    const Case c{kSteps, estimator, 60};
     auto log = Record(c, 5);
     ASSERT_GT(log.size(), 30u);
     for (size_t k = 0; k < log.size(); ++k) {
@@ -257,8 +268,9 @@ BothMetrics RunBoth(const Case& c, std::uint64_t seed, LoadedController& ctl) {
 }
 
 TEST(ExportClosedLoop, DoubleDrivesThePlantToTheSameMetrics) {
-  for (const Case& c : {Cases()[0], Cases()[1]}) {
-    auto ctl = Load(c, Precision::kDouble, "closed_double_" + c.task);
+  for (const Case& c : {Cases()[0], Cases()[1], Cases()[2]}) {
+    auto ctl = Load(c, Precision::kDouble,
+                    "closed_double_" + std::filesystem::path(c.task).stem().string());
     ASSERT_TRUE(ctl);
     for (std::uint64_t seed : {1, 2}) {
       const BothMetrics m = RunBoth(c, seed, *ctl);
@@ -281,9 +293,9 @@ TEST(ExportClosedLoop, DoubleDrivesThePlantToTheSameMetrics) {
 // draw only rarely, so most runs are identical; one changed draw makes the rest of that run
 // another sample of the same process.
 TEST(ExportClosedLoop, FloatGivesTheSameMetricsOver20Seeds) {
-  for (const Case& c :
-       {Case{"isometric_steps.json", "", 60}, Case{"arm_reach_hold.json", "", 40}}) {
-    auto ctl = Load(c, Precision::kFloat, "closed_float_" + c.task);
+  for (const Case& c : {Case{kSteps, "", 60}, Case{kArmHand, "", 40}}) {
+    auto ctl =
+        Load(c, Precision::kFloat, "closed_float_" + std::filesystem::path(c.task).stem().string());
     ASSERT_TRUE(ctl);
     MetricMeans means({"tracking_rmse", "iae", "overshoot", "settled_fraction", "switching_rate",
                        "estimator_rmse"});
@@ -325,7 +337,7 @@ TEST(ExportM4, CrossCompilesWithinBudgetAndReplaysUnderQemu) {
     GTEST_SKIP() << "arm-none-eabi-gcc or qemu-system-arm is not installed "
                     "(scripts/install-deps.sh installs them)";
   }
-  const Case c{"arm_reach_hold.json", "", 110};
+  const Case c{kArmHand, "", 110};
   const sim::Task task = LoadTask(c.task);
   auto pkg = ExportController(task, Options(c, 1), Precision::kFloat);
   ASSERT_TRUE(pkg.ok()) << pkg.error();

@@ -21,7 +21,14 @@ namespace {
 
 namespace fs = std::filesystem;
 const std::string kRecruit = RECRUIT_BIN;
-const std::string kTasks = std::string(RECRUIT_SOURCE_DIR) + "/models/tasks/";
+// Tasks by their path in the source tree without ".json". The arm: tests/export/data's copy of
+// arm_reach_hold with hand-set gains (recruit sil drives hand-set and force tasks only; the
+// shipped arm tasks run the self-tuned loop).
+const std::string kArmTask = "tests/export/data/arm_reach_hold_hand";
+const std::string kStepsTask = "models/tasks/isometric_steps";
+std::string TaskFile(const std::string& task) {
+  return std::string(RECRUIT_SOURCE_DIR) + "/" + task + ".json";
+}
 
 fs::path Dir() {
   static const fs::path d =
@@ -96,12 +103,12 @@ Plant StartPlant(const std::string& args, const std::string& name) {
 
 // The task's double package built with the example controller, once per task.
 std::string Controller(const std::string& task) {
-  const fs::path pkg = Dir() / ("pkg_" + task);
+  const fs::path pkg = Dir() / ("pkg_" + fs::path(task).filename().string());
   const fs::path bin = pkg / "sil_controller";
   if (fs::exists(bin)) return bin.string();
   const std::string cc = RECRUIT_HOST_CC;
   const std::string cmd =
-      "'" + kRecruit + "' export --task '" + kTasks + task + ".json' --precision double --out '" +
+      "'" + kRecruit + "' export --task '" + TaskFile(task) + "' --precision double --out '" +
       pkg.string() + "' > /dev/null && '" + cc +
       "' -std=c99 -O2 -ffp-contract=off -fno-math-errno -Wall -Wextra -Werror -I '" + pkg.string() +
       "' '" + RECRUIT_SOURCE_DIR + "/examples/sil/sil_controller.c' '" + pkg.string() +
@@ -112,8 +119,8 @@ std::string Controller(const std::string& task) {
 
 nlohmann::json Simulate(const std::string& task, const std::string& opts, const std::string& name) {
   const fs::path out = Dir() / ("sim_" + name + ".json");
-  const std::string cmd = "'" + kRecruit + "' simulate --task '" + kTasks + task + ".json' " +
-                          opts + " --out '" + Dir().string() + "' --summary '" + out.string() +
+  const std::string cmd = "'" + kRecruit + "' simulate --task '" + TaskFile(task) + "' " + opts +
+                          " --out '" + Dir().string() + "' --summary '" + out.string() +
                           "' --csv '" + (Dir() / (name + ".csv")).string() + "' > /dev/null";
   EXPECT_EQ(Shell(cmd), 0) << cmd;
   return nlohmann::json::parse(ReadText(out));
@@ -130,8 +137,8 @@ SilRun RunSil(const std::string& task, const std::string& opts, const std::strin
               const std::string& faults, const std::string& name, double dT) {
   const fs::path summary = Dir() / ("sil_" + name + ".json");
   const fs::path pty = Dir() / ("pty_" + name);
-  std::string args = "--task '" + kTasks + task + ".json' " + opts + " --summary '" +
-                     summary.string() + "' --connect-timeout 20";
+  std::string args = "--task '" + TaskFile(task) + "' " + opts + " --summary '" + summary.string() +
+                     "' --connect-timeout 20";
   if (link == "pty") args += " --link pty --pty-link '" + pty.string() + "'";
   const std::string ctl = Controller(task);
   Plant plant = StartPlant(args, name);
@@ -158,13 +165,13 @@ void ExpectSameMetrics(const nlohmann::json& a, const nlohmann::json& b, const s
 const std::string kArm = "--duration 20 --seed 3";
 
 TEST(Sil, UdpRunEqualsSimulateAndCountsInjectedBadPackets) {
-  const nlohmann::json ref = Simulate("arm_reach_hold", kArm, "arm");
+  const nlohmann::json ref = Simulate(kArmTask, kArm, "arm");
   const SilRun r =
-      RunSil("arm_reach_hold", kArm + " --speed max", "udp",
+      RunSil(kArmTask, kArm + " --speed max", "udp",
              "--corrupt 3 --truncate 4 --oversize 5 --replay 6 --junk 7", "udp_bad", 1);
   ASSERT_EQ(r.plant_rc, 0) << r.log;
   EXPECT_EQ(r.controller_rc, 0);
-  ExpectSameMetrics(ref, r.summary, "arm_reach_hold over udp");
+  ExpectSameMetrics(ref, r.summary, "arm_reach_hold_hand over udp");
   const nlohmann::json& s = r.summary["sil"];
   EXPECT_EQ(s["instants"], ref["control_instants"]);
   EXPECT_EQ(s["applied"], ref["control_instants"]);
@@ -179,9 +186,9 @@ TEST(Sil, UdpRunEqualsSimulateAndCountsInjectedBadPackets) {
 
 TEST(Sil, ForceTaskOverUdpEqualsSimulate) {
   const std::string opts = "--duration 20 --seed 5";
-  const nlohmann::json ref = Simulate("isometric_steps", opts, "iso");
+  const nlohmann::json ref = Simulate(kStepsTask, opts, "iso");
   const double dT = ref["dT"].get<double>();
-  const SilRun r = RunSil("isometric_steps", opts + " --speed 0", "udp", "", "udp_iso", dT);
+  const SilRun r = RunSil(kStepsTask, opts + " --speed 0", "udp", "", "udp_iso", dT);
   ASSERT_EQ(r.plant_rc, 0) << r.log;
   ExpectSameMetrics(ref, r.summary, "isometric_steps over udp");
   EXPECT_EQ(r.summary["sil"]["lost"], 0);
@@ -190,8 +197,8 @@ TEST(Sil, ForceTaskOverUdpEqualsSimulate) {
 // A skipped answer and a late one: both instants lost (the plant held the previous command),
 // the late answer counted and dropped.
 TEST(Sil, LostAndLateAnswersAreCountedAndHeld) {
-  const SilRun r = RunSil("arm_reach_hold", kArm + " --speed max --deadline 1", "udp",
-                          "--skip 3 --late 7", "udp_lost", 1);
+  const SilRun r = RunSil(kArmTask, kArm + " --speed max --deadline 1", "udp", "--skip 3 --late 7",
+                          "udp_lost", 1);
   ASSERT_EQ(r.plant_rc, 0) << r.log;
   const nlohmann::json& s = r.summary["sil"];
   EXPECT_EQ(s["lost"], 2);
@@ -205,11 +212,11 @@ TEST(Sil, LostAndLateAnswersAreCountedAndHeld) {
 // sync); a frame followed by junk is a good frame, so the oversized copy then makes the real
 // answer a replay.
 TEST(Sil, PtyRunEqualsSimulate) {
-  const nlohmann::json ref = Simulate("arm_reach_hold", kArm, "arm_pty");
-  const SilRun r = RunSil("arm_reach_hold", kArm + " --speed max", "pty",
-                          "--corrupt 3 --replay 6 --junk 7", "pty", 1);
+  const nlohmann::json ref = Simulate(kArmTask, kArm, "arm_pty");
+  const SilRun r =
+      RunSil(kArmTask, kArm + " --speed max", "pty", "--corrupt 3 --replay 6 --junk 7", "pty", 1);
   ASSERT_EQ(r.plant_rc, 0) << r.log;
-  ExpectSameMetrics(ref, r.summary, "arm_reach_hold over a pty");
+  ExpectSameMetrics(ref, r.summary, "arm_reach_hold_hand over a pty");
   EXPECT_EQ(r.controller_rc, 0) << "the controller read the end frame";
   const nlohmann::json& s = r.summary["sil"];
   EXPECT_EQ(s["lost"], 0);
@@ -224,9 +231,9 @@ TEST(Sil, PtyRunEqualsSimulate) {
 // simulate's.
 TEST(Sil, PacedRunTakesItsWallTime) {
   const std::string opts = "--duration 10 --seed 2";
-  const nlohmann::json ref = Simulate("arm_reach_hold", opts, "arm_paced");
+  const nlohmann::json ref = Simulate(kArmTask, opts, "arm_paced");
   const auto t0 = std::chrono::steady_clock::now();
-  const SilRun r = RunSil("arm_reach_hold", opts + " --speed 20", "udp", "", "paced", 1);
+  const SilRun r = RunSil(kArmTask, opts + " --speed 20", "udp", "", "paced", 1);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   ASSERT_EQ(r.plant_rc, 0) << r.log;
   ExpectSameMetrics(ref, r.summary, "paced");
@@ -237,9 +244,8 @@ TEST(Sil, PacedRunTakesItsWallTime) {
 
 TEST(Sil, NoControllerExitsSixWithinTheTimeout) {
   const auto t0 = std::chrono::steady_clock::now();
-  Plant p = StartPlant("--task '" + kTasks +
-                           "arm_reach_hold.json' --duration 5 --connect-timeout 0.5 --out '" +
-                           Dir().string() + "'",
+  Plant p = StartPlant("--task '" + TaskFile(kArmTask) +
+                           "' --duration 5 --connect-timeout 0.5 --out '" + Dir().string() + "'",
                        "noctl");
   EXPECT_EQ(p.Wait(30), 6);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -249,14 +255,25 @@ TEST(Sil, NoControllerExitsSixWithinTheTimeout) {
 }
 
 TEST(Sil, ControllerWithAnotherPeriodIsRefused) {
-  const SilRun r = RunSil("arm_reach_hold", kArm + " --speed max", "udp", "", "wrong_dT", 0.5);
+  const SilRun r = RunSil(kArmTask, kArm + " --speed max", "udp", "", "wrong_dT", 0.5);
   EXPECT_EQ(r.plant_rc, 3) << r.log;
   EXPECT_EQ(r.controller_rc, 0) << "the end frame tells the controller";
   EXPECT_NE(r.log.find("export with the same --dT"), std::string::npos) << r.log;
 }
 
+// The shipped arm task's self-tuned loop runs in the plant's process only: refused, exit 3,
+// naming it, before any controller is awaited.
+TEST(Sil, SelfTunedTaskIsRefused) {
+  const std::string log = (Dir() / "auto.log").string();
+  EXPECT_EQ(Shell("'" + kRecruit + "' sil --task '" + TaskFile("models/tasks/arm_reach_hold") +
+                  "' --duration 5 --connect-timeout 5 --out '" + Dir().string() + "' > '" + log +
+                  "' 2>&1"),
+            3);
+  EXPECT_NE(ReadText(log).find("\"outer_loop\": \"auto\""), std::string::npos) << ReadText(log);
+}
+
 TEST(Sil, BadOptionsExitTwo) {
-  const std::string base = "'" + kRecruit + "' sil --task '" + kTasks + "arm_reach_hold.json' ";
+  const std::string base = "'" + kRecruit + "' sil --task '" + TaskFile(kArmTask) + "' ";
   EXPECT_EQ(Shell(base + "--speed fast 2>/dev/null"), 2);
   EXPECT_EQ(Shell(base + "--speed -1 2>/dev/null"), 2);
   EXPECT_EQ(Shell(base + "--link serial 2>/dev/null"), 2);

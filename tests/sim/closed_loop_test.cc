@@ -166,12 +166,17 @@ TEST(ClosedLoop, RealSweepIsByteIdenticalOnOneAndTwoThreads) {
 
 TEST(ClosedLoop, ArmLiftsTowardTheReferenceAngle) {
   Task task = LoadTask("arm_reach_hold.json");
+  EXPECT_TRUE(task.auto_loop) << "the shipped arm tasks run the self-tuned loop";
   RunOptions o;
   o.duration = 28;  // the 20 deg step at 10 s, held to 30 s
   auto r = RunTask(task, o);
   ASSERT_TRUE(r.ok()) << r.error();
   EXPECT_EQ(r->unit, "rad");
   ASSERT_EQ(r->steps.size(), 1u);
+  // One design per reference reached: the start (0 deg, kept 3 % of the range inside the limit)
+  // and 20 deg.
+  ASSERT_EQ(r->loop_designs.size(), 2u);
+  EXPECT_NEAR(r->loop_designs[1]["reference"].get<double>(), 20 * M_PI / 180, 1e-12);
   // It reaches the 20 deg band (the overshoot is > -1, i.e. the step was completed in part) and
   // does not run away past twice the step.
   EXPECT_LT(r->metrics.max_overshoot, 1.0);
@@ -196,11 +201,16 @@ TEST(ClosedLoop, ArmScoresEveryBundleAndKeepsItsUnitsWithinTheirLimits) {
     EXPECT_GT(b.peak_wire_stress, 0.0) << b.actuator;
     EXPECT_LE(b.peak_wire_stress, b.max_wire_stress) << b.actuator;
     // The task's Kalman filter on each bundle's own length-aware model: a variance for each
-    // bundle and a count close to the truth (28 s, 28 instants: a loose band).
+    // bundle that its count errors agree with (28 s, 28 instants: a loose band).
     EXPECT_GT(b.mean_nees, 0.1) << b.actuator;
     EXPECT_LT(b.mean_nees, 5.0) << b.actuator;
-    EXPECT_LT(b.estimator_rmse, 2.0) << b.actuator;
   }
+  // The flexor's count is close to the truth: a hot unit adds 0.7-0.9 N at these poses. The
+  // extensor's is not held to it: near the hanging pose a hot extensor unit pulls 0.06-0.1 N
+  // (models/elbow_arm.xml), and the self-tuned loop recruits 20 or more of them there to hold
+  // the start pose against the flexor's co-contraction floor, so its count is weakly observed
+  // while they heat (errors up to 10 units, which the filter's variance reports: NEES above).
+  EXPECT_LT(r->bundles[0].estimator_rmse, 2.0);
   EXPECT_TRUE(r->warnings.empty());
   const nlohmann::json j = r->ToJson();
   EXPECT_EQ(j["bundles"].size(), 2u);
