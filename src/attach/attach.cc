@@ -73,6 +73,20 @@ Result<double> PeakForce(const mjModel* m, int a, const std::string& name, doubl
   return Error{"actuator '" + name + "': MuJoCo gives no F0 (acc0 = 0): give --force N"};
 }
 
+// The first free joint on the way from joint j's body to the world ("" when none): a limb that
+// hangs from one falls, or is pushed about, instead of moving on its joints.
+std::string FreeJointAbove(const mjModel* m, int j) {
+  for (int b = m->jnt_bodyid[j]; b > 0; b = m->body_parentid[b]) {
+    for (int k = m->body_jntadr[b]; k >= 0 && k < m->body_jntadr[b] + m->body_jntnum[b]; ++k) {
+      if (m->jnt_type[k] == mjJNT_FREE) {
+        const char* n = mj_id2name(m, mjOBJ_JOINT, k);
+        return n != nullptr ? n : "#" + std::to_string(k);
+      }
+    }
+  }
+  return "";
+}
+
 // Probes the original model (compiled without lengthrange computation, which a bundle does not
 // need) for each bundle's force and tendon range.
 // The bundles' tendons, joints and loads, on a copy of the model with the locked joints held.
@@ -116,6 +130,9 @@ Result<std::vector<BundleReport>> Probe(const mjSpec* spec, const std::vector<st
                           mm->jnt_range[2 * j + 1], r.usable_lo[i], r.usable_hi[i]});
     }
     for (const sma::TendonJump& jump : r.jumps) b.jumps.push_back(sma::JumpText(mm, jump));
+    for (int j : r.joints) {
+      if (b.free_base.empty()) b.free_base = FreeJointAbove(mm, j);
+    }
     b.length_min = r.length_min;
     b.length_max = r.length_max;
     b.holding = SampleHoldingLoad(mm, d.get(), b.tendon_id, r.joints, r.usable_lo, r.usable_hi);
@@ -191,6 +208,13 @@ Result<AttachReport> Attach(const AttachOptions& o) {
                                 ": sized on the usable range");
     }
     for (const std::string& n : b.design.notes) report.warnings.push_back("'" + b.name + "': " + n);
+    if (!b.free_base.empty()) {
+      report.warnings.push_back(
+          "'" + b.name + "': the joints it moves hang from the free joint '" + b.free_base +
+          "': the limb's base is not held, so it falls or is pushed about instead of moving on "
+          "those joints (the starter task assumes a fixed base): fix the base (remove its free "
+          "joint, or weld the body) before driving it");
+    }
   }
   if (!o.size_only) {
     mjSpec* s = spec->get();

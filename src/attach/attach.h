@@ -44,6 +44,8 @@ struct BundleReport {
   std::string force_source;  // "muscle F0" or "--force"
   std::vector<JointUse> joints;
   std::vector<std::string> jumps;  // "elbow at 114 deg (376.0 -> 211.0 mm)"
+  // The free joint the moved joints hang from ("" when the limb's base is fixed).
+  std::string free_base;
   double length_min = 0, length_max = 0, ref_length = 0;
   HoldingLoad holding;  // the limb's own weight at the tendon (sizing's resolution)
   std::string instance, sensor;

@@ -637,6 +637,34 @@ TEST(StarterTask, RunsThroughTheSeveralJointLoop) {
 // A muscle kept beside the bundles keeps the lengthrange of the free limb: MuJoCo computing it at
 // load with the lock active would make it a fraction of a millimetre wide. Reference: MuJoCo's
 // own computation on the original model (the bundles' passive pull moves it a little).
+// A limb hanging from a free joint is not held: attach says so for each bundle on it, naming the
+// joint; a fixed base says nothing of the kind.
+TEST(Attach, ALimbOnAFreeBaseIsNamedInTheWarnings) {
+  sma::testing::WarningCapture quiet;  // the fit check may warn: not into MUJOCO_LOG.TXT
+  auto said = [](const AttachReport& r, const std::string& bundle) {
+    for (const std::string& w : r.warnings) {
+      if (w.find("'" + bundle + "': the joints it moves hang from the free joint 'root'") !=
+          std::string::npos) {
+        return true;
+      }
+    }
+    return false;
+  };
+  AttachOptions o;
+  o.model = kSrc + "/tests/attach/data/floating_arm.xml";
+  o.muscles = {"all"};
+  o.size_only = true;
+  auto floating = Attach(o);
+  ASSERT_TRUE(floating.ok()) << floating.error();
+  EXPECT_TRUE(said(*floating, "flx"));
+  EXPECT_TRUE(said(*floating, "ext"));
+  o.model = kSrc + "/tests/attach/data/jump_arm.xml";
+  o.muscles = {"flx"};
+  auto fixed = Attach(o);
+  ASSERT_TRUE(fixed.ok()) << fixed.error();
+  for (const std::string& w : fixed->warnings) EXPECT_EQ(w.find("free joint"), std::string::npos);
+}
+
 TEST(Lock, KeptMusclesKeepTheFreeLimbsLengthRange) {
   sma::testing::WarningCapture quiet;  // the fit check may warn: not into MUJOCO_LOG.TXT
   const std::string dir = TempDir("lock_kept_muscles");
