@@ -92,12 +92,15 @@ void RefineForResolution(const SizingInput& in, const SizingLimits& limits, Bund
     out.units = wire->wires;
   }
   if (out.units < wanted) {
-    out.notes.push_back("resolution: " + std::to_string(out.units) + " units (at most " +
-                        std::to_string(limits.max_units_resolution) +
-                        ", one wire each at least), fewer than the " + Num(wanted) +
-                        " that would make one unit 1/" +
-                        std::to_string(limits.units_per_holding_force) +
-                        " of the limb's holding force (" + Num(in.holding_force) + " N)");
+    // The resolution rule adds units only up to its cap, and a unit is one wire at least.
+    const std::string why =
+        out.units >= limits.max_units_resolution
+            ? "the rule adds units up to " + std::to_string(limits.max_units_resolution)
+            : "one wire per unit of the thinnest wire that fits";
+    out.notes.push_back(
+        "resolution: " + std::to_string(out.units) + " units, fewer than the " + Num(wanted) +
+        " that would make one unit 1/" + std::to_string(limits.units_per_holding_force) +
+        " of the limb's holding force (" + Num(in.holding_force) + " N; " + why + ")");
   }
 }
 
