@@ -96,7 +96,8 @@ void RefineForResolution(const SizingInput& in, const SizingLimits& limits, Bund
     const std::string why =
         out.units >= limits.max_units_resolution
             ? "the rule adds units up to " + std::to_string(limits.max_units_resolution)
-            : "one wire per unit of the thinnest wire that fits";
+            : "no thinner stock wire makes the force within " +
+                  std::to_string(limits.max_units_resolution) + " units of one wire";
     out.notes.push_back(
         "resolution: " + std::to_string(out.units) + " units, fewer than the " + Num(wanted) +
         " that would make one unit 1/" + std::to_string(limits.units_per_holding_force) +
