@@ -32,7 +32,7 @@ void PrintDesign(const sim::JointDesignRecord& r, bool response) {
       d.gains.kd, "", "", 100 * d.nominal.overshoot, d.nominal.settling_time,
       d.nominal.settled ? "" : " (not settled)", 100 * d.robust.overshoot,
       d.robust.settled ? "settles" : "does not settle",
-      d.meets ? "" : "  [no design on the grid meets the target]");
+      d.meets ? "" : ("  [" + d.note + "]").c_str());
   if (!response) return;
   std::printf("%-14s %8s  step response (fraction of the step) at t = 0, dT, ...:", "", "");
   for (double y : d.nominal.angle) std::printf(" %.3f", y);

@@ -7,6 +7,7 @@
 #include <limits>
 #include <map>
 #include <mutex>
+#include <string>
 #include <unsupported/Eigen/MatrixFunctions>
 #include <vector>
 
@@ -158,6 +159,27 @@ Result<LoopDesign> DesignJointLoop(const JointDynamics& joint, const ActuatorRes
 
 namespace {
 
+// What a design misses of the target, e.g. "robust overshoot 9.8 % > 25 %".
+std::string Shortfalls(const LoopDesign& d, const LoopTarget& target) {
+  std::string out;
+  auto check = [&](const char* name, const PredictedStep& p, double allowed) {
+    char buf[96];
+    if (!p.settled) {
+      std::snprintf(buf, sizeof buf, "%s step does not settle", name);
+      out += (out.empty() ? "" : "; ") + std::string(buf);
+    }
+    if (p.overshoot > allowed) {
+      std::snprintf(buf, sizeof buf, "%s overshoot %.1f %% > %.0f %%", name, 100 * p.overshoot,
+                    100 * allowed);
+      out += (out.empty() ? "" : "; ") + std::string(buf);
+    }
+  };
+  check("nominal", d.nominal, target.overshoot);
+  check("robust (1.5x slower bundles, 1.5x gain)", d.robust, 0.25);
+  check("feedforward-off", d.offset, 0.25);
+  return out;
+}
+
 // The grid search of DesignJointLoop (inputs checked).
 LoopDesign SearchGrid(const JointDynamics& joint, const ActuatorResponse& act, double dT,
                       const LoopTarget& target) {
@@ -186,8 +208,9 @@ LoopDesign SearchGrid(const JointDynamics& joint, const ActuatorResponse& act, d
       }
     }
   }
-  best.note =
-      best.meets ? "meets the target" : "no gain on the grid meets the target: the closest is used";
+  best.note = best.meets ? "meets the target"
+                         : "no gain on the grid meets the target (the closest is used: " +
+                               Shortfalls(best, target) + ")";
   return best;
 }
 

@@ -444,7 +444,8 @@ nlohmann::json DesignJson(const JointDesignRecord& r) {
           {"predicted_settling_time", d.nominal.settling_time},
           {"robust_overshoot", d.robust.overshoot},
           {"robust_settled", d.robust.settled},
-          {"meets", d.meets}};
+          {"meets", d.meets},
+          {"note", d.note}};
 }
 
 // Several driven joints: each scored on its own reference, and the run's metrics over all of

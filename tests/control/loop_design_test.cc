@@ -64,6 +64,27 @@ TEST(LoopDesign, PredictionMatchesAFineRk4IntegrationOfTheSameLoop) {
   }
 }
 
+// A target no gain meets (a 1 % band within 1.5 s of a 1 s sampling period): the note names
+// exactly what the chosen design misses, from its own predictions.
+TEST(LoopDesign, ADesignThatMissesItsTargetSaysWhatItMisses) {
+  const ActuatorResponse act = TwoState(1.0, 0.2);
+  const JointDynamics joint{0.003, 0.02, 0.1};
+  LoopTarget target;
+  target.hold = 1.5;
+  target.band = 0.01;
+  auto d = DesignJointLoop(joint, act, 1.0, target);
+  ASSERT_TRUE(d.ok()) << d.error();
+  ASSERT_FALSE(d->meets);
+  auto says = [&](const std::string& s) { return d->note.find(s) != std::string::npos; };
+  EXPECT_EQ(says("nominal step does not settle"), !d->nominal.settled) << d->note;
+  EXPECT_EQ(says("robust (1.5x slower bundles, 1.5x gain) step does not settle"),
+            !d->robust.settled)
+      << d->note;
+  EXPECT_EQ(says("feedforward-off step does not settle"), !d->offset.settled) << d->note;
+  EXPECT_EQ(says("nominal overshoot"), d->nominal.overshoot > target.overshoot) << d->note;
+  EXPECT_TRUE(says("nominal step does not settle")) << d->note;
+}
+
 TEST(LoopDesign, TheDesignMeetsItsTargetInItsOwnPredictionAndBeatsNoFeedback) {
   const ActuatorResponse act = TwoState(1.0, 0.2);
   const JointDynamics joint{0.003, 0.02, 0.1};
