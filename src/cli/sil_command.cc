@@ -53,6 +53,16 @@ int RunSil(const SilArgs& a) {
   if (!speed.ok()) return Fail(cmd, speed.error(), exit_code::kUsage);
   auto task = sim::Task::FromFile(a.task);
   if (!task.ok()) return Fail(cmd, task.failure());
+  if (task->auto_loop) {  // before anything listens: the firmware would drive only the force
+    return Fail(
+        cmd,
+        a.task +
+            ": \"outer_loop\": \"auto\" is not driven over the SIL link (it sets "
+            "every bundle's force reference from the joints' angles inside recruit); "
+            "give the task hand-set gains (docs/sil.md), or run the self-tuned loop's package with "
+            "`recruit export` (docs/export.md)",
+        exit_code::kBadInput);
+  }
   if (a.summary.empty()) {
     if (Status s = CheckFileNameComponent(task->name, a.task + ": name"); !s.ok()) {
       return Fail(cmd, s.error(), exit_code::kBadInput);

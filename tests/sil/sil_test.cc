@@ -270,6 +270,8 @@ TEST(Sil, SelfTunedTaskIsRefused) {
                   "' 2>&1"),
             3);
   EXPECT_NE(ReadText(log).find("\"outer_loop\": \"auto\""), std::string::npos) << ReadText(log);
+  // Refused before it listens for a firmware.
+  EXPECT_EQ(ReadText(log).find("listening"), std::string::npos) << ReadText(log);
 }
 
 TEST(Sil, BadOptionsExitTwo) {
