@@ -72,16 +72,9 @@ std::string MyoSimDir() {
   return dir;
 }
 
-// RECRUIT_BENCH_MERGE="T,XI" (an experiment, not the default): every bundle of the attached model
-// gets merge_temperature T and merge_xi XI (plugin/README.md), for the cost of fewer cohorts.
-Status LoosenMerge(const std::string& xml) {
-  const char* merge = std::getenv("RECRUIT_BENCH_MERGE");
-  if (merge == nullptr || *merge == 0) return Status::Ok();
-  const std::string m = merge;
-  const auto comma = m.find(',');
-  if (comma == std::string::npos) return Error{"RECRUIT_BENCH_MERGE: expected T,XI, got " + m};
-  const std::string keys = "<config key=\"merge_temperature\" value=\"" + m.substr(0, comma) +
-                           "\"/><config key=\"merge_xi\" value=\"" + m.substr(comma + 1) + "\"/>";
+// Every bundle config of the attached model `xml` (a <config key="units" .../> each) gets the
+// config lines `keys` after its units; `knob` names the variable in errors.
+Status InsertKeys(const std::string& xml, const std::string& keys, const char* knob) {
   std::ifstream in(xml);
   std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   int n = 0;
@@ -92,9 +85,27 @@ Status LoosenMerge(const std::string& xml) {
     text.insert(end + 2, keys);
     ++n;
   }
-  if (n == 0) return Error{"RECRUIT_BENCH_MERGE: no units config in " + xml};
+  if (n == 0) return Error{std::string(knob) + ": no units config in " + xml};
   std::ofstream(xml, std::ios::trunc) << text;
   return Status::Ok();
+}
+
+std::string ConfigLine(const std::string& key, const std::string& value) {
+  return "<config key=\"" + key + "\" value=\"" + value + "\"/>";
+}
+
+// RECRUIT_BENCH_MERGE="T,XI" (an experiment, not the default): every bundle of the attached model
+// gets merge_temperature T and merge_xi XI (plugin/README.md), for the cost of fewer cohorts.
+Status LoosenMerge(const std::string& xml) {
+  const char* merge = std::getenv("RECRUIT_BENCH_MERGE");
+  if (merge == nullptr || *merge == 0) return Status::Ok();
+  const std::string m = merge;
+  const auto comma = m.find(',');
+  if (comma == std::string::npos) return Error{"RECRUIT_BENCH_MERGE: expected T,XI, got " + m};
+  return InsertKeys(xml,
+                    ConfigLine("merge_temperature", m.substr(0, comma)) +
+                        ConfigLine("merge_xi", m.substr(comma + 1)),
+                    "RECRUIT_BENCH_MERGE");
 }
 
 // RECRUIT_BENCH_KEYS="key=value ..." (an experiment, not the default): every bundle of the
@@ -110,21 +121,9 @@ Status AddKeys(const std::string& xml) {
     if (eq == std::string::npos || eq == 0) {
       return Error{"RECRUIT_BENCH_KEYS: expected key=value pairs, got " + pair};
     }
-    keys += "<config key=\"" + pair.substr(0, eq) + "\" value=\"" + pair.substr(eq + 1) + "\"/>";
+    keys += ConfigLine(pair.substr(0, eq), pair.substr(eq + 1));
   }
-  std::ifstream in(xml);
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  int n = 0;
-  for (auto at = text.find("key=\"units\""); at != std::string::npos;
-       at = text.find("key=\"units\"", at + 1)) {
-    const auto end = text.find("/>", at);
-    if (end == std::string::npos) break;
-    text.insert(end + 2, keys);
-    ++n;
-  }
-  if (n == 0) return Error{"RECRUIT_BENCH_KEYS: no units config in " + xml};
-  std::ofstream(xml, std::ios::trunc) << text;
-  return Status::Ok();
+  return InsertKeys(xml, keys, "RECRUIT_BENCH_KEYS");
 }
 
 struct Limb {
