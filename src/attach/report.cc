@@ -80,6 +80,11 @@ std::string DesignTable(const AttachReport& r) {
            F("%.2g", 100 * d.force_mid / d.units / b.holding.force()) + " % of the " +
            F("%.4g", b.holding.force()) + " N that holds the limb's weight (" +
            F("%.3g", b.holding.torque) + " N m at " + F("%.3g", 1000 * b.holding.arm) + " mm)\n";
+    } else {
+      t += "  resolution: one unit " + F("%.3g", d.force_mid / d.units) + " N, " +
+           F("%.2g", 100 * d.force_mid / d.units / b.peak_force) +
+           " % of the peak force (no weight on the bundle: sized on the co-contraction that "
+           "holds it)\n";
     }
     t += "  force all on: " + F("%.4g", d.force_short) + " / " + F("%.4g", d.force_mid) + " / " +
          F("%.4g", d.force_long) + " N (shortest / mid / longest tendon); stroke " +

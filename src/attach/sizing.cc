@@ -72,11 +72,14 @@ Result<Wire> WireFor(double d, double length, int series, double gear, const Siz
 // thinner stock wire (more wires of it, the same force; they also cool faster), up to
 // max_units_resolution units.
 void RefineForResolution(const SizingInput& in, const SizingLimits& limits, BundleDesign& out) {
-  if (!(in.holding_force > 0) || limits.units_per_holding_force <= 0) return;
-  const double wanted =
-      std::ceil(limits.units_per_holding_force * in.peak_force / in.holding_force);
+  const bool weight = in.holding_force > 0;
+  const double holding = weight ? in.holding_force : limits.rest_tension_fraction * in.peak_force;
+  if (!(holding > 0) || limits.units_per_holding_force <= 0) return;
+  const double wanted = std::ceil(limits.units_per_holding_force * in.peak_force / holding);
   const int target = static_cast<int>(std::min<double>(wanted, limits.max_units_resolution));
   const int wires = out.units * out.unit.parallel;
+  // At least `target` units by fewer wires per unit (the same wires; this may pass
+  // max_units_resolution, which bounds the thinner wire taken below).
   const int parallel = std::max(1, wires / target);
   if (out.units < target && parallel < out.unit.parallel) {
     out.unit.parallel = parallel;
@@ -92,16 +95,19 @@ void RefineForResolution(const SizingInput& in, const SizingLimits& limits, Bund
     out.units = wire->wires;
   }
   if (out.units < wanted) {
-    // The resolution rule adds units only up to its cap, and a unit is one wire at least.
+    // The rule stops at its cap, or the next thinner wire would pass it.
     const std::string why =
         out.units >= limits.max_units_resolution
-            ? "the rule adds units up to " + std::to_string(limits.max_units_resolution)
+            ? "the rule stops at " + std::to_string(limits.max_units_resolution) + " units"
             : "no thinner stock wire makes the force within " +
                   std::to_string(limits.max_units_resolution) + " units of one wire";
     out.notes.push_back(
         "resolution: " + std::to_string(out.units) + " units, fewer than the " + Num(wanted) +
         " that would make one unit 1/" + std::to_string(limits.units_per_holding_force) +
-        " of the limb's holding force (" + Num(in.holding_force) + " N; " + why + ")");
+        (weight ? " of the limb's holding force (" + Num(holding) + " N; "
+                : " of the co-contraction that holds a limb with no weight on it (" + Num(holding) +
+                      " N; ") +
+        why + ")");
   }
 }
 

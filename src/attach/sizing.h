@@ -37,6 +37,10 @@ struct SizingLimits {
   // (SizingInput::holding_force), up to max_units_resolution units.
   int units_per_holding_force = 50;
   int max_units_resolution = 1000;
+  // A bundle that holds no weight (a limb moving in a horizontal plane) is held by the
+  // co-contraction the self-tuned loop keeps, this fraction of its peak force (the task's
+  // default co_contraction): the resolution rule takes that as its load.
+  double rest_tension_fraction = 0.05;
 };
 
 // Stock Flexinol diameters (m), thinnest first.

@@ -244,7 +244,8 @@ TEST(Sizing, TheBandwidthRuleTradesHeatingPowerForTheTimeConstant) {
 // A force no fast-enough wire makes within max_units_fast units takes up to max_units_resolution
 // of them before a slow wire; past that the slow design says so in its notes.
 TEST(Sizing, TheBandwidthRuleTakesMoreUnitsBeforeASlowWireAndSaysWhenItCannot) {
-  const SizingLimits limits;
+  SizingLimits limits;
+  limits.units_per_holding_force = 0;  // the resolution rule off: the bandwidth rule alone
   auto slow_note = [](const BundleDesign& d) {
     for (const std::string& n : d.notes) {
       if (n.find("thermal time constant") != std::string::npos) return true;
@@ -252,7 +253,7 @@ TEST(Sizing, TheBandwidthRuleTakesMoreUnitsBeforeASlowWireAndSaysWhenItCannot) {
     return false;
   };
   SizingInput big{"b", 4000, 0.04, 0.1, 0.14, 0.12};
-  auto many = SizeBundle(big);
+  auto many = SizeBundle(big, limits);
   ASSERT_TRUE(many.ok()) << many.error();
   EXPECT_LE(many->time_constant, limits.max_time_constant);
   EXPECT_GT(many->units, limits.max_units_fast);
@@ -261,7 +262,7 @@ TEST(Sizing, TheBandwidthRuleTakesMoreUnitsBeforeASlowWireAndSaysWhenItCannot) {
   EXPECT_GE(many->force_mid, 4000);
   EXPECT_FALSE(slow_note(*many));
   SizingInput huge{"b", 8000, 0.04, 0.1, 0.14, 0.12};
-  auto slow = SizeBundle(huge);
+  auto slow = SizeBundle(huge, limits);
   ASSERT_TRUE(slow.ok()) << slow.error();
   EXPECT_GT(slow->time_constant, limits.max_time_constant);
   EXPECT_GE(slow->force_mid, 8000);
@@ -316,7 +317,9 @@ TEST(Sizing, TheStrokeRuleSetsTheBundlesForceLengthSlope) {
 // weight, by fewer wires per unit (the same wires: the force is unchanged), never past the cap.
 TEST(Sizing, ResolutionGivesMoreSmallerUnitsForTheSameForce) {
   SizingInput in{"b", 900, 0.04, 0.1, 0.14, 0.12};
-  auto coarse = SizeBundle(in);
+  SizingLimits off;
+  off.units_per_holding_force = 0;  // the rule off
+  auto coarse = SizeBundle(in, off);
   ASSERT_TRUE(coarse.ok()) << coarse.error();
   in.holding_force = 60;  // 50 units per 60 N: 750 units of 1.2 N
   auto fine = SizeBundle(in);
@@ -336,6 +339,16 @@ TEST(Sizing, ResolutionGivesMoreSmallerUnitsForTheSameForce) {
   ASSERT_TRUE(capped.ok()) << capped.error();
   EXPECT_LT(capped->units, 2 * SizingLimits{}.max_units_resolution);
   EXPECT_THAT(capped->notes, testing::Contains(testing::HasSubstr("resolution")));
+  // No weight on the bundle (a limb in a horizontal plane): the load is the co-contraction the
+  // loop holds, 5 % of the peak force: 50 units in 45 N, i.e. 1000 units wanted (the cap):
+  // one wire per unit, as with a 60 N weight.
+  in.holding_force = 0;
+  auto weightless = SizeBundle(in);
+  ASSERT_TRUE(weightless.ok()) << weightless.error();
+  EXPECT_EQ(weightless->unit.parallel, 1);
+  EXPECT_EQ(weightless->units, wires);
+  EXPECT_GT(weightless->units, coarse->units);
+  EXPECT_GE(weightless->force_mid, 900);
 }
 
 // The holding load against closed forms: a rod of mass m with its centre l from a hinge,
@@ -791,7 +804,9 @@ TEST(TendonRange, AJointAnEqualityHoldsIsLeftOut) {
 // bundle still meets the peak force to within one unit), and faster units.
 TEST(Sizing, ResolutionTakesThinnerWireWhenOneWirePerUnitIsNotEnough) {
   SizingInput in{"b", 40, 0.03, 0.1, 0.13, 0.115};
-  auto coarse = SizeBundle(in);
+  SizingLimits off;
+  off.units_per_holding_force = 0;  // the rule off
+  auto coarse = SizeBundle(in, off);
   ASSERT_TRUE(coarse.ok()) << coarse.error();
   in.holding_force = 4;  // 50 units per 4 N: 500 units wanted, more than its wires
   ASSERT_LT(coarse->units * coarse->unit.parallel, 500);
