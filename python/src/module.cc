@@ -4,9 +4,11 @@
 // Python-side helpers.
 #include "bindings.h"
 #include "common/data_path.h"
+#include "common/mujoco_warnings.h"
 
 PYBIND11_MODULE(_recruit, mod) {
   mod.doc() = "Recruit's C++ core (see the recruit package for documentation).";
+  recruit::InstallMujocoWarnings();  // stderr, once each, no MUJOCO_LOG.TXT in the working folder
   recruit::py_bind::BindPlugin(mod);
   recruit::py_bind::BindFilter(mod);
   recruit::py_bind::BindControl(mod);

@@ -5,9 +5,7 @@
 
 #include <exception>
 #include <iostream>
-#include <mutex>
 #include <new>
-#include <set>
 #include <sstream>
 #include <string>
 
@@ -15,6 +13,7 @@
 #include "cli/errors.h"
 #include "common/atomic_file.h"
 #include "common/data_path.h"
+#include "common/mujoco_warnings.h"
 #include "common/version.h"
 
 namespace {
@@ -30,23 +29,12 @@ std::string VersionText() {
   return s.str();
 }
 
-// MuJoCo's warnings (the plugin's design and fit checks among them) on stderr, each text once
-// per process (a model compiled several times warns as often), and never into MUJOCO_LOG.TXT in
-// the working folder, which MuJoCo's default handler appends to: a command writes only its
-// outputs.
-void WarnOnce(const char* message) {
-  static std::mutex mutex;
-  static std::set<std::string> said;
-  std::lock_guard<std::mutex> lock(mutex);
-  if (said.insert(message).second) std::cerr << "WARNING: " << message << "\n";
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
   using namespace recruit;
   InstallTempFileCleanupOnSignals();
-  mju_user_warning = WarnOnce;
+  InstallMujocoWarnings();               // stderr, once each, no MUJOCO_LOG.TXT
   SetDataDir(RECRUIT_DATA_DIR_DEFAULT);  // models/identified/ of the tree it was built from
   CLI::App app{
       "Recruit: stochastic recruitment control of SMA muscle bundles in MuJoCo, with the "

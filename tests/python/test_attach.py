@@ -4,6 +4,7 @@ before; the returned report is the one --report writes; bad input raises and wri
 import json
 import os
 import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -183,3 +184,18 @@ def test_lock_holds_the_joint_in_mujocos_own_simulation(tmp_path):
         assert all(j["joint"] != "elbow" for j in b["joints"]), b["name"]
     with open(task) as f:
         assert [j["joint"] for j in json.load(f)["joints"]] == ["shoulder"]
+
+
+def test_mujocos_warnings_go_to_stderr_not_into_the_working_folder(tmp_path):
+    """A model whose tendon path jumps makes the plugin warn while attach compiles it: the
+    warning is printed once on stderr, and no MUJOCO_LOG.TXT (MuJoCo's default handler) appears
+    in the working folder. In a child process, so that this session's handler is the module's."""
+    out = tmp_path / "out"
+    out.mkdir()
+    code = ("import recruit; recruit.attach({!r}, muscles=['all'], output={!r})"
+            .format(str(ROOT / "tests/attach/data/jump_arm.xml"), str(out / "m.xml")))
+    r = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, capture_output=True, text=True,
+                       env=dict(os.environ))
+    assert r.returncode == 0, r.stderr
+    assert r.stderr.count("tendon path jumps") == 1, r.stderr
+    assert sorted(os.listdir(tmp_path)) == ["out"]
