@@ -194,8 +194,13 @@ def test_mujocos_warnings_go_to_stderr_not_into_the_working_folder(tmp_path):
     out.mkdir()
     code = ("import recruit; recruit.attach({!r}, muscles=['all'], output={!r})"
             .format(str(ROOT / "tests/attach/data/jump_arm.xml"), str(out / "m.xml")))
+    import recruit as module  # where this session found it (conftest may have added a path)
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.pathsep.join(
+        [os.path.dirname(os.path.dirname(module.__file__))] +
+        ([env["PYTHONPATH"]] if env.get("PYTHONPATH") else []))
     r = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, capture_output=True, text=True,
-                       env=dict(os.environ))
+                       env=env)
     assert r.returncode == 0, r.stderr
     assert r.stderr.count("tendon path jumps") == 1, r.stderr
     assert sorted(os.listdir(tmp_path)) == ["out"]
