@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "common/mujoco_ptr.h"
+#include "common/mujoco_warnings.h"
 #include "common/result.h"
 
 namespace recruit::attach {
@@ -57,21 +58,5 @@ void RebaseAssetDirs(mjSpec* spec, const std::string& input_path, const std::str
 
 // The spec as MJCF text.
 Result<std::string> SaveXmlString(const mjSpec* spec);
-
-// While alive, MuJoCo's warnings are dropped: for compiles of intermediate copies (the model
-// before its locks, whose bundles' fit check would warn of joints the locks will hold). The
-// handler in force before is restored.
-class QuietMujocoWarnings {
- public:
-  QuietMujocoWarnings() : saved_(mju_user_warning) {
-    mju_user_warning = [](const char*) {};
-  }
-  ~QuietMujocoWarnings() { mju_user_warning = saved_; }
-  QuietMujocoWarnings(const QuietMujocoWarnings&) = delete;
-  QuietMujocoWarnings& operator=(const QuietMujocoWarnings&) = delete;
-
- private:
-  void (*saved_)(const char*);
-};
 
 }  // namespace recruit::attach

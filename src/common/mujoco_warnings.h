@@ -26,4 +26,21 @@ inline void InstallMujocoWarnings() {
   if (mju_user_warning == nullptr) mju_user_warning = WarnOnceOnStderr;
 }
 
+// While alive, MuJoCo's warnings are dropped: e.g. attach's compiles of intermediate copies
+// (the model before its locks, whose bundles' fit check would warn of joints the locks will
+// hold). The handler is process-wide: only where no other thread compiles a model meanwhile. The
+// handler in force before is restored.
+class QuietMujocoWarnings {
+ public:
+  QuietMujocoWarnings() : saved_(mju_user_warning) {
+    mju_user_warning = [](const char*) {};
+  }
+  ~QuietMujocoWarnings() { mju_user_warning = saved_; }
+  QuietMujocoWarnings(const QuietMujocoWarnings&) = delete;
+  QuietMujocoWarnings& operator=(const QuietMujocoWarnings&) = delete;
+
+ private:
+  void (*saved_)(const char*);
+};
+
 }  // namespace recruit
