@@ -30,11 +30,19 @@ std::string TaskFile(const std::string& task) {
   return std::string(RECRUIT_SOURCE_DIR) + "/" + task + ".json";
 }
 
+// This process's scratch folder, removed when the process ends (ctest runs each test in a
+// process of its own, so every one would otherwise leave a folder in the temp directory).
+struct ScratchDir {
+  fs::path path = fs::temp_directory_path() / ("recruit_sil_test_" + std::to_string(::getpid()));
+  ScratchDir() { fs::create_directories(path); }
+  ~ScratchDir() {
+    std::error_code ec;
+    fs::remove_all(path, ec);
+  }
+};
 fs::path Dir() {
-  static const fs::path d =
-      fs::temp_directory_path() / ("recruit_sil_test_" + std::to_string(::getpid()));
-  fs::create_directories(d);
-  return d;
+  static const ScratchDir d;
+  return d.path;
 }
 
 int Shell(const std::string& cmd) {
