@@ -739,11 +739,16 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
     const double t = plant.time();
     sample.control_instant = t + 0.5 * h >= next_control;
     if (sample.control_instant) {
+      // The controller's clock is its own: the instant is k dT, not MuJoCo's accumulated time
+      // (20 s is 19.999999999999794 after 10^4 steps of 2 ms, which would read a step's
+      // reference one period late).
+      const double instant_time = next_control;
       ++control_instants;
       next_control = control_instants * settings.dT;
-      if (Status st = ControlInstantStep(task, angle_loop, joint_loops ? &*joint_loops : nullptr,
-                                         plant, channels, t, settings.dT, options.control_hook,
-                                         instant, on_before, force_ref, sample);
+      if (Status st =
+              ControlInstantStep(task, angle_loop, joint_loops ? &*joint_loops : nullptr, plant,
+                                 channels, instant_time, settings.dT, options.control_hook, instant,
+                                 on_before, force_ref, sample);
           !st.ok()) {
         return Error{where + ": " + st.error(), st.code()};
       }

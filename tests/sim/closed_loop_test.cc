@@ -47,6 +47,38 @@ std::vector<std::vector<std::string>> ReadCsv(const std::string& path) {
   return rows;
 }
 
+// Records what the controller saw at each control instant.
+class InstantRecorder : public ControlInstantHook {
+ public:
+  bool Replaces() const override { return false; }
+  Status OnInstant(ControlInstant& instant) override {
+    times.push_back(instant.time);
+    references.push_back(instant.reference);
+    return Status::Ok();
+  }
+  std::vector<double> times, references;
+};
+
+TEST(ClosedLoop, ControlInstantsRunOnTheControllersClockAndSeeAStepAtItsTime) {
+  // isometric_steps steps to 12, 24 and 8 N at 5, 20 and 35 s; MuJoCo's accumulated time after
+  // 2500 steps of 2 ms is 4.999999999999671, so an instant read at the plant's time would see
+  // each step one period late.
+  Task task = LoadTask("isometric_steps.json");
+  RunOptions o;
+  o.duration = 36;
+  o.dT = 1;
+  InstantRecorder rec;
+  o.control_hook = &rec;
+  auto r = RunTask(task, o, {});
+  ASSERT_TRUE(r.ok()) << r.error();
+  ASSERT_EQ(rec.times.size(), 36u);
+  for (size_t k = 0; k < rec.times.size(); ++k) {
+    EXPECT_EQ(rec.times[k], static_cast<double>(k));
+    const double expected = k < 5 ? 0 : k < 20 ? 12 : k < 35 ? 24 : 8;
+    EXPECT_EQ(rec.references[k], expected) << "instant at " << k << " s";
+  }
+}
+
 TEST(ClosedLoop, SimulateWritesCsvWhoseSignalsReproduceTheSummary) {
   const fs::path dir = fs::temp_directory_path() / "recruit_closed_loop_csv";
   fs::create_directories(dir);
