@@ -128,24 +128,27 @@ std::pair<double, double> LengthRangeOverOneJoint(LengthFn length) {
 // More: a grid with an odd number of points per joint (so the limits and the middle are on it),
 // 65 x 65 for two, up to ~4096 in all; beyond 6 joints 4096 seeded random points plus the all-low
 // and all-high corners.
-std::pair<double, double> LengthRange(const mjModel* m, mjData* d, int t,
-                                      const std::vector<int>& joints,
-                                      const std::vector<double>& jlo,
-                                      const std::vector<double>& jhi) {
+// Fills r.length_min/max and the joint values where they were found (r.q_shortest/longest).
+void LengthRange(const mjModel* m, mjData* d, int t, TendonRange& r) {
+  const std::vector<int>& joints = r.joints;
+  const std::vector<double>&jlo = r.usable_lo, &jhi = r.usable_hi;
   const int n = static_cast<int>(joints.size());
   double lo = INFINITY, hi = -INFINITY;
+  std::vector<double> q(n);
   auto sample = [&](const std::vector<double>& f) {
     RestPose(m, d);
-    for (int i = 0; i < n; ++i)
-      d->qpos[m->jnt_qposadr[joints[i]]] = jlo[i] + f[i] * (jhi[i] - jlo[i]);
+    for (int i = 0; i < n; ++i) {
+      q[i] = jlo[i] + f[i] * (jhi[i] - jlo[i]);
+      d->qpos[m->jnt_qposadr[joints[i]]] = q[i];
+    }
     const double l = TendonLengthNow(m, d, t);
-    lo = std::min(lo, l);
-    hi = std::max(hi, l);
+    if (l < lo) lo = l, r.q_shortest = q;
+    if (l > hi) hi = l, r.q_longest = q;
     return l;
   };
   std::vector<double> f(n, 0.0);
   if (n == 1) {
-    std::tie(lo, hi) = LengthRangeOverOneJoint([&](double x) {
+    LengthRangeOverOneJoint([&](double x) {  // its extremes are among the samples
       f[0] = x;
       return sample(f);
     });
@@ -166,7 +169,8 @@ std::pair<double, double> LengthRange(const mjModel* m, mjData* d, int t,
       sample(f);
     }
   }
-  return {lo, hi};
+  r.length_min = lo;
+  r.length_max = hi;
 }
 
 }  // namespace
@@ -209,7 +213,7 @@ TendonRange SampleTendonRange(const mjModel* m, mjData* d, int t) {
     r.jumps.insert(r.jumps.end(), jumps.begin(), jumps.end());
   }
   if (!r.joints.empty()) {
-    std::tie(r.length_min, r.length_max) = LengthRange(m, d, t, r.joints, r.usable_lo, r.usable_hi);
+    LengthRange(m, d, t, r);
   } else {
     RestPose(m, d);
     r.length_min = r.length_max = TendonLengthNow(m, d, t);

@@ -26,6 +26,8 @@ struct TendonRange {
   std::vector<double> usable_lo, usable_hi;
   std::vector<TendonJump> jumps;          // every jump found, in joint order then by position
   double length_min = 0, length_max = 0;  // tendon length range over the usable ranges (m)
+  // The values of `joints` (same order) where length_min and length_max were found.
+  std::vector<double> q_shortest, q_longest;
   double excursion() const { return length_max - length_min; }
 };
 

@@ -11,78 +11,82 @@
 #include "common/mujoco_ptr.h"
 #include "identification/plant_record.h"
 #include "plugin/sma_host.h"
+#include "plugin/tendon_range.h"
 
 namespace recruit::identification {
 namespace {
 
 struct HeldPose {
-  int qadr = -1;  // -1: nothing held
-  double q = 0;
-  double q_short = 0, q_long = 0;  // the joint where the tendon is shortest and longest
+  std::vector<int> qadr;  // empty: nothing held
+  std::vector<double> q;
+  std::vector<double> q_short, q_long;  // where the tendon is shortest and longest
   std::string text;
 };
 
-// The pose of the limited 1-dof joint that moves `tendon` the most (the first of equals),
-// sampled over its range, whose tendon length is at `place` of that joint's length range (0
-// shortest, 1 longest), the other joints at qpos0. (A joint that barely moves the tendon, such
-// as a finger's abduction for its extensor, would hold it where a unit pulls little.)
-HeldPose ChoosePose(const mjModel* m, mjData* d, int tendon, double place) {
-  constexpr int kSamples = 201;
-  HeldPose chosen;
-  double chosen_span = 0;
-  for (int j = 0; j < m->njnt; ++j) {
-    const int type = m->jnt_type[j];
-    if ((type != mjJNT_HINGE && type != mjJNT_SLIDE) || !m->jnt_limited[j]) continue;
-    const int qadr = m->jnt_qposadr[j];
-    const double lo = m->jnt_range[2 * j], hi = m->jnt_range[2 * j + 1];
-    std::vector<double> q(kSamples), len(kSamples);
-    for (int i = 0; i < kSamples; ++i) {
-      mju_copy(d->qpos, m->qpos0, m->nq);
-      q[i] = lo + (hi - lo) * i / (kSamples - 1);
-      d->qpos[qadr] = q[i];
-      mj_kinematics(m, d);
-      mj_comPos(m, d);
-      mj_tendon(m, d);
-      len[i] = d->ten_length[tendon];
-    }
-    const auto [mn, mx] = std::minmax_element(len.begin(), len.end());
-    if (*mx - *mn < 1e-9 || *mx - *mn <= chosen_span) continue;  // moves it less
-    const double want = *mn + place * (*mx - *mn);
-    int best = 0;
-    for (int i = 1; i < kSamples; ++i) {
-      if (std::abs(len[i] - want) < std::abs(len[best] - want)) best = i;
-    }
-    HeldPose p;
-    p.qadr = qadr;
-    p.q = q[best];
-    p.q_short = q[mn - len.begin()];
-    p.q_long = q[mx - len.begin()];
-    const char* name = mj_id2name(m, mjOBJ_JOINT, j);
-    char buf[160];
-    if (type == mjJNT_HINGE) {
-      std::snprintf(buf, sizeof buf, "%s %.1f deg", name ? name : "joint", q[best] * 180 / M_PI);
-    } else {
-      std::snprintf(buf, sizeof buf, "%s %.4f m", name ? name : "joint", q[best]);
-    }
-    p.text = buf;
-    chosen = p;
-    chosen_span = *mx - *mn;
-  }
-  mju_copy(d->qpos, m->qpos0, m->nq);
-  return chosen;
+void SetPose(const mjModel* m, mjData* d, const HeldPose& p, const std::vector<double>& q) {
+  for (std::size_t i = 0; i < p.qadr.size(); ++i) d->qpos[p.qadr[i]] = q[i];
 }
 
-// Holds the pose before each physics step: the joint at q and every velocity zero; with a
-// sweep period T > 0 the joint is driven instead, q(t) = q_short + (q_long - q_short)
+// The pose of every joint that moves `tendon` (plugin/tendon_range.h: usable ranges, cut at
+// path jumps, joints a lock holds left out) whose tendon length is at `place` of the tendon's
+// length range over them (0 shortest, 1 longest), on the straight path between the poses of the
+// shortest and the longest, the other joints at qpos0. All the joints: a bundle that crosses
+// two (a biarticular muscle's) reaches lengths one joint alone does not, and its units are seen
+// there.
+HeldPose ChoosePose(const mjModel* m, mjData* d, int tendon, double place) {
+  constexpr int kSamples = 201;
+  const sma::TendonRange range = sma::SampleTendonRange(m, d, tendon);
+  HeldPose p;
+  if (range.joints.empty() || !(range.excursion() > 1e-9)) {
+    mju_copy(d->qpos, m->qpos0, m->nq);
+    return p;
+  }
+  for (int j : range.joints) p.qadr.push_back(m->jnt_qposadr[j]);
+  p.q_short = range.q_shortest;
+  p.q_long = range.q_longest;
+  const double want = range.length_min + place * range.excursion();
+  double best_gap = INFINITY;
+  std::vector<double> q(p.qadr.size());
+  for (int k = 0; k < kSamples; ++k) {
+    const double f = double(k) / (kSamples - 1);
+    for (std::size_t i = 0; i < q.size(); ++i)
+      q[i] = p.q_short[i] + f * (p.q_long[i] - p.q_short[i]);
+    mju_copy(d->qpos, m->qpos0, m->nq);
+    SetPose(m, d, p, q);
+    mj_kinematics(m, d);
+    mj_comPos(m, d);
+    mj_tendon(m, d);
+    const double gap = std::abs(d->ten_length[tendon] - want);
+    if (gap < best_gap) best_gap = gap, p.q = q;
+  }
+  for (std::size_t i = 0; i < p.q.size(); ++i) {
+    const int j = range.joints[i];
+    const char* name = mj_id2name(m, mjOBJ_JOINT, j);
+    char buf[160];
+    if (m->jnt_type[j] == mjJNT_HINGE) {
+      std::snprintf(buf, sizeof buf, "%s %.1f deg", name ? name : "joint", p.q[i] * 180 / M_PI);
+    } else {
+      std::snprintf(buf, sizeof buf, "%s %.4f m", name ? name : "joint", p.q[i]);
+    }
+    p.text += (p.text.empty() ? "" : ", ") + std::string(buf);
+  }
+  mju_copy(d->qpos, m->qpos0, m->nq);
+  return p;
+}
+
+// Holds the pose before each physics step: the joints at q and every velocity zero; with a
+// sweep period T > 0 the joints are driven instead, q(t) = q_short + (q_long - q_short)
 // (1 - cos(2 pi t / T)) / 2, from the shortest tendon to the longest and back.
 void Hold(const mjModel* m, mjData* d, const HeldPose& p, double period) {
-  if (p.qadr < 0) return;
+  if (p.qadr.empty()) return;
   mju_zero(d->qvel, m->nv);
   if (period > 0) {
-    const double w = 2 * M_PI / period, span = p.q_long - p.q_short;
-    d->qpos[p.qadr] = p.q_short + span * 0.5 * (1 - std::cos(w * d->time));
+    const double f = 0.5 * (1 - std::cos(2 * M_PI / period * d->time));
+    for (std::size_t i = 0; i < p.qadr.size(); ++i) {
+      d->qpos[p.qadr[i]] = p.q_short[i] + (p.q_long[i] - p.q_short[i]) * f;
+    }
   } else {
-    d->qpos[p.qadr] = p.q;
+    SetPose(m, d, p, p.q);
   }
 }
 

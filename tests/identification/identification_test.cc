@@ -198,7 +198,7 @@ TEST(SwitchingLog, CsvRoundTripsAndBadFilesNameTheLineAndColumn) {
 
 // The pose is set on the joint that moves the tendon the most: here the second of two hinges
 // (a fixed tendon, length 0.001 a + 0.02 b), held at its longest, b = 1 rad.
-TEST(Identification, BenchHoldsTheJointThatMovesTheTendonMost) {
+TEST(Identification, BenchHoldsEveryJointThatMovesTheTendonWhereItIsLongest) {
   const std::string path = TempPath("two_hinges.xml");
   std::ofstream(path) << R"(<mujoco><compiler angle="radian"/>
   <extension><plugin plugin="recruit.sma"><instance name="u">
@@ -215,8 +215,15 @@ TEST(Identification, BenchHoldsTheJointThatMovesTheTendonMost) {
   auto rec = RecordBench(path, "p", e, 0.5, 5);
   ASSERT_TRUE(rec.ok()) << rec.error();
   ASSERT_FALSE(rec->lengths.empty());
-  // The bundle's length coordinate is gear (1) x the tendon's length: 0.02 x 1 rad.
-  EXPECT_NEAR(rec->lengths.front(), 0.02, 1e-9);
+  // The bundle's length coordinate is gear (1) x the tendon's length, 0.001 a + 0.02 b: both
+  // joints at their upper limit (1 rad), not only b, which moves it most.
+  EXPECT_NEAR(rec->lengths.front(), 0.021, 1e-9);
+  EXPECT_EQ(rec->pose, "a 57.3 deg, b 57.3 deg");
+  RecordOptions shortest;
+  shortest.length_place = 0;
+  auto low = RecordBench(path, "p", e, 0.5, 5, shortest);
+  ASSERT_TRUE(low.ok()) << low.error();
+  EXPECT_NEAR(low->lengths.front(), -0.021, 1e-9);
   std::filesystem::remove(path);
 }
 
