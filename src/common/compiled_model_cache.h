@@ -40,21 +40,15 @@
 #include <string_view>
 #include <vector>
 
+#include "common/cache_folder.h"
 #include "common/content_hash.h"
 
 namespace recruit::compiled_cache {
 
 // The cache's folder ("" = off or no home).
 inline std::string Folder() {
-  if (const char* c = std::getenv("RECRUIT_COMPILED_CACHE"); c && *c) {
-    return std::string(c) == "off" ? "" : c;
-  }
-  if (const char* x = std::getenv("XDG_CACHE_HOME"); x && *x) {
-    return std::string(x) + "/recruit/compiled";
-  }
-  if (const char* h = std::getenv("HOME"); h && *h)
-    return std::string(h) + "/.cache/recruit/compiled";
-  return "";
+  const std::string f = CacheFolder("RECRUIT_COMPILED_CACHE", "compiled");
+  return f == "off" ? "" : f;
 }
 
 // True if the MJCF text names no other file (so its bytes determine the model).

@@ -7,9 +7,12 @@
 #include <limits>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <unsupported/Eigen/MatrixFunctions>
 #include <vector>
+
+#include "control/loop_design_store.h"
 
 namespace recruit::control {
 namespace {
@@ -68,17 +71,8 @@ double Penalty(const LoopDesign& d, const LoopTarget& target) {
 // Designs already made in this process, keyed by the exact bits of every input: a sweep's runs
 // of one task design the same loops again (the design is a sixth of a short auto-loop run), and
 // a design is a pure function of its inputs, so a stored one is the one a new search would make.
+// Between processes: control/loop_design_store.h.
 constexpr std::size_t kDesignMemoEntries = 512;
-
-std::vector<std::uint64_t> DesignKey(const JointDynamics& j, const ActuatorResponse& act, double dT,
-                                     const LoopTarget& t) {
-  const double head[] = {j.inertia,   j.damping, j.stiffness, act.dT,        dT,
-                         t.overshoot, t.band,    t.hold,      t.torque_error};
-  std::vector<std::uint64_t> key(std::size(head) + act.s.size());
-  std::memcpy(key.data(), head, sizeof head);
-  std::memcpy(key.data() + std::size(head), act.s.data(), act.s.size() * sizeof(double));
-  return key;
-}
 
 std::mutex design_memo_mutex;
 std::map<std::vector<std::uint64_t>, LoopDesign>& DesignMemo() {
@@ -90,6 +84,16 @@ LoopDesign SearchGrid(const JointDynamics& joint, const ActuatorResponse& act, d
                       const LoopTarget& target);
 
 }  // namespace
+
+std::vector<std::uint64_t> LoopDesignKey(const JointDynamics& j, const ActuatorResponse& act,
+                                         double dT, const LoopTarget& t) {
+  const double head[] = {j.inertia,   j.damping, j.stiffness, act.dT,        dT,
+                         t.overshoot, t.band,    t.hold,      t.torque_error};
+  std::vector<std::uint64_t> key(std::size(head) + act.s.size());
+  std::memcpy(key.data(), head, sizeof head);
+  std::memcpy(key.data() + std::size(head), act.s.data(), act.s.size() * sizeof(double));
+  return key;
+}
 
 PredictedStep PredictStep(const JointDynamics& joint, const ActuatorResponse& act, double dT,
                           const LoopGains& gains, const LoopTarget& target,
@@ -148,13 +152,15 @@ Result<LoopDesign> DesignJointLoop(const JointDynamics& joint, const ActuatorRes
   if (act.s.size() < 2 || !(dT > 0) || !(target.hold > dT)) {
     return Error{"loop design: needs an actuator response, dT > 0 and a hold longer than dT"};
   }
-  const std::vector<std::uint64_t> key = DesignKey(joint, act, dT, target);
+  const std::vector<std::uint64_t> key = LoopDesignKey(joint, act, dT, target);
   {
     std::lock_guard<std::mutex> lock(design_memo_mutex);
     auto it = DesignMemo().find(key);
     if (it != DesignMemo().end()) return it->second;
   }
-  LoopDesign design = SearchGrid(joint, act, dT, target);
+  std::optional<LoopDesign> stored = design_store::Load(key);
+  LoopDesign design = stored ? std::move(*stored) : SearchGrid(joint, act, dT, target);
+  if (!stored) design_store::Save(key, design);
   std::lock_guard<std::mutex> lock(design_memo_mutex);
   if (DesignMemo().size() < kDesignMemoEntries) DesignMemo().emplace(key, design);
   return design;

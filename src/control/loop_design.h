@@ -14,6 +14,7 @@
 // model, the estimate's bias).
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -68,6 +69,11 @@ PredictedStep PredictStep(const JointDynamics& joint, const ActuatorResponse& ac
                           const LoopGains& gains, const LoopTarget& target,
                           double actuator_slowdown = 1, double gain_scale = 1,
                           double feedforward_error = 0);
+
+// The exact bits of every input of DesignJointLoop: the key its designs are kept under, in this
+// process and between processes (control/loop_design_store.h).
+std::vector<std::uint64_t> LoopDesignKey(const JointDynamics& joint, const ActuatorResponse& act,
+                                         double dT, const LoopTarget& target);
 
 Result<LoopDesign> DesignJointLoop(const JointDynamics& joint, const ActuatorResponse& act,
                                    double dT, const LoopTarget& target);

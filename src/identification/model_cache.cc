@@ -5,6 +5,7 @@
 #include <filesystem>
 
 #include "common/atomic_file.h"
+#include "common/cache_folder.h"
 #include "common/data_path.h"
 #include "common/file_lock.h"
 #include "common/json_file.h"
@@ -34,15 +35,8 @@ std::vector<std::string> ModelSearchPath() {
   if (const std::string data = DataDir(); !data.empty()) {
     dirs.push_back(data + "/models/identified");
   }
-  if (const char* c = std::getenv("RECRUIT_MODEL_CACHE"); c && *c) {
-    dirs.push_back(c);
-  } else if (const char* x = std::getenv("XDG_CACHE_HOME"); x && *x) {
-    dirs.push_back(std::string(x) + "/recruit/models");
-  } else if (const char* h = std::getenv("HOME"); h && *h) {
-    dirs.push_back(std::string(h) + "/.cache/recruit/models");
-  } else {
-    dirs.push_back((fs::temp_directory_path() / "recruit-models").string());
-  }
+  const std::string cache = CacheFolder("RECRUIT_MODEL_CACHE", "models");
+  dirs.push_back(cache.empty() ? (fs::temp_directory_path() / "recruit-models").string() : cache);
   return dirs;
 }
 
