@@ -44,6 +44,21 @@ double ActuatorResponse::TimeTo(double fraction) const {
   return s.size() * dT;
 }
 
+ActuatorResponse ActuatorResponse::Released() const {
+  ActuatorResponse r;
+  r.dT = dT;
+  r.s = release.empty() ? s : release;
+  return r;
+}
+
+ActuatorResponse ActuatorResponse::Reversed() const {
+  ActuatorResponse r;
+  r.dT = dT;
+  r.s = release.empty() ? s : release;
+  if (!release.empty()) r.release = s;
+  return r;
+}
+
 Result<ActuatorResponse> PredictActuatorResponse(const estimation::BroadcastTransitionModel& chain,
                                                  const std::vector<double>& force, double lambda,
                                                  double from, double to, int max_samples) {
@@ -81,6 +96,16 @@ Result<ActuatorResponse> PredictActuatorResponse(const estimation::BroadcastTran
     if (k > 2 && std::abs(1 - r.s.back()) < 1e-4 && std::abs(1 - r.s[k - 1]) < 1e-4) break;
   }
   return r;
+}
+
+Result<ActuatorResponse> PredictBundleResponse(const estimation::BroadcastTransitionModel& chain,
+                                               const std::vector<double>& force, double lambda) {
+  auto rise = PredictActuatorResponse(chain, force, lambda, 0.25, 0.5);
+  if (!rise) return rise;
+  auto release = PredictActuatorResponse(chain, force, lambda, 0.5, 0.25);
+  if (!release) return release.failure();
+  rise->release = std::move(release->s);
+  return rise;
 }
 
 ActuatorResponse FirstOrderActuatorResponse(double dT, double lambda, double tau, int max_samples) {

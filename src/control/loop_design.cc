@@ -74,9 +74,13 @@ std::vector<std::uint64_t> DesignKey(const JointDynamics& j, const ActuatorRespo
                                      const LoopTarget& t) {
   const double head[] = {j.inertia,   j.damping, j.stiffness, act.dT,        dT,
                          t.overshoot, t.band,    t.hold,      t.torque_error};
-  std::vector<std::uint64_t> key(std::size(head) + act.s.size());
+  // s's length first, so that the same samples split differently between s and release differ.
+  std::vector<std::uint64_t> key(std::size(head) + 1 + act.s.size() + act.release.size());
   std::memcpy(key.data(), head, sizeof head);
-  std::memcpy(key.data() + std::size(head), act.s.data(), act.s.size() * sizeof(double));
+  key[std::size(head)] = act.s.size();
+  std::memcpy(key.data() + std::size(head) + 1, act.s.data(), act.s.size() * sizeof(double));
+  std::memcpy(key.data() + std::size(head) + 1 + act.s.size(), act.release.data(),
+              act.release.size() * sizeof(double));
   return key;
 }
 
@@ -105,12 +109,20 @@ PredictedStep PredictStep(const JointDynamics& joint, const ActuatorResponse& ac
   PredictedStep out;
   std::vector<double> t_fine, y_fine;
   // The step response m sampling periods and s + 1/2 substeps after a change of the demand
-  // (at [m * kSubsteps + s]), tabulated once, and each instant's tensions over its substeps
-  // summed change by change (the same terms in the same order for every substep).
-  std::vector<double> response(static_cast<size_t>(instants) * kSubsteps);
+  // (at [m * kSubsteps + s]), tabulated once (a second table after the first for the release
+  // response, when there is one), and each instant's tensions over its substeps summed change by
+  // change (the same terms in the same order for every substep). A rise of the demand moves the
+  // tension along s, a fall along the release response: a sum of increments, each along its own
+  // direction's response.
+  const size_t table = static_cast<size_t>(instants) * kSubsteps;
+  const size_t fall = act.release.empty() ? 0 : table;  // where a fall's response starts
+  std::vector<double> response(table + fall);
+  const ActuatorResponse released = act.Released();
   for (int m = 0; m < instants; ++m) {
     for (int s = 0; s < kSubsteps; ++s) {
-      response[m * kSubsteps + s] = act.At((m * dT + (s + 0.5) * h) / actuator_slowdown);
+      const double t = (m * dT + (s + 0.5) * h) / actuator_slowdown;
+      response[m * kSubsteps + s] = act.At(t);
+      if (fall != 0) response[fall + m * kSubsteps + s] = released.At(t);
     }
   }
   std::vector<double> change;  // u[i] - u[i - 1], i >= 1
@@ -127,7 +139,7 @@ PredictedStep PredictStep(const JointDynamics& joint, const ActuatorResponse& ac
     std::fill(tau, tau + kSubsteps, u[0]);
     for (int i = 1; i <= n + 1; ++i) {
       const double c = change[i - 1];
-      const double* r = &response[static_cast<size_t>(n + 1 - i) * kSubsteps];
+      const double* r = &response[(c < 0 ? fall : 0) + static_cast<size_t>(n + 1 - i) * kSubsteps];
       for (int s = 0; s < kSubsteps; ++s) tau[s] += c * r[s];
     }
     for (int s = 0; s < kSubsteps; ++s) {
@@ -145,7 +157,7 @@ Result<LoopDesign> DesignJointLoop(const JointDynamics& joint, const ActuatorRes
   if (!(joint.inertia > 0) || !(joint.damping >= 0) || !std::isfinite(joint.stiffness)) {
     return Error{"loop design: the joint needs inertia > 0, damping >= 0, finite stiffness"};
   }
-  if (act.s.size() < 2 || !(dT > 0) || !(target.hold > dT)) {
+  if (act.s.size() < 2 || act.release.size() == 1 || !(dT > 0) || !(target.hold > dT)) {
     return Error{"loop design: needs an actuator response, dT > 0 and a hold longer than dT"};
   }
   const std::vector<std::uint64_t> key = DesignKey(joint, act, dT, target);
