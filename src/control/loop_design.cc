@@ -117,7 +117,7 @@ PredictedStep PredictStep(const JointDynamics& joint, const ActuatorResponse& ac
   const size_t table = static_cast<size_t>(instants) * kSubsteps;
   const size_t fall = act.release.empty() ? 0 : table;  // where a fall's response starts
   std::vector<double> response(table + fall);
-  const ActuatorResponse released = act.Released();
+  const ActuatorResponse released = fall != 0 ? act.Released() : ActuatorResponse{};
   for (int m = 0; m < instants; ++m) {
     for (int s = 0; s < kSubsteps; ++s) {
       const double t = (m * dT + (s + 0.5) * h) / actuator_slowdown;
@@ -137,10 +137,21 @@ PredictedStep PredictStep(const JointDynamics& joint, const ActuatorResponse& ac
     out.angle.push_back(z[0] + 1);
     // Each change of the demand moves the tension along the bundle's step response.
     std::fill(tau, tau + kSubsteps, u[0]);
-    for (int i = 1; i <= n + 1; ++i) {
-      const double c = change[i - 1];
-      const double* r = &response[(c < 0 ? fall : 0) + static_cast<size_t>(n + 1 - i) * kSubsteps];
-      for (int s = 0; s < kSubsteps; ++s) tau[s] += c * r[s];
+    // Apart when every change takes the one response: the choice in the inner loop cost the
+    // symmetric design (the only one JointLoops makes) 40 % of its time.
+    if (fall == 0) {
+      for (int i = 1; i <= n + 1; ++i) {
+        const double c = change[i - 1];
+        const double* r = &response[static_cast<size_t>(n + 1 - i) * kSubsteps];
+        for (int s = 0; s < kSubsteps; ++s) tau[s] += c * r[s];
+      }
+    } else {
+      for (int i = 1; i <= n + 1; ++i) {
+        const double c = change[i - 1];
+        const double* r =
+            &response[(c < 0 ? fall : 0) + static_cast<size_t>(n + 1 - i) * kSubsteps];
+        for (int s = 0; s < kSubsteps; ++s) tau[s] += c * r[s];
+      }
     }
     for (int s = 0; s < kSubsteps; ++s) {
       z = dis.phi * z + dis.gam * tau[s];

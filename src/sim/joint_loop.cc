@@ -130,11 +130,11 @@ Result<JointDesignRecord> JointLoops::Design(const Plant& plant, int j, const Ei
   auto d = control::DesignJointLoop(rec.dynamics, rise, dT_, target);
   if (!d.ok()) return d.failure().In("joint '" + rec.joint + "': ");
   rec.design = std::move(d).value();
-  // The same gains with each way of the demand through the bundles that move it that way.
+  rec.dT = dT_;
+  rec.target = target;
+  // Each way of the demand through the bundles that move it that way (not a design input).
   rec.both_ways = BothWays(plant, j, r, step);
   rec.release_t63 = rec.both_ways.Released().TimeTo(0.63);
-  rec.both_ways_step =
-      control::PredictStep(rec.dynamics, rec.both_ways, dT_, rec.design.gains, target);
   return rec;
 }
 

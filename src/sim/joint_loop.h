@@ -38,11 +38,13 @@ struct JointDesignRecord {
   double torque_error = 0;  // N m, the feedforward error the integral must remove
   double actuator_t63 = 0;  // s, the design's bundle response: its time to 63 % of a step
   control::LoopDesign design;
-  // The joint's torque response each way for this step (JointLoops::BothWays), its release's
-  // time to 63 % (s) and the design's gains' step response with it (not a design input).
+  double dT = 0;               // s, the loop's sampling period
+  control::LoopTarget target;  // what the design asked of the step
+  // The joint's torque response each way for this step (JointLoops::BothWays) and its release's
+  // time to 63 % (s): not a design input; control::PredictStep with it shows the design's gains
+  // as the bundles will move the demand each way (recruit tune-loop).
   control::ActuatorResponse both_ways;
   double release_t63 = 0;
-  control::PredictedStep both_ways_step;
 };
 
 class JointLoops {
