@@ -74,13 +74,17 @@ std::vector<std::uint64_t> DesignKey(const JointDynamics& j, const ActuatorRespo
                                      const LoopTarget& t) {
   const double head[] = {j.inertia,   j.damping, j.stiffness, act.dT,        dT,
                          t.overshoot, t.band,    t.hold,      t.torque_error};
-  // s's length first, so that the same samples split differently between s and release differ.
-  std::vector<std::uint64_t> key(std::size(head) + 1 + act.s.size() + act.release.size());
+  std::vector<std::uint64_t> key(std::size(head) + act.s.size());
   std::memcpy(key.data(), head, sizeof head);
-  key[std::size(head)] = act.s.size();
-  std::memcpy(key.data() + std::size(head) + 1, act.s.data(), act.s.size() * sizeof(double));
-  std::memcpy(key.data() + std::size(head) + 1 + act.s.size(), act.release.data(),
-              act.release.size() * sizeof(double));
+  std::memcpy(key.data() + std::size(head), act.s.data(), act.s.size() * sizeof(double));
+  if (act.release.empty()) return key;
+  // A release response after a NaN's bits, which no (finite) sample of s has: the same samples
+  // split differently between s and release make different keys, and a key without a release
+  // is what it was before responses had one.
+  key.push_back(0x7ff8'5e1e'a5e0'0000);
+  const size_t at = key.size();
+  key.resize(at + act.release.size());
+  std::memcpy(key.data() + at, act.release.data(), act.release.size() * sizeof(double));
   return key;
 }
 
