@@ -33,9 +33,24 @@ void PrintDesign(const sim::JointDesignRecord& r, bool response) {
       d.nominal.settled ? "" : " (not settled)", 100 * d.robust.overshoot,
       d.robust.settled ? "settles" : "does not settle",
       d.meets ? "" : ("  [" + d.note + "]").c_str());
+  // The same gains as the joint will move the demand: each way through the bundles that move
+  // it that way, rising or releasing (JointLoops::BothWays).
+  const control::PredictedStep w =
+      control::PredictStep(r.dynamics, r.both_ways, r.dT, d.gains, r.target);
+  std::printf(
+      "%-14s %8s  each way through its bundles' rise or release (t63 %.2f s the step's way, "
+      "%.2f s back): overshoot %.1f %%, ",
+      "", "", r.both_ways.TimeTo(0.63), r.release_t63, 100 * w.overshoot);
+  if (w.settled) {
+    std::printf("settles in %.1f s\n", w.settling_time);
+  } else {
+    std::printf("does not settle\n");
+  }
   if (!response) return;
   std::printf("%-14s %8s  step response (fraction of the step) at t = 0, dT, ...:", "", "");
   for (double y : d.nominal.angle) std::printf(" %.3f", y);
+  std::printf("\n%-14s %8s  each way through its bundles' rise or release:", "", "");
+  for (double y : w.angle) std::printf(" %.3f", y);
   std::printf("\n");
 }
 

@@ -19,6 +19,9 @@ struct ActuatorResponse {
   // s[k]: the fraction of a step of the force reference that the tension has made k sampling
   // periods after it (s[0] = 0; tends to 1).
   std::vector<double> s;
+  // The same for a step the other way (the reference stepped back down, units released and
+  // cooling; PredictBundleResponse), when it differs from s; empty: the same as s.
+  std::vector<double> release;
 
   // Linear interpolation between samples; 1 after the last. Inline: the loop design calls it
   // millions of times per joint (control::PredictStep), and an out-of-line call kept those
@@ -34,6 +37,10 @@ struct ActuatorResponse {
   }
   // The first time the response reaches `fraction` (linear between samples).
   double TimeTo(double fraction) const;
+  // The response to a step the other way (`release` as s, or s when there is none), and this
+  // one with its two directions swapped.
+  ActuatorResponse Released() const;
+  ActuatorResponse Reversed() const;
 
   // t / d, bit for bit. When d is a power of two (dT is 0.5, 1 or 2 s in every shipped task)
   // its reciprocal 2^-n is exact, and t * 2^-n and t / 2^n are both the correctly rounded value
@@ -64,6 +71,13 @@ Result<ActuatorResponse> PredictActuatorResponse(const estimation::BroadcastTran
                                                  const std::vector<double>& force, double lambda,
                                                  double from = 0.25, double to = 0.5,
                                                  int max_samples = 1000);
+
+// A bundle's response both ways under the law: the rise from 0.25 to 0.5 of the settled on-force
+// (s) and the release from 0.5 back to 0.25 (release). The identified chains of the project's
+// limbs release within 0.6-1.12x the rise's time to 63 %, some with one more sampling period of
+// dead time (the elbow arm's flexor at dT 1 s: docs/controller.md).
+Result<ActuatorResponse> PredictBundleResponse(const estimation::BroadcastTransitionModel& chain,
+                                               const std::vector<double>& force, double lambda);
 
 // Without a usable chain: the expected on-count's approach under the law, 1 - (1 - lambda)^k at
 // the control instants (held between them), through a first-order thermal lag of time constant

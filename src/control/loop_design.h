@@ -64,7 +64,10 @@ struct LoopDesign {
 };
 
 // The design model's response to a unit step of the reference; `feedforward_error` (N m) is
-// taken off every demand from the step on.
+// taken off every demand from the step on. Each rise of the demand moves the actuator's torque
+// along act.s, each fall along its release response (ActuatorResponse::Released, s when it has
+// none): the torque is the sum of the demand's increments, each through its own direction's
+// response.
 PredictedStep PredictStep(const JointDynamics& joint, const ActuatorResponse& act, double dT,
                           const LoopGains& gains, const LoopTarget& target,
                           double actuator_slowdown = 1, double gain_scale = 1,

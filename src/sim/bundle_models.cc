@@ -79,7 +79,7 @@ Result<std::vector<control::ActuatorResponse>> ActuatorResponses(
                    "': the self-tuned loop needs a broadcast chain model with a force row"};
     }
     const Eigen::VectorXd h = model.H.row(0).transpose();
-    auto r = control::PredictActuatorResponse(
+    auto r = control::PredictBundleResponse(
         model.broadcast, std::vector<double>(h.data(), h.data() + h.size()), settings.lambda);
     if (r) {
       out.push_back(std::move(r).value());

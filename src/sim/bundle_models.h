@@ -31,7 +31,8 @@ inline constexpr double kMinHoldoutR2 = 0.9;
 void IdentificationWarning(const estimation::FilterModel& model, const std::string& bundle,
                            std::vector<std::string>& warnings);
 
-// Each bundle's tension step response under the law (control/actuator_response.h), predicted on
+// Each bundle's tension step response under the law, rise and release
+// (control::PredictBundleResponse), predicted on
 // the chain identified for it: its Kalman estimator's own model (estimators[i]), else the
 // identified one, else (none found and none to be made) the unit's thermal lag, with a warning.
 Result<std::vector<control::ActuatorResponse>> ActuatorResponses(

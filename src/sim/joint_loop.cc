@@ -124,10 +124,59 @@ Result<JointDesignRecord> JointLoops::Design(const Plant& plant, int j, const Ei
   rec.actuator_t63 = act->TimeTo(0.63);
   control::LoopTarget target = target_;
   target.torque_error = rec.torque_error / rec.step;
-  auto d = control::DesignJointLoop(rec.dynamics, *act, dT_, target);
+  // Designed on the rise both ways (docs/controller.md, "Rise and release").
+  control::ActuatorResponse rise = *act;
+  rise.release.clear();
+  auto d = control::DesignJointLoop(rec.dynamics, rise, dT_, target);
   if (!d.ok()) return d.failure().In("joint '" + rec.joint + "': ");
   rec.design = std::move(d).value();
+  rec.dT = dT_;
+  rec.target = target;
+  // Each way of the demand through the bundles that move it that way (not a design input).
+  rec.both_ways = BothWays(plant, j, r, step);
+  rec.release_t63 = rec.both_ways.Released().TimeTo(0.63);
   return rec;
+}
+
+control::ActuatorResponse JointLoops::BothWays(const Plant& plant, int j, const Eigen::VectorXd& r,
+                                               double step) const {
+  const Eigen::MatrixXd arms = plant.MomentArmsAt(r);
+  const double tiny = 1e-9 * arms.row(j).cwiseAbs().maxCoeff();
+  // The fastest rise and release of each side (flexing, extending) by their times to 63 %.
+  struct Fastest {
+    double t63 = std::numeric_limits<double>::infinity();
+    const control::ActuatorResponse* r = nullptr;
+    bool release = false;
+    void Take(const control::ActuatorResponse& b, bool back) {
+      const double t = back ? b.Released().TimeTo(0.63) : b.TimeTo(0.63);
+      if (t < t63) t63 = t, r = &b, release = back;
+    }
+    const std::vector<double>& s() const {
+      return release && !r->release.empty() ? r->release : r->s;
+    }
+  };
+  Fastest rise[2], release[2];
+  for (int i = 0; i < plant.num_bundles(); ++i) {
+    if (std::abs(arms(j, i)) <= tiny) continue;
+    const int side = arms(j, i) > 0 ? 0 : 1;
+    rise[side].Take(responses_[i], false);
+    release[side].Take(responses_[i], true);
+  }
+  // The slower of two ways of moving the torque (either side may have no bundle): a rise of the
+  // joint's torque is a flexing bundle's rise or an extending one's release.
+  auto slower = [](const Fastest& a, const Fastest& b) {
+    return a.r == nullptr || (b.r != nullptr && b.t63 > a.t63) ? b : a;
+  };
+  const Fastest up = slower(rise[0], release[1]), down = slower(release[0], rise[1]);
+  control::ActuatorResponse out;
+  if (up.r == nullptr) return out;
+  // Oriented for the step: s for the demand moving the step's way, release for the other.
+  const Fastest& ahead = step >= 0 ? up : down;
+  const Fastest& back = step >= 0 ? down : up;
+  out.dT = ahead.r->dT;
+  out.s = ahead.s();
+  if (back.r->dT == out.dT && back.s() != out.s) out.release = back.s();
+  return out;
 }
 
 void JointLoops::Step(double t, const Plant& plant, std::vector<double>& force_ref) {

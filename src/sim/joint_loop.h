@@ -38,6 +38,13 @@ struct JointDesignRecord {
   double torque_error = 0;  // N m, the feedforward error the integral must remove
   double actuator_t63 = 0;  // s, the design's bundle response: its time to 63 % of a step
   control::LoopDesign design;
+  double dT = 0;               // s, the loop's sampling period
+  control::LoopTarget target;  // what the design asked of the step
+  // The joint's torque response each way for this step (JointLoops::BothWays) and its release's
+  // time to 63 % (s): not a design input; control::PredictStep with it shows the design's gains
+  // as the bundles will move the demand each way (recruit tune-loop).
+  control::ActuatorResponse both_ways;
+  double release_t63 = 0;
 };
 
 class JointLoops {
@@ -65,6 +72,12 @@ class JointLoops {
   // other joints at theirs).
   Result<JointDesignRecord> Design(const Plant& plant, int j, const Eigen::VectorXd& r,
                                    double step) const;
+  // Joint j's torque response for a step of sign `step` to pose r, each way: s for the demand
+  // moving the step's way, release for it moving back. A rise of the torque is as slow as the
+  // slower of the fastest flexing bundle's rise and the fastest extending bundle's release
+  // (control::PredictBundleResponse), a fall the other way round. dT 0 when no bundle crosses j.
+  control::ActuatorResponse BothWays(const Plant& plant, int j, const Eigen::VectorXd& r,
+                                     double step) const;
   // How the bundles hold joint j at pose r (sim/holding.h).
   JointHolding HoldingAt(const Plant& plant, int j, const Eigen::VectorXd& r) const;
 

@@ -46,6 +46,61 @@ TEST(ActuatorResponse, AHeatingChainLagsTheCountAndStillSettles) {
   EXPECT_NEAR(r->s.back(), 1.0, 1e-3);
 }
 
+// On the two-state chain (no thermal lag) the law closes lambda of the gap each period either
+// way, so the release is the rise: both 1 - (1 - lambda)^k.
+TEST(ActuatorResponse, TwoStateChainReleasesAsItRises) {
+  const double lambda = 0.3;
+  auto r =
+      PredictBundleResponse(estimation::BroadcastTransitionModel::TwoState(1.0), {0, 0.5}, lambda);
+  ASSERT_TRUE(r.ok()) << r.error();
+  ASSERT_GE(r->release.size(), 10u);
+  for (size_t k = 0; k < r->release.size(); ++k) {
+    EXPECT_NEAR(r->release[k], 1 - std::pow(1 - lambda, static_cast<double>(k)), 1e-9) << k;
+  }
+}
+
+// A chain whose released units keep pulling while they cool: off, on, and off-but-hot (pulling
+// as an on unit does, cooling to off with probability c per period). The law moves the on
+// fraction by lambda of its gap either way, so the rise is geometric and the release lags it
+// by the hot units. With r = 1 - lambda and q = 1 - c, from the chain by hand:
+//   rise     s(k) = 1 - r^k
+//   release  s(k) = 1 - r^k - lambda (q^k - r^k) / (q - r)
+TEST(ActuatorResponse, UnitsThatPullWhileTheyCoolSlowOnlyTheRelease) {
+  const double lambda = 0.2, c = 0.3, r = 1 - lambda, q = 1 - c;
+  estimation::BroadcastTransitionModel chain;
+  chain.state_names = {"off", "on", "hot"};
+  chain.is_on = {false, true, false};
+  chain.interior = Eigen::Matrix3d::Identity();
+  chain.interior(0, 2) = c;  // a hot unit cools to off
+  chain.interior(2, 2) = 1 - c;
+  chain.on_target = {1, -1, 1};
+  chain.off_target = {-1, 2, -1};
+  chain.dt = 0.5;
+  ASSERT_TRUE(chain.Validate().ok());
+  auto b = PredictBundleResponse(chain, {0, 1, 1}, lambda);
+  ASSERT_TRUE(b.ok()) << b.error();
+  ASSERT_GE(b->s.size(), 20u);
+  ASSERT_GE(b->release.size(), 20u);
+  for (size_t k = 0; k < b->s.size(); ++k) {
+    EXPECT_NEAR(b->s[k], 1 - std::pow(r, k), 1e-9) << k;
+  }
+  for (size_t k = 0; k < b->release.size(); ++k) {
+    const double want = 1 - std::pow(r, k) - lambda * (std::pow(q, k) - std::pow(r, k)) / (q - r);
+    EXPECT_NEAR(b->release[k], want, 1e-9) << k;
+  }
+  // The release is the slower, and the two views swap the directions.
+  EXPECT_GT(b->Released().TimeTo(0.63), b->TimeTo(0.63) + 2 * chain.dt);
+  EXPECT_EQ(b->Released().s, b->release);
+  EXPECT_TRUE(b->Released().release.empty());
+  EXPECT_EQ(b->Reversed().s, b->release);
+  EXPECT_EQ(b->Reversed().release, b->s);
+  // Without a release of its own a response releases as it rises.
+  ActuatorResponse rise = *b;
+  rise.release.clear();
+  EXPECT_EQ(rise.Released().s, rise.s);
+  EXPECT_TRUE(rise.Reversed().release.empty());
+}
+
 // At divides by dT with a multiplication when dT is a power of two: the same bits as the
 // division for every t (normal, subnormal, zero, negative, huge, infinite) and every dT, a power
 // of two or not (including ones whose reciprocal would not be normal).

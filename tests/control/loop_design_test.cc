@@ -64,6 +64,79 @@ TEST(LoopDesign, PredictionMatchesAFineRk4IntegrationOfTheSameLoop) {
   }
 }
 
+// Bundles that rise with one first-order lag and release with another (closed form at the
+// samples: FirstOrderActuatorResponse with lambda 1 is 1 - exp(-k dT / tau)).
+ActuatorResponse UpDown(double dT, double tau_up, double tau_down) {
+  ActuatorResponse a = FirstOrderActuatorResponse(dT, 1.0, tau_up);
+  a.release = FirstOrderActuatorResponse(dT, 1.0, tau_down).s;
+  return a;
+}
+
+// No gains and a feedforward off by twice the stiffness: the demand falls once, by one step's
+// torque, so a quasi-static limb moves along the release response alone,
+// angle(t) = -(1 - exp(-t / tau_down)); a rise of the demand (no error) along the rise.
+TEST(LoopDesign, AFallOfTheDemandMovesAlongTheReleaseAndARiseAlongTheRise) {
+  const double dT = 0.5, tau_up = 1.0, tau_down = 3.0;
+  const ActuatorResponse act = UpDown(dT, tau_up, tau_down);
+  const JointDynamics joint{1e-6, 0.01, 1.0};
+  LoopTarget target;
+  target.hold = 10;
+  const PredictedStep fall = PredictStep(joint, act, dT, LoopGains{}, target, 1, 1, 2.0);
+  const PredictedStep rise = PredictStep(joint, act, dT, LoopGains{}, target);
+  ASSERT_EQ(fall.angle.size(), 20u);
+  for (size_t k = 1; k < fall.angle.size(); ++k) {
+    EXPECT_NEAR(fall.angle[k], -(1 - std::exp(-(k * dT) / tau_down)), 0.02) << k;
+    EXPECT_NEAR(rise.angle[k], 1 - std::exp(-(k * dT) / tau_up), 0.02) << k;
+  }
+}
+
+// With a release slower than the rise, PredictStep against a fine fixed-step RK4 integration of
+// the same loop in which each change of the demand moves the torque along its own direction's
+// response; and the slow release, which the kick's withdrawal goes through, adds overshoot.
+TEST(LoopDesign, ADirectionAwarePredictionMatchesAFineRk4IntegrationOfTheSameLoop) {
+  const ActuatorResponse act = UpDown(1.0, 1.5, 4.0);
+  const ActuatorResponse released = act.Released();
+  const JointDynamics joint{0.003, 0.02, 0.1};
+  const LoopGains g{0.3, 0.02, 0.03};
+  LoopTarget target;
+  target.hold = 30;
+  const PredictedStep p = PredictStep(joint, act, 1.0, g, target);
+  const double h = 1e-4;
+  double q = -1, v = 0, integral = 0;
+  std::vector<double> u{-joint.stiffness};
+  for (int n = 0; n < 30; ++n) {
+    EXPECT_NEAR(q + 1, p.angle[n], 2e-3) << "instant " << n;
+    integral += -q;
+    u.push_back(g.kp * -q + g.ki * integral - g.kd * v);
+    auto tau = [&](double t) {
+      double x = u[0];
+      for (int i = 1; i <= n + 1; ++i) {
+        const double c = u[i] - u[i - 1];
+        x += c * (c < 0 ? released : act).At(t - (i - 1));
+      }
+      return x;
+    };
+    for (int s = 0; s < 10000; ++s) {
+      const double t = n + s * h;
+      auto f = [&](double qq, double vv, double tt) {
+        return (tau(tt) - joint.damping * vv - joint.stiffness * qq) / joint.inertia;
+      };
+      const double k1q = v, k1v = f(q, v, t);
+      const double k2q = v + 0.5 * h * k1v,
+                   k2v = f(q + 0.5 * h * k1q, v + 0.5 * h * k1v, t + h / 2);
+      const double k3q = v + 0.5 * h * k2v,
+                   k3v = f(q + 0.5 * h * k2q, v + 0.5 * h * k2v, t + h / 2);
+      const double k4q = v + h * k3v, k4v = f(q + h * k3q, v + h * k3v, t + h);
+      q += h / 6 * (k1q + 2 * k2q + 2 * k3q + k4q);
+      v += h / 6 * (k1v + 2 * k2v + 2 * k3v + k4v);
+    }
+  }
+  ActuatorResponse rise_only = act;
+  rise_only.release.clear();
+  const PredictedStep symmetric = PredictStep(joint, rise_only, 1.0, g, target);
+  EXPECT_GT(p.overshoot, symmetric.overshoot + 0.05);
+}
+
 // A target no gain meets (a 1 % band within 1.5 s of a 1 s sampling period): the note names
 // exactly what the chosen design misses, from its own predictions.
 TEST(LoopDesign, ADesignThatMissesItsTargetSaysWhatItMisses) {
@@ -139,11 +212,29 @@ TEST(LoopDesign, AKeptDesignIsTheOneItsOwnInputsMade) {
   EXPECT_EQ(again.angle, b2->nominal.angle);
 }
 
+// Two actuators alike in their rise but not their release get their own designs.
+TEST(LoopDesign, AKeptDesignTellsReleasesApart) {
+  const ActuatorResponse slow = UpDown(1.0, 1.5, 4.0);
+  ActuatorResponse rise_only = slow;
+  rise_only.release.clear();
+  const JointDynamics joint{0.003, 0.02, 0.1};
+  LoopTarget target;
+  target.hold = 20;
+  auto a = DesignJointLoop(joint, rise_only, 1.0, target);
+  auto b = DesignJointLoop(joint, slow, 1.0, target);
+  ASSERT_TRUE(a.ok() && b.ok());
+  EXPECT_NE(a->nominal.angle, b->nominal.angle);
+  EXPECT_EQ(PredictStep(joint, slow, 1.0, b->gains, target).angle, b->nominal.angle);
+}
+
 TEST(LoopDesign, BadInputsAreRefused) {
   const ActuatorResponse act = TwoState(1.0, 0.2);
   LoopTarget target;
   EXPECT_FALSE(DesignJointLoop({0, 0.1, 0.1}, act, 1.0, target).ok());
   EXPECT_FALSE(DesignJointLoop({0.1, -1, 0.1}, act, 1.0, target).ok());
+  ActuatorResponse one_sample = act;
+  one_sample.release = {0};  // a release response needs two samples at least
+  EXPECT_FALSE(DesignJointLoop({0.1, 0.1, 0.1}, one_sample, 1.0, target).ok());
   target.hold = 0.5;
   EXPECT_FALSE(DesignJointLoop({0.1, 0.1, 0.1}, act, 1.0, target).ok());
 }

@@ -233,6 +233,52 @@ TEST(JointLoop, ANewDesignTakesOverTheIntegratedTorqueWithoutAJump) {
   EXPECT_GT(std::abs(ki1 - ki0), 0.01 * std::max(ki0, ki1));  // the two designs differ
 }
 
+// The joint's torque each way: a rise of the torque (the way a bundle with a positive arm pulls)
+// is as slow as the slower of the fastest such bundle's rise and the fastest other bundle's
+// release, a fall the other way round; oriented by the step's sign (s: the demand moving the
+// step's way). The design itself is made on the rise both ways; its record carries BothWays.
+TEST(JointLoop, BothWaysTakesEachBundlesRiseOrReleaseByTheWayItMovesTheTorque) {
+  auto t = TaskFromText(ArmTask("\"auto\""), kRoot + "/models/tasks");
+  ASSERT_TRUE(t.ok()) << t.error();
+  auto plant = Plant::Create(*t, /*drawn=*/false);
+  ASSERT_TRUE(plant.ok()) << plant.error();
+  Plant& pl = **plant;
+  pl.Reset(1);
+  ASSERT_EQ(pl.num_bundles(), 2);
+  const double dT = 1.0;
+  Eigen::VectorXd r(1);
+  r[0] = 0.7;
+  const Eigen::MatrixXd arms = pl.MomentArmsAt(r);
+  ASSERT_LT(arms(0, 0) * arms(0, 1), 0);  // an agonist and an antagonist
+  const int pos = arms(0, 0) > 0 ? 0 : 1, neg = 1 - pos;
+  auto lag = [&](double tau) { return control::FirstOrderActuatorResponse(dT, 1.0, tau).s; };
+  std::vector<control::ActuatorResponse> responses(2);
+  for (auto& b : responses) b.dT = dT;
+  responses[pos].s = lag(0.5);  // rises fast, releases slowly
+  responses[pos].release = lag(4.0);
+  responses[neg].s = lag(2.0);
+  responses[neg].release = lag(1.0);
+  std::vector<UnitForce> unit_force(2, [](double) { return 0.5; });
+  auto loops = JointLoops::Create(*t, pl, responses, unit_force, dT);
+  ASSERT_TRUE(loops.ok()) << loops.error();
+  // Up: the slower of pos's rise (0.5 s) and neg's release (1 s); down: of pos's release (4 s)
+  // and neg's rise (2 s).
+  const control::ActuatorResponse up = loops->BothWays(pl, 0, r, +0.1);
+  EXPECT_EQ(up.s, lag(1.0));
+  EXPECT_EQ(up.release, lag(4.0));
+  const control::ActuatorResponse down = loops->BothWays(pl, 0, r, -0.1);
+  EXPECT_EQ(down.s, lag(4.0));
+  EXPECT_EQ(down.release, lag(1.0));
+  auto rec = loops->Design(pl, 0, r, -0.1);
+  ASSERT_TRUE(rec.ok()) << rec.error();
+  EXPECT_EQ(rec->both_ways.s, down.s);
+  EXPECT_NEAR(rec->release_t63, down.Released().TimeTo(0.63), 1e-12);
+  // What the design asked of the step: the task's band, its shortest hold (at most 60 s).
+  EXPECT_EQ(rec->target.band, t->settle_band);
+  EXPECT_EQ(rec->target.hold, std::min(60.0, ShortestHold(t->joints[0].reference, t->duration)));
+  EXPECT_EQ(rec->dT, dT);
+}
+
 // A bundle designed past the wire's long-life temperature: the warning loading printed is in
 // the run's summary too.
 TEST(JointLoop, TheSummaryCarriesWhatLoadingTheModelWarnedOf) {
