@@ -75,8 +75,20 @@ int Within(const std::vector<double>& v, double lo, double hi) {
   return n;
 }
 
+// The broadcast census (ControllerParams::census_period): FAILURE_CENSUS_PERIOD (s, 0 = off)
+// and the plant's census keys FAILURE_CENSUS_CONFIG (default: census_noise=0.01).
+double CensusPeriod() {
+  const char* e = std::getenv("FAILURE_CENSUS_PERIOD");
+  return e ? std::atof(e) : 0.0;
+}
+
 std::vector<fl::Instant> MustRun(fl::Spec s) {
   if (s.estimator.failures) s.exploration = Exploration();
+  if (s.estimator.failures && CensusPeriod() > 0) {
+    s.census_period = CensusPeriod();
+    const char* c = std::getenv("FAILURE_CENSUS_CONFIG");
+    s.plant_config += std::string(" ") + (c ? c : "census_noise=0.01");
+  }
   auto r = fl::Run(s);
   if (!r) {
     std::fprintf(stderr, "%s\n", r.error().c_str());
@@ -154,12 +166,13 @@ int main(int argc, char** argv) {
                               100,
                               [](double) { return 15.0; },
                               {}});
-    std::printf("t force on est_on var_on working est_working var_working declared susp expl\n");
+    std::printf(
+        "t force on est_on var_on working est_working var_working declared susp expl census\n");
     for (const auto& r : run) {
       if (r.t < 55) continue;
-      std::printf("%.1f %.2f %d %.2f %.2f %d %.2f %.2f %d %.1f %d\n", r.t, r.force, r.on, r.est_on,
-                  r.est_on_var, r.working, r.est_working, r.est_working_var, r.declared,
-                  r.suspicion, r.exploring);
+      std::printf("%.1f %.2f %d %.2f %.2f %d %.2f %.2f %d %.1f %d %d\n", r.t, r.force, r.on,
+                  r.est_on, r.est_on_var, r.working, r.est_working, r.est_working_var, r.declared,
+                  r.suspicion, r.exploring, r.census);
     }
     return 0;
   }
