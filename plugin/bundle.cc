@@ -135,7 +135,6 @@ void SmaBundle::Reset(double* s, std::uint64_t seed, double stretch) const {
   if (census_) {
     double* c = CensusBlock(s);
     StoreRng(Rng(Rng::DeriveSeed(seed, kCensusStream)), c + kCensusRngSlot);
-    c[kCensusOnReadingSlot] = c[kCensusOffReadingSlot] = std::nan("");
   }
 }
 

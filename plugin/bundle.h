@@ -59,7 +59,7 @@ class SmaBundle {
   // is integrated first. Error without a census block or while a census runs.
   Status StartCensus(double* s, double stretch) const;
   bool CensusRunning(const double* s) const;
-  // The shunt's readings of the last finished census (A; NaN before the first) and how many
+  // The shunt's readings of the last finished census (A; 0 before the first) and how many
   // censuses have finished since Reset. A reading is (conducting units) x UnitCurrent() plus
   // Gaussian noise of std census.noise, taken at the end of its phase.
   struct CensusReading {
