@@ -76,7 +76,8 @@ int Within(const std::vector<double>& v, double lo, double hi) {
 }
 
 // The broadcast census (ControllerParams::census_period): FAILURE_CENSUS_PERIOD (s, 0 = off)
-// and the plant's census keys FAILURE_CENSUS_CONFIG (default: census_noise=0.01).
+// and the plant's census keys FAILURE_CENSUS_CONFIG (default: census_noise=0.01);
+// FAILURE_CENSUS_END=1: each census ends at the next control instant (Spec::census_at_end).
 double CensusPeriod() {
   const char* e = std::getenv("FAILURE_CENSUS_PERIOD");
   return e ? std::atof(e) : 0.0;
@@ -86,6 +87,7 @@ std::vector<fl::Instant> MustRun(fl::Spec s) {
   if (s.estimator.failures) s.exploration = Exploration();
   if (s.estimator.failures && CensusPeriod() > 0) {
     s.census_period = CensusPeriod();
+    if (const char* e = std::getenv("FAILURE_CENSUS_END")) s.census_at_end = std::atoi(e) != 0;
     const char* c = std::getenv("FAILURE_CENSUS_CONFIG");
     s.plant_config += std::string(" ") + (c ? c : "census_noise=0.01");
   }
@@ -126,10 +128,13 @@ Blind BlindInstants(const std::vector<fl::Instant>& run, const std::vector<fl::I
   Blind b;
   double sum = 0;
   int n = 0;
-  bool seen = false;
+  bool seen = false, counted = false;
   for (size_t i = 0; i < run.size() && i < base.size(); ++i) {
     const fl::Instant& r = run[i];
-    if (std::abs(r.t - t_fail) < 1e-9) b.heated_lost = base[i].on - r.on;
+    if (r.t >= t_fail - 1e-9 && r.open + r.stuck > 0 && !counted) {  // the first that has it
+      b.heated_lost = base[i].on - r.on;
+      counted = true;
+    }
     if (r.t >= t_fail - 1e-9 && !seen && std::abs(r.force - base[i].force) < kNoiseStd) {
       ++b.instants;
       continue;
@@ -389,7 +394,10 @@ int main(int argc, char** argv) {
       std::vector<double> blind, nees_seen;
       int by_heated[10][2] = {};  // runs and runs within 10 instants, by heated units lost
       std::string missed;         // seeds not within 2 units within 10 instants
-      const std::string config = "failures=60:" + std::to_string(lost) + ":open";
+      // FAILURE_LOSS_AT: the loss's time (s, default 60; e.g. 60.25, within a control period).
+      const char* at = std::getenv("FAILURE_LOSS_AT");
+      const std::string config =
+          std::string("failures=") + (at ? at : "60") + ":" + std::to_string(lost) + ":open";
       for (int s = first; s < first + seeds; ++s) {
         fl::Spec spec{config,
                       Failures(),

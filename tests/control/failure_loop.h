@@ -34,6 +34,9 @@ struct Spec {
   // The broadcast census every this many s (ControllerParams::census_period; 0 = none). The
   // plant's census keys come from plant_config; without any, census_noise=0.01 is added.
   double census_period = 0;
+  // Where in the control period the census runs: right after the broadcast (false; its count
+  // is then dT old when the estimator gets it) or ending at the next control instant (true).
+  bool census_at_end = false;
 };
 
 struct Instant {
@@ -149,10 +152,18 @@ inline Result<std::vector<Instant>> Run(const Spec& spec) {
     }
     out.push_back(r);
     if (Status s = p.Broadcast(d.get(), 0, b.p_on, b.p_off); !s) return Error{s.error()};
-    if (c->census()) {
-      if (Status s = p.Census(d.get(), 0); !s) return Error{s.error()};
+    const auto& cc = p.bundle(0).config().census;
+    const int start =
+        !c->census() ? -1
+        : spec.census_at_end
+            ? std::max(0, steps - static_cast<int>(std::lround((cc.on + cc.off) / m->opt.timestep)))
+            : 0;
+    for (int i = 0; i < steps; ++i) {
+      if (i == start) {
+        if (Status s = p.Census(d.get(), 0); !s) return Error{s.error()};
+      }
+      mj_step(m, d.get());
     }
-    for (int i = 0; i < steps; ++i) mj_step(m, d.get());
   }
   return out;
 }
