@@ -49,8 +49,9 @@ struct ControllerParams {
   ExplorationParams exploration;
   // The broadcast census (docs/failures.md section 5), with a failure-aware estimator only:
   // every census_period s (rounded to whole control instants P >= 1; 0 = never) census() asks
-  // the host to start one after broadcasting, at instants P - 1, 2P - 1, ... after Reset; the
-  // host hands the shunt's counts to Census() before the next Step.
+  // the host to run one in the control period that follows instants P - 1, 2P - 1, ... after
+  // Reset (right after broadcasting, or ending at the next instant: the later, the fresher its
+  // count); the host hands the shunt's counts to Census() before the next Step.
   double census_period = 0;
 
   // Checks N >= 1, unit_force > 0, dT (CheckDT), 0 < lambda <= 1 (finite); the message names the
@@ -75,7 +76,7 @@ class RecruitmentController {
   Broadcast Step(double reference_force, double measured_force,
                  double tendon_length = std::numeric_limits<double>::quiet_NaN());
 
-  // Whether the host should start a census now (after broadcasting the last Step's broadcast).
+  // Whether the host should run a census in the period after the last Step's broadcast.
   bool census() const { return census_; }
   // The last census's counts (working + stuck, stuck; units) and their measurement variance
   // (units^2), before the next Step: the estimator takes them (FailureOnCountEstimator).
