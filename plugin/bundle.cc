@@ -82,6 +82,14 @@ void PickUnits(Rng& rng, int n, int pool, int want, Eligible eligible, std::vect
 }
 
 constexpr std::uint64_t kFailureStream = 0xFA11ED;  // sub-stream index of the failure draws
+constexpr std::uint64_t kCensusStream = 0xCE4505;   // sub-stream of the census's shunt noise
+
+// A standard normal draw (Box-Muller, the cosine branch: two uniforms per draw).
+double StandardNormal(Rng& rng) {
+  const double u1 = 1 - rng.Uniform();  // (0, 1]
+  const double u2 = rng.Uniform();
+  return std::sqrt(-2 * std::log(u1)) * std::cos(2 * 3.14159265358979323846 * u2);
+}
 
 }  // namespace
 
@@ -92,6 +100,7 @@ SmaBundle::SmaBundle(BundleConfig c, UnitModel u, double dt)
       dt_(dt),
       decay_(unit_.DecayFactor(dt)) {
   failures_ = config_.failure.given;
+  census_ = config_.census.given;
   fatigue_ = failures_ && config_.failure.fatigue_loss > 0;
   if (config_.update_period > 0) {
     // The pending time reaches about a whole number of steps >= update_period.
@@ -123,6 +132,10 @@ void SmaBundle::Reset(double* s, std::uint64_t seed, double stretch) const {
   // Unit index block is already 0: every unit in cohort 0.
   if (failures_) StoreRng(Rng(Rng::DeriveSeed(seed, kFailureStream)), Fail(s) + kFailRngSlot);
   // Modes and damage are 0: every unit working and fresh.
+  if (census_) {
+    double* c = CensusBlock(s);
+    StoreRng(Rng(Rng::DeriveSeed(seed, kCensusStream)), c + kCensusRngSlot);
+  }
 }
 
 bool SmaBundle::Initialized(const double* s) { return s[kMagicSlot] == kMagic; }
@@ -202,9 +215,83 @@ Status SmaBundle::Broadcast(double* s, double p_on, double p_off, double stretch
   return Status::Ok();
 }
 
+Status SmaBundle::StartCensus(double* s, double stretch) const {
+  if (!census_) {
+    return Error{"actuator '" + config_.actuator +
+                 "': no census: give a census key (census_on, census_off, census_noise)"};
+  }
+  if (CensusRunning(s)) return Error{"actuator '" + config_.actuator + "': a census is running"};
+  DropKept(s);
+  Flush(s, stretch);  // pending time ran with the latched heaters
+  double* c = CensusBlock(s);
+  c[kCensusOnLeftSlot] = config_.census.on;
+  c[kCensusOffLeftSlot] = config_.census.off;
+  return Status::Ok();
+}
+
+bool SmaBundle::CensusRunning(const double* s) const {
+  if (!census_) return false;
+  const double* c = CensusBlock(s);
+  return c[kCensusOnLeftSlot] > 0 || c[kCensusOffLeftSlot] > 0;
+}
+
+SmaBundle::CensusReading SmaBundle::LastCensus(const double* s) const {
+  CensusReading r;
+  if (!census_) return r;
+  const double* c = CensusBlock(s);
+  r.number = static_cast<int>(c[kCensusNumberSlot]);
+  r.on_current = c[kCensusOnReadingSlot];
+  r.off_current = c[kCensusOffReadingSlot];
+  return r;
+}
+
+double SmaBundle::CensusReadingNow(double* s, bool on) const {
+  const FailureCounts f = Failures(s);
+  const int conducting = on ? f.working + f.stuck : f.stuck;
+  double* c = CensusBlock(s);
+  Rng rng = LoadRng(c + kCensusRngSlot);
+  const double noise = config_.census.noise * StandardNormal(rng);
+  StoreRng(rng, c + kCensusRngSlot);
+  return conducting * UnitCurrent() + noise;
+}
+
+void SmaBundle::AdvanceCensus(double* s, double stretch, double dt) const {
+  double* c = CensusBlock(s);
+  std::vector<double> heater;
+  double left = dt;
+  for (const bool on : {true, false}) {
+    double& phase = c[on ? kCensusOnLeftSlot : kCensusOffLeftSlot];
+    if (!(phase > 0) || !(left > 0)) continue;
+    const int k = NumCohorts(s);
+    heater.assign(k, 0.0);
+    for (int j = 0; j < k; ++j) {
+      const int mode = failures_ ? static_cast<int>(Mode(s)[j]) : kModeWorking;
+      heater[j] = on ? (mode != kModeOpen) : (mode == kModeStuck);
+    }
+    // A phase that ends within 1e-9 s of the step's end ends with it (sums of dt round).
+    const bool ends = phase <= left + 1e-9;
+    const double piece = ends ? std::min(phase, left) : left;
+    Integrate(s, stretch, piece, heater.data());
+    phase = ends ? 0 : phase - left;
+    left = left - piece < 1e-9 ? 0 : left - piece;
+    if (ends) {
+      c[on ? kCensusOnReadingSlot : kCensusOffReadingSlot] = CensusReadingNow(s, on);
+      if (!on) c[kCensusNumberSlot] += 1;
+    }
+  }
+  if (!(left > 0)) return;
+  if (config_.update_period <= 0) {
+    Integrate(s, stretch, left);
+  } else {
+    s[kPendingSlot] += left;
+  }
+}
+
 void SmaBundle::Advance(double* s, double stretch, double dt) const {
   DropKept(s);
-  if (config_.update_period <= 0) {
+  if (census_ && CensusRunning(s)) {
+    AdvanceCensus(s, stretch, dt);
+  } else if (config_.update_period <= 0) {
     Integrate(s, stretch, dt);
   } else {
     s[kPendingSlot] += dt;
@@ -318,7 +405,7 @@ void SmaBundle::Flush(double* s, double stretch) const {
   if (t > 0) Integrate(s, stretch, t);
 }
 
-void SmaBundle::Integrate(double* s, double stretch, double dt) const {
+void SmaBundle::Integrate(double* s, double stretch, double dt, const double* heater) const {
   double decay;
   if (dt == dt_) {
     decay = decay_;
@@ -328,8 +415,12 @@ void SmaBundle::Integrate(double* s, double stretch, double dt) const {
     decay = unit_.DecayFactor(dt);
   }
   const int k = NumCohorts(s);
-  const UnitModel::Cohorts c{Field(s, kOn),   Field(s, kTemp),      Field(s, kXi),
-                             Field(s, kTeff), Field(s, kHeatScale), Field(s, kCoolScale)};
+  const UnitModel::Cohorts c{heater ? heater : Field(s, kOn),
+                             Field(s, kTemp),
+                             Field(s, kXi),
+                             Field(s, kTeff),
+                             Field(s, kHeatScale),
+                             Field(s, kCoolScale)};
   unit_.AdvanceCohorts(c, k, stretch, decay);
   s[kCounterSlot] += 1;
   // The counter is a whole number: integer modulo instead of a libm fmod call.

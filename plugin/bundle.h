@@ -26,10 +26,13 @@ class SmaBundle {
   // (config().failure.given), FailureBlockSize(units) more after them.
   static int StateSize(int units) { return kHeader + (kFields + 1) * units; }
   static int FailureBlockSize(int units) { return kFailHeader + 2 * units; }
+  // With a census block (config().census.given), kCensusBlock more after those.
   int state_size() const {
-    return StateSize(config_.units) + (failures_ ? FailureBlockSize(config_.units) : 0);
+    return StateSize(config_.units) + (failures_ ? FailureBlockSize(config_.units) : 0) +
+           (census_ ? kCensusBlock : 0);
   }
   bool has_failures() const { return failures_; }
+  bool has_census() const { return census_; }
 
   const BundleConfig& config() const { return config_; }
   const UnitModel& unit() const { return unit_; }
@@ -50,6 +53,23 @@ class SmaBundle {
   // units are integrated once the accumulated time reaches it (exact thermal step, implicit
   // phase solve: both stay accurate for long steps).
   void Advance(double* s, double stretch, double dt) const;
+
+  // The broadcast census (CensusConfig): from the next Advance, every heater forced on for
+  // census.on s, then off for census.off s, then back to its latch. Pending time (update_period)
+  // is integrated first. Error without a census block or while a census runs.
+  Status StartCensus(double* s, double stretch) const;
+  bool CensusRunning(const double* s) const;
+  // The shunt's readings of the last finished census (A; 0 before the first) and how many
+  // censuses have finished since Reset. A reading is (conducting units) x UnitCurrent() plus
+  // Gaussian noise of std census.noise, taken at the end of its phase.
+  struct CensusReading {
+    int number = 0;
+    double on_current = 0, off_current = 0;
+  };
+  CensusReading LastCensus(const double* s) const;
+  // One conducting unit's supply current (A): `current` through each of its `parallel` wires
+  // (its series segments carry the same current).
+  double UnitCurrent() const { return config_.unit.current * config_.unit.parallel; }
 
   // Total tension of the bundle (N, >= 0) at unit extension `stretch`: pure, reads s only
   // (the "compute" step of a MuJoCo actuator plugin).
@@ -138,6 +158,23 @@ class SmaBundle {
   static constexpr int kFailHeader = 16;
   static constexpr int kFailRngSlot = 0, kFailTimeSlot = 8, kFailNextSlot = 9;
   static constexpr int kModeWorking = 0, kModeOpen = 1, kModeStuck = 2;
+  // The census block (after the failure block, if any): the noise stream's 8 halves, the on and
+  // off time still to run (s), the last readings (A), the number of finished censuses, 3
+  // reserved.
+  static constexpr int kCensusBlock = 16;
+  static constexpr int kCensusRngSlot = 0, kCensusOnLeftSlot = 8, kCensusOffLeftSlot = 9,
+                       kCensusOnReadingSlot = 10, kCensusOffReadingSlot = 11,
+                       kCensusNumberSlot = 12;
+  double* CensusBlock(double* s) const {
+    return s + StateSize(config_.units) + (failures_ ? FailureBlockSize(config_.units) : 0);
+  }
+  const double* CensusBlock(const double* s) const {
+    return s + StateSize(config_.units) + (failures_ ? FailureBlockSize(config_.units) : 0);
+  }
+  // Advances dt of which the census's phases take the first part; the rest as usual.
+  void AdvanceCensus(double* s, double stretch, double dt) const;
+  // The shunt's reading of the units conducting in phase `on` (census forced on / off).
+  double CensusReadingNow(double* s, bool on) const;
   double* Fail(double* s) const { return s + StateSize(config_.units); }
   const double* Fail(const double* s) const { return s + StateSize(config_.units); }
   double* Mode(double* s) const { return Fail(s) + kFailHeader; }
@@ -173,7 +210,8 @@ class SmaBundle {
     s[kKeptSlot] = 0, s[kKeptStretchSlot] = 0, s[kKeptTensionSlot] = 0;
   }
   void Flush(double* s, double stretch) const;
-  void Integrate(double* s, double stretch, double dt) const;
+  // heater: per cohort 0/1, the heaters' state over dt; null = the latches (kOn).
+  void Integrate(double* s, double stretch, double dt, const double* heater = nullptr) const;
   // Drops cohorts with count 0 and relabels units; forward[j] >= 0 sends the units of an
   // emptied cohort j to cohort forward[j] (k entries); remap: k ints of scratch.
   void Compact(double* s, const int* forward, int* remap) const;
@@ -182,7 +220,7 @@ class SmaBundle {
   UnitModel unit_;
   UnitLimits limits_;
   double dt_ = 0, decay_ = 1, period_ = 0, decay_period_ = 1;
-  bool failures_ = false, fatigue_ = false;
+  bool failures_ = false, fatigue_ = false, census_ = false;
 };
 
 }  // namespace recruit::sma

@@ -78,6 +78,15 @@ const std::vector<Key>& NumericKeys() {
       {"fatigue_stress", 0, 2e9, true, "Pa", FAILURE_FIELD(fatigue_stress)},
       {"fatigue_exponent", 0, 10, false, "", FAILURE_FIELD(fatigue_exponent)},
 #undef FAILURE_FIELD
+#define CENSUS_FIELD(f)           \
+  [](BundleConfig& c, double v) { \
+    c.census.f = v;               \
+    c.census.given = true;        \
+  }
+      {"census_on", 0, 0.1, true, "s", CENSUS_FIELD(on)},
+      {"census_off", 0, 0.1, true, "s", CENSUS_FIELD(off)},
+      {"census_noise", 0, 10, false, "A", CENSUS_FIELD(noise)},
+#undef CENSUS_FIELD
       {"bins", 2, 1e6, false, "cohorts (unit_model=binned)",
        [](BundleConfig& c, double v) { c.bins = int(v); }},
   };
@@ -202,11 +211,13 @@ Status CheckFailures(const BundleConfig& c, const std::map<std::string, std::str
 std::vector<std::string> BundleConfig::Keys() {
   std::vector<std::string> k = {"law"};
   for (const Key& key : NumericKeys()) {
-    if (std::string(key.name) != "bins") k.push_back(key.name);
+    const std::string name = key.name;
+    if (name != "bins" && name.rfind("census_", 0) != 0) k.push_back(name);
   }
   k.push_back("failures");
   k.push_back("unit_model");  // the unit model's keys last (the older keys keep their places)
   k.push_back("bins");
+  for (const char* c : {"census_on", "census_off", "census_noise"}) k.push_back(c);
   return k;
 }
 

@@ -45,6 +45,19 @@ struct FailureConfig {
   static Result<std::vector<Event>> ParseSchedule(const std::string& text);
 };
 
+// The broadcast census (plugin/README.md "Census"; docs/failures.md section 5). On request
+// (SmaHost::Census) every unit's heater is forced on for `on` s, then off for `off` s, whatever
+// its latch, and then follows its latch again: no unit is addressed. Open units cannot conduct
+// and stuck ones cannot stop, so the bundle's supply current, read by one shunt at the end of
+// each phase with Gaussian noise of standard deviation `noise` (A), counts the working plus stuck
+// units (on phase) and the stuck ones (off phase). Off unless a census key is given: then the
+// bundle's block has a census block.
+struct CensusConfig {
+  bool given = false;
+  double on = 2e-3, off = 2e-3;  // s, the phases' lengths
+  double noise = 0.01;           // A, standard deviation of one shunt reading
+};
+
 // How a bundle's cohorts are kept (plugin/README.md "Unit models"). kExact: cohorts merge only
 // within merge_temperature and merge_xi, so the bundle follows every unit's exact update to ~1e-4
 // of one unit's force. kBinned: after each merge pass the cohorts are merged further, the closest
@@ -74,6 +87,7 @@ struct BundleConfig {
   UnitModelKind unit_model = UnitModelKind::kExact;
   int bins = 16;  // kBinned: the most cohorts a merge pass leaves
   FailureConfig failure;
+  CensusConfig census;
 
   // Parses key/value pairs; an empty value keeps the default (MuJoCo gives "" for a declared key
   // that MJCF did not set). Errors start with `where` and name the key and value.

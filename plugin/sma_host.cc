@@ -74,4 +74,12 @@ Status SmaHost::Broadcast(mjData* d, int b, double p_on, double p_off) const {
   return bundle(b).Broadcast(State(d, b), p_on, p_off, Stretch(d, b));
 }
 
+Status SmaHost::Census(mjData* d, int b) const {
+  if (b < 0 || b >= num_bundles()) {
+    return Error{"Census: bundle " + std::to_string(b) + " does not exist (model has " +
+                 std::to_string(num_bundles()) + ")"};
+  }
+  return bundle(b).StartCensus(State(d, b), Stretch(d, b));
+}
+
 }  // namespace recruit::sma

@@ -62,6 +62,14 @@ class SmaHost {
   // Each unit of bundle b draws its transition (off->on with p_on, on->off with p_off).
   Status Broadcast(mjData* d, int b, double p_on, double p_off) const;
 
+  // Starts bundle b's broadcast census (CensusConfig: heaters forced on, then off, for a few ms
+  // from the next mj_step). Error when b has no census key or a census is running.
+  Status Census(mjData* d, int b) const;
+  // The shunt's readings of bundle b's last finished census (SmaBundle::CensusReading).
+  SmaBundle::CensusReading LastCensus(const mjData* d, int b) const {
+    return bundle(b).LastCensus(State(d, b));
+  }
+
   // Ground truth and telemetry.
   int OnCount(const mjData* d, int b) const { return bundle(b).OnCount(State(d, b)); }
   // Working, open and stuck units of bundle b (all working without failure keys).

@@ -75,8 +75,22 @@ int Within(const std::vector<double>& v, double lo, double hi) {
   return n;
 }
 
+// The broadcast census (ControllerParams::census_period): FAILURE_CENSUS_PERIOD (s, 0 = off)
+// and the plant's census keys FAILURE_CENSUS_CONFIG (default: census_noise=0.01);
+// FAILURE_CENSUS_END=1: each census ends at the next control instant (Spec::census_at_end).
+double CensusPeriod() {
+  const char* e = std::getenv("FAILURE_CENSUS_PERIOD");
+  return e ? std::atof(e) : 0.0;
+}
+
 std::vector<fl::Instant> MustRun(fl::Spec s) {
   if (s.estimator.failures) s.exploration = Exploration();
+  if (s.estimator.failures && CensusPeriod() > 0) {
+    s.census_period = CensusPeriod();
+    if (const char* e = std::getenv("FAILURE_CENSUS_END")) s.census_at_end = std::atoi(e) != 0;
+    const char* c = std::getenv("FAILURE_CENSUS_CONFIG");
+    s.plant_config += std::string(" ") + (c ? c : "census_noise=0.01");
+  }
   auto r = fl::Run(s);
   if (!r) {
     std::fprintf(stderr, "%s\n", r.error().c_str());
@@ -114,10 +128,13 @@ Blind BlindInstants(const std::vector<fl::Instant>& run, const std::vector<fl::I
   Blind b;
   double sum = 0;
   int n = 0;
-  bool seen = false;
+  bool seen = false, counted = false;
   for (size_t i = 0; i < run.size() && i < base.size(); ++i) {
     const fl::Instant& r = run[i];
-    if (std::abs(r.t - t_fail) < 1e-9) b.heated_lost = base[i].on - r.on;
+    if (r.t >= t_fail - 1e-9 && r.open + r.stuck > 0 && !counted) {  // the first that has it
+      b.heated_lost = base[i].on - r.on;
+      counted = true;
+    }
     if (r.t >= t_fail - 1e-9 && !seen && std::abs(r.force - base[i].force) < kNoiseStd) {
       ++b.instants;
       continue;
@@ -129,6 +146,83 @@ Blind BlindInstants(const std::vector<fl::Instant>& run, const std::vector<fl::I
   }
   b.nees_seen = n > 0 ? sum / n : NAN;
   return b;
+}
+
+// One census on the bench in open loop: 60 units, p_on 0.55 broadcast at 0 s, settled for 20 s,
+// then (0.3, 0.3) broadcast and the census `delay` s later (delay 0: at the settled hold, before
+// that broadcast): the state copied, the census run on one copy, both stepped 0.5 s (one control
+// period). Returns the largest |force difference| (N).
+double CensusPulse(const std::string& keys, double period, std::uint64_t seed, double delay) {
+  auto xml = fl::BenchXml(keys);
+  auto model = recruit::LoadModelFromString(*xml);
+  if (!model) {
+    std::fprintf(stderr, "%s\n", model.error().c_str());
+    std::exit(1);
+  }
+  const mjModel* m = model->get();
+  auto host = recruit::sma::SmaHost::Create(m);
+  const recruit::sma::SmaHost& p = **host;
+  mjData* a = mj_makeData(m);
+  p.Reset(a, seed);
+  (void)p.Broadcast(a, 0, 0.55, 0);
+  for (int i = 0; i < 20000; ++i) mj_step(m, a);
+  if (delay > 0) {
+    (void)p.Broadcast(a, 0, 0.3, 0.3);
+    for (int i = 0; i < std::lround(delay / m->opt.timestep); ++i) mj_step(m, a);
+  }
+  mjData* b = mj_copyData(nullptr, m, a);
+  const recruit::sma::SmaBundle& bundle = p.bundle(0);
+  const recruit::sma::UnitModel& u = bundle.unit();
+  const auto& cc = bundle.config().census;
+  const int n = p.num_units(0), on = p.OnCount(a, 0);
+  double p_off_units = 0, p_on_units = 0;  // heating power of the off and the on units (W)
+  for (int i = 0; i < n; ++i) {
+    (p.UnitOn(a, 0, i) ? p_on_units : p_off_units) += u.HeatingPower(true, p.UnitXi(a, 0, i));
+  }
+  (void)p.Census(a, 0);
+  const int on_steps = static_cast<int>(std::lround(cc.on / m->opt.timestep));
+  const int off_end = on_steps + static_cast<int>(std::lround(cc.off / m->opt.timestep)) - 1;
+  double max_df = 0, rise_off = 0, drop_on = 0;
+  for (int k = 0; k < 500; ++k) {
+    mj_step(m, a);
+    mj_step(m, b);
+    max_df = std::max(max_df, std::abs(p.Force(a, 0) - p.Force(b, 0)));
+    for (int i = 0; k == on_steps - 1 && i < n; ++i) {
+      if (!p.UnitOn(a, 0, i)) {
+        rise_off = std::max(rise_off, p.UnitTemperature(a, 0, i) - p.UnitTemperature(b, 0, i));
+      }
+    }
+    for (int i = 0; k == off_end && i < n; ++i) {
+      if (p.UnitOn(a, 0, i)) {
+        drop_on = std::min(drop_on, p.UnitTemperature(a, 0, i) - p.UnitTemperature(b, 0, i));
+      }
+    }
+  }
+  const double extra = p_off_units * cc.on - p_on_units * cc.off;  // J
+  std::printf("census pulse (%s; on %.3g s, off %.3g s), %d of %d units on, seed %llu, %s:\n",
+              keys.c_str(), cc.on, cc.off, on, n, static_cast<unsigned long long>(seed),
+              delay > 0 ? ("census " + std::to_string(delay).substr(0, 4) +
+                           " s after a (0.3, 0.3) broadcast")
+                              .c_str()
+                        : "settled hold");
+  std::printf(
+      "  largest rise of an off unit at the end of the on phase +%.4f K, largest drop "
+      "of an on unit after the off phase %.4f K\n",
+      rise_off, drop_on);
+  std::printf(
+      "  force disturbance: max |dF| %.3g N over 0.5 s, %.3g N at 0.5 s (force noise "
+      "std %.3g N)\n",
+      max_df, std::abs(p.Force(a, 0) - p.Force(b, 0)), kNoiseStd);
+  std::printf(
+      "  energy: %+.4f J per census (off units heated %.4f J, on units' off phase "
+      "-%.4f J); the bundle heats at %.2f W, %.1f J per %.3g s census period: %+.3g %%\n",
+      extra, p_off_units * cc.on, p_on_units * cc.off, p_on_units, p_on_units * period, period,
+      100 * extra / (p_on_units * period));
+  std::printf("  shunt: %.3g A per unit, noise %.3g A = %.3g units\n", bundle.UnitCurrent(),
+              cc.noise, cc.noise / bundle.UnitCurrent());
+  mj_deleteData(a);
+  mj_deleteData(b);
+  return max_df;
 }
 
 double Steps(double t) {  // 10, 20, 5, 15 N, every 25 s
@@ -154,12 +248,13 @@ int main(int argc, char** argv) {
                               100,
                               [](double) { return 15.0; },
                               {}});
-    std::printf("t force on est_on var_on working est_working var_working declared susp expl\n");
+    std::printf(
+        "t force on est_on var_on working est_working var_working declared susp expl census\n");
     for (const auto& r : run) {
       if (r.t < 55) continue;
-      std::printf("%.1f %.2f %d %.2f %.2f %d %.2f %.2f %d %.1f %d\n", r.t, r.force, r.on, r.est_on,
-                  r.est_on_var, r.working, r.est_working, r.est_working_var, r.declared,
-                  r.suspicion, r.exploring);
+      std::printf("%.1f %.2f %d %.2f %.2f %d %.2f %.2f %d %.1f %d %d\n", r.t, r.force, r.on,
+                  r.est_on, r.est_on_var, r.working, r.est_working, r.est_working_var, r.declared,
+                  r.suspicion, r.exploring, r.census);
     }
     return 0;
   }
@@ -199,6 +294,43 @@ int main(int argc, char** argv) {
     Report("mean |error| over 500 s of steps, exploring", steps);
     Report("the same seeds, no exploration", steps0);
     Report("fraction of instants exploring (steps)", frac);
+    return 0;
+  }
+
+  // "census": the census's price. Open loop on the bench (about 33 of 60 units settled on):
+  // the pulse's temperature change and force disturbance against a copy without it, and its
+  // energy; closed loop with no failure: |error| with a census every FAILURE_CENSUS_PERIOD s
+  // (default 2.5) against none, same seeds.
+  if (argc > 3 && std::string(argv[3]) == "census") {
+    const double period = CensusPeriod() > 0 ? CensusPeriod() : 2.5;
+    const char* keys = std::getenv("FAILURE_CENSUS_CONFIG");
+    double worst = 0;
+    for (double delay : {0.0, 0.5, 1.0, 1.5, 2.0, 3.0}) {
+      worst = std::max(worst, CensusPulse(keys ? keys : "census_noise=0.01", period,
+                                          static_cast<std::uint64_t>(first), delay));
+    }
+    std::printf("largest force disturbance over these: %.3g N\n", worst);
+    std::vector<double> hold, hold0, steps, steps0;
+    for (int s = first; s < first + seeds; ++s) {
+      const auto seed = static_cast<std::uint64_t>(s);
+      auto ref = [](double) { return 15.0; };
+      fl::Spec with{"", Failures(), 0.5, 0.2, seed, 100, ref, {}};
+      with.census_period = period;
+      fl::Spec without{"", Failures(), 0.5, 0.2, seed, 100, ref, {}};
+      auto a = fl::Run(with), b = fl::Run(without);
+      hold.push_back(fl::MeanError(*a, 20, 100));
+      hold0.push_back(fl::MeanError(*b, 20, 100));
+      with.duration = without.duration = 500;
+      with.reference = without.reference = Steps;
+      a = fl::Run(with), b = fl::Run(without);
+      steps.push_back(fl::MeanError(*a, 0, 500));
+      steps0.push_back(fl::MeanError(*b, 0, 500));
+    }
+    std::printf("closed loop, no failure, census every %.3g s:\n", period);
+    Report("mean |error| 20-100 s at 15 N, census", hold);
+    Report("the same seeds, no census", hold0);
+    Report("mean |error| over 500 s of steps, census", steps);
+    Report("the same seeds, no census", steps0);
     return 0;
   }
 
@@ -262,7 +394,10 @@ int main(int argc, char** argv) {
       std::vector<double> blind, nees_seen;
       int by_heated[10][2] = {};  // runs and runs within 10 instants, by heated units lost
       std::string missed;         // seeds not within 2 units within 10 instants
-      const std::string config = "failures=60:" + std::to_string(lost) + ":open";
+      // FAILURE_LOSS_AT: the loss's time (s, default 60; e.g. 60.25, within a control period).
+      const char* at = std::getenv("FAILURE_LOSS_AT");
+      const std::string config =
+          std::string("failures=") + (at ? at : "60") + ":" + std::to_string(lost) + ":open";
       for (int s = first; s < first + seeds; ++s) {
         fl::Spec spec{config,
                       Failures(),

@@ -25,6 +25,12 @@ class FailureOnCountEstimator final : public OnCountEstimator {
   using OnCountEstimator::UpdateWithMeasurement;
   void UpdateWithMeasurement(double measured_force, double tendon_length) override;
   void Broadcasted(const Broadcast& b) override { filter_.PredictBroadcast(b.p_on, b.p_off); }
+  // A broadcast census read before this instant's UpdateWithMeasurement: the working plus stuck
+  // and the stuck units counted by the shunt (currents over one unit's), with measurement
+  // variance `variance` (units^2; FailureKalmanFilter::UpdateCensus).
+  void UpdateWithCensus(double conducting, double stuck, double variance) {
+    filter_.UpdateCensus(conducting, stuck, variance);
+  }
   double EstimatedOn() const override;
   double EstimatedOnVariance() const override;
   // [model states; open: model states; stuck: model states].

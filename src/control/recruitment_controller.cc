@@ -4,6 +4,8 @@
 #include <cmath>
 #include <string>
 
+#include "control/failure_estimator.h"
+
 namespace recruit::control {
 
 Status ControllerParams::Validate() const {
@@ -38,6 +40,10 @@ Status ControllerParams::Validate() const {
     return Error{"controller: exploration.period = " + std::to_string(e.period) +
                  " s must be finite and >= 0"};
   }
+  if (!std::isfinite(census_period) || census_period < 0) {
+    return Error{"controller: census_period = " + std::to_string(census_period) +
+                 " s must be finite and >= 0"};
+  }
   return Status::Ok();
 }
 
@@ -45,6 +51,10 @@ Result<RecruitmentController> RecruitmentController::Create(
     const ControllerParams& params, std::unique_ptr<OnCountEstimator> estimator) {
   if (Status s = params.Validate(); !s) return Error{s.error(), s.code()};
   if (!estimator) return Error{"controller: no estimator"};
+  if (params.census_period > 0 && !dynamic_cast<FailureOnCountEstimator*>(estimator.get())) {
+    return Error{"controller: census_period = " + std::to_string(params.census_period) +
+                 " s needs the failure-aware estimator (kalman-failures)"};
+  }
   std::optional<UnitForceMap> on_force;
   if (params.geometry) {
     auto map = UnitForceMap::FromForces(*params.geometry, params.geometry->unit.prestretch,
@@ -79,7 +89,15 @@ void RecruitmentController::Reset() {
   unmeasured_left_ = 0;
   since_period_ = 0;
   exploring_ = false;
+  instants_ = 0;
+  census_ = false;
   last_ = Broadcast{};
+}
+
+void RecruitmentController::Census(double conducting, double stuck, double variance) {
+  if (auto* f = dynamic_cast<FailureOnCountEstimator*>(estimator_.get())) {
+    f->UpdateWithCensus(conducting, stuck, variance);
+  }
 }
 
 double RecruitmentController::OnUnitForce(double tendon_length) const {
@@ -108,6 +126,11 @@ Broadcast RecruitmentController::Step(double reference_force, double measured_fo
     last_ = ExpectationLaw(target_on_, estimated_on_, params_.num_units, params_.lambda);
   }
   estimator_->Broadcasted(last_);
+  ++instants_;
+  if (params_.census_period > 0) {
+    const long period = std::max(1L, std::lround(params_.census_period / params_.dT));
+    census_ = instants_ % period == 0;
+  }
   return last_;
 }
 

@@ -47,6 +47,12 @@ struct ControllerParams {
   // settled on unit's force at the measured tendon length (UnitForceMap), not at ref_length.
   std::optional<UnitGeometry> geometry;
   ExplorationParams exploration;
+  // The broadcast census (docs/failures.md section 5), with a failure-aware estimator only:
+  // every census_period s (rounded to whole control instants P >= 1; 0 = never) census() asks
+  // the host to run one in the control period that follows instants P - 1, 2P - 1, ... after
+  // Reset (right after broadcasting, or ending at the next instant: the later, the fresher its
+  // count); the host hands the shunt's counts to Census() before the next Step.
+  double census_period = 0;
 
   // Checks N >= 1, unit_force > 0, dT (CheckDT), 0 < lambda <= 1 (finite); the message names the
   // field.
@@ -69,6 +75,12 @@ class RecruitmentController {
   // estimator.Broadcasted(b). tendon_length NaN: not measured (the force at ref_length).
   Broadcast Step(double reference_force, double measured_force,
                  double tendon_length = std::numeric_limits<double>::quiet_NaN());
+
+  // Whether the host should run a census in the period after the last Step's broadcast.
+  bool census() const { return census_; }
+  // The last census's counts (working + stuck, stuck; units) and their measurement variance
+  // (units^2), before the next Step: the estimator takes them (FailureOnCountEstimator).
+  void Census(double conducting, double stuck, double variance);
 
   const ControllerParams& params() const { return params_; }
   const OnCountEstimator& estimator() const { return *estimator_; }
@@ -115,6 +127,8 @@ class RecruitmentController {
   int unmeasured_left_ = 0;  // instants whose force the estimator is not given
   long since_period_ = 0;    // instants since the last periodic exploration began
   bool exploring_ = false;
+  long instants_ = 0;  // Steps since Reset
+  bool census_ = false;
   Broadcast last_;
 };
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include "estimation/population_chain.h"
@@ -99,6 +100,24 @@ FailureGlr::Best FailureGlr::Hypothesis(int to, int age) const {
   return b;
 }
 
+FailureGlr::Best FailureGlr::ForCount(int to, double k) const {
+  Best b;
+  double best = -std::numeric_limits<double>::infinity();
+  for (int col = (to - 1) * window_; col < to * window_; ++col) {
+    if (age_[col] < 0) continue;
+    const double l = k * d_[col] - 0.5 * k * k * C_[col];
+    if (!(l > best)) continue;
+    best = l;
+    b.to = to;
+    b.age = age_[col];
+    b.count = k;
+    b.variance = C_[col] > 0 ? 1 / C_[col] : 0.0;
+    b.llr = l;
+    b.deviation = truth_.col(col) - filt_.col(col);
+  }
+  return b;
+}
+
 FailureGlr::Best FailureGlr::Strongest(double max_std) const {
   Best b;
   const double min_information = 1 / (max_std * max_std);
@@ -147,6 +166,12 @@ Status FailureFilterParams::Validate() const {
     return Error{"failure filter: scale_initial_variance = " +
                  std::to_string(scale_initial_variance) + " must be finite and >= 0"};
   }
+  if (!(std::isfinite(census_min_jump) && census_min_jump >= 0) ||
+      !(std::isfinite(census_jump_sigma) && census_jump_sigma >= 0)) {
+    return Error{"failure filter: census_min_jump = " + std::to_string(census_min_jump) +
+                 " and census_jump_sigma = " + std::to_string(census_jump_sigma) +
+                 " must be finite and >= 0"};
+  }
   if (!(std::isfinite(scale_variance) && scale_variance >= 0)) {
     return Error{"failure filter: scale_variance = " + std::to_string(scale_variance) +
                  " must be finite and >= 0"};
@@ -189,6 +214,8 @@ void FailureKalmanFilter::Reset() {
   glr_.Clear();
   declarations_ = 0;
   declared_last_ = false;
+  census_declared_ = false;
+  censuses_ = 0;
   suspicion_ = 0;
   last_declared_ = {};
   declared_class_[1] = declared_class_[2] = false;
@@ -297,7 +324,8 @@ void FailureKalmanFilter::UpdateCore(double y, const Eigen::MatrixXd& H, double 
 }
 
 void FailureKalmanFilter::Update(double y) {
-  declared_last_ = false;
+  declared_last_ = census_declared_;
+  census_declared_ = false;
   suspicion_ = 0;
   const int n = 3 * m_;
   // The innovation and its variance on the filter that runs now, and the prior for the GLR.
@@ -333,6 +361,82 @@ void FailureKalmanFilter::Update(double y) {
   if (best.to != 0 && best.llr > params_.glr_threshold && best.count >= params_.glr_min_count) {
     Declare(best);
     suspicion_ = 0;
+  }
+}
+
+void FailureKalmanFilter::ScalarUpdate(const Eigen::RowVectorXd& h, double z, double r) {
+  const double s = h * P_ * h.transpose() + r;
+  const Eigen::VectorXd K = P_ * h.transpose() / s;
+  x_ += K * (z - h.dot(x_));
+  const Eigen::MatrixXd IKH = Eigen::MatrixXd::Identity(x_.size(), x_.size()) - K * h;
+  P_ = IKH * P_ * IKH.transpose() + K * r * K.transpose();
+  P_ = 0.5 * (P_ + P_.transpose()).eval();
+}
+
+void FailureKalmanFilter::AddCensusJump(int to, double k) {
+  const int n = 3 * m_;
+  Eigen::VectorXd g = Eigen::VectorXd::Zero(n);
+  const Eigen::VectorXd xq = ProjectOntoSimplex(x_.head(n), N_);
+  if (k > 0) {
+    // Units lost: the onset and the filter's response that best explain the innovations for
+    // that count; without a hypothesis, lost now from the working states in proportion.
+    const FailureGlr::Best b = params_.detect ? glr_.ForCount(to, k) : FailureGlr::Best{};
+    if (b.to != 0) {
+      g = b.deviation;
+    } else {
+      const double W = xq.head(m_).sum();
+      for (int j = 0; W > 0 && j < m_; ++j) {
+        g[j] -= xq[j] / W;
+        g[FailEntry(j, to)] += xq[j] / W;
+      }
+    }
+    const double W = xq.head(m_).sum();
+    if (W > 0) P_.topLeftCorner(n, n) += JumpQz(xq, std::min(1.0, k / W), to);
+  } else {
+    // Fewer lost than declared: units of the class back to the same thermal state of the chain.
+    const Eigen::VectorXd c = xq.segment(to * m_, m_);
+    const double C = c.sum();
+    for (int j = 0; C > 0 && j < m_; ++j) {
+      g[to * m_ + j] -= c[j] / C;
+      g[j] += c[j] / C;
+    }
+  }
+  P_.topLeftCorner(n, n) += kCensusJumpVariance * g * g.transpose();
+}
+
+void FailureKalmanFilter::UpdateCensus(double conducting, double stuck_count, double variance) {
+  census_declared_ = false;
+  if (!(variance > 0) || !std::isfinite(conducting) || !std::isfinite(stuck_count)) return;
+  ++censuses_;
+  const int n = 3 * m_;
+  // Residuals in units: units newly open (conducting fewer than estimated), newly stuck.
+  const double e[3] = {0, N_ - open() - stuck() - conducting, stuck_count - stuck()};
+  bool jump[3] = {false, false, false};
+  for (int to : {1, 2}) {
+    const double var = augmented_ ? P_.block(to * m_, to * m_, m_, m_).sum() : 0.0;
+    jump[to] = std::abs(e[to]) > params_.census_min_jump &&
+               std::abs(e[to]) > params_.census_jump_sigma * std::sqrt(var + variance);
+  }
+  if (!augmented_ && !jump[1] && !jump[2]) {
+    glr_.Clear();  // the census confirms the no-loss filter: nothing moves
+    return;
+  }
+  if (!augmented_) Augment();
+  for (int to : {1, 2}) {
+    if (jump[to]) AddCensusJump(to, e[to]);
+  }
+  Eigen::RowVectorXd h1 = Eigen::RowVectorXd::Zero(n + 1), h2 = Eigen::RowVectorXd::Zero(n + 1);
+  h1.head(m_).setOnes();
+  h1.segment(2 * m_, m_).setOnes();
+  h2.segment(2 * m_, m_).setOnes();
+  ScalarUpdate(h1, conducting, variance);
+  ScalarUpdate(h2, stuck_count, variance);
+  x_.head(n).array() += (N_ - x_.head(n).sum()) / n;  // round-off of sum = N
+  glr_.Clear();
+  if (jump[1] || jump[2]) {
+    ++declarations_;
+    census_declared_ = true;
+    for (int to : {1, 2}) declared_class_[to] = declared_class_[to] || (jump[to] && e[to] > 0);
   }
 }
 

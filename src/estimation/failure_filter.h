@@ -85,6 +85,9 @@ class FailureGlr {
   // The hypothesis of class `to` with onset `age` instants ago (to = 0 if there is none; its
   // ratio is 0 when k^ <= 0).
   Best Hypothesis(int to, int age) const;
+  // The onset of class `to` that best explains the innovations when the count k is known (a
+  // census): the largest k d - k^2 C / 2 over its hypotheses (to = 0 if there is none).
+  Best ForCount(int to, double k) const;
 
  private:
   int m_ = 0, window_ = 0, next_ = 0;
@@ -113,6 +116,11 @@ struct FailureFilterParams {
   double scale_variance = 0;
   // Variance of the force scale at Reset (c = 1), when it is estimated.
   double scale_initial_variance = 0;
+  // The census (UpdateCensus): a class's residual (census count minus estimate) is a new jump
+  // when it exceeds both census_min_jump units and census_jump_sigma standard deviations;
+  // smaller residuals update the estimate as ordinary measurements.
+  double census_min_jump = 0.5;
+  double census_jump_sigma = 5;
 
   Status Validate() const;
 };
@@ -129,9 +137,23 @@ class FailureKalmanFilter {
   // Measurement update with the force y; runs the GLR (and a declaration).
   void Update(double y);
   // A control instant without a measurement (a lost sample): nothing is declared or suspected.
-  void NoMeasurement() { declared_last_ = false, suspicion_ = 0; }
+  void NoMeasurement() {
+    declared_last_ = census_declared_, census_declared_ = false, suspicion_ = 0;
+  }
   // Time update with the broadcast just sent.
   void PredictBroadcast(double p_on, double p_off);
+  // A broadcast census (docs/failures.md section 5), before this instant's Update: `conducting`
+  // counts the working plus stuck units, `stuck` the stuck ones, each with measurement variance
+  // `variance` (units^2). Rows h1 = [1_w, 0, 1_s], h2 = [0, 0, 1_s] on the 3m states. A residual
+  // beyond the jump thresholds first adds a loss of unknown count (prior variance
+  // kCensusJumpVariance) along the failure test's best hypothesis for that count, and the spread
+  // of which states the units left; then both rows update the augmented filter (Joseph form).
+  // A census that finds the no-loss filter's counts exactly (no jump, not augmented) changes no
+  // estimate. Either way the failure test starts again (the census accounts for every onset
+  // before it). A jump counts as a declaration (declared_last() after this instant's Update).
+  void UpdateCensus(double conducting, double stuck_count, double variance);
+  static constexpr double kCensusJumpVariance = 1e4;  // units^2: a diffuse prior on the count
+  int censuses() const { return censuses_; }
 
   int num_working_states() const { return m_; }
   // The augmented estimate [x_w; x_open; x_stuck] (3m) and its covariance.
@@ -175,6 +197,11 @@ class FailureKalmanFilter {
   void UpdateCore(double y, const Eigen::MatrixXd& H, double R);
   // The augmented time update with the transition in A_.
   void PredictCore();
+  // Joseph-form update of the augmented state with the scalar measurement z = h x + v, Var v = r.
+  void ScalarUpdate(const Eigen::RowVectorXd& h, double z, double r);
+  // Adds the covariance of a loss of unknown count into class `to` (residual k units, > 0: units
+  // lost; < 0: fewer than declared).
+  void AddCensusJump(int to, double k);
 
   FilterModel model_;
   CovarianceMode mode_;
@@ -193,6 +220,8 @@ class FailureKalmanFilter {
   bool declared_class_[3] = {false, false, false};  // classes declared since Reset
   int declarations_ = 0;
   bool declared_last_ = false;
+  bool census_declared_ = false;  // the census of this instant found a jump
+  int censuses_ = 0;
   double suspicion_ = 0;
   FailureGlr::Best last_declared_;
 };

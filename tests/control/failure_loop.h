@@ -7,6 +7,7 @@
 
 #include <mujoco/mujoco.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <functional>
@@ -30,6 +31,12 @@ struct Spec {
   double duration = 120;                    // s
   std::function<double(double)> reference;  // N, at time t
   ExplorationParams exploration;            // the controller's (off by default)
+  // The broadcast census every this many s (ControllerParams::census_period; 0 = none). The
+  // plant's census keys come from plant_config; without any, census_noise=0.01 is added.
+  double census_period = 0;
+  // Where in the control period the census runs: right after the broadcast (false; its count
+  // is then dT old when the estimator gets it) or ending at the next control instant (true).
+  bool census_at_end = false;
 };
 
 struct Instant {
@@ -39,6 +46,7 @@ struct Instant {
   double est_working = 0, est_working_var = 0;  // N and 0 without a failure-aware estimator
   int saturation = 0;
   bool declared = false, exploring = false;
+  bool census = false;   // a census's counts reached the estimator at this instant
   double suspicion = 0;  // the failure test's largest ratio
   // Fatigue: the plant's mean force scale over its heated working units (1 without fatigue or
   // with none heated) and the estimator's (FailureEstimate::force_scale).
@@ -81,7 +89,11 @@ inline Result<std::string> BenchXml(const std::string& config) {
 }
 
 inline Result<std::vector<Instant>> Run(const Spec& spec) {
-  auto xml = BenchXml(spec.plant_config);
+  std::string config = spec.plant_config;
+  if (spec.census_period > 0 && config.find("census_") == std::string::npos) {
+    config += " census_noise=0.01";
+  }
+  auto xml = BenchXml(config);
   if (!xml) return Error{xml.error()};
   auto model = LoadModelFromString(*xml);
   if (!model) return Error{model.error()};
@@ -98,14 +110,26 @@ inline Result<std::vector<Instant>> Run(const Spec& spec) {
   params.dT = spec.dT;
   params.lambda = spec.lambda;
   params.exploration = spec.exploration;
+  params.census_period = spec.census_period;
   auto c = RecruitmentController::Create(params, spec.estimator);
   if (!c) return Error{c.error()};
   const int steps = static_cast<int>(std::lround(spec.dT / m->opt.timestep));
   const int instants = static_cast<int>(std::lround(spec.duration / spec.dT));
   std::vector<Instant> out;
   out.reserve(instants);
+  int censuses = 0;  // censuses handed to the controller
   for (int k = 0; k < instants; ++k) {
     Instant r;
+    if (spec.census_period > 0) {
+      const auto cr = p.LastCensus(d.get(), 0);
+      if (cr.number > censuses) {  // the shunt's currents as unit counts
+        censuses = cr.number;
+        const double unit = p.bundle(0).UnitCurrent();
+        const double sd = p.bundle(0).config().census.noise / unit;
+        c->Census(cr.on_current / unit, cr.off_current / unit, std::max(sd * sd, 1e-9));
+        r.census = true;
+      }
+    }
     r.t = d->time;
     r.reference = spec.reference(r.t);
     r.force = p.Force(d.get(), 0);
@@ -128,7 +152,18 @@ inline Result<std::vector<Instant>> Run(const Spec& spec) {
     }
     out.push_back(r);
     if (Status s = p.Broadcast(d.get(), 0, b.p_on, b.p_off); !s) return Error{s.error()};
-    for (int i = 0; i < steps; ++i) mj_step(m, d.get());
+    const auto& cc = p.bundle(0).config().census;
+    const int start =
+        !c->census() ? -1
+        : spec.census_at_end
+            ? std::max(0, steps - static_cast<int>(std::lround((cc.on + cc.off) / m->opt.timestep)))
+            : 0;
+    for (int i = 0; i < steps; ++i) {
+      if (i == start) {
+        if (Status s = p.Census(d.get(), 0); !s) return Error{s.error()};
+      }
+      mj_step(m, d.get());
+    }
   }
   return out;
 }

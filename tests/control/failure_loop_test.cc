@@ -204,5 +204,92 @@ TEST(FailureLoop, StuckUnitsAboveTheReferenceAreFlagged) {
   EXPECT_EQ(last.on, 8);  // only the stuck units are heated
 }
 
+// The census: asked every census_period (rounded to whole instants) after broadcasting, and
+// refused without a failure-aware estimator.
+TEST(Census, AskedEveryPeriodAndOnlyWithAFailureAwareEstimator) {
+  ControllerParams p;
+  p.num_units = 60;
+  p.unit_force = 0.45;
+  p.dT = 0.5;
+  p.census_period = 2.4;  // 5 instants
+  auto c = RecruitmentController::Create(p, *EstimatorSpec::Parse("kalman-failures"));
+  ASSERT_TRUE(c.ok()) << c.error();
+  std::vector<int> asked;
+  for (int k = 0; k < 16; ++k) {
+    c->Step(10, 0);
+    if (c->census()) asked.push_back(k);
+  }
+  EXPECT_EQ(asked, (std::vector<int>{4, 9, 14}));
+  auto plain = RecruitmentController::Create(p, *EstimatorSpec::Parse("kalman-augmented"));
+  ASSERT_FALSE(plain.ok());
+  EXPECT_NE(plain.error().find("census_period = 2.4"), std::string::npos) << plain.error();
+  EXPECT_NE(plain.error().find("kalman-failures"), std::string::npos) << plain.error();
+  p.census_period = -1;
+  EXPECT_FALSE(p.Validate().ok());
+}
+
+// Census keys in the plant without a census: every recorded value of the closed loop is that
+// of the plant without them.
+TEST(FailureLoop, CensusKeysWithoutACensusChangeNothing) {
+  auto ref = [](double t) { return t < 30 ? 12.0 : 18.0; };
+  const auto a = fl::Run(Bench("failures=20:6:open", 2, 60, ref));
+  const auto b = fl::Run(Bench("failures=20:6:open census_noise=0.01", 2, 60, ref));
+  ASSERT_TRUE(a.ok() && b.ok());
+  ASSERT_EQ(a->size(), b->size());
+  for (size_t i = 0; i < a->size(); ++i) {
+    const fl::Instant &x = (*a)[i], &y = (*b)[i];
+    ASSERT_EQ(x.force, y.force) << x.t;
+    ASSERT_EQ(x.est_on, y.est_on) << x.t;
+    ASSERT_EQ(x.est_on_var, y.est_on_var) << x.t;
+    ASSERT_EQ(x.est_working, y.est_working) << x.t;
+    ASSERT_EQ(x.on, y.on) << x.t;
+  }
+}
+
+// With a census every 5 instants (2.5 s), losses of 10 % and 30 % open and 10 % stuck at 60 s
+// (right after a census: the worst phase) are counted within 2 units within 5 instants, and a
+// run without loss declares nothing.
+TEST(FailureLoop, ACensusEveryFiveInstantsFindsEveryLossWithinFive) {
+  auto ref = [](double) { return 15.0; };
+  for (const char* loss :
+       {"failures=60:6:open", "failures=60:18:open", "failures=60:6:stuck", ""}) {
+    for (std::uint64_t seed : {1, 2, 3}) {
+      fl::Spec spec = Bench(loss, seed, 80, ref);
+      spec.census_period = 2.5;
+      const auto run = fl::Run(spec);
+      ASSERT_TRUE(run.ok()) << run.error();
+      EXPECT_EQ(fl::DeclarationsBefore(*run, 60), 0) << loss << " seed " << seed;
+      if (*loss == 0) {
+        EXPECT_EQ(fl::DeclarationsBefore(*run, 1e9), 0) << "seed " << seed;
+        continue;
+      }
+      const int k = fl::InstantsToFind(*run, 60);
+      EXPECT_GE(k, 0) << loss << " seed " << seed;
+      EXPECT_LE(k, 5) << loss << " seed " << seed;
+      EXPECT_NEAR(run->back().est_working, run->back().working, 0.5) << loss << " seed " << seed;
+    }
+  }
+}
+
+// A census every instant that ends at the instant: a loss within a control period (60.25 s) is
+// counted at the next instant, and the on count's NEES over the whole run stays in [0.3, 2]
+// even for 30 % lost (the census gives the count; the covariance carries which units they were).
+TEST(FailureLoop, ACensusEndingAtEveryInstantKeepsTheWholeRunHonest) {
+  auto ref = [](double) { return 15.0; };
+  for (const char* loss : {"failures=60.25:6:open", "failures=60.25:18:open"}) {
+    for (std::uint64_t seed : {1, 2, 3}) {
+      fl::Spec spec = Bench(loss, seed, 100, ref);
+      spec.census_period = 0.5;
+      spec.census_at_end = true;
+      const auto run = fl::Run(spec);
+      ASSERT_TRUE(run.ok()) << run.error();
+      EXPECT_EQ(fl::InstantsToFind(*run, 60), 0) << loss << " seed " << seed;
+      EXPECT_GE(fl::MeanNees(*run), 0.3) << loss << " seed " << seed;
+      EXPECT_LE(fl::MeanNees(*run), 2) << loss << " seed " << seed;
+      EXPECT_EQ(fl::DeclarationsBefore(*run, 60), 0) << loss << " seed " << seed;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace recruit::control
