@@ -150,7 +150,9 @@ TEST(Census, ReadingsCountTheConductingUnitsWithTheStatedNoise) {
   const int n = 2000;
   double sum[2] = {0, 0}, sq[2] = {0, 0};
   for (int k = 0; k < n; ++k) {
-    if (k % 40 == 0) ASSERT_TRUE(b.Broadcast(s.data(), 0.3, 0.3, x).ok());
+    if (k % 40 == 0) {
+      ASSERT_TRUE(b.Broadcast(s.data(), 0.3, 0.3, x).ok());
+    }
     const auto r = RunCensus(b, s.data(), x, dt);
     ASSERT_EQ(r.number, k + 1);
     const double e[2] = {r.on_current - 54 * b.UnitCurrent(), r.off_current - 3 * b.UnitCurrent()};
