@@ -109,12 +109,11 @@ Eigen::VectorXd RefineFractions(const TransientChain& chain, const control::Unit
 }
 
 // Negative log-likelihood of recordings under the length-aware filter with
-// R = R0 + rho^2 (H x^-)^2, the filter driven by the broadcasts as in operation.
+// R = R0 + r_transit TransitCount(x^-) + rho^2 (H x^-)^2 (the filter's own innovation and its
+// variance), the filter driven by the broadcasts as in operation.
 double NegLogLikelihood(const estimation::FilterModel& model, const control::UnitForceMap& map,
                         const std::vector<BenchRecording>& recs, double rho) {
   double total = 0;
-  const double r0 = model.R(0, 0);
-  Eigen::RowVectorXd h(model.num_states());
   for (const BenchRecording& rec : recs) {
     auto est = control::KalmanOnCountEstimator::Create(model, estimation::CovarianceMode::kExtended,
                                                        map, rho);
@@ -122,14 +121,10 @@ double NegLogLikelihood(const estimation::FilterModel& model, const control::Uni
     control::KalmanOnCountEstimator& e = **est;
     const SwitchingLog& log = rec.log;
     for (int k = 0; k < log.size(); ++k) {
-      map.Forces(rec.lengths[k], h);
-      const Eigen::VectorXd& x = e.filter().estimate();
-      const double predicted = h.dot(x);
-      const double s =
-          h * e.filter().covariance() * h.transpose() + r0 + rho * rho * predicted * predicted;
-      const double innovation = log.force[k] - predicted;
-      total += std::log(s) + innovation * innovation / s;
       e.UpdateWithMeasurement(log.force[k], rec.lengths[k]);
+      const double s = e.filter().innovation_covariance()(0, 0);
+      const double innovation = e.filter().innovation()(0);
+      total += std::log(s) + innovation * innovation / s;
       e.Broadcasted({log.p_on[k], log.p_off[k]});
     }
   }
@@ -224,7 +219,7 @@ Result<PlantIdentification> IdentifyOnPlant(const std::string& model_path,
   TransientChain exported = c;
   map->Forces(rec->tendon_length, exported.force);
   const estimation::FilterModel model =
-      ToFilterModel(exported, rec->log.num_units, rec->log.dT, fit->force_noise_var);
+      ToFilterModel(exported, rec->log.num_units, rec->log.dT, fit->noise.r0, fit->noise.r_transit);
   if (Status s = model.Validate("identified model"); !s) return Error{s.error(), s.code()};
   // 4. R's part that grows with the force, by maximum likelihood over every recording.
   const double rho = FitRelativeNoise(model, *map, recordings);
@@ -250,7 +245,9 @@ Result<PlantIdentification> IdentifyOnPlant(const std::string& model_path,
       {"holdout", MetricsJson(fit->holdout)},
       {"two_state_holdout", MetricsJson(fit->two_state_holdout)},
       {"length_checks", checks},
-      {"R_N2", fit->force_noise_var},
+      {"R_N2", fit->noise.r0},
+      {"R_transit_N2", fit->noise.r_transit},
+      {"R_constant_N2", fit->force_noise_var},
       {"relative_noise", rho},
       {"plant", rec->plant}};
   out.model = std::move(j);
