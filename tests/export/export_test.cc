@@ -163,8 +163,23 @@ std::string UncertainStartModel() {
   return path;
 }
 
+// The same with measurement noise growing with the units in transit (R_transit = 0.01 N^2 per
+// unit in transit, against R = 0.0027 N^2): the package evaluates R at the predicted counts.
+std::string TransitNoiseModel() {
+  static const std::string path = [] {
+    std::ifstream in(UncertainStartModel());
+    nlohmann::json j = nlohmann::json::parse(in);
+    j["R_transit"] = {{0.01}};
+    const auto out = FreshDir("models_transit") / "bench_p0_transit.json";
+    std::ofstream(out) << j.dump();
+    return out.string();
+  }();
+  return path;
+}
+
 const std::vector<Case>& Cases() {
   static const std::vector<Case> cases = {{kSteps, "", 40, UncertainStartModel()},
+                                          {kSteps, "", 40, TransitNoiseModel()},
                                           {kSteps, "", 60},
                                           {kArmHand, "", 60},
                                           {kPushHand, "", 40},
@@ -193,6 +208,30 @@ TEST(ExportEquivalence, DoubleReproducesTheControllerOnRecordedRuns) {
       EXPECT_LE(d.relative, 1e-12) << c.task << " " << c.estimator << " seed " << seed;
     }
   }
+}
+
+// The transit case's package carries R_transit and its states (Cases()' second case, replayed
+// above), and the term changes what the controller does: not a case equal to the first.
+TEST(ExportEquivalence, TransitNoiseReachesThePackage) {
+  const Case plain = Cases()[0], transit = Cases()[1];
+  auto pkg = ExportController(LoadTask(transit.task), Options(transit, 1), Precision::kDouble);
+  ASSERT_TRUE(pkg.ok()) << pkg.error();
+  std::string c_file;
+  for (const ExportedFile& f : pkg->files) {
+    if (f.name == "recruit_controller.c") c_file = f.contents;
+  }
+  EXPECT_NE(c_file.find(".R_transit = 0.01"), std::string::npos);
+  // cold (0) and hot (10) settled, the heating and cooling states in transit.
+  EXPECT_NE(c_file.find("b0_transit[20] = {\n    0, 1, 1, 1, 1, 1,\n    1, 1, 1, 1, 0, 1,"),
+            std::string::npos);
+  const auto a = Record(plain, 7), b = Record(transit, 7);
+  ASSERT_EQ(a.size(), b.size());
+  double largest = 0;
+  for (size_t k = 0; k < a.size(); ++k) {
+    largest =
+        std::max(largest, std::abs(a[k].estimated_on_variance[0] - b[k].estimated_on_variance[0]));
+  }
+  EXPECT_GT(largest, 1e-3);
 }
 
 TEST(ExportEquivalence, FloatStaysWithinItsStatedBound) {
