@@ -2,11 +2,11 @@
 
 #include <Eigen/Cholesky>
 #include <algorithm>
-#include <array>
 #include <cmath>
-#include <functional>
 #include <limits>
 #include <utility>
+
+#include "identification/nelder_mead.h"
 
 namespace recruit::identification {
 namespace {
@@ -280,61 +280,6 @@ double MaxLikelihoodNoise(const TransientChain& c, const SwitchingLog& log, int 
   return std::exp((a + b) / 2);
 }
 
-namespace {
-
-// Nelder-Mead (reflection 1, expansion 2, contraction 1/2, shrink 1/2) on f over two
-// parameters, from the simplex {x0, x0 + step e1, x0 + step e2}, until the simplex's values
-// agree within `tol` or `max_evals` evaluations. Returns the best vertex and its value.
-std::pair<Eigen::Vector2d, double> NelderMead2(
-    const std::function<double(const Eigen::Vector2d&)>& f, const Eigen::Vector2d& x0, double step,
-    double tol, int max_evals) {
-  std::array<Eigen::Vector2d, 3> v = {x0, x0 + Eigen::Vector2d(step, 0),
-                                      x0 + Eigen::Vector2d(0, step)};
-  std::array<double, 3> fv = {f(v[0]), f(v[1]), f(v[2])};
-  int evals = 3;
-  while (evals < max_evals) {
-    std::array<int, 3> o = {0, 1, 2};
-    std::sort(o.begin(), o.end(), [&](int a, int b) { return fv[a] < fv[b]; });
-    const int best = o[0], mid = o[1], worst = o[2];
-    if (fv[worst] - fv[best] < tol && (v[worst] - v[best]).norm() < 1e-3) break;
-    const Eigen::Vector2d centre = (v[best] + v[mid]) / 2;
-    const Eigen::Vector2d r = centre + (centre - v[worst]);
-    const double fr = f(r);
-    ++evals;
-    if (fr < fv[best]) {
-      const Eigen::Vector2d e = centre + 2 * (centre - v[worst]);
-      const double fe = f(e);
-      ++evals;
-      if (fe < fr) {
-        v[worst] = e, fv[worst] = fe;
-      } else {
-        v[worst] = r, fv[worst] = fr;
-      }
-    } else if (fr < fv[mid]) {
-      v[worst] = r, fv[worst] = fr;
-    } else {
-      const bool outside = fr < fv[worst];
-      const Eigen::Vector2d c =
-          outside ? centre + 0.5 * (r - centre) : centre + 0.5 * (v[worst] - centre);
-      const double fc = f(c);
-      ++evals;
-      if (fc < std::min(fr, fv[worst])) {
-        v[worst] = c, fv[worst] = fc;
-      } else {
-        for (int i : {mid, worst}) {
-          v[i] = v[best] + 0.5 * (v[i] - v[best]);
-          fv[i] = f(v[i]);
-          ++evals;
-        }
-      }
-    }
-  }
-  const int best = static_cast<int>(std::min_element(fv.begin(), fv.end()) - fv.begin());
-  return {v[best], fv[best]};
-}
-
-}  // namespace
-
 NoiseModel MaxLikelihoodNoiseModel(const TransientChain& c, const SwitchingLog& log, int rows,
                                    double constant, double lo, double hi) {
   const NoiseModel flat{constant, 0.0};
@@ -345,18 +290,19 @@ NoiseModel MaxLikelihoodNoiseModel(const TransientChain& c, const SwitchingLog& 
   const double log_lo = std::log(lo), log_hi = std::log(hi);
   // r_transit is searched down to 1e-6 of the floor per unit: below that its term is nothing.
   const double log_rlo = std::log(lo * 1e-6), log_rhi = std::log(hi / transit);
-  auto model_at = [&](const Eigen::Vector2d& p) {
+  auto model_at = [&](const Eigen::VectorXd& p) {
     return NoiseModel{std::exp(std::clamp(p[0], log_lo, log_hi)),
                       std::exp(std::clamp(p[1], log_rlo, log_rhi))};
   };
-  auto nll = [&](const Eigen::Vector2d& p) {
+  auto nll = [&](const Eigen::VectorXd& p) {
     return NoiseNegLogLikelihood(c, log, rows, model_at(p));
   };
   // Start with a tenth of the constant R left at every state and the rest per unit in transit.
   const Eigen::Vector2d start(std::log(std::max(0.1 * constant, lo)),
                               std::log(std::max(0.9 * constant / transit, lo * 1e-6)));
-  const auto [p, f] = NelderMead2(nll, start, std::log(10.0), 1e-4, 200);
-  return f < NoiseNegLogLikelihood(c, log, rows, flat) ? model_at(p) : flat;
+  const NelderMeadResult best =
+      NelderMead(nll, start, Eigen::Vector2d::Constant(std::log(10.0)), 1e-4, 1e-3, 200);
+  return best.value < NoiseNegLogLikelihood(c, log, rows, flat) ? model_at(best.x) : flat;
 }
 
 namespace {
@@ -472,6 +418,8 @@ Result<IdentificationResult> IdentifyTransientModel(const SwitchingLog& log,
     var_y = (y.array() - y.mean()).square().mean();
   }
   const double ceiling = std::max(var_y, 100 * floor);
+  best.noise_floor = floor;
+  best.noise_ceiling = ceiling;
   best.force_noise_var = MaxLikelihoodNoise(best.chain, log, train, floor, ceiling);
   // The same likelihood with R growing with the units in transit, whose spread about the mean
   // the chain's geometric dwell times model least exactly.

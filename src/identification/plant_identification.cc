@@ -10,6 +10,7 @@
 #include "identification/bench_recorder.h"
 #include "identification/excitation.h"
 #include "identification/model_export.h"
+#include "identification/nelder_mead.h"
 
 namespace recruit::identification {
 namespace {
@@ -109,13 +110,17 @@ Eigen::VectorXd RefineFractions(const TransientChain& chain, const control::Unit
 }
 
 // Negative log-likelihood of recordings under the length-aware filter with
-// R = R0 + r_transit TransitCount(x^-) + rho^2 (H x^-)^2 (the filter's own innovation and its
+// R = r0 + r_transit TransitCount(x^-) + rho^2 (H x^-)^2 (the filter's own innovation and its
 // variance), the filter driven by the broadcasts as in operation.
 double NegLogLikelihood(const estimation::FilterModel& model, const control::UnitForceMap& map,
-                        const std::vector<BenchRecording>& recs, double rho) {
+                        const std::vector<BenchRecording>& recs, const NoiseModel& noise,
+                        double rho) {
   double total = 0;
+  estimation::FilterModel with = model;
+  with.R(0, 0) = noise.r0;
+  with.R_transit = Eigen::MatrixXd::Constant(1, 1, noise.r_transit);
   for (const BenchRecording& rec : recs) {
-    auto est = control::KalmanOnCountEstimator::Create(model, estimation::CovarianceMode::kExtended,
+    auto est = control::KalmanOnCountEstimator::Create(with, estimation::CovarianceMode::kExtended,
                                                        map, rho);
     if (!est) return std::numeric_limits<double>::infinity();
     control::KalmanOnCountEstimator& e = **est;
@@ -131,24 +136,57 @@ double NegLogLikelihood(const estimation::FilterModel& model, const control::Uni
   return total;
 }
 
-// The rho in [0, 0.5] of the largest likelihood (golden section): the part of the force model's
-// error that grows with the force, seen when it is carried to other lengths.
+// The rho in [0, 0.5] of the largest likelihood (golden section), r0 and r_transit given: the
+// part of the force model's error that grows with the force, seen when it is carried to other
+// lengths.
 double FitRelativeNoise(const estimation::FilterModel& model, const control::UnitForceMap& map,
-                        const std::vector<BenchRecording>& recs) {
+                        const std::vector<BenchRecording>& recs, const NoiseModel& noise) {
+  auto nll = [&](double rho) { return NegLogLikelihood(model, map, recs, noise, rho); };
   double a = 0, b = 0.5;
   const double g = (std::sqrt(5.0) - 1) / 2;
   double x1 = b - g * (b - a), x2 = a + g * (b - a);
-  double f1 = NegLogLikelihood(model, map, recs, x1), f2 = NegLogLikelihood(model, map, recs, x2);
+  double f1 = nll(x1), f2 = nll(x2);
   for (int it = 0; it < 40 && b - a > 1e-4; ++it) {
     if (f1 < f2) {
       b = x2, x2 = x1, f2 = f1, x1 = b - g * (b - a);
-      f1 = NegLogLikelihood(model, map, recs, x1);
+      f1 = nll(x1);
     } else {
       a = x1, x1 = x2, f1 = f2, x2 = a + g * (b - a);
-      f2 = NegLogLikelihood(model, map, recs, x2);
+      f2 = nll(x2);
     }
   }
   return (a + b) / 2;
+}
+
+struct LimbNoise {
+  NoiseModel noise;
+  double rho = 0;
+};
+
+// (r0, r_transit, rho) of the largest likelihood over every recording under the length-aware
+// filter, as it runs in operation: Nelder-Mead on (log r0, log r_transit, rho) from the held
+// pose's (r0, r_transit) and the rho fitted with them; r0 in the fit's [floor, ceiling],
+// r_transit from 1e-6 floor (nothing) to the ceiling, rho in [0, 0.5]. The start is kept when
+// the search finds nothing more likely.
+LimbNoise FitLimbNoise(const estimation::FilterModel& model, const control::UnitForceMap& map,
+                       const std::vector<BenchRecording>& recs, const IdentificationResult& fit) {
+  const double lo = fit.noise_floor, hi = fit.noise_ceiling;
+  LimbNoise start{fit.noise, FitRelativeNoise(model, map, recs, fit.noise)};
+  auto at = [&](const Eigen::VectorXd& p) {
+    return LimbNoise{{std::exp(std::clamp(p[0], std::log(lo), std::log(hi))),
+                      std::exp(std::clamp(p[1], std::log(1e-6 * lo), std::log(hi)))},
+                     std::clamp(p[2], 0.0, 0.5)};
+  };
+  auto nll = [&](const Eigen::VectorXd& p) {
+    const LimbNoise n = at(p);
+    return NegLogLikelihood(model, map, recs, n.noise, n.rho);
+  };
+  const Eigen::Vector3d p0(std::log(std::max(start.noise.r0, lo)),
+                           std::log(std::max(start.noise.r_transit, 1e-6 * lo)), start.rho);
+  const NelderMeadResult best =
+      NelderMead(nll, p0, Eigen::Vector3d(std::log(4.0), std::log(4.0), 0.05), 1e-3, 1e-2, 150);
+  return best.value < NegLogLikelihood(model, map, recs, start.noise, start.rho) ? at(best.x)
+                                                                                 : start;
 }
 
 }  // namespace
@@ -221,11 +259,16 @@ Result<PlantIdentification> IdentifyOnPlant(const std::string& model_path,
   const estimation::FilterModel model =
       ToFilterModel(exported, rec->log.num_units, rec->log.dT, fit->noise.r0, fit->noise.r_transit);
   if (Status s = model.Validate("identified model"); !s) return Error{s.error(), s.code()};
-  // 4. R's part that grows with the force, by maximum likelihood over every recording.
-  const double rho = FitRelativeNoise(model, *map, recordings);
+  // 4. R0, R_transit and R's part that grows with the force, by maximum likelihood over every
+  // recording.
+  const LimbNoise noise = FitLimbNoise(model, *map, recordings, *fit);
+  const double rho = noise.rho;
+  estimation::FilterModel written = model;
+  written.R(0, 0) = noise.noise.r0;
+  written.R_transit(0, 0) = noise.noise.r_transit;
 
   const Eigen::VectorXd& xi = map->fractions();
-  nlohmann::json j = model.ToJson();
+  nlohmann::json j = written.ToJson();
   j["identification"] = {
       {"version", kIdentificationVersion},
       {"command", command},
@@ -245,8 +288,10 @@ Result<PlantIdentification> IdentifyOnPlant(const std::string& model_path,
       {"holdout", MetricsJson(fit->holdout)},
       {"two_state_holdout", MetricsJson(fit->two_state_holdout)},
       {"length_checks", checks},
-      {"R_N2", fit->noise.r0},
-      {"R_transit_N2", fit->noise.r_transit},
+      {"R_N2", noise.noise.r0},
+      {"R_transit_N2", noise.noise.r_transit},
+      {"R_held_N2", fit->noise.r0},
+      {"R_transit_held_N2", fit->noise.r_transit},
       {"R_constant_N2", fit->force_noise_var},
       {"relative_noise", rho},
       {"plant", rec->plant}};

@@ -14,6 +14,7 @@
 #include "estimation/population_chain.h"
 #include "identification/bench_recorder.h"
 #include "identification/excitation.h"
+#include "identification/nelder_mead.h"
 #include "identification/transient_chain.h"
 #include "tests/plugin/mujoco_util.h"
 
@@ -186,6 +187,24 @@ TEST(Identification, MaxLikelihoodNoiseModelRecoversTheTransitNoise) {
     EXPECT_LT(fit.r_transit * 100, 0.01 * fit.r0)
         << seed;  // < 1 % of r0 with every unit in transit
   }
+}
+
+// Nelder-Mead against known minima: a shifted, scaled 3-d quadratic (minimum (1, -2, 0.5)) and
+// Rosenbrock's valley (minimum (1, 1)) from (-1.2, 1).
+TEST(NelderMead, FindsKnownMinima) {
+  auto quad = [](const Eigen::VectorXd& x) {
+    return std::pow(x[0] - 1, 2) + 10 * std::pow(x[1] + 2, 2) + 0.1 * std::pow(x[2] - 0.5, 2);
+  };
+  const NelderMeadResult q =
+      NelderMead(quad, Eigen::Vector3d::Zero(), Eigen::Vector3d::Constant(0.5), 1e-14, 1e-7, 2000);
+  EXPECT_LT((q.x - Eigen::Vector3d(1, -2, 0.5)).cwiseAbs().maxCoeff(), 1e-4) << q.x.transpose();
+  auto rosen = [](const Eigen::VectorXd& x) {
+    return 100 * std::pow(x[1] - x[0] * x[0], 2) + std::pow(1 - x[0], 2);
+  };
+  const NelderMeadResult r = NelderMead(rosen, Eigen::Vector2d(-1.2, 1),
+                                        Eigen::Vector2d::Constant(0.1), 1e-14, 1e-7, 4000);
+  EXPECT_LT((r.x - Eigen::Vector2d(1, 1)).cwiseAbs().maxCoeff(), 1e-3) << r.x.transpose();
+  EXPECT_LT(r.evaluations, 4000);  // converged, not stopped by the cap
 }
 
 TEST(Identification, RejectsTooShortLogsAndBadOptions) {
