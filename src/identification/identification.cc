@@ -418,8 +418,6 @@ Result<IdentificationResult> IdentifyTransientModel(const SwitchingLog& log,
     var_y = (y.array() - y.mean()).square().mean();
   }
   const double ceiling = std::max(var_y, 100 * floor);
-  best.noise_floor = floor;
-  best.noise_ceiling = ceiling;
   best.force_noise_var = MaxLikelihoodNoise(best.chain, log, train, floor, ceiling);
   // The same likelihood with R growing with the units in transit, whose spread about the mean
   // the chain's geometric dwell times model least exactly.

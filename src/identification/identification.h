@@ -50,7 +50,6 @@ struct IdentificationResult {
   double force_noise_var = 0;  // R, N^2: what the population's own spread does not explain
   // R as a function of the units in transit (MaxLikelihoodNoiseModel), on the same samples.
   NoiseModel noise;
-  double noise_floor = 0, noise_ceiling = 0;  // N^2: the range R was searched in
   FitMetrics train, holdout;
   // The two-state model (H = [h_off, h_on] fitted the same way) on the same held-out data.
   FitMetrics two_state_holdout;

@@ -10,7 +10,6 @@
 #include "identification/bench_recorder.h"
 #include "identification/excitation.h"
 #include "identification/model_export.h"
-#include "identification/nelder_mead.h"
 
 namespace recruit::identification {
 namespace {
@@ -158,37 +157,6 @@ double FitRelativeNoise(const estimation::FilterModel& model, const control::Uni
   return (a + b) / 2;
 }
 
-struct LimbNoise {
-  NoiseModel noise;
-  double rho = 0;
-};
-
-// (r0, r_transit, rho) of the largest likelihood over every recording under the length-aware
-// filter, as it runs in operation: Nelder-Mead on (log r0, log r_transit, rho) from the held
-// pose's (r0, r_transit) and the rho fitted with them; r0 in the fit's [floor, ceiling],
-// r_transit from 1e-6 floor (nothing) to the ceiling, rho in [0, 0.5]. The start is kept when
-// the search finds nothing more likely.
-LimbNoise FitLimbNoise(const estimation::FilterModel& model, const control::UnitForceMap& map,
-                       const std::vector<BenchRecording>& recs, const IdentificationResult& fit) {
-  const double lo = fit.noise_floor, hi = fit.noise_ceiling;
-  LimbNoise start{fit.noise, FitRelativeNoise(model, map, recs, fit.noise)};
-  auto at = [&](const Eigen::VectorXd& p) {
-    return LimbNoise{{std::exp(std::clamp(p[0], std::log(lo), std::log(hi))),
-                      std::exp(std::clamp(p[1], std::log(1e-6 * lo), std::log(hi)))},
-                     std::clamp(p[2], 0.0, 0.5)};
-  };
-  auto nll = [&](const Eigen::VectorXd& p) {
-    const LimbNoise n = at(p);
-    return NegLogLikelihood(model, map, recs, n.noise, n.rho);
-  };
-  const Eigen::Vector3d p0(std::log(std::max(start.noise.r0, lo)),
-                           std::log(std::max(start.noise.r_transit, 1e-6 * lo)), start.rho);
-  const NelderMeadResult best =
-      NelderMead(nll, p0, Eigen::Vector3d(std::log(4.0), std::log(4.0), 0.05), 1e-3, 1e-2, 150);
-  return best.value < NegLogLikelihood(model, map, recs, start.noise, start.rho) ? at(best.x)
-                                                                                 : start;
-}
-
 }  // namespace
 
 nlohmann::json MetricsJson(const FitMetrics& m) {
@@ -259,16 +227,12 @@ Result<PlantIdentification> IdentifyOnPlant(const std::string& model_path,
   const estimation::FilterModel model =
       ToFilterModel(exported, rec->log.num_units, rec->log.dT, fit->noise.r0, fit->noise.r_transit);
   if (Status s = model.Validate("identified model"); !s) return Error{s.error(), s.code()};
-  // 4. R0, R_transit and R's part that grows with the force, by maximum likelihood over every
-  // recording.
-  const LimbNoise noise = FitLimbNoise(model, *map, recordings, *fit);
-  const double rho = noise.rho;
-  estimation::FilterModel written = model;
-  written.R(0, 0) = noise.noise.r0;
-  written.R_transit(0, 0) = noise.noise.r_transit;
+  // 4. R's part that grows with the force, by maximum likelihood over every recording (R0 and
+  // R_transit those of the held pose).
+  const double rho = FitRelativeNoise(model, *map, recordings, fit->noise);
 
   const Eigen::VectorXd& xi = map->fractions();
-  nlohmann::json j = written.ToJson();
+  nlohmann::json j = model.ToJson();
   j["identification"] = {
       {"version", kIdentificationVersion},
       {"command", command},
@@ -288,10 +252,8 @@ Result<PlantIdentification> IdentifyOnPlant(const std::string& model_path,
       {"holdout", MetricsJson(fit->holdout)},
       {"two_state_holdout", MetricsJson(fit->two_state_holdout)},
       {"length_checks", checks},
-      {"R_N2", noise.noise.r0},
-      {"R_transit_N2", noise.noise.r_transit},
-      {"R_held_N2", fit->noise.r0},
-      {"R_transit_held_N2", fit->noise.r_transit},
+      {"R_N2", fit->noise.r0},
+      {"R_transit_N2", fit->noise.r_transit},
       {"R_constant_N2", fit->force_noise_var},
       {"relative_noise", rho},
       {"plant", rec->plant}};
