@@ -27,8 +27,11 @@ struct FilterModel {
   int64_t N = 0;                         // agents (units), >= 1
   Eigen::MatrixXd H;                     // r x m output matrix, y = H X + v (eq. 12)
   Eigen::MatrixXd R;                     // r x r measurement noise covariance, SPD
-  Eigen::MatrixXd G;                     // m x q process noise input (q may be 0)
-  Eigen::MatrixXd Qw;                    // q x q process noise covariance, PSD
+  // r x r, symmetric PSD (default 0): the measurement noise each unit in transit adds, so that
+  // the covariance at a predicted state x is R + TransitCount(x) R_transit (kBroadcast only).
+  Eigen::MatrixXd R_transit;
+  Eigen::MatrixXd G;   // m x q process noise input (q may be 0)
+  Eigen::MatrixXd Qw;  // q x q process noise covariance, PSD
   TransitionSource transition = TransitionSource::kBroadcast;
   BroadcastTransitionModel broadcast;  // kBroadcast
   Eigen::MatrixXd A;                   // kConstant: m x m column-stochastic
@@ -42,6 +45,12 @@ struct FilterModel {
   int num_outputs() const { return static_cast<int>(H.rows()); }
   // G Qw G^T (m x m); zero when q = 0.
   Eigen::MatrixXd ProcessNoise() const;
+  // True when R_transit is not all zero (the measurement noise depends on the state).
+  bool has_transit_noise() const { return R_transit.size() > 0 && (R_transit.array() != 0).any(); }
+  // 1 for the states a unit leaves without being switched (interior(j, j) < 1 in the broadcast
+  // model: the heating and cooling transients), 0 for the others (the settled states); all 0
+  // for other transition sources.
+  Eigen::VectorXd TransitMask() const;
 
   // Checks every field and the relations between them; `where` (the file) prefixes messages.
   // G Qw G^T must have zero column sums: process noise cannot change the total N.

@@ -121,12 +121,25 @@ class PopulationKalmanFilterT {
   // and its calls cost more (m = 2: the controller's step measured 3-6 % slower with it).
   static constexpr int kAvxMinStates = 8;
   void set_avx_kernels(bool on) { avx_ = on && kf_detail::CpuHasAvx(); }
-  // Measurement update with y(t) (eqs. 15, 17, 19, 20 in Joseph form).
+  // Measurement update with y(t) (eqs. 15, 17, 19, 20 in Joseph form). The measurement noise
+  // is R + TransitCount() R_transit (the model's R_transit; R alone when it has none), evaluated
+  // at the predicted estimate.
   void Update(const OutVec& y);
+  // The expected number of units in transit at the current estimate: the sum of max(0, x_j)
+  // over the states of FilterModel::TransitMask, in state order (0 without R_transit).
+  double TransitCount() const {
+    double n = 0.0;
+    if (!has_transit_noise_) return n;
+    for (Eigen::Index j = 0; j < x_.size(); ++j) {
+      if (transit_mask_[j] != 0.0 && x_[j] > 0.0) n += x_[j];
+    }
+    return n;
+  }
 
   // Replaces the output model for the next Updates: H (r x m, the force per unit in each state,
   // which may depend on the plant's measured configuration, e.g. the tendon's length) and R
-  // (r x r, symmetric positive definite). Sizes must match (not checked); no allocation.
+  // (r x r, symmetric positive definite; the state-independent part: the model's R_transit
+  // still adds TransitCount() R_transit). Sizes must match (not checked); no allocation.
   void SetOutput(const OutputMat& H, const OutMat& noise) {
     H_ = H;
     R_ = noise;
@@ -143,10 +156,11 @@ class PopulationKalmanFilterT {
     Reproject();
   }
 
-  const Vec& estimate() const { return x_; }           // X^, counts per state, sums to N
-  const Mat& covariance() const { return P_; }         // P
-  const OutVec& innovation() const { return innov_; }  // y - H X^(t|t-1) of the last Update
-  const GainMat& gain() const { return K_; }           // K of the last Update
+  const Vec& estimate() const { return x_; }                  // X^, counts per state, sums to N
+  const Mat& covariance() const { return P_; }                // P
+  const OutVec& innovation() const { return innov_; }         // y - H X^(t|t-1) of the last Update
+  const OutMat& innovation_covariance() const { return S_; }  // H P H^T + R of the last Update
+  const GainMat& gain() const { return K_; }                  // K of the last Update
   CovarianceMode mode() const { return mode_; }
   double population() const { return N_; }
   int num_states() const { return static_cast<int>(x_.size()); }
@@ -183,6 +197,9 @@ class PopulationKalmanFilterT {
   double N_ = 0.0;
   OutputMat H_;
   OutMat R_;
+  OutMat R_transit_;  // per unit in transit (has_transit_noise_ only)
+  Vec transit_mask_;  // FilterModel::TransitMask
+  bool has_transit_noise_ = false;
   Mat GQG_;  // G Qw G^T, precomputed
   bool has_process_noise_ = false;
   // State.
@@ -319,6 +336,9 @@ Result<PopulationKalmanFilterT<M, R>> PopulationKalmanFilterT<M, R>::Create(
   f.N_ = N;
   f.H_ = model.H;
   f.R_ = model.R;
+  f.has_transit_noise_ = model.has_transit_noise();
+  f.R_transit_ = f.has_transit_noise_ ? OutMat(model.R_transit) : OutMat::Zero(r, r);
+  f.transit_mask_ = model.TransitMask();
   f.GQG_ = model.ProcessNoise();
   f.has_process_noise_ = model.G.cols() > 0;
   f.x_ = x0;
@@ -334,7 +354,7 @@ Result<PopulationKalmanFilterT<M, R>> PopulationKalmanFilterT<M, R>::Create(
   f.U_.resize(m, r);
   f.K_.setZero(m, r);
   f.KS_.resize(m, r);
-  f.S_.resize(r, r);
+  f.S_.setZero(r, r);
   f.innov_.setZero(r);
   f.Kt_.resize(r, m);
   f.llt_.compute(OutMat::Identity(r, r));
@@ -555,7 +575,9 @@ void PopulationKalmanFilterT<M, R>::UpdateScalarWith(double y) {
   // P h^T as a combination of P's columns, three per pass over u (no call into Eigen's general
   // matrix-vector kernel, whose set-up dominates at these sizes). H is 1 x m: h is contiguous.
   Kernels::template MatVec<M>(u.data(), P_.data(), m, iota_.data(), H_.data());
-  const double s = h.dot(u) + R_(0, 0);
+  double noise = R_(0, 0);
+  if (has_transit_noise_) noise += TransitCount() * R_transit_(0, 0);
+  const double s = h.dot(u) + noise;
   S_(0, 0) = s;
   k = u / s;
   innov_(0) = y - h.dot(x_);
@@ -578,6 +600,7 @@ void PopulationKalmanFilterT<M, R>::Update(const OutVec& y) {
   }
   U_.noalias() = P_ * H_.transpose();  // P H^T
   S_ = R_;
+  if (has_transit_noise_) S_ += TransitCount() * R_transit_;
   S_.noalias() += H_ * U_;  // H P H^T + R
   llt_.compute(S_);
   Kt_ = U_.transpose();

@@ -24,9 +24,9 @@ struct BundleConstants {
   double N = 0, lambda = 0, unit_force = 0;
   bool length_aware = false;
   double prestretch = 0, ref_length = 0, on_k = 0, on_c = 0;
-  std::vector<int> ptr, col, target, is_on;
-  std::vector<double> base, k, c, h, x0, P0, gqg;  // P0, gqg packed; empty = none
-  double R = 0, relative_noise = 0;
+  std::vector<int> ptr, col, target, is_on, transit;  // transit: empty when R_transit = 0
+  std::vector<double> base, k, c, h, x0, P0, gqg;     // P0, gqg packed; empty = none
+  double R = 0, relative_noise = 0, R_transit = 0;
 };
 
 // The unit's stiffness at fraction xi: sma::UnitModel's arithmetic (wire in series with the
@@ -119,6 +119,11 @@ Result<BundleConstants> Constants(const sim::BundleController& bc, const std::st
   out.h.assign(model.H.data(), model.H.data() + out.m);
   out.R = model.R(0, 0);
   out.relative_noise = k->relative_noise();
+  if (model.has_transit_noise()) {
+    out.R_transit = model.R_transit(0, 0);
+    const Eigen::VectorXd mask = model.TransitMask();
+    for (int i = 0; i < out.m; ++i) out.transit.push_back(mask[i] != 0.0 ? 1 : 0);
+  }
   out.x0.assign(model.x0.data(), model.x0.data() + out.m);
   out.P0 = Packed(model.P0);
   if (model.G.cols() > 0) {
@@ -147,6 +152,7 @@ std::string BundleBlock(const BundleConstants& b, int i, const Writer& w) {
     s += w.Array("uint8_t", n + "col", b.col, false);
     s += w.Array("uint8_t", n + "target", b.target, false);
     s += w.Array("uint8_t", n + "is_on", b.is_on, false);
+    if (!b.transit.empty()) s += w.Array("uint8_t", n + "transit", b.transit, false);
     s += w.Array("recruit_real", n + "base", b.base, true);
     s += w.Array("recruit_real", n + "h", b.h, true);
     s += w.Array("recruit_real", n + "x0", b.x0, true);
@@ -171,6 +177,9 @@ std::string BundleBlock(const BundleConstants& b, int i, const Writer& w) {
     if (!b.k.empty()) s += field("k", n + "k") + field("c", n + "c");
     s += field("h", n + "h") + field("R", w.Num(b.R)) +
          field("relative_noise", w.Num(b.relative_noise)) + field("x0", n + "x0");
+    if (!b.transit.empty()) {
+      s += field("R_transit", w.Num(b.R_transit)) + field("transit", n + "transit");
+    }
     if (!b.P0.empty()) s += field("P0", n + "P0");
     if (!b.gqg.empty()) s += field("gqg", n + "gqg");
   }

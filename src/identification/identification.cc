@@ -4,6 +4,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
+
+#include "identification/nelder_mead.h"
 
 namespace recruit::identification {
 namespace {
@@ -206,10 +209,21 @@ bool RefineTargets(Problem& p, const Eigen::VectorXd& a) {
   return changed;
 }
 
-// Negative log-likelihood (up to constants) of the force samples [0, rows) under the population
-// Kalman filter on `c` with measurement variance R (extended covariance, eqs. 15-27).
-double NegLogLikelihood(const TransientChain& c, const SwitchingLog& log, int rows, double R) {
+}  // namespace
+
+Eigen::VectorXd TransitMask(const TransientChain& c) {
+  const Eigen::MatrixXd interior = c.Interior();
+  Eigen::VectorXd mask = Eigen::VectorXd::Zero(c.num_states());
+  for (int j = 0; j < c.num_states(); ++j) mask[j] = interior(j, j) < 1.0 ? 1.0 : 0.0;
+  return mask;
+}
+
+// The population Kalman filter of eqs. 15-27 (extended covariance), dense and written out here:
+// the reference the fast filter (src/estimation) is tested against is not used to fit.
+double NoiseNegLogLikelihood(const TransientChain& c, const SwitchingLog& log, int rows,
+                             const NoiseModel& noise) {
   const int m = c.num_states();
+  const Eigen::VectorXd mask = TransitMask(c);
   Eigen::VectorXd x = Eigen::VectorXd::Zero(m);
   x[c.cold()] = log.num_units;
   Eigen::MatrixXd P = Eigen::MatrixXd::Zero(m, m);
@@ -217,6 +231,8 @@ double NegLogLikelihood(const TransientChain& c, const SwitchingLog& log, int ro
   const Eigen::MatrixXd I = Eigen::MatrixXd::Identity(m, m);
   double nll = 0;
   for (int k = 0; k < rows; ++k) {
+    double R = noise.r0;
+    if (noise.r_transit != 0) R += noise.r_transit * mask.dot(x.cwiseMax(0.0));
     const Eigen::VectorXd ph = P * h;
     const double S = h.dot(ph) + R;
     const double nu = log.force[k] - h.dot(x);
@@ -235,11 +251,12 @@ double NegLogLikelihood(const TransientChain& c, const SwitchingLog& log, int ro
   return nll;
 }
 
-}  // namespace
-
 // R by maximum likelihood: golden-section search on log R in [lo, hi].
 double MaxLikelihoodNoise(const TransientChain& c, const SwitchingLog& log, int rows, double lo,
                           double hi) {
+  auto NegLogLikelihood = [](const TransientChain& c, const SwitchingLog& log, int rows, double R) {
+    return NoiseNegLogLikelihood(c, log, rows, {R, 0.0});
+  };
   double a = std::log(lo), b = std::log(hi);
   const double g = (std::sqrt(5.0) - 1) / 2;
   double x1 = b - g * (b - a), x2 = a + g * (b - a);
@@ -261,6 +278,31 @@ double MaxLikelihoodNoise(const TransientChain& c, const SwitchingLog& log, int 
     }
   }
   return std::exp((a + b) / 2);
+}
+
+NoiseModel MaxLikelihoodNoiseModel(const TransientChain& c, const SwitchingLog& log, int rows,
+                                   double constant, double lo, double hi) {
+  const NoiseModel flat{constant, 0.0};
+  // The mean units in transit along the mean trajectory: the scale of r_transit's start.
+  const Eigen::VectorXd mask = TransitMask(c);
+  const double transit = (MeanTrajectory(c, log, rows) * mask).mean();
+  if (!(transit > 1e-9)) return flat;
+  const double log_lo = std::log(lo), log_hi = std::log(hi);
+  // r_transit is searched down to 1e-6 of the floor per unit: below that its term is nothing.
+  const double log_rlo = std::log(lo * 1e-6), log_rhi = std::log(hi / transit);
+  auto model_at = [&](const Eigen::VectorXd& p) {
+    return NoiseModel{std::exp(std::clamp(p[0], log_lo, log_hi)),
+                      std::exp(std::clamp(p[1], log_rlo, log_rhi))};
+  };
+  auto nll = [&](const Eigen::VectorXd& p) {
+    return NoiseNegLogLikelihood(c, log, rows, model_at(p));
+  };
+  // Start with a tenth of the constant R left at every state and the rest per unit in transit.
+  const Eigen::Vector2d start(std::log(std::max(0.1 * constant, lo)),
+                              std::log(std::max(0.9 * constant / transit, lo * 1e-6)));
+  const NelderMeadResult best =
+      NelderMead(nll, start, Eigen::Vector2d::Constant(std::log(10.0)), 1e-4, 1e-3, 200);
+  return best.value < NoiseNegLogLikelihood(c, log, rows, flat) ? model_at(best.x) : flat;
 }
 
 namespace {
@@ -375,8 +417,12 @@ Result<IdentificationResult> IdentifyTransientModel(const SwitchingLog& log,
     const Eigen::VectorXd y = Eigen::Map<const Eigen::VectorXd>(log.force.data(), train);
     var_y = (y.array() - y.mean()).square().mean();
   }
-  best.force_noise_var =
-      MaxLikelihoodNoise(best.chain, log, train, floor, std::max(var_y, 100 * floor));
+  const double ceiling = std::max(var_y, 100 * floor);
+  best.force_noise_var = MaxLikelihoodNoise(best.chain, log, train, floor, ceiling);
+  // The same likelihood with R growing with the units in transit, whose spread about the mean
+  // the chain's geometric dwell times model least exactly.
+  best.noise =
+      MaxLikelihoodNoiseModel(best.chain, log, train, best.force_noise_var, floor, ceiling);
   return best;
 }
 

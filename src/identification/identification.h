@@ -37,9 +37,19 @@ struct FitMetrics {
   double r2 = 0;    // 1 - SS_res / SS_tot
 };
 
+// The measurement noise model R(x) = r0 + r_transit TransitCount(x), TransitCount(x) the sum of
+// max(0, x_j) over the states a unit leaves without being switched (TransitMask), x the
+// filter's predicted counts.
+struct NoiseModel {
+  double r0 = 0;         // N^2
+  double r_transit = 0;  // N^2 per unit in transit
+};
+
 struct IdentificationResult {
   TransientChain chain;
   double force_noise_var = 0;  // R, N^2: what the population's own spread does not explain
+  // R as a function of the units in transit (MaxLikelihoodNoiseModel), on the same samples.
+  NoiseModel noise;
   FitMetrics train, holdout;
   // The two-state model (H = [h_off, h_on] fitted the same way) on the same held-out data.
   FitMetrics two_state_holdout;
@@ -57,6 +67,22 @@ Eigen::VectorXd PredictMeanForce(const TransientChain& chain, const SwitchingLog
 // population Kalman filter on `chain` (extended covariance), searched in [lo, hi] N^2.
 double MaxLikelihoodNoise(const TransientChain& chain, const SwitchingLog& log, int rows, double lo,
                           double hi);
+
+// 1 for the chain's states a unit leaves without being switched (interior(j, j) < 1: the
+// heating and cooling states), 0 for cold and hot (FilterModel::TransitMask of its export).
+Eigen::VectorXd TransitMask(const TransientChain& chain);
+
+// Negative log-likelihood (up to constants, sum of log S_k + nu_k^2 / S_k) of
+// log.force[0, rows) under the population Kalman filter on `chain` (extended covariance) with
+// R(x^-) = noise.r0 + noise.r_transit TransitCount(x^-).
+double NoiseNegLogLikelihood(const TransientChain& chain, const SwitchingLog& log, int rows,
+                             const NoiseModel& noise);
+
+// The (r0, r_transit) maximising that likelihood: Nelder-Mead on (log r0, log r_transit) from a
+// start that splits the constant ML R (`constant`) between the two terms, r0 in [lo, hi]; the
+// constant model (constant, 0) when the fit does not beat it.
+NoiseModel MaxLikelihoodNoiseModel(const TransientChain& chain, const SwitchingLog& log, int rows,
+                                   double constant, double lo, double hi);
 
 // RMSE and R^2 of `predicted` against log.force over samples [begin, end).
 FitMetrics Score(const Eigen::VectorXd& predicted, const SwitchingLog& log, int begin, int end);

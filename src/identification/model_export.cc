@@ -3,13 +3,14 @@
 namespace recruit::identification {
 
 estimation::FilterModel ToFilterModel(const TransientChain& chain, std::int64_t num_units,
-                                      double dT, double force_noise_var) {
+                                      double dT, double force_noise_var, double transit_noise_var) {
   const int m = chain.num_states();
   estimation::FilterModel f;
   f.state_names = chain.StateNames();
   f.N = num_units;
   f.H = chain.force.transpose();
   f.R = Eigen::MatrixXd::Constant(1, 1, force_noise_var);
+  f.R_transit = Eigen::MatrixXd::Constant(1, 1, transit_noise_var);
   f.G = Eigen::MatrixXd::Zero(m, 0);
   f.Qw = Eigen::MatrixXd::Zero(0, 0);
   f.transition = estimation::TransitionSource::kBroadcast;

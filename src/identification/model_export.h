@@ -9,9 +9,11 @@
 namespace recruit::identification {
 
 // states = chain.StateNames(), H = chain.force^T (1 x m), R = [force_noise_var],
-// no process noise, transition "broadcast" with the chain's interior, is_on and switching
-// targets (-1 where a switch does not apply), dt = dT; x0 = N in "cold", P0 = 0.
+// R_transit = [transit_noise_var] (N^2 per unit in transit; 0: constant R), no process noise,
+// transition "broadcast" with the chain's interior, is_on and switching targets (-1 where a switch
+// does not apply), dt = dT; x0 = N in "cold", P0 = 0.
 estimation::FilterModel ToFilterModel(const TransientChain& chain, std::int64_t num_units,
-                                      double dT, double force_noise_var);
+                                      double dT, double force_noise_var,
+                                      double transit_noise_var = 0);
 
 }  // namespace recruit::identification

@@ -109,48 +109,49 @@ Eigen::VectorXd RefineFractions(const TransientChain& chain, const control::Unit
 }
 
 // Negative log-likelihood of recordings under the length-aware filter with
-// R = R0 + rho^2 (H x^-)^2, the filter driven by the broadcasts as in operation.
+// R = r0 + r_transit TransitCount(x^-) + rho^2 (H x^-)^2 (the filter's own innovation and its
+// variance), the filter driven by the broadcasts as in operation.
 double NegLogLikelihood(const estimation::FilterModel& model, const control::UnitForceMap& map,
-                        const std::vector<BenchRecording>& recs, double rho) {
+                        const std::vector<BenchRecording>& recs, const NoiseModel& noise,
+                        double rho) {
   double total = 0;
-  const double r0 = model.R(0, 0);
-  Eigen::RowVectorXd h(model.num_states());
+  estimation::FilterModel with = model;
+  with.R(0, 0) = noise.r0;
+  with.R_transit = Eigen::MatrixXd::Constant(1, 1, noise.r_transit);
   for (const BenchRecording& rec : recs) {
-    auto est = control::KalmanOnCountEstimator::Create(model, estimation::CovarianceMode::kExtended,
+    auto est = control::KalmanOnCountEstimator::Create(with, estimation::CovarianceMode::kExtended,
                                                        map, rho);
     if (!est) return std::numeric_limits<double>::infinity();
     control::KalmanOnCountEstimator& e = **est;
     const SwitchingLog& log = rec.log;
     for (int k = 0; k < log.size(); ++k) {
-      map.Forces(rec.lengths[k], h);
-      const Eigen::VectorXd& x = e.filter().estimate();
-      const double predicted = h.dot(x);
-      const double s =
-          h * e.filter().covariance() * h.transpose() + r0 + rho * rho * predicted * predicted;
-      const double innovation = log.force[k] - predicted;
-      total += std::log(s) + innovation * innovation / s;
       e.UpdateWithMeasurement(log.force[k], rec.lengths[k]);
+      const double s = e.filter().innovation_covariance()(0, 0);
+      const double innovation = e.filter().innovation()(0);
+      total += std::log(s) + innovation * innovation / s;
       e.Broadcasted({log.p_on[k], log.p_off[k]});
     }
   }
   return total;
 }
 
-// The rho in [0, 0.5] of the largest likelihood (golden section): the part of the force model's
-// error that grows with the force, seen when it is carried to other lengths.
+// The rho in [0, 0.5] of the largest likelihood (golden section), r0 and r_transit given: the
+// part of the force model's error that grows with the force, seen when it is carried to other
+// lengths.
 double FitRelativeNoise(const estimation::FilterModel& model, const control::UnitForceMap& map,
-                        const std::vector<BenchRecording>& recs) {
+                        const std::vector<BenchRecording>& recs, const NoiseModel& noise) {
+  auto nll = [&](double rho) { return NegLogLikelihood(model, map, recs, noise, rho); };
   double a = 0, b = 0.5;
   const double g = (std::sqrt(5.0) - 1) / 2;
   double x1 = b - g * (b - a), x2 = a + g * (b - a);
-  double f1 = NegLogLikelihood(model, map, recs, x1), f2 = NegLogLikelihood(model, map, recs, x2);
+  double f1 = nll(x1), f2 = nll(x2);
   for (int it = 0; it < 40 && b - a > 1e-4; ++it) {
     if (f1 < f2) {
       b = x2, x2 = x1, f2 = f1, x1 = b - g * (b - a);
-      f1 = NegLogLikelihood(model, map, recs, x1);
+      f1 = nll(x1);
     } else {
       a = x1, x1 = x2, f1 = f2, x2 = a + g * (b - a);
-      f2 = NegLogLikelihood(model, map, recs, x2);
+      f2 = nll(x2);
     }
   }
   return (a + b) / 2;
@@ -224,10 +225,11 @@ Result<PlantIdentification> IdentifyOnPlant(const std::string& model_path,
   TransientChain exported = c;
   map->Forces(rec->tendon_length, exported.force);
   const estimation::FilterModel model =
-      ToFilterModel(exported, rec->log.num_units, rec->log.dT, fit->force_noise_var);
+      ToFilterModel(exported, rec->log.num_units, rec->log.dT, fit->noise.r0, fit->noise.r_transit);
   if (Status s = model.Validate("identified model"); !s) return Error{s.error(), s.code()};
-  // 4. R's part that grows with the force, by maximum likelihood over every recording.
-  const double rho = FitRelativeNoise(model, *map, recordings);
+  // 4. R's part that grows with the force, by maximum likelihood over every recording (R0 and
+  // R_transit those of the held pose).
+  const double rho = FitRelativeNoise(model, *map, recordings, fit->noise);
 
   const Eigen::VectorXd& xi = map->fractions();
   nlohmann::json j = model.ToJson();
@@ -250,7 +252,9 @@ Result<PlantIdentification> IdentifyOnPlant(const std::string& model_path,
       {"holdout", MetricsJson(fit->holdout)},
       {"two_state_holdout", MetricsJson(fit->two_state_holdout)},
       {"length_checks", checks},
-      {"R_N2", fit->force_noise_var},
+      {"R_N2", fit->noise.r0},
+      {"R_transit_N2", fit->noise.r_transit},
+      {"R_constant_N2", fit->force_noise_var},
       {"relative_noise", rho},
       {"plant", rec->plant}};
   out.model = std::move(j);

@@ -74,7 +74,28 @@ TEST(EstimationFilterModel, SaveAndLoadRoundTrip) {
   EXPECT_EQ(g->x0, f.x0);
   EXPECT_EQ(g->P0, f.P0);
   EXPECT_EQ(g->broadcast.Matrix(0.2, 0.4), f.broadcast.Matrix(0.2, 0.4));
+  EXPECT_FALSE(g->has_transit_noise());
+  // A model without transit noise writes no R_transit (old readers see the file they knew).
+  EXPECT_FALSE(g->ToJson().contains("R_transit"));
+  f.R_transit(0, 0) = 0.125;
+  ASSERT_TRUE(f.Save(path).ok());
+  auto t = estimation::FilterModel::FromJson(path);
+  ASSERT_TRUE(t.ok()) << t.error();
+  EXPECT_EQ(t->R_transit, f.R_transit);
+  EXPECT_TRUE(t->has_transit_noise());
   std::remove(path.c_str());
+}
+
+// The states in transit are those a unit leaves without a broadcast: interior(j, j) < 1.
+TEST(EstimationFilterModel, TransitMaskIsTheStatesAUnitLeavesUnswitched) {
+  estimation::FilterModel f = estimation::FilterModel::TwoState(60, 0.5, 0.45, 0.3);
+  EXPECT_EQ(f.TransitMask(), Eigen::Vector2d::Zero());
+  f.broadcast = estimation::BroadcastTransitionModel::HeatingChain(6, 0.5);
+  f.state_names = f.broadcast.state_names;
+  // HeatingChain(6): 0 settled off, 1..3 on (3 settled), 4..5 cooling.
+  Eigen::VectorXd expected(6);
+  expected << 0, 1, 1, 0, 1, 1;
+  EXPECT_EQ(f.TransitMask(), expected);
 }
 
 nlohmann::json GoodJson() {
@@ -98,8 +119,8 @@ TEST(EstimationFilterModel, ClearErrorsForBadFields) {
   const std::vector<Case> cases = {
       // an unknown key, at the top and inside an object
       {"/Hx", 1,
-       "m.json: unknown field 'Hx'; allowed: G, H, N, Qw, R, format, identification, initial, "
-       "states, transition, version"},
+       "m.json: unknown field 'Hx'; allowed: G, H, N, Qw, R, R_transit, format, identification, "
+       "initial, states, transition, version"},
       {"/transition/A", parse("[[1, 0], [0, 1]]"),
        "m.json.transition: unknown field 'A'; allowed: dt, interior, is_on, off_target, "
        "on_target, type"},
@@ -137,6 +158,10 @@ TEST(EstimationFilterModel, ClearErrorsForBadFields) {
        "m.json.initial.x0[1]: must be a finite number, got null"},
       // values that are each allowed but not together, or not as a matrix
       {"/R", parse("[[-1]]"), "m.json.R: must be positive definite"},
+      {"/R_transit", parse("[[-0.5]]"), "m.json.R_transit: must be positive semi-definite"},
+      {"/R_transit", parse("[[1, 0]]"),
+       "m.json.R_transit[0]: must be an array of 1 numbers (row 0 of a 1 x 1 matrix)"},
+      {"/R_transit", "0.5", "m.json.R_transit: must be an array of rows"},
       {"/initial", parse(R"({"x0": [50, 9]})"),
        "m.json.initial.x0: must sum to N = 60, sums to 59"},
       {"/states", parse(R"(["off", "off"])"), "m.json.states: duplicate name 'off'"},
@@ -191,6 +216,20 @@ TEST(EstimationFilterModel, ClearErrorsForBadFields) {
   EXPECT_NE(f.error().find("m.json.G, Qw: G Qw G^T must have zero column sums"), std::string::npos)
       << f.error();
   EXPECT_EQ(exit_code::Of(f.failure()), exit_code::kBadInput);
+}
+
+// R_transit needs the broadcast model's interior to say which states are in transit.
+TEST(EstimationFilterModel, TransitNoiseNeedsABroadcastTransition) {
+  nlohmann::json j = GoodJson();
+  j["R_transit"] = nlohmann::json::parse("[[0.5]]");
+  ASSERT_TRUE(estimation::FilterModel::FromJsonValue(j, "m.json").ok());
+  j["transition"] = nlohmann::json::parse(R"({"type": "constant", "A": [[1, 0], [0, 1]]})");
+  auto f = estimation::FilterModel::FromJsonValue(j, "m.json");
+  ASSERT_FALSE(f.ok());
+  EXPECT_NE(f.error().find("m.json.R_transit: needs a \"broadcast\" transition"), std::string::npos)
+      << f.error();
+  j["R_transit"] = nlohmann::json::parse("[[0]]");  // zero: no transit noise, any transition
+  EXPECT_TRUE(estimation::FilterModel::FromJsonValue(j, "m.json").ok());
 }
 
 // The optional fields, given as identify writes them, are accepted and read: format, version,

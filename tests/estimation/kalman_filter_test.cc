@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "estimation/population_kalman_filter.h"
+#include "test_util.h"
 
 namespace recruit {
 namespace {
@@ -195,6 +196,79 @@ TEST(EstimationKalman, RejectsBadInitialBeliefAndInputs) {
   EXPECT_FALSE(kf->UpdateChecked(Eigen::VectorXd::Constant(1, NAN)).ok());
   EXPECT_FALSE(kf->UpdateChecked(Eigen::VectorXd::Zero(2)).ok());
   EXPECT_EQ(kf->estimate(), Eigen::Vector2d(10, 0));  // untouched by the rejected inputs
+}
+
+// R growing with the units in transit, R(x^-) = R + TransitCount(x^-) R_transit, against a
+// textbook filter written out densely (explicit Qz, Joseph form with its own R_k) over a run of
+// broadcasts and measurements of the three-state unit, whose only state in transit is
+// "warming" (interior 0.4 on the diagonal). The dynamic and the fixed-size filters both.
+TEST(EstimationKalman, TransitNoiseMatchesTextbookFilterWithStateDependentR) {
+  estimation::FilterModel f = testing_util::ThreeStateModel(40, 0.3);
+  f.R_transit = Eigen::MatrixXd::Constant(1, 1, 0.05);
+  EXPECT_EQ(f.TransitMask(), Eigen::Vector3d(0, 1, 0));
+  auto d = estimation::PopulationKalmanFilter::Create(f, estimation::CovarianceMode::kExtended);
+  auto s =
+      estimation::PopulationKalmanFilterT<3, 1>::Create(f, estimation::CovarianceMode::kExtended);
+  ASSERT_TRUE(d.ok() && s.ok());
+  Eigen::Vector3d x = f.x0;
+  Eigen::Matrix3d P = Eigen::Matrix3d::Zero();
+  const Eigen::RowVector3d h = f.H;
+  const double r0 = f.R(0, 0), rt = f.R_transit(0, 0);
+  for (int t = 0; t < 60; ++t) {
+    const double p_on = 0.05 + 0.1 * ((t / 7) % 3), p_off = 0.02 + 0.04 * ((t / 5) % 4);
+    d->PredictBroadcast(p_on, p_off);
+    s->PredictBroadcast(p_on, p_off);
+    const Eigen::Matrix3d A = f.broadcast.Matrix(p_on, p_off);
+    ASSERT_TRUE((x.array() >= 0).all()) << t;  // Qz at x itself (the extended mode, feasible)
+    Eigen::Matrix3d Qz = Eigen::Matrix3d::Zero();
+    for (int j = 0; j < 3; ++j) {
+      const Eigen::Vector3d a = A.col(j);
+      Qz += x(j) * (Eigen::Matrix3d(a.asDiagonal()) - a * a.transpose());
+    }
+    P = A * P * A.transpose() + Qz;
+    x = A * x;
+    if (t % 4 == 3) continue;  // a lost sample: prediction only
+    const double y = 0.2 * x(1) + 0.45 * x(2) + 0.7 * std::sin(0.9 * t);
+    const double R = r0 + rt * std::max(0.0, x(1));
+    EXPECT_NEAR(d->TransitCount(), std::max(0.0, x(1)), 1e-9) << t;
+    const double S = (h * P * h.transpose())(0, 0) + R;
+    const Eigen::Vector3d K = P * h.transpose() / S;
+    x += K * (y - h.dot(x));
+    const Eigen::Matrix3d IKH = Eigen::Matrix3d::Identity() - K * h;
+    P = IKH * P * IKH.transpose() + K * R * K.transpose();
+    d->Update(Eigen::VectorXd::Constant(1, y));
+    s->Update(Eigen::Matrix<double, 1, 1>(y));
+    EXPECT_NEAR(d->innovation_covariance()(0, 0), S, 1e-9 * S) << t;
+    EXPECT_NEAR(s->innovation_covariance()(0, 0), S, 1e-9 * S) << t;
+  }
+  EXPECT_LT((d->estimate() - x).cwiseAbs().maxCoeff(), 1e-9);
+  EXPECT_LT((d->covariance() - P).cwiseAbs().maxCoeff(), 1e-9);
+  EXPECT_LT((s->estimate() - x).cwiseAbs().maxCoeff(), 1e-9);
+  EXPECT_LT((s->covariance() - P).cwiseAbs().maxCoeff(), 1e-9);
+}
+
+// A model whose R_transit is zero is the constant-R filter bit for bit (the path of every model
+// file written before R_transit existed); one with R_transit > 0 differs.
+TEST(EstimationKalman, ZeroTransitNoiseIsTheConstantFilterBitForBit) {
+  const estimation::FilterModel plain = testing_util::ThreeStateModel(40, 0.3);
+  estimation::FilterModel zero = plain, some = plain;
+  zero.R_transit = Eigen::MatrixXd::Zero(1, 1);
+  some.R_transit = Eigen::MatrixXd::Constant(1, 1, 0.05);
+  auto a = estimation::PopulationKalmanFilter::Create(plain, estimation::CovarianceMode::kExtended);
+  auto b = estimation::PopulationKalmanFilter::Create(zero, estimation::CovarianceMode::kExtended);
+  auto c = estimation::PopulationKalmanFilter::Create(some, estimation::CovarianceMode::kExtended);
+  ASSERT_TRUE(a.ok() && b.ok() && c.ok());
+  for (int t = 0; t < 60; ++t) {
+    for (auto* k : {&*a, &*b, &*c}) {
+      k->PredictBroadcast(0.1, 0.05);
+      k->Update(Eigen::VectorXd::Constant(1, 5.0 + std::sin(0.3 * t)));
+    }
+    ASSERT_EQ(a->estimate(), b->estimate()) << t;
+    ASSERT_EQ(a->covariance(), b->covariance()) << t;
+  }
+  EXPECT_EQ(b->TransitCount(), 0.0);
+  EXPECT_GT(c->TransitCount(), 1.0);
+  EXPECT_GT((a->estimate() - c->estimate()).cwiseAbs().maxCoeff(), 1e-6);
 }
 
 }  // namespace

@@ -163,8 +163,46 @@ std::string UncertainStartModel() {
   return path;
 }
 
+// The same with measurement noise growing with the units in transit (R_transit = 0.01 N^2 per
+// unit in transit, against R = 0.0027 N^2): the package evaluates R at the predicted counts.
+std::string TransitNoiseModel() {
+  static const std::string path = [] {
+    std::ifstream in(UncertainStartModel());
+    nlohmann::json j = nlohmann::json::parse(in);
+    j["R_transit"] = {{0.01}};
+    const auto out = FreshDir("models_transit") / "bench_p0_transit.json";
+    std::ofstream(out) << j.dump();
+    return out.string();
+  }();
+  return path;
+}
+
+// The elbow arm's shipped flexor and extensor models (dT = 1 s) with R_transit = their R and an
+// uncertain start (as UncertainStartModel): the length-aware filter with the transit term, as
+// "{bundle}" files (one per bundle).
+std::string ArmTransitModels() {
+  static const std::string path = [] {
+    const auto dir = FreshDir("models_arm_transit");
+    const std::string shipped = std::string(RECRUIT_SOURCE_DIR) + "/models/identified/";
+    for (const auto& [bundle, file] :
+         {std::pair<std::string, std::string>{"flexor", "flexor_4b2b9e8fdcf19d9b_dt1_m20.json"},
+          {"extensor", "extensor_748ab7310148dd2a_dt1_m20.json"}}) {
+      std::ifstream in(shipped + file);
+      nlohmann::json j = nlohmann::json::parse(in);
+      j["R_transit"] = j["R"];
+      auto& P0 = j["initial"]["P0"];
+      for (size_t i = 0; i < P0.size(); ++i) P0[i][i] = 0.5;
+      std::ofstream(dir / (bundle + ".json")) << j.dump();
+    }
+    return (dir / "{bundle}.json").string();
+  }();
+  return path;
+}
+
 const std::vector<Case>& Cases() {
   static const std::vector<Case> cases = {{kSteps, "", 40, UncertainStartModel()},
+                                          {kSteps, "", 40, TransitNoiseModel()},
+                                          {kArmHand, "", 60, ArmTransitModels()},
                                           {kSteps, "", 60},
                                           {kArmHand, "", 60},
                                           {kPushHand, "", 40},
@@ -193,6 +231,30 @@ TEST(ExportEquivalence, DoubleReproducesTheControllerOnRecordedRuns) {
       EXPECT_LE(d.relative, 1e-12) << c.task << " " << c.estimator << " seed " << seed;
     }
   }
+}
+
+// The transit case's package carries R_transit and its states (Cases()' second case, replayed
+// above), and the term changes what the controller does: not a case equal to the first.
+TEST(ExportEquivalence, TransitNoiseReachesThePackage) {
+  const Case plain = Cases()[0], transit = Cases()[1];
+  auto pkg = ExportController(LoadTask(transit.task), Options(transit, 1), Precision::kDouble);
+  ASSERT_TRUE(pkg.ok()) << pkg.error();
+  std::string c_file;
+  for (const ExportedFile& f : pkg->files) {
+    if (f.name == "recruit_controller.c") c_file = f.contents;
+  }
+  EXPECT_NE(c_file.find(".R_transit = 0.01"), std::string::npos);
+  // cold (0) and hot (10) settled, the heating and cooling states in transit.
+  EXPECT_NE(c_file.find("b0_transit[20] = {\n    0, 1, 1, 1, 1, 1,\n    1, 1, 1, 1, 0, 1,"),
+            std::string::npos);
+  const auto a = Record(plain, 7), b = Record(transit, 7);
+  ASSERT_EQ(a.size(), b.size());
+  double largest = 0;
+  for (size_t k = 0; k < a.size(); ++k) {
+    largest =
+        std::max(largest, std::abs(a[k].estimated_on_variance[0] - b[k].estimated_on_variance[0]));
+  }
+  EXPECT_GT(largest, 1e-3);
 }
 
 TEST(ExportEquivalence, FloatStaysWithinItsStatedBound) {
@@ -332,6 +394,49 @@ std::array<float, 5> RowFloats(const std::string& row) {
   return {BitsFloat(v[0]), BitsFloat(v[1]), BitsFloat(v[2]), BitsFloat(v[3]), BitsFloat(v[4])};
 }
 
+// Records the case's run (seed 3, 110 instants, two bundles), replays it as float bit patterns
+// through the package in m4.dir() on the host and on the M4 (qemu), and checks every output
+// within the float bounds.
+struct M4Replay {
+  int identical = -1;  // of the 220 outputs, bit-identical to the host build's (-1: failed)
+  unsigned long ticks = 0;
+  int steps = 0;
+};
+M4Replay ReplayOnM4(const Case& c, const M4Package& m4) {
+  // A recorded run as float bit patterns, replayed on the host and on the M4.
+  const auto log = Record(c, 3);
+  EXPECT_EQ(log.size(), 110u);
+  {
+    std::ofstream out(m4.dir() / "log.txt");
+    out << log.size() << " 2\n";
+    for (const sim::ControlInstant& k : log) {
+      for (double x : {k.reference, k.angle, k.angular_velocity, k.sensed_force[0],
+                       k.sensed_force[1], k.tendon_length[0], k.tendon_length[1]}) {
+        out << testing::FloatHex(x) << " ";
+      }
+      out << "\n";
+    }
+  }
+  if (log.size() != 110u || !m4.ReplayOnHostAndM4(60)) return {};
+  const M4Package::Replayed host = m4.ReadReplay("host.txt");
+  const M4Package::Replayed target = m4.ReadReplay("m4.txt");
+  EXPECT_EQ(host.rows.size(), 220u);
+  if (host.rows.size() != 220u || target.rows.size() != host.rows.size()) return {};
+  int identical = 0;
+  for (size_t r = 0; r < host.rows.size(); ++r) {
+    const std::array<float, 5> a = RowFloats(host.rows[r]), b = RowFloats(target.rows[r]);
+    identical += std::memcmp(a.data(), b.data(), sizeof(float) * 5) == 0 ? 1 : 0;
+    EXPECT_LE(std::abs(a[0] - b[0]), kFloatForceRef) << "row " << r;
+    EXPECT_LE(std::abs(a[1] - b[1]), kFloatBroadcast) << "row " << r;
+    EXPECT_LE(std::abs(a[2] - b[2]), kFloatBroadcast) << "row " << r;
+    EXPECT_LE(std::abs(a[3] - b[3]), kFloatEstimate) << "row " << r;
+    EXPECT_LE(std::abs(a[4] - b[4]) / std::max(1.0f, std::abs(a[4])), kFloatVariance)
+        << "row " << r;
+  }
+  EXPECT_EQ(target.steps, 110);
+  return {identical, target.ticks, target.steps};
+}
+
 TEST(ExportM4, CrossCompilesWithinBudgetAndReplaysUnderQemu) {
   if (!testing::HasM4Tools()) {
     GTEST_SKIP() << "arm-none-eabi-gcc or qemu-system-arm is not installed "
@@ -369,42 +474,31 @@ TEST(ExportM4, CrossCompilesWithinBudgetAndReplaysUnderQemu) {
                     "firmware.elf && timeout 60 qemu-system-arm -M mps2-an386 -nographic "
                     "-no-reboot -semihosting-config enable=on,target=native -kernel firmware.elf"));
 
-  // A recorded run as float bit patterns, replayed on the host and on the M4.
-  const auto log = Record(c, 3);
-  ASSERT_EQ(log.size(), 110u);
-  {
-    std::ofstream out(m4.dir() / "log.txt");
-    out << log.size() << " 2\n";
-    for (const sim::ControlInstant& k : log) {
-      for (double x : {k.reference, k.angle, k.angular_velocity, k.sensed_force[0],
-                       k.sensed_force[1], k.tendon_length[0], k.tendon_length[1]}) {
-        out << testing::FloatHex(x) << " ";
-      }
-      out << "\n";
-    }
-  }
-  ASSERT_TRUE(m4.ReplayOnHostAndM4(60));
-  const M4Package::Replayed host = m4.ReadReplay("host.txt");
-  const M4Package::Replayed target = m4.ReadReplay("m4.txt");
-  ASSERT_EQ(host.rows.size(), 220u);
-  ASSERT_EQ(target.rows.size(), host.rows.size());
-  int identical = 0;
-  for (size_t r = 0; r < host.rows.size(); ++r) {
-    const std::array<float, 5> a = RowFloats(host.rows[r]), b = RowFloats(target.rows[r]);
-    identical += std::memcmp(a.data(), b.data(), sizeof(float) * 5) == 0 ? 1 : 0;
-    EXPECT_LE(std::abs(a[0] - b[0]), kFloatForceRef) << "row " << r;
-    EXPECT_LE(std::abs(a[1] - b[1]), kFloatBroadcast) << "row " << r;
-    EXPECT_LE(std::abs(a[2] - b[2]), kFloatBroadcast) << "row " << r;
-    EXPECT_LE(std::abs(a[3] - b[3]), kFloatEstimate) << "row " << r;
-    EXPECT_LE(std::abs(a[4] - b[4]) / std::max(1.0f, std::abs(a[4])), kFloatVariance)
-        << "row " << r;
-  }
+  const M4Replay target = ReplayOnM4(c, m4);
+  ASSERT_GE(target.identical, 0);
   ASSERT_EQ(target.steps, 110);
   std::printf(
-      "m4: %d of %zu outputs bit-identical to the host build; %lu SysTick ticks over %d "
+      "m4: %d of 220 outputs bit-identical to the host build; %lu SysTick ticks over %d "
       "steps: about %.0f instructions per control step (40 per tick, -icount shift=0)\n",
-      identical, host.rows.size(), target.ticks, target.steps, 40.0 * target.ticks / target.steps);
+      target.identical, target.ticks, target.steps, 40.0 * target.ticks / target.steps);
   EXPECT_GT(target.ticks, 0u);
+}
+
+// The same replay with the transit term: the arm's models with R_transit (ArmTransitModels).
+TEST(ExportM4, TransitNoiseReplaysUnderQemuAsOnTheHost) {
+  if (!testing::HasM4Tools()) {
+    GTEST_SKIP() << "arm-none-eabi-gcc or qemu-system-arm is not installed "
+                    "(scripts/install-deps.sh installs them)";
+  }
+  const Case c{kArmHand, "", 110, ArmTransitModels()};
+  auto pkg = ExportController(LoadTask(c.task), Options(c, 1), Precision::kFloat);
+  ASSERT_TRUE(pkg.ok()) << pkg.error();
+  const M4Package m4(FreshDir("m4_transit"));
+  testing::WriteFiles(pkg->files, m4.dir());
+  const M4Replay target = ReplayOnM4(c, m4);
+  std::printf("m4 (transit noise): %d of 220 outputs bit-identical to the host build\n",
+              target.identical);
+  EXPECT_GE(target.identical, 0);
 }
 
 }  // namespace

@@ -35,6 +35,10 @@ struct recruit_bundle_params {
   recruit_real R, relative_noise; /* R + (relative_noise H x)^2: the measurement variance */
   const recruit_real *x0, *P0;    /* initial belief (P0 packed; NULL = 0) */
   const recruit_real *gqg;        /* process noise G Qw G^T, packed; NULL = none */
+  /* The variance each unit in transit adds (FilterModel::R_transit), and which states are in
+   * transit (1; TransitMask); transit NULL: none. */
+  recruit_real R_transit;
+  const uint8_t *transit;
 };
 
 /* clang-format off */
@@ -238,6 +242,13 @@ static void kalman_observe(recruit_bundle *b, recruit_work *w, recruit_real y,
     }
     predicted = dot(h, b->x, m);
     R = p->R + p->relative_noise * p->relative_noise * predicted * predicted;
+  }
+  if (p->transit != NULL) { /* PopulationKalmanFilter::TransitCount, in state order */
+    recruit_real n = RK(0);
+    for (i = 0; i < m; ++i) {
+      if (p->transit[i] && b->x[i] > RK(0)) n += b->x[i];
+    }
+    R += n * p->R_transit;
   }
   kalman_update(b, w, h, R, y);
 }
