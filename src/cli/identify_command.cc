@@ -72,7 +72,8 @@ void PrintFit(const recruit::identification::IdentificationResult& fit) {
       "R^2 %.4f)\n",
       fit.holdout.samples, fit.holdout.rmse, fit.holdout.r2, fit.two_state_holdout.rmse,
       fit.two_state_holdout.r2);
-  std::printf("R = %.4g N^2 (sd %.3f N)\n", fit.force_noise_var, std::sqrt(fit.force_noise_var));
+  std::printf("R = %.4g N^2 + %.4g N^2 per unit in transit (constant R: %.4g N^2)\n", fit.noise.r0,
+              fit.noise.r_transit, fit.force_noise_var);
 }
 
 // --log: the chain fitted to a recorded switching log (plant unknown: no length model).
@@ -92,7 +93,7 @@ Result<nlohmann::json> IdentifyFromLog(const IdentifyArgs& a, const std::string&
   TransientChain c = fit->chain;
   c.force = c.force.cwiseMax(0.0);
   const estimation::FilterModel model =
-      ToFilterModel(c, log->num_units, log->dT, fit->force_noise_var);
+      ToFilterModel(c, log->num_units, log->dT, fit->noise.r0, fit->noise.r_transit);
   if (Status s = model.Validate("identified model"); !s) return Error{s.error(), s.code()};
   nlohmann::json j = model.ToJson();
   j["identification"] = {{"command", command_line},
@@ -102,7 +103,9 @@ Result<nlohmann::json> IdentifyFromLog(const IdentifyArgs& a, const std::string&
                          {"train", MetricsJson(fit->train)},
                          {"holdout", MetricsJson(fit->holdout)},
                          {"two_state_holdout", MetricsJson(fit->two_state_holdout)},
-                         {"R_N2", fit->force_noise_var}};
+                         {"R_N2", fit->noise.r0},
+                         {"R_transit_N2", fit->noise.r_transit},
+                         {"R_constant_N2", fit->force_noise_var}};
   std::printf("identified %d-state model, N = %d, dT = %g s, from %s\n", c.num_states(),
               log->num_units, log->dT, a.log_in.c_str());
   PrintModel(c, j);

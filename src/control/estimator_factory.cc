@@ -257,8 +257,9 @@ Result<std::unique_ptr<OnCountEstimator>> MakeEstimator(const EstimatorSpec& spe
       return Error{"estimator: " + file + ": H must have one row (the bundle's force)"};
     }
     if (model.N != num_units) model = model.WithPopulation(num_units);
-    if (spec.force_noise_std > 0) {
+    if (spec.force_noise_std > 0) {  // the user's noise replaces the model's, all of it
       model.R = Eigen::MatrixXd::Constant(1, 1, spec.force_noise_std * spec.force_noise_std);
+      model.R_transit.resize(0, 0);
     }
     const nlohmann::json ident = IdentificationOf((*parsed)->json);
     if (geometry) {

@@ -205,6 +205,7 @@ FailureKalmanFilter::FailureKalmanFilter(FilterModel model, CovarianceMode mode,
   N_ = static_cast<double>(model_.N);
   H_ = model_.H;
   R_ = model_.R;
+  if (model_.has_transit_noise()) transit_ = model_.TransitMask();
   A_ = Eigen::MatrixXd::Identity(3 * m_ + 1, 3 * m_ + 1);
 }
 
@@ -255,6 +256,19 @@ const Eigen::MatrixXd& FailureKalmanFilter::covariance() const {
 double FailureKalmanFilter::working_variance() const {
   if (!augmented_) return 0;
   return P_.block(m_, m_, 2 * m_, 2 * m_).sum();
+}
+
+double FailureKalmanFilter::OutputNoise() const {
+  if (transit_.size() == 0) return R_(0, 0);
+  if (!augmented_) return R_(0, 0) + inner_.TransitCount() * model_.R_transit(0, 0);
+  // Working, open and stuck units alike are in transit while their wires heat or cool.
+  double n = 0;
+  for (int b = 0; b < 3; ++b) {
+    for (int j = 0; j < m_; ++j) {
+      if (transit_[j] != 0.0 && x_[b * m_ + j] > 0.0) n += x_[b * m_ + j];
+    }
+  }
+  return R_(0, 0) + n * model_.R_transit(0, 0);
 }
 
 void FailureKalmanFilter::SetOutput(const Eigen::MatrixXd& H, const Eigen::MatrixXd& R) {
@@ -333,17 +347,17 @@ void FailureKalmanFilter::Update(double y) {
   if (augmented_) {
     const Eigen::RowVectorXd h = OutputRow(H_);
     nu = y - Predicted(H_);
-    s = h * P_ * h.transpose() + R_(0, 0);
+    s = h * P_ * h.transpose() + OutputNoise();
   } else {
     const auto hw = H_.row(0);
     nu = y - hw.dot(inner_.estimate());
-    s = hw * inner_.covariance() * hw.transpose() + R_(0, 0);
+    s = hw * inner_.covariance() * hw.transpose() + OutputNoise();
   }
   const bool test = params_.detect && s > 0 && std::isfinite(nu);
   if (test) glr_.Open(estimate());
   Eigen::VectorXd K = Eigen::VectorXd::Zero(n);
   if (augmented_) {
-    UpdateCore(y, H_, R_(0, 0));
+    UpdateCore(y, H_, OutputNoise());
     K = last_gain_.head(n);
   } else {
     Eigen::VectorXd yv(1);

@@ -194,6 +194,9 @@ class FailureKalmanFilter {
   // The augmented output row [c H, H, H, dy/dc] for the working-state row H.
   Eigen::RowVectorXd OutputRow(const Eigen::MatrixXd& H) const;
   double Predicted(const Eigen::MatrixXd& H) const;
+  // The force's noise variance at the present estimate: R + the units in transit times the
+  // model's R_transit (as the inner filter's), in whichever filter runs now.
+  double OutputNoise() const;
   void UpdateCore(double y, const Eigen::MatrixXd& H, double R);
   // The augmented time update with the transition in A_.
   void PredictCore();
@@ -212,7 +215,8 @@ class FailureKalmanFilter {
   bool augmented_ = false;
   Eigen::VectorXd x_;  // 3m + 1: [x_w; x_open; x_stuck; c]
   Eigen::MatrixXd P_, A_;
-  Eigen::MatrixXd H_, R_;  // the working states' output (1 x m), noise
+  Eigen::MatrixXd H_, R_;    // the working states' output (1 x m), noise
+  Eigen::VectorXd transit_;  // 1 on the states of FilterModel::TransitMask (empty: no R_transit)
   mutable Eigen::VectorXd view_x_;
   mutable Eigen::MatrixXd view_P_;
   FailureGlr glr_;
