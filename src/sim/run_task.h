@@ -78,6 +78,9 @@ struct BundleSummary {
   double peak_wire_stress = 0;       // Pa, most stressed wire over the run
   double max_temperature = 0;        // C, the limit
   double max_wire_stress = 0;        // Pa, the limit
+  // With a census (controller.census_period > 0): the censuses whose counts reached the
+  // controller. Unset (and not in the JSON) without one.
+  std::optional<long> censuses;
 };
 
 // One driven joint's scores (self-tuned angle tasks).
