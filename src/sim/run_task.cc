@@ -181,7 +181,7 @@ Result<std::vector<Channel>> MakeChannels(const Task& task, const ControllerSett
   }
   spec->failure.scale_variance = settings.force_scale_variance;
   if (settings.census_period > 0 && !spec->failures) {
-    return Error{where + ".controller.census_period: " + std::to_string(settings.census_period) +
+    return Error{where + ".controller.census_period: " + fmt::format("{}", settings.census_period) +
                  "; allowed: 0 unless the estimator is kalman-failures (the one that reads a "
                  "census's counts)"};
   }
@@ -277,6 +277,7 @@ Status ControlInstantStep(const Task& task, AngleLoop& loop, JointLoops* joints,
   ci.broadcast.resize(nb);
   ci.estimated_on.resize(nb);
   ci.estimated_on_variance.resize(nb);
+  ci.estimated_working.assign(nb, std::numeric_limits<double>::quiet_NaN());
   on_before.resize(nb);  // the a-posteriori estimate is of the state before broadcasting
   for (int i = 0; i < nb; ++i) {
     on_before[i] = plant.OnCount(i);
@@ -297,6 +298,7 @@ Status ControlInstantStep(const Task& task, AngleLoop& loop, JointLoops* joints,
       ci.broadcast[i] = c.Step(force_ref[i], ci.sensed_force[i], ci.tendon_length[i]);
       ci.estimated_on[i] = c.estimated_on();
       ci.estimated_on_variance[i] = c.estimated_on_variance();
+      if (const auto f = c.estimator().Failures()) ci.estimated_working[i] = f->working;
       channels[i].out_of_reach += c.saturation() > 0;
       channels[i].stuck_over += c.saturation() < 0;
       ++channels[i].instants;

@@ -31,6 +31,9 @@ struct ControlInstant {
   std::vector<double> force_reference;
   std::vector<control::Broadcast> broadcast;
   std::vector<double> estimated_on, estimated_on_variance;
+  // Failure-aware estimators: the working units' estimate after the Step (NaN otherwise, and
+  // when a replacing hook decides).
+  std::vector<double> estimated_working;
 };
 
 // A hook at the control instants of RunTask. Replaces() false: OnInstant sees what the task's
