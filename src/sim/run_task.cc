@@ -127,6 +127,7 @@ nlohmann::json RunSummary::ToJson() const {
                             {"peak_wire_stress", b.peak_wire_stress},
                             {"max_temperature", b.max_temperature},
                             {"max_wire_stress", b.max_wire_stress}});
+    if (b.censuses) bundles_json.back()["censuses"] = *b.censuses;
   }
   j["bundles"] = bundles_json;
   j["sensor"] = sensor.ToJson();
@@ -151,6 +152,7 @@ struct Channel {
   // that count failed units set it).
   long out_of_reach = 0, stuck_over = 0;
   long instants = 0;
+  long censuses = 0;  // censuses whose counts reached the controller
 };
 
 // What loading the plant's model warned of for its bundles, each text once.
@@ -178,6 +180,11 @@ Result<std::vector<Channel>> MakeChannels(const Task& task, const ControllerSett
                  "the working units' force scale)"};
   }
   spec->failure.scale_variance = settings.force_scale_variance;
+  if (settings.census_period > 0 && !spec->failures) {
+    return Error{where + ".controller.census_period: " + fmt::format("{}", settings.census_period) +
+                 "; allowed: 0 unless the estimator is kalman-failures (the one that reads a "
+                 "census's counts)"};
+  }
   const sma::SmaHost& host = plant.host();
   std::vector<Channel> channels;
   for (int i = 0; i < plant.num_bundles(); ++i) {
@@ -187,6 +194,7 @@ Result<std::vector<Channel>> MakeChannels(const Task& task, const ControllerSett
     p.unit_force = host.SettledUnitForce(b);
     p.dT = settings.dT;
     p.lambda = settings.lambda;
+    p.census_period = settings.census_period;
     // The estimator and the target follow the tendon's length (the joint encoder's reading).
     p.geometry = control::UnitGeometry{host.bundle(b).config().unit, host.unit_ref_length(b)};
     // A model identified on another plant (unit, geometry) is refused with both named.
@@ -269,6 +277,7 @@ Status ControlInstantStep(const Task& task, AngleLoop& loop, JointLoops* joints,
   ci.broadcast.resize(nb);
   ci.estimated_on.resize(nb);
   ci.estimated_on_variance.resize(nb);
+  ci.estimated_working.assign(nb, std::numeric_limits<double>::quiet_NaN());
   on_before.resize(nb);  // the a-posteriori estimate is of the state before broadcasting
   for (int i = 0; i < nb; ++i) {
     on_before[i] = plant.OnCount(i);
@@ -289,6 +298,7 @@ Status ControlInstantStep(const Task& task, AngleLoop& loop, JointLoops* joints,
       ci.broadcast[i] = c.Step(force_ref[i], ci.sensed_force[i], ci.tendon_length[i]);
       ci.estimated_on[i] = c.estimated_on();
       ci.estimated_on_variance[i] = c.estimated_on_variance();
+      if (const auto f = c.estimator().Failures()) ci.estimated_working[i] = f->working;
       channels[i].out_of_reach += c.saturation() > 0;
       channels[i].stuck_over += c.saturation() < 0;
       ++channels[i].instants;
@@ -314,6 +324,32 @@ Status ControlInstantStep(const Task& task, AngleLoop& loop, JointLoops* joints,
   return Status::Ok();
 }
 
+// The broadcast census (docs/failures.md section 5), as tests/control/failure_loop.h drives it.
+// Before a control instant's Step: each bundle's last finished census not yet handed over goes to
+// its controller, as unit counts with the shunt's variance.
+void HandCensuses(const Plant& plant, std::vector<Channel>& channels) {
+  for (int i = 0; i < plant.num_bundles(); ++i) {
+    const int b = plant.bundle_index(i);
+    const auto reading = plant.host().LastCensus(plant.data(), b);
+    if (reading.number <= channels[i].censuses) continue;
+    channels[i].censuses = reading.number;
+    const sma::SmaBundle& bundle = plant.host().bundle(b);
+    const double unit = bundle.UnitCurrent();
+    const double sd = bundle.config().census.noise / unit;
+    channels[i].controller.Census(reading.on_current / unit, reading.off_current / unit,
+                                  std::max(sd * sd, 1e-9));
+  }
+}
+
+// After the broadcast: a census starts in the period that follows where a controller asks.
+Status StartCensuses(Plant& plant, const std::vector<Channel>& channels) {
+  for (int i = 0; i < plant.num_bundles(); ++i) {
+    if (!channels[i].controller.census()) continue;
+    if (Status st = plant.host().Census(plant.data(), plant.bundle_index(i)); !st.ok()) return st;
+  }
+  return Status::Ok();
+}
+
 // The per-step telemetry observers see (the plant keeps each bundle's reads from one pass).
 // `heat`: only the drawing observers use it (another pass over the units).
 void FillTelemetry(const Plant& plant, double reference, double measured, bool heat,
@@ -334,7 +370,7 @@ void FillTelemetry(const Plant& plant, double reference, double measured, bool h
 }
 
 void Summarize(const Task& task, const Plant& plant, const SignalMetrics& sig,
-               const std::vector<Channel>& channels, RunSummary& s) {
+               const std::vector<Channel>& channels, bool task_census, RunSummary& s) {
   const double duration = plant.time(), h = plant.timestep();
   RunMetrics& mt = s.metrics;
   mt.tracking_rmse = sig.TrackingRmse();
@@ -376,6 +412,7 @@ void Summarize(const Task& task, const Plant& plant, const SignalMetrics& sig,
     bs.peak_wire_stress = plant.peak_wire_stress(i);
     bs.max_temperature = lim.max_temperature;
     bs.max_wire_stress = lim.max_wire_stress;
+    if (task_census) bs.censuses = ch.censuses;
     s.bundles.push_back(bs);
     if (i == 0) {
       mt.estimator_rmse = es.rmse;
@@ -530,13 +567,41 @@ class Progress {
   double next_wall_ = 0;
 };
 
+// With a census: every bundle whose model gives no census key gets the plugin's census block
+// (census_noise at its default), set on its plugin instance in `xml`.
+Status AddCensusKeys(const mjModel* m, std::string& xml) {
+  auto host = sma::SmaHost::Create(m);
+  if (!host.ok()) return Error{host.error(), host.code()};
+  std::vector<std::string> done;
+  for (int b = 0; b < (*host)->num_bundles(); ++b) {
+    if ((*host)->bundle(b).config().census.given) continue;
+    const char* instance = mj_id2name(m, mjOBJ_PLUGIN, m->actuator_plugin[(*host)->actuator_id(b)]);
+    if (instance == nullptr) {
+      return Error{"bundle '" + (*host)->bundle_name(b) +
+                   "': its plugin instance has no name (name it: <instance name=\"...\">) "
+                   "for the census keys"};
+    }
+    if (std::find(done.begin(), done.end(), instance) != done.end()) continue;
+    done.push_back(instance);
+    auto edited = SetPluginConfig(xml, instance, "census_noise",
+                                  fmt::format("{}", sma::CensusConfig{}.noise));
+    if (!edited.ok()) return edited.failure();
+    xml = std::move(edited).value();
+  }
+  return Status::Ok();
+}
+
 // The plant of a task. With "failures", the model is the task's with each named bundle's
-// failure keys set on its plugin instance, written beside the model (so that relative includes
-// and assets resolve as for the original) for the compiler and removed once loaded; `holder`
-// keeps the task the plant reads (with that model's path). Without them, Plant::Create(task).
+// failure keys set on its plugin instance, and with a census (controller.census_period > 0) the
+// census keys AddCensusKeys sets; the model is written beside the original (so that relative
+// includes and assets resolve as for the original) for the compiler and removed once loaded;
+// `holder` keeps the task the plant reads (with that model's path). Without either,
+// Plant::Create(task).
 Result<std::unique_ptr<Plant>> CreatePlant(const Task& task, bool drawn, Task& holder) {
-  if (task.failures.empty()) return Plant::Create(task, drawn);
-  const std::string where = (task.source.empty() ? task.name : task.source) + ".failures";
+  const bool census = task.controller.census_period > 0;
+  if (task.failures.empty() && !census) return Plant::Create(task, drawn);
+  const std::string file_name = task.source.empty() ? task.name : task.source;
+  const std::string where = file_name + (census ? "" : ".failures");
   auto text = ReadFile(task.model_path);
   if (!text.ok()) return Error{where + ": " + text.error(), text.code()};
   auto model = LoadModel(task.model_path);
@@ -545,6 +610,7 @@ Result<std::unique_ptr<Plant>> CreatePlant(const Task& task, bool drawn, Task& h
   std::string xml = std::move(text).value();
   std::vector<std::string> instances;  // of the bundles given failures, in the task's order
   for (const BundleFailures& f : task.failures) {
+    const std::string fw = file_name + ".failures";
     const int id = mj_name2id(m, mjOBJ_ACTUATOR, f.actuator.c_str());
     if (id < 0 || m->actuator_plugin[id] < 0) {
       std::string bundles;
@@ -553,23 +619,28 @@ Result<std::unique_ptr<Plant>> CreatePlant(const Task& task, bool drawn, Task& h
         const char* n = mj_id2name(m, mjOBJ_ACTUATOR, a);
         bundles += (bundles.empty() ? "" : ", ") + std::string(n ? n : "?");
       }
-      return Error{where + "." + f.actuator + ": no SMA bundle '" + f.actuator + "' in '" +
+      return Error{fw + "." + f.actuator + ": no SMA bundle '" + f.actuator + "' in '" +
                    task.model_path + "'; bundles: " + (bundles.empty() ? "none" : bundles)};
     }
     const char* instance = mj_id2name(m, mjOBJ_PLUGIN, m->actuator_plugin[id]);
     if (instance == nullptr) {
-      return Error{where + "." + f.actuator + ": its plugin instance has no name in '" +
+      return Error{fw + "." + f.actuator + ": its plugin instance has no name in '" +
                    task.model_path + "' (name it: <instance name=\"...\">)"};
     }
     if (std::find(instances.begin(), instances.end(), instance) != instances.end()) {
-      return Error{where + "." + f.actuator + ": its plugin instance '" + instance +
+      return Error{fw + "." + f.actuator + ": its plugin instance '" + instance +
                    "' drives a bundle already given failures; give them once per instance"};
     }
     instances.push_back(instance);
     for (const auto& [key, value] : f.keys) {
       auto edited = SetPluginConfig(xml, instance, key, value);
-      if (!edited.ok()) return edited.failure().In(where + "." + f.actuator + ": ");
+      if (!edited.ok()) return edited.failure().In(fw + "." + f.actuator + ": ");
       xml = std::move(edited).value();
+    }
+  }
+  if (census) {
+    if (Status st = AddCensusKeys(m, xml); !st.ok()) {
+      return Error{file_name + ".controller.census_period: " + st.error(), st.code()};
     }
   }
   namespace fs = std::filesystem;
@@ -732,6 +803,7 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
     return task.tracked == Tracked::kForce ? plant.Force(0) : plant.angle();
   };
 
+  const bool census = settings.census_period > 0;
   long control_instants = 0;
   double next_control = 0;
   Progress progress(options.progress, duration, wall_start);
@@ -745,6 +817,7 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
       const double instant_time = next_control;
       ++control_instants;
       next_control = control_instants * settings.dT;
+      if (census) HandCensuses(plant, channels);
       if (Status st =
               ControlInstantStep(task, angle_loop, joint_loops ? &*joint_loops : nullptr, plant,
                                  channels, instant_time, settings.dT, options.control_hook, instant,
@@ -754,6 +827,11 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
       }
       sample.p_on = sample.bundles[0].p_on;
       sample.p_off = sample.bundles[0].p_off;
+      if (census) {
+        if (Status st = StartCensuses(plant, channels); !st.ok()) {
+          return Error{where + ": " + st.error(), st.code()};
+        }
+      }
     }
     plant.Step();
 
@@ -800,7 +878,7 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
   s.unit = sample.reference_unit;
   s.warnings = std::move(warnings);
   const size_t load_warnings = s.warnings.size();  // already printed when the model loaded
-  Summarize(task, plant, sig, channels, s);
+  Summarize(task, plant, sig, channels, settings.census_period > 0, s);
   if (joint_loops) SummarizeJoints(task, plant, sig, more_joints, *joint_loops, s);
   s.identification_seconds = identify_s;
   for (size_t k = load_warnings; k < s.warnings.size(); ++k) {

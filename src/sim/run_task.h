@@ -31,6 +31,9 @@ struct ControlInstant {
   std::vector<double> force_reference;
   std::vector<control::Broadcast> broadcast;
   std::vector<double> estimated_on, estimated_on_variance;
+  // Failure-aware estimators: the working units' estimate after the Step (NaN otherwise, and
+  // when a replacing hook decides).
+  std::vector<double> estimated_working;
 };
 
 // A hook at the control instants of RunTask. Replaces() false: OnInstant sees what the task's
@@ -78,6 +81,9 @@ struct BundleSummary {
   double peak_wire_stress = 0;       // Pa, most stressed wire over the run
   double max_temperature = 0;        // C, the limit
   double max_wire_stress = 0;        // Pa, the limit
+  // With a census (controller.census_period > 0): the censuses whose counts reached the
+  // controller. Unset (and not in the JSON) without one.
+  std::optional<long> censuses;
 };
 
 // One driven joint's scores (self-tuned angle tasks).

@@ -278,9 +278,10 @@ Result<Task> Task::FromJsonText(const std::string& text, const std::string& sour
     const json& c = j["controller"];
     const std::string where = file + ".controller";
     if (!c.is_object()) return Error{where + ": must be an object"};
-    RECRUIT_TRY(CheckKeys(
-        c, {"estimator", "filter_model", "dT", "lambda", "force_noise_std", "force_scale_variance"},
-        where));
+    RECRUIT_TRY(CheckKeys(c,
+                          {"estimator", "filter_model", "dT", "lambda", "force_noise_std",
+                           "force_scale_variance", "census_period"},
+                          where));
     RECRUIT_TRY(String(c, "estimator", where, &task.controller.estimator, false));
     RECRUIT_TRY(String(c, "filter_model", where, &task.controller.filter_model, false));
     task.controller.filter_model = Resolve(task.controller.filter_model, source);
@@ -293,6 +294,8 @@ Result<Task> Task::FromJsonText(const std::string& text, const std::string& sour
     RECRUIT_TRY(Number(c, "force_scale_variance", where, &task.controller.force_scale_variance,
                        false, 0, 1, false,
                        "0 <= force_scale_variance <= 1 per control period (0: the scale fixed)"));
+    RECRUIT_TRY(Number(c, "census_period", where, &task.controller.census_period, false, 0, 1e6,
+                       false, "0 <= census_period <= 1e6 s (0: no census)"));
   }
 
   if (j.contains("sensor")) {

@@ -30,6 +30,10 @@ struct ControllerSettings {
   // kalman-failures: random-walk variance per control period of the working units' fatigue
   // force scale, estimated online (docs/failures.md); 0 = the scale fixed at 1.
   double force_scale_variance = 0;
+  // kalman-failures: the broadcast census every this many s (docs/failures.md section 5; 0 =
+  // none). The plant's bundles get the plugin's census block (census_noise at its default) unless
+  // their model gives census keys.
+  double census_period = 0;
 };
 
 // Outer loop of arm tasks: PI(D) on the joint angle error gives a net tendon force; positive
