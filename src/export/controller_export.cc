@@ -256,6 +256,13 @@ Result<ExportedPackage> ExportController(const sim::Task& task, const sim::RunOp
   if (!(settings.dT > 0) || !std::isfinite(settings.dT)) {
     return Error{where + ": controller.dT must be finite and > 0 s"};
   }
+  if (task.controller.census_period > 0) {
+    char period[32];
+    std::snprintf(period, sizeof period, "%g", task.controller.census_period);
+    return Error{where + ": controller.census_period: " + period +
+                 "; the exported controller has no census (docs/failures.md): export the task "
+                 "with census_period 0"};
+  }
   auto controllers = sim::TaskControllers(task, options);
   if (!controllers) return controllers.failure();
   std::vector<BundleConstants> bundles;

@@ -503,3 +503,22 @@ TEST(ExportM4, TransitNoiseReplaysUnderQemuAsOnTheHost) {
 
 }  // namespace
 }  // namespace recruit::exporter
+
+namespace recruit::exporter {
+namespace {
+
+// The C controller has no census: a task that asks for one is refused, naming the key, rather
+// than exported without it.
+TEST(ExportRefuses, ATaskWithACensus) {
+  sim::Task task = LoadTask("tests/sim/data/census_loss.json");
+  ASSERT_GT(task.controller.census_period, 0);
+  auto pkg = ExportController(task, sim::RunOptions{}, Precision::kDouble);
+  ASSERT_FALSE(pkg.ok());
+  EXPECT_NE(pkg.error().find("controller.census_period: 2.5"), std::string::npos) << pkg.error();
+  task.controller.census_period = 0;
+  task.controller.estimator = "kalman-augmented";
+  EXPECT_TRUE(ExportController(task, sim::RunOptions{}, Precision::kDouble).ok());
+}
+
+}  // namespace
+}  // namespace recruit::exporter
