@@ -152,7 +152,8 @@ struct Channel {
   // that count failed units set it).
   long out_of_reach = 0, stuck_over = 0;
   long instants = 0;
-  long censuses = 0;  // censuses whose counts reached the controller
+  long censuses = 0;        // censuses whose counts reached the controller
+  bool census_due = false;  // the controller asked for a census in this period
 };
 
 // What loading the plant's model warned of for its bundles, each text once.
@@ -341,11 +342,17 @@ void HandCensuses(const Plant& plant, std::vector<Channel>& channels) {
   }
 }
 
-// After the broadcast: a census starts in the period that follows where a controller asks.
-Status StartCensuses(Plant& plant, const std::vector<Channel>& channels) {
+// Before a physics step: a census the controller asked for at the last instant starts so that
+// it ends at the next one (its counts are then the state the controller decides on, fresh).
+Status StartDueCensuses(Plant& plant, std::vector<Channel>& channels, double next_control) {
+  const double t = plant.time(), h = plant.timestep();
   for (int i = 0; i < plant.num_bundles(); ++i) {
-    if (!channels[i].controller.census()) continue;
-    if (Status st = plant.host().Census(plant.data(), plant.bundle_index(i)); !st.ok()) return st;
+    if (!channels[i].census_due) continue;
+    const int b = plant.bundle_index(i);
+    const sma::CensusConfig& cc = plant.host().bundle(b).config().census;
+    if (t + 0.5 * h < next_control - (cc.on + cc.off)) continue;
+    if (Status st = plant.host().Census(plant.data(), b); !st.ok()) return st;
+    channels[i].census_due = false;
   }
   return Status::Ok();
 }
@@ -827,10 +834,11 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
       }
       sample.p_on = sample.bundles[0].p_on;
       sample.p_off = sample.bundles[0].p_off;
-      if (census) {
-        if (Status st = StartCensuses(plant, channels); !st.ok()) {
-          return Error{where + ": " + st.error(), st.code()};
-        }
+      for (Channel& c : channels) c.census_due = census && c.controller.census();
+    }
+    if (census) {
+      if (Status st = StartDueCensuses(plant, channels, next_control); !st.ok()) {
+        return Error{where + ": " + st.error(), st.code()};
       }
     }
     plant.Step();
