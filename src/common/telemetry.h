@@ -27,6 +27,8 @@ struct BundleTelemetry {
   // N, the load cell's reading at the last control instant, as the controller saw it (held
   // between instants; NaN before the first).
   double sensed_force = std::numeric_limits<double>::quiet_NaN();
+  // The failure-aware estimator's count of units still working (NaN for other estimators).
+  double estimated_working = std::numeric_limits<double>::quiet_NaN();
 };
 
 // A driven joint after the first of a several-joint task (the first is `reference`/`angle`).

@@ -30,6 +30,10 @@ Status CsvStepWriter::OnStep(const mjModel*, const mjData*, const TelemetrySampl
     header += ",control_instant";
     // Added after every older column, so that readers by position keep working.
     for (const auto& b : s.bundles) header += fmt::format(",{}.sensed_force", b.actuator);
+    for (const auto& b : s.bundles) working_ = working_ || std::isfinite(b.estimated_working);
+    if (working_) {
+      for (const auto& b : s.bundles) header += fmt::format(",{}.estimated_working", b.actuator);
+    }
     header += '\n';
     Reserve(header.size());
     std::memcpy(buffer_.data() + used_, header.data(), header.size());
@@ -46,8 +50,8 @@ Status CsvStepWriter::OnStep(const mjModel*, const mjData*, const TelemetrySampl
   if (s.joints.size() != joints_ || s.bundles.size() != bundles_ || row_max_ == 0) {
     joints_ = s.joints.size();
     bundles_ = s.bundles.size();
-    row_max_ = 8 + (4 + 2 * joints_ + 9 * bundles_) * kFormatGMax;
-    cache_.resize(4 + 2 * joints_ + 8 * bundles_);
+    row_max_ = 8 + (4 + 2 * joints_ + 10 * bundles_) * kFormatGMax;
+    cache_.resize(4 + 2 * joints_ + 9 * bundles_);
   }
   Reserve(row_max_);
   char* p = buffer_.data() + used_;
@@ -120,6 +124,14 @@ Status CsvStepWriter::OnStep(const mjModel*, const mjData*, const TelemetrySampl
     comma();
     if (std::isfinite(b.sensed_force)) {
       num(b.sensed_force, 9);
+    } else {
+      ++col;
+    }
+  }
+  for (std::size_t i = 0; working_ && i < s.bundles.size(); ++i) {
+    comma();
+    if (std::isfinite(s.bundles[i].estimated_working)) {
+      num(s.bundles[i].estimated_working, 6);
     } else {
       ++col;
     }

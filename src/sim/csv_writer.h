@@ -29,6 +29,8 @@ class CsvStepWriter : public StepObserver {
   long count_ = 0;  // steps seen (only counted when every_ > 1)
   // The row layout the sizes below are for: joints, bundles, the longest row's bytes.
   std::size_t joints_ = 0, bundles_ = 0, row_max_ = 0;
+  // The run's estimator counts working units (kalman-failures): one more column per bundle.
+  bool working_ = false;
   bool header_written_ = false;
   // Rows not yet written (the first used_ bytes), flushed past kFlushBytes. Small and reserved
   // once: a 1 MB buffer grown by doubling touched ~650 more pages (a 60 s arm run: 1392 -> 732

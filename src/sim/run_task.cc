@@ -320,6 +320,7 @@ Status ControlInstantStep(const Task& task, AngleLoop& loop, JointLoops* joints,
     bt.p_off = bc.p_off;
     bt.force_reference = force_ref[i];
     bt.sensed_force = ci.sensed_force[i];
+    if (!ci.estimated_working.empty()) bt.estimated_working = ci.estimated_working[i];
     channels[i].score.Add(bt.estimated_on, on_before[i], var);
   }
   return Status::Ok();

@@ -149,6 +149,36 @@ TEST(CensusTask, CensusPeriodZeroIsTheTaskWithoutTheKeyByteForByte) {
   EXPECT_EQ(csv[0], csv[1]);
 }
 
+// The CSV carries the working estimate (a column per bundle, kalman-failures only): at each
+// control instant it is what the controller held (the hook's ControlInstant, another path).
+TEST(CensusTask, TheCsvCarriesTheWorkingEstimate) {
+  const fs::path dir = fs::temp_directory_path() / "recruit_census_task_working";
+  fs::create_directories(dir);
+  const fs::path file = dir / "run.csv";
+  CsvStepWriter writer(file.string());
+  auto r = RunCensusTask(CensusTask(R"(, "census_period": 2.5)"), 3, {&writer});
+  ASSERT_TRUE(r.ok()) << r.error();
+  ASSERT_TRUE(writer.Commit().ok());
+  std::istringstream in(ReadAll(file));
+  std::string line;
+  std::getline(in, line);
+  const std::string suffix = ",control_instant,bundle.sensed_force,bundle.estimated_working";
+  ASSERT_GE(line.size(), suffix.size());
+  EXPECT_EQ(line.substr(line.size() - suffix.size()), suffix);
+  size_t k = 0;
+  while (std::getline(in, line)) {
+    const size_t last = line.rfind(',');
+    const size_t flag = line.rfind(',', line.rfind(',', last - 1) - 1);
+    if (line.substr(flag + 1, 1) != "1") continue;  // control_instant
+    ASSERT_LT(k, r->estimate.size());
+    EXPECT_NEAR(std::stod(line.substr(last + 1)), r->estimate[k], 5e-6 * 60) << "instant " << k;
+    ++k;
+  }
+  EXPECT_EQ(k, r->estimate.size());
+  EXPECT_LT(r->estimate.back(), 57) << "the loss is in the estimate";
+  fs::remove_all(dir);
+}
+
 TEST(CensusTask, BadCensusPeriodsAreNamed) {
   auto negative = RunCensusTask(CensusTask(R"(, "census_period": -1)"), 1);
   ASSERT_FALSE(negative.ok());
