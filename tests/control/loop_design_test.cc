@@ -26,32 +26,30 @@ TEST(LoopDesign, WithoutFeedbackAQuasiStaticJointFollowsTheBundlesResponse) {
   }
 }
 
-// PredictStep against a fine fixed-step RK4 integration of the same closed loop.
-TEST(LoopDesign, PredictionMatchesAFineRk4IntegrationOfTheSameLoop) {
-  const ActuatorResponse act = TwoState(1.0, 0.2);
-  const JointDynamics joint{0.003, 0.02, 0.1};
-  const LoopGains g{0.1, 0.02, 0.03};
-  LoopTarget target;
-  target.hold = 30;
-  const PredictedStep p = PredictStep(joint, act, 1.0, g, target);
-  // Reference: q'' = (tau - b q' - k q) / I, tau from the demands through the response.
+// The closed loop integrated by fixed-step RK4 (1e-4 s; dT 1 s): q'' = (tau - b q' - k q) / I,
+// tau the demand before the step plus each later change of the demand through
+// `response(change, time since the change)`. The angle (+1: a fraction of the unit step) at each
+// of `instants` control instants.
+template <typename Response>
+std::vector<double> Rk4Angles(const JointDynamics& joint, const LoopGains& g, int instants,
+                              Response response) {
   const double h = 1e-4;
   double q = -1, v = 0, integral = 0;
-  std::vector<double> u{-joint.stiffness};
-  for (int n = 0; n < 30; ++n) {
-    EXPECT_NEAR(q + 1, p.angle[n], 2e-3) << "instant " << n;
+  std::vector<double> u{-joint.stiffness}, angles;
+  for (int n = 0; n < instants; ++n) {
+    angles.push_back(q + 1);
     integral += -q;
     u.push_back(g.kp * -q + g.ki * integral - g.kd * v);
     auto tau = [&](double t) {
       double x = u[0];
-      for (int i = 1; i <= n + 1; ++i) x += (u[i] - u[i - 1]) * act.At(t - (i - 1));
+      for (int i = 1; i <= n + 1; ++i) x += response(u[i] - u[i - 1], t - (i - 1));
       return x;
+    };
+    auto f = [&](double qq, double vv, double tt) {
+      return (tau(tt) - joint.damping * vv - joint.stiffness * qq) / joint.inertia;
     };
     for (int s = 0; s < 10000; ++s) {
       const double t = n + s * h;
-      auto f = [&](double qq, double vv, double tt) {
-        return (tau(tt) - joint.damping * vv - joint.stiffness * qq) / joint.inertia;
-      };
       const double k1q = v, k1v = f(q, v, t);
       const double k2q = v + 0.5 * h * k1v,
                    k2v = f(q + 0.5 * h * k1q, v + 0.5 * h * k1v, t + h / 2);
@@ -62,6 +60,20 @@ TEST(LoopDesign, PredictionMatchesAFineRk4IntegrationOfTheSameLoop) {
       v += h / 6 * (k1v + 2 * k2v + 2 * k3v + k4v);
     }
   }
+  return angles;
+}
+
+// PredictStep against a fine fixed-step RK4 integration of the same closed loop.
+TEST(LoopDesign, PredictionMatchesAFineRk4IntegrationOfTheSameLoop) {
+  const ActuatorResponse act = TwoState(1.0, 0.2);
+  const JointDynamics joint{0.003, 0.02, 0.1};
+  const LoopGains g{0.1, 0.02, 0.03};
+  LoopTarget target;
+  target.hold = 30;
+  const PredictedStep p = PredictStep(joint, act, 1.0, g, target);
+  const std::vector<double> q =
+      Rk4Angles(joint, g, 30, [&](double change, double t) { return change * act.At(t); });
+  for (int n = 0; n < 30; ++n) EXPECT_NEAR(q[n], p.angle[n], 2e-3) << "instant " << n;
 }
 
 // Bundles that rise with one first-order lag and release with another (closed form at the
@@ -101,36 +113,10 @@ TEST(LoopDesign, ADirectionAwarePredictionMatchesAFineRk4IntegrationOfTheSameLoo
   LoopTarget target;
   target.hold = 30;
   const PredictedStep p = PredictStep(joint, act, 1.0, g, target);
-  const double h = 1e-4;
-  double q = -1, v = 0, integral = 0;
-  std::vector<double> u{-joint.stiffness};
-  for (int n = 0; n < 30; ++n) {
-    EXPECT_NEAR(q + 1, p.angle[n], 2e-3) << "instant " << n;
-    integral += -q;
-    u.push_back(g.kp * -q + g.ki * integral - g.kd * v);
-    auto tau = [&](double t) {
-      double x = u[0];
-      for (int i = 1; i <= n + 1; ++i) {
-        const double c = u[i] - u[i - 1];
-        x += c * (c < 0 ? released : act).At(t - (i - 1));
-      }
-      return x;
-    };
-    for (int s = 0; s < 10000; ++s) {
-      const double t = n + s * h;
-      auto f = [&](double qq, double vv, double tt) {
-        return (tau(tt) - joint.damping * vv - joint.stiffness * qq) / joint.inertia;
-      };
-      const double k1q = v, k1v = f(q, v, t);
-      const double k2q = v + 0.5 * h * k1v,
-                   k2v = f(q + 0.5 * h * k1q, v + 0.5 * h * k1v, t + h / 2);
-      const double k3q = v + 0.5 * h * k2v,
-                   k3v = f(q + 0.5 * h * k2q, v + 0.5 * h * k2v, t + h / 2);
-      const double k4q = v + h * k3v, k4v = f(q + h * k3q, v + h * k3v, t + h);
-      q += h / 6 * (k1q + 2 * k2q + 2 * k3q + k4q);
-      v += h / 6 * (k1v + 2 * k2v + 2 * k3v + k4v);
-    }
-  }
+  const std::vector<double> q = Rk4Angles(joint, g, 30, [&](double change, double t) {
+    return change * (change < 0 ? released : act).At(t);
+  });
+  for (int n = 0; n < 30; ++n) EXPECT_NEAR(q[n], p.angle[n], 2e-3) << "instant " << n;
   ActuatorResponse rise_only = act;
   rise_only.release.clear();
   const PredictedStep symmetric = PredictStep(joint, rise_only, 1.0, g, target);
