@@ -230,6 +230,28 @@ double Steps(double t) {  // 10, 20, 5, 15 N, every 25 s
   return level[static_cast<int>(t / 25) % 4];
 }
 
+// A setting's price with no failure, on one seed: mean |error| 20-100 s at a 15 N hold and over
+// 500 s of steps, with the setting (`with`) and without it (`without`, the same seed). `steps`
+// keeps the steps run with it.
+struct PairedCost {
+  double hold = 0, hold0 = 0, steps = 0, steps0 = 0;
+  std::vector<fl::Instant> steps_run;
+};
+
+PairedCost RunPairedCost(fl::Spec with, fl::Spec without) {
+  PairedCost c;
+  auto a = fl::Run(with), b = fl::Run(without);
+  c.hold = fl::MeanError(*a, 20, 100);
+  c.hold0 = fl::MeanError(*b, 20, 100);
+  with.duration = without.duration = 500;
+  with.reference = without.reference = Steps;
+  a = fl::Run(with), b = fl::Run(without);
+  c.steps = fl::MeanError(*a, 0, 500);
+  c.steps0 = fl::MeanError(*b, 0, 500);
+  c.steps_run = std::move(*a);
+  return c;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -275,19 +297,15 @@ int main(int argc, char** argv) {
     for (int s = first; s < first + seeds; ++s) {
       const auto seed = static_cast<std::uint64_t>(s);
       auto ref = [](double) { return 15.0; };
-      fl::Spec with{"", Failures(), 0.5, 0.2, seed, 100, ref, explore};
-      fl::Spec without{"", Failures(), 0.5, 0.2, seed, 100, ref, {}};
-      auto a = fl::Run(with), b = fl::Run(without);
-      hold.push_back(fl::MeanError(*a, 20, 100));
-      hold0.push_back(fl::MeanError(*b, 20, 100));
-      with.duration = without.duration = 500;
-      with.reference = without.reference = Steps;
-      a = fl::Run(with), b = fl::Run(without);
-      steps.push_back(fl::MeanError(*a, 0, 500));
-      steps0.push_back(fl::MeanError(*b, 0, 500));
+      const PairedCost c = RunPairedCost({"", Failures(), 0.5, 0.2, seed, 100, ref, explore},
+                                         {"", Failures(), 0.5, 0.2, seed, 100, ref, {}});
+      hold.push_back(c.hold);
+      hold0.push_back(c.hold0);
+      steps.push_back(c.steps);
+      steps0.push_back(c.steps0);
       int n = 0;
-      for (const auto& r : *a) n += r.exploring;
-      frac.push_back(double(n) / a->size());
+      for (const auto& r : c.steps_run) n += r.exploring;
+      frac.push_back(double(n) / c.steps_run.size());
     }
     Report("mean |error| 20-100 s at 15 N, exploring", hold);
     Report("the same seeds, no exploration", hold0);
@@ -316,15 +334,11 @@ int main(int argc, char** argv) {
       auto ref = [](double) { return 15.0; };
       fl::Spec with{"", Failures(), 0.5, 0.2, seed, 100, ref, {}};
       with.census_period = period;
-      fl::Spec without{"", Failures(), 0.5, 0.2, seed, 100, ref, {}};
-      auto a = fl::Run(with), b = fl::Run(without);
-      hold.push_back(fl::MeanError(*a, 20, 100));
-      hold0.push_back(fl::MeanError(*b, 20, 100));
-      with.duration = without.duration = 500;
-      with.reference = without.reference = Steps;
-      a = fl::Run(with), b = fl::Run(without);
-      steps.push_back(fl::MeanError(*a, 0, 500));
-      steps0.push_back(fl::MeanError(*b, 0, 500));
+      const PairedCost c = RunPairedCost(with, {"", Failures(), 0.5, 0.2, seed, 100, ref, {}});
+      hold.push_back(c.hold);
+      hold0.push_back(c.hold0);
+      steps.push_back(c.steps);
+      steps0.push_back(c.steps0);
     }
     std::printf("closed loop, no failure, census every %.3g s:\n", period);
     Report("mean |error| 20-100 s at 15 N, census", hold);
