@@ -30,7 +30,9 @@ class Writer {
     Word(s.size());
     Bytes(s.data(), s.size());
   }
-  void Bytes(const void* p, std::size_t n) { out_.append(static_cast<const char*>(p), n); }
+  void Bytes(const void* p, std::size_t n) {
+    if (n > 0) out_.append(static_cast<const char*>(p), n);  // an empty vector's data() may be null
+  }
   const std::string& bytes() const { return out_; }
 
  private:
@@ -79,6 +81,7 @@ class Reader {
       ok_ = false;
       return;
     }
+    if (n == 0) return;  // an empty vector's data() may be null: no memcpy from or to it
     std::memcpy(p, in_.data() + at_, n);
     at_ += n;
   }
