@@ -325,15 +325,8 @@ double FailureKalmanFilter::Predicted(const Eigen::MatrixXd& H) const {
 }
 
 void FailureKalmanFilter::UpdateCore(double y, const Eigen::MatrixXd& H, double R) {
-  // Kalman update in Joseph form (r = 1), linearised in c.
-  const Eigen::RowVectorXd h = OutputRow(H);
-  const double s = h * P_ * h.transpose() + R;
-  last_gain_ = P_ * h.transpose() / s;
-  const Eigen::VectorXd& K = last_gain_;
-  x_ += K * (y - Predicted(H));
-  const Eigen::MatrixXd IKH = Eigen::MatrixXd::Identity(3 * m_ + 1, 3 * m_ + 1) - K * h;
-  P_ = IKH * P_ * IKH.transpose() + K * R * K.transpose();
-  P_ = 0.5 * (P_ + P_.transpose()).eval();
+  // Linearised in c: the row is the output's derivative, the innovation its exact value.
+  last_gain_ = ScalarUpdate(OutputRow(H), y - Predicted(H), R);
   x_.head(3 * m_).array() += (N_ - x_.head(3 * m_).sum()) / (3 * m_);  // round-off of sum = N
 }
 
@@ -378,13 +371,16 @@ void FailureKalmanFilter::Update(double y) {
   }
 }
 
-void FailureKalmanFilter::ScalarUpdate(const Eigen::RowVectorXd& h, double z, double r) {
+Eigen::VectorXd FailureKalmanFilter::ScalarUpdate(const Eigen::RowVectorXd& h, double innovation,
+                                                  double r) {
+  // Kalman update in Joseph form, one output.
   const double s = h * P_ * h.transpose() + r;
   const Eigen::VectorXd K = P_ * h.transpose() / s;
-  x_ += K * (z - h.dot(x_));
+  x_ += K * innovation;
   const Eigen::MatrixXd IKH = Eigen::MatrixXd::Identity(x_.size(), x_.size()) - K * h;
   P_ = IKH * P_ * IKH.transpose() + K * r * K.transpose();
   P_ = 0.5 * (P_ + P_.transpose()).eval();
+  return K;
 }
 
 void FailureKalmanFilter::AddCensusJump(int to, double k) {
@@ -443,8 +439,8 @@ void FailureKalmanFilter::UpdateCensus(double conducting, double stuck_count, do
   h1.head(m_).setOnes();
   h1.segment(2 * m_, m_).setOnes();
   h2.segment(2 * m_, m_).setOnes();
-  ScalarUpdate(h1, conducting, variance);
-  ScalarUpdate(h2, stuck_count, variance);
+  ScalarUpdate(h1, conducting - h1.dot(x_), variance);
+  ScalarUpdate(h2, stuck_count - h2.dot(x_), variance);
   x_.head(n).array() += (N_ - x_.head(n).sum()) / n;  // round-off of sum = N
   glr_.Clear();
   if (jump[1] || jump[2]) {

@@ -200,8 +200,9 @@ class FailureKalmanFilter {
   void UpdateCore(double y, const Eigen::MatrixXd& H, double R);
   // The augmented time update with the transition in A_.
   void PredictCore();
-  // Joseph-form update of the augmented state with the scalar measurement z = h x + v, Var v = r.
-  void ScalarUpdate(const Eigen::RowVectorXd& h, double z, double r);
+  // Joseph-form update of the augmented state with one measurement of output row h, given its
+  // innovation (the reading minus its prediction) and noise variance r; returns the gain.
+  Eigen::VectorXd ScalarUpdate(const Eigen::RowVectorXd& h, double innovation, double r);
   // Adds the covariance of a loss of unknown count into class `to` (residual k units, > 0: units
   // lost; < 0: fewer than declared).
   void AddCensusJump(int to, double k);
