@@ -84,13 +84,6 @@ void PickUnits(Rng& rng, int n, int pool, int want, Eligible eligible, std::vect
 constexpr std::uint64_t kFailureStream = 0xFA11ED;  // sub-stream index of the failure draws
 constexpr std::uint64_t kCensusStream = 0xCE4505;   // sub-stream of the census's shunt noise
 
-// A standard normal draw (Box-Muller, the cosine branch: two uniforms per draw).
-double StandardNormal(Rng& rng) {
-  const double u1 = 1 - rng.Uniform();  // (0, 1]
-  const double u2 = rng.Uniform();
-  return std::sqrt(-2 * std::log(u1)) * std::cos(2 * 3.14159265358979323846 * u2);
-}
-
 }  // namespace
 
 SmaBundle::SmaBundle(BundleConfig c, UnitModel u, double dt)
@@ -250,7 +243,7 @@ double SmaBundle::CensusReadingNow(double* s, bool on) const {
   const int conducting = on ? f.working + f.stuck : f.stuck;
   double* c = CensusBlock(s);
   Rng rng = LoadRng(c + kCensusRngSlot);
-  const double noise = config_.census.noise * StandardNormal(rng);
+  const double noise = config_.census.noise * rng.Gaussian();
   StoreRng(rng, c + kCensusRngSlot);
   return conducting * UnitCurrent() + noise;
 }

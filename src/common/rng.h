@@ -6,6 +6,7 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 
@@ -44,6 +45,14 @@ class Rng {
 
   // Uniform in [0, 1) with 53 random bits.
   double Uniform() { return static_cast<double>((*this)() >> 11) * 0x1.0p-53; }
+
+  // A standard normal draw: Box-Muller, the cosine branch, two uniforms per draw (written out
+  // because std::normal_distribution's algorithm, and so its numbers, differ between libraries).
+  double Gaussian() {
+    const double u1 = 1.0 - Uniform();  // (0, 1]
+    const double u2 = Uniform();
+    return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * M_PI * u2);
+  }
 
   const State& state() const { return s_; }
 

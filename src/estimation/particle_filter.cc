@@ -60,9 +60,7 @@ Result<ParticleFilter> ParticleFilter::Create(const FilterModel& model,
     if (!point) {
       Eigen::VectorXd g(m);
       for (int i = 0; i < m; ++i) {
-        // Box-Muller from the caller's Rng.
-        const double u1 = 1.0 - rng.Uniform(), u2 = rng.Uniform();
-        g(i) = std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * M_PI * u2);
+        g(i) = rng.Gaussian();
       }
       x += L * g;
     }

@@ -47,17 +47,9 @@ Result<ForceSensor> ForceSensor::Create(const SensorParams& params, std::uint64_
   return ForceSensor(*p, seed);
 }
 
-// Box-Muller on the sensor's own stream (std::normal_distribution's algorithm is not fixed by
-// the standard, so its numbers would differ between standard libraries).
-double ForceSensor::Gaussian() {
-  const double u1 = 1.0 - rng_.Uniform();  // (0, 1]
-  const double u2 = rng_.Uniform();
-  return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * M_PI * u2);
-}
-
 double ForceSensor::SampleAndHold(double true_force) {
   double y = true_force;
-  if (params_.noise_std > 0) y += params_.noise_std * Gaussian();
+  if (params_.noise_std > 0) y += params_.noise_std * rng_.Gaussian();
   if (params_.resolution > 0) y = params_.resolution * std::round(y / params_.resolution);
   held_ = y;
   return y;

@@ -44,7 +44,6 @@ class ForceSensor {
 
  private:
   ForceSensor(const SensorParams& p, std::uint64_t seed) : params_(p), rng_(seed) {}
-  double Gaussian();
 
   SensorParams params_;
   Rng rng_;
