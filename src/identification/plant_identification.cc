@@ -108,18 +108,14 @@ Eigen::VectorXd RefineFractions(const TransientChain& chain, const control::Unit
   return xi;
 }
 
-// Negative log-likelihood of recordings under the length-aware filter with
-// R = r0 + r_transit TransitCount(x^-) + rho^2 (H x^-)^2 (the filter's own innovation and its
-// variance), the filter driven by the broadcasts as in operation.
+// Negative log-likelihood of recordings under the length-aware filter with the model's R and
+// R_transit and rho: R(x^-) = R + R_transit TransitCount(x^-) + rho^2 (H x^-)^2 (the filter's own
+// innovation and its variance), the filter driven by the broadcasts as in operation.
 double NegLogLikelihood(const estimation::FilterModel& model, const control::UnitForceMap& map,
-                        const std::vector<BenchRecording>& recs, const NoiseModel& noise,
-                        double rho) {
+                        const std::vector<BenchRecording>& recs, double rho) {
   double total = 0;
-  estimation::FilterModel with = model;
-  with.R(0, 0) = noise.r0;
-  with.R_transit = Eigen::MatrixXd::Constant(1, 1, noise.r_transit);
   for (const BenchRecording& rec : recs) {
-    auto est = control::KalmanOnCountEstimator::Create(with, estimation::CovarianceMode::kExtended,
+    auto est = control::KalmanOnCountEstimator::Create(model, estimation::CovarianceMode::kExtended,
                                                        map, rho);
     if (!est) return std::numeric_limits<double>::infinity();
     control::KalmanOnCountEstimator& e = **est;
@@ -135,12 +131,12 @@ double NegLogLikelihood(const estimation::FilterModel& model, const control::Uni
   return total;
 }
 
-// The rho in [0, 0.5] of the largest likelihood (golden section), r0 and r_transit given: the
-// part of the force model's error that grows with the force, seen when it is carried to other
-// lengths.
+// The rho in [0, 0.5] of the largest likelihood (golden section), the model's R and R_transit
+// given: the part of the force model's error that grows with the force, seen when it is carried
+// to other lengths.
 double FitRelativeNoise(const estimation::FilterModel& model, const control::UnitForceMap& map,
-                        const std::vector<BenchRecording>& recs, const NoiseModel& noise) {
-  auto nll = [&](double rho) { return NegLogLikelihood(model, map, recs, noise, rho); };
+                        const std::vector<BenchRecording>& recs) {
+  auto nll = [&](double rho) { return NegLogLikelihood(model, map, recs, rho); };
   double a = 0, b = 0.5;
   const double g = (std::sqrt(5.0) - 1) / 2;
   double x1 = b - g * (b - a), x2 = a + g * (b - a);
@@ -229,7 +225,7 @@ Result<PlantIdentification> IdentifyOnPlant(const std::string& model_path,
   if (Status s = model.Validate("identified model"); !s) return Error{s.error(), s.code()};
   // 4. R's part that grows with the force, by maximum likelihood over every recording (R0 and
   // R_transit those of the held pose).
-  const double rho = FitRelativeNoise(model, *map, recordings, fit->noise);
+  const double rho = FitRelativeNoise(model, *map, recordings);
 
   const Eigen::VectorXd& xi = map->fractions();
   nlohmann::json j = model.ToJson();
