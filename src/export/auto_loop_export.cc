@@ -387,12 +387,13 @@ static int find_pose(double *r, int *exact) {
 }
 
 /* JointLoops::Step: each joint's demand (the pose's static torque plus the PID, integrating
- * while the bundles can deliver), shared by the bundles at the pose, as whole units there; the
- * force reference is that count at the bundle's present length. */
+ * while the bundles can deliver), shared by the bundles at the pose, its transient share
+ * delivered where the limb is, as whole units there; the force reference is that count at the
+ * bundle's present length. */
 static void force_references(recruit_controller *c, const recruit_input *in, recruit_real *fr) {
-  double r[NJ], trial[NJ], tension[NB], whole[NB], achieved;
+  double r[NJ], trial[NJ], tension[NB], whole[NB], held[NB], present[NB], achieved;
   const recruit_pose *pose;
-  alloc_problem p;
+  alloc_problem p, held_problem;
   int j, b;
   for (j = 0; j < NJ; ++j) {
     r[j] = (double)in->reference[j];
@@ -426,10 +427,24 @@ static void force_references(recruit_controller *c, const recruit_input *in, rec
     short_by = p.torque[j] - achieved;
     if (!(fabs(short_by) > 1e-3 * span && short_by * e > 0)) c->integral[j] = trial[j];
   }
+  /* sim::DeliveredAtPresentPose: the transient share (tension - held) scaled by the pose's unit
+   * force over the present one where the present one is larger. */
+  for (b = 0; b < NB; ++b) present[b] = (double)on_unit_force(recruit_bundles[b], in->length[b]);
+  held_problem = p;
+  for (j = 0; j < NJ; ++j) held_problem.torque[j] = pose->feedforward[j] + trial[j];
+  allocate_holding(&held_problem, pose, held);
+  for (b = 0; b < NB; ++b) {
+    const double u = pose->unit_force[b];
+    if (present[b] > u && u > 0) tension[b] = held[b] + (tension[b] - held[b]) * u / present[b];
+  }
+  for (j = 0; j < NJ; ++j) {
+    p.torque[j] = p.arms[j][0] * tension[0];
+    for (b = 1; b < NB; ++b) p.torque[j] += p.arms[j][b] * tension[b];
+  }
   round_to_units(&p, tension, pose->unit_force, whole);
   for (b = 0; b < NB; ++b) {
     const double count = pose->unit_force[b] > 0 ? whole[b] / pose->unit_force[b] : 0.0;
-    fr[b] = (recruit_real)(count * (double)on_unit_force(recruit_bundles[b], in->length[b]));
+    fr[b] = (recruit_real)(count * present[b]);
   }
 }
 )RECRUIT_C";

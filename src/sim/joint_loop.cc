@@ -241,13 +241,43 @@ void JointLoops::Step(double t, const Plant& plant, std::vector<double>& force_r
     const bool saturated = std::abs(short_by) > 1e-3 * span && short_by * e > 0;
     if (!saturated) integral_[j] = trial[j];
   }
+  Eigen::VectorXd present_force(nb);
+  for (int i = 0; i < nb; ++i) present_force[i] = on_unit_force_[i](plant.UnitLength(i));
+  const Eigen::VectorXd held = HeldTensions(p, holding, feedforward, trial);
+  const Eigen::VectorXd aimed = DeliveredAtPresentPose(held, continuous, unit_force, present_force);
   // Whole units: each bundle's controller holds whole on-counts, so the demand is met by the
   // combination of counts that comes nearest it (control::RoundToUnits).
-  const Eigen::VectorXd tensions = control::RoundToUnits(p, continuous, unit_force, units);
+  control::AllocationProblem whole = p;
+  for (int j = 0; j < nj; ++j) {  // term by term, as the exported C sums it
+    whole.torque[j] = p.arms(j, 0) * aimed[0];
+    for (int i = 1; i < nb; ++i) whole.torque[j] += p.arms(j, i) * aimed[i];
+  }
+  const Eigen::VectorXd tensions = control::RoundToUnits(whole, aimed, unit_force, units);
   for (int i = 0; i < nb; ++i) {
     const double count = unit_force[i] > 0 ? tensions[i] / unit_force[i] : 0.0;
-    force_ref[i] = count * on_unit_force_[i](plant.UnitLength(i));
+    force_ref[i] = count * present_force[i];
   }
+}
+
+Eigen::VectorXd JointLoops::HeldTensions(const control::AllocationProblem& p,
+                                         const std::vector<const JointHolding*>& holding,
+                                         const Eigen::VectorXd& feedforward,
+                                         const Eigen::VectorXd& integral) {
+  control::AllocationProblem hold = p;
+  hold.torque = feedforward + integral;
+  return AllocateHolding(hold, holding);
+}
+
+Eigen::VectorXd DeliveredAtPresentPose(const Eigen::VectorXd& held, const Eigen::VectorXd& demanded,
+                                       const Eigen::VectorXd& ref_unit_force,
+                                       const Eigen::VectorXd& present_unit_force) {
+  Eigen::VectorXd out = demanded;
+  for (int i = 0; i < out.size(); ++i) {
+    if (present_unit_force[i] > ref_unit_force[i] && ref_unit_force[i] > 0) {
+      out[i] = held[i] + (demanded[i] - held[i]) * ref_unit_force[i] / present_unit_force[i];
+    }
+  }
+  return out;
 }
 
 }  // namespace recruit::sim

@@ -327,4 +327,25 @@ TEST(JointLoop, BundlePricesChargeSlowAndMultiJointBundles) {
   EXPECT_NEAR(p[2], 1.5 * 10, 1e-12);
 }
 
+// The loop's transient share of each bundle's tension, turned into units, pulls where the limb is
+// what it was designed to pull at the reference pose: (count - held count) x present unit force
+// equals demanded - held wherever the present unit force is the larger; elsewhere, and at the
+// reference itself, the demand is left as it is.
+TEST(JointLoop, TheTransientShareMovesTheLimbWithItsDesignedTensionWhereItIs) {
+  Eigen::VectorXd held(4), demanded(4), f_ref(4), f_now(4);
+  held << 3.0, 2.0, 0.5, 1.0;
+  demanded << 7.0, 0.5, 0.5, 4.0;
+  f_ref << 0.11, 0.30, 0.20, 0.0;  // N per unit at the reference pose (the last: slack there)
+  f_now << 0.50, 0.60, 0.10, 0.4;  // N per unit where the limb is
+  const Eigen::VectorXd out = DeliveredAtPresentPose(held, demanded, f_ref, f_now);
+  ASSERT_EQ(out.size(), 4);
+  for (int i : {0, 1}) {
+    const double count_change = (out[i] - held[i]) / f_ref[i];  // units, as the loop rounds them
+    EXPECT_NEAR(count_change * f_now[i], demanded[i] - held[i], 1e-12) << i;
+  }
+  EXPECT_EQ(out[2], demanded[2]);  // shorter than at the reference: not raised
+  EXPECT_EQ(out[3], demanded[3]);  // no unit force at the reference: left
+  EXPECT_EQ(DeliveredAtPresentPose(held, demanded, f_ref, f_ref), demanded);
+}
+
 }  // namespace recruit::sim
