@@ -10,6 +10,7 @@
 #include "identification/bench_recorder.h"
 #include "identification/excitation.h"
 #include "identification/model_export.h"
+#include "identification/settled_fraction.h"
 
 namespace recruit::identification {
 namespace {
@@ -50,9 +51,11 @@ FitMetrics CheckAtLength(const TransientChain& chain, const control::UnitForceMa
 // The fractions that best fit the first `fraction` of every recording, the chain fixed:
 // bounded Gauss-Newton (Levenberg-Marquardt damping) on sum_k (y_k - sum_i x_ki T(xi_i, s_k))^2
 // from xi0. Recordings at several lengths and in motion pin what one length cannot: states
-// slack at the longest tendon, and the stress each state's transformation sees in use.
+// slack at the longest tendon, and the stress each state's transformation sees in use. The
+// states where `fixed` is true keep their fraction of xi0 (the settled ones, settled_fraction.h).
 Eigen::VectorXd RefineFractions(const TransientChain& chain, const control::UnitForceMap& map0,
-                                const std::vector<BenchRecording>& recs, double fraction) {
+                                const std::vector<BenchRecording>& recs, double fraction,
+                                const std::vector<bool>& fixed) {
   const int m = chain.num_states();
   const sma::UnitModel& unit = map0.unit();
   std::vector<Eigen::MatrixXd> X;
@@ -73,6 +76,9 @@ Eigen::VectorXd RefineFractions(const TransientChain& chain, const control::Unit
         }
         const double e = recs[r].log.force[k] - predicted;
         cost += e * e;
+        for (int i = 0; i < m; ++i) {
+          if (fixed[i]) row[i] = 0;  // no step along a fixed fraction
+        }
         if (JtJ) {
           JtJ->noalias() += row.transpose() * row;
           *g -= e * row.transpose();  // gradient of cost / 2
@@ -90,6 +96,9 @@ Eigen::VectorXd RefineFractions(const TransientChain& chain, const control::Unit
     for (int tries = 0; tries < 10 && !improved; ++tries) {
       Eigen::MatrixXd M = JtJ;
       M.diagonal().array() += damping * (JtJ.diagonal().array() + 1e-9 * JtJ.trace() / m + 1e-12);
+      for (int i = 0; i < m; ++i) {
+        if (fixed[i]) M(i, i) = 1;  // its row and gradient are 0: the step leaves it
+      }
       const Eigen::VectorXd trial = (xi - M.ldlt().solve(g)).cwiseMax(0.0).cwiseMin(1.0);
       const double c = cost_and_normal(trial, nullptr, nullptr);
       if (c < cost) {
@@ -106,6 +115,18 @@ Eigen::VectorXd RefineFractions(const TransientChain& chain, const control::Unit
     if (!improved) break;
   }
   return xi;
+}
+
+// `n` extensions evenly spread from the least to the greatest the recordings saw.
+std::vector<double> StretchGrid(const control::UnitForceMap& map,
+                                const std::vector<BenchRecording>& recs, int n) {
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (const BenchRecording& r : recs) {
+    for (double L : r.lengths) lo = std::min(lo, map.Stretch(L)), hi = std::max(hi, map.Stretch(L));
+  }
+  std::vector<double> grid;
+  for (int i = 0; i < n; ++i) grid.push_back(lo + (hi - lo) * i / (n - 1));
+  return grid;
 }
 
 // Negative log-likelihood of recordings under the length-aware filter with the model's R and
@@ -198,9 +219,18 @@ Result<PlantIdentification> IdentifyOnPlant(const std::string& model_path,
       poses.push_back(plan[i].sweep_period > 0 ? moving : chk->pose);
       recordings.push_back(std::move(chk).value());
     }
+    // The settled states: a settled unit's fraction over the extensions recorded, not fitted.
+    const std::vector<double> stretches = StretchGrid(*map, recordings, 5);
+    Eigen::VectorXd xi0 = map->fractions();
+    std::vector<bool> fixed(c.num_states(), false);
+    xi0[c.hot()] = SettledStateFraction(map->unit(), stretches, true);
+    xi0[c.cold()] = SettledStateFraction(map->unit(), stretches, false);
+    fixed[c.hot()] = fixed[c.cold()] = true;
+    auto settled = control::UnitForceMap::FromFractions(rec->geometry, xi0);
+    if (!settled) return Error{"identify: " + settled.error(), settled.code()};
     const double train = 1.0 - o.holdout;
     auto refined = control::UnitForceMap::FromFractions(
-        rec->geometry, RefineFractions(c, *map, recordings, train));
+        rec->geometry, RefineFractions(c, *settled, recordings, train, fixed));
     if (!refined) return Error{"identify: " + refined.error(), refined.code()};
     map = std::move(refined);
   }
