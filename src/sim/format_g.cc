@@ -60,12 +60,12 @@ constexpr double kExactPow10[] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,
                                   1e8,  1e9,  1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
                                   1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
 
-// x > 0 (normal) rounded to `precision` <= 9 significant digits as s 10^e, s of `precision`
+// x > 0 (normal) rounded to `precision` (1..9) significant digits as s 10^e, s of `precision`
 // digits, without Dragonbox: y = x 10^k in one correctly rounded operation (10^k exact for |k| <=
 // 22) is within 2^-24 of the exact product (y < 2^30), so rounding y to an integer rounds the exact
 // product the same way unless y is within 1e-6 of a midpoint (then false: the caller decides).
-bool RoundByScaling(double x, int precision, std::uint64_t* s, int* e) {
-  if (precision > 9) return false;
+inline __attribute__((always_inline)) bool RoundByScaling(double x, int precision, std::uint64_t* s,
+                                                          int* e) {
   std::uint64_t bits;
   std::memcpy(&bits, &x, sizeof bits);
   const int e2 = static_cast<int>((bits >> 52) & 0x7ff) - 1023;
@@ -99,30 +99,39 @@ bool RoundByScaling(double x, int precision, std::uint64_t* s, int* e) {
   return false;
 }
 
-// The 9 decimal digits of v < 10^9, leading zeros included, at p[0..9). Each pair comes from v by
-// its own constant division: independent of the others, so they overlap in the pipeline where a
-// chain of divisions by 100 waits for each step (the formatter is latency-bound, not
-// instruction-bound).
-void NineDigits(std::uint32_t v, char* p) {
-  p[0] = static_cast<char>('0' + v / 100000000);
-  std::memcpy(p + 1, kDigitPairs + 2 * (v / 1000000 % 100), 2);
-  std::memcpy(p + 3, kDigitPairs + 2 * (v / 10000 % 100), 2);
-  std::memcpy(p + 5, kDigitPairs + 2 * (v / 100 % 100), 2);
-  std::memcpy(p + 7, kDigitPairs + 2 * (v % 100), 2);
+// The 9 decimal digits of v, 10^8 <= v < 10^9, at p[0..9): y is v 2^32 / 10^8 in fixed point
+// (jeaiii's constants, checked for every v < 10^9), so the integer part is the first digit and
+// each multiplication of the fraction by 100 moves the next pair into the integer part: a multiply
+// per pair, where divisions by constants cost two multiplies and a subtraction each.
+inline __attribute__((always_inline)) void NineDigits(std::uint32_t v, char* p) {
+  std::uint64_t y = (v * 2882303762ull >> 26) + 4;
+  p[0] = static_cast<char>('0' + (y >> 32));
+  y = (y & 0xffffffffu) * 100;
+  std::memcpy(p + 1, kDigitPairs + 2 * (y >> 32), 2);
+  y = (y & 0xffffffffu) * 100;
+  std::memcpy(p + 3, kDigitPairs + 2 * (y >> 32), 2);
+  y = (y & 0xffffffffu) * 100;
+  std::memcpy(p + 5, kDigitPairs + 2 * (y >> 32), 2);
+  y = (y & 0xffffffffu) * 100;
+  std::memcpy(p + 7, kDigitPairs + 2 * (y >> 32), 2);
 }
 
 // s (exactly `precision` <= 9 digits) x 10^e in %g's fixed form, if its leading digit's exponent
 // X is in -4..precision-1 (else nullptr): the digits, trailing zeros dropped, around the point.
 // Moves are 16 bytes of constant size (one instruction each); out has kFormatGMax bytes.
-char* FixedForm(std::uint64_t s, int e, int precision, char* out) {
+inline __attribute__((always_inline)) char* FixedForm(std::uint64_t s, int e, int precision,
+                                                      char* out) {
   const int X = e + precision - 1;
   if (X < -4 || X >= precision) return nullptr;
-  char buf[32] = {};
-  NineDigits(static_cast<std::uint32_t>(s), buf);
-  const char* d = buf + 9 - precision;
-  int n = precision;
-  while (n > 1 && d[n - 1] == '0') --n;  // %g drops trailing zeros
-  if (X < 0) {                           // 0.000ddd
+  char d[32] = {};
+  // s with 9 - precision zeros appended: always 9 digits, none of them leading zeros.
+  NineDigits(static_cast<std::uint32_t>(s * kPow10[9 - precision]), d);
+  // %g drops trailing zeros: the '0' bytes among d[1..9) at the top of the little-endian word.
+  std::uint64_t w;
+  std::memcpy(&w, d + 1, 8);
+  w ^= 0x3030303030303030ull;
+  const int n = w == 0 ? 1 : 9 - (__builtin_clzll(w) >> 3);
+  if (X < 0) {  // 0.000ddd
     std::memcpy(out, "0.000000", 8);
     std::memcpy(out + 1 - X, d, 16);
     return out + 1 - X + n;
@@ -139,15 +148,13 @@ char* Slow(double x, int precision, char* out) {
   return fmt::format_to(out, "{:.{}g}", x, precision);
 }
 
-}  // namespace
-
-// Most doubles at precision <= 9: RoundByScaling. Else the shortest decimal S that reads back as
-// x (Dragonbox), of n digits. If n <= precision, S is
-// also x rounded to `precision` digits: x is within half an ulp of S, far less than half a unit
-// in the precision-th digit. If n >= precision + 2, rounding S gives the rounding of x: a
-// rounding midpoint (precision + 1 digits) between x and S would be a shorter decimal that reads
-// back as x. With n == precision + 1, S itself can be a midpoint: fmt decides.
-char* FormatG(double x, int precision, char* out) {
+// Every case (FormatG calls it for what its fast path leaves). Most doubles at precision <= 9:
+// RoundByScaling. Else the shortest decimal S that reads back as x (Dragonbox), of n digits. If
+// n <= precision, S is also x rounded to `precision` digits: x is within half an ulp of S, far less
+// than half a unit in the precision-th digit. If n >= precision + 2, rounding S gives the rounding
+// of x: a rounding midpoint (precision + 1 digits) between x and S would be a shorter decimal that
+// reads back as x. With n == precision + 1, S itself can be a midpoint: fmt decides.
+__attribute__((noinline)) char* General(double x, int precision, char* out) {
   if (!std::isfinite(x) || precision < 1 || precision > 15) return Slow(x, precision, out);
   // (Subnormals too: their ulp is not small against the digits kept.)
   if (x != 0 && std::abs(x) < 2.2250738585072014e-308) return Slow(x, precision, out);
@@ -161,7 +168,7 @@ char* FormatG(double x, int precision, char* out) {
   }
   std::uint64_t s;
   int e;
-  const bool scaled = RoundByScaling(x, precision, &s, &e);
+  const bool scaled = precision <= 9 && RoundByScaling(x, precision, &s, &e);
   if (scaled) {
     if (char* end = FixedForm(s, e, precision, out)) return end;
   } else {
@@ -229,6 +236,25 @@ char* FormatG(double x, int precision, char* out) {
   out[X + 1] = '.';
   WriteDigits(fraction, n - X - 1, out + X + 2);
   return out + n + 1;
+}
+
+}  // namespace
+
+// The fast path alone (a normal double at precision <= 9 in fixed form: a CSV's every column)
+// keeps the call short; the rest is General's.
+char* FormatG(double x, int precision, char* out) {
+  std::uint64_t bits;
+  std::memcpy(&bits, &x, sizeof bits);
+  const auto biased = static_cast<unsigned>(bits >> 52) & 0x7ff;
+  if (biased - 1u < 2046u && static_cast<unsigned>(precision - 1) < 9u) {  // normal, 1..9
+    *out = '-';  // kept only when negative
+    std::uint64_t s;
+    int e;
+    if (RoundByScaling(std::abs(x), precision, &s, &e)) {
+      if (char* end = FixedForm(s, e, precision, out + (bits >> 63))) return end;
+    }
+  }
+  return General(x, precision, out);
 }
 
 char* FormatInt(long x, char* out) { return std::to_chars(out, out + 24, x).ptr; }
