@@ -8,6 +8,7 @@
 #include "identification/model_cache.h"
 #include "identification/plant_record.h"
 #include "plugin/sma_host.h"
+#include "sim/response_store.h"
 
 namespace recruit::sim {
 
@@ -79,7 +80,7 @@ Result<std::vector<control::ActuatorResponse>> ActuatorResponses(
                    "': the self-tuned loop needs a broadcast chain model with a force row"};
     }
     const Eigen::VectorXd h = model.H.row(0).transpose();
-    auto r = control::PredictBundleResponse(
+    auto r = StoredBundleResponse(
         model.broadcast, std::vector<double>(h.data(), h.data() + h.size()), settings.lambda);
     if (r) {
       out.push_back(std::move(r).value());

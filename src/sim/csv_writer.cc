@@ -51,7 +51,7 @@ Status CsvStepWriter::OnStep(const mjModel*, const mjData*, const TelemetrySampl
     joints_ = s.joints.size();
     bundles_ = s.bundles.size();
     row_max_ = 8 + (4 + 2 * joints_ + 10 * bundles_) * kFormatGMax;
-    cache_.resize(4 + 2 * joints_ + 9 * bundles_);
+    cache_.resize(4 + 2 * joints_ + 10 * bundles_);
   }
   Reserve(row_max_);
   char* p = buffer_.data() + used_;
@@ -77,6 +77,17 @@ Status CsvStepWriter::OnStep(const mjModel*, const mjData*, const TelemetrySampl
     std::memcpy(p, c.text, sizeof c.text);  // fixed size: one move, the end is overwritten
     p += c.len;
   };
+  // A count (a bundle's units on): its text cached like a number's, apart from `last`.
+  auto count = [&](int v) __attribute__((always_inline)) {
+    Column& c = *col++;
+    const auto bits = static_cast<std::uint64_t>(static_cast<std::int64_t>(v));
+    if (c.len == 0 || bits != c.bits) {
+      c.bits = bits;
+      c.len = static_cast<std::uint8_t>(FormatInt(v, c.text) - c.text);
+    }
+    std::memcpy(p, c.text, sizeof c.text);
+    p += c.len;
+  };
   auto comma = [&p] { *p++ = ','; };
   num(s.time, 6);
   comma();
@@ -97,7 +108,7 @@ Status CsvStepWriter::OnStep(const mjModel*, const mjData*, const TelemetrySampl
     comma();
     num(b.force_reference, 9);
     comma();
-    p = FormatInt(b.true_on, p);
+    count(b.true_on);
     comma();
     // Non-finite estimates (no estimator, no variance) are left empty: readers take them as NaN.
     if (std::isfinite(b.estimated_on)) {
@@ -140,10 +151,6 @@ Status CsvStepWriter::OnStep(const mjModel*, const mjData*, const TelemetrySampl
   used_ = static_cast<std::size_t>(p - buffer_.data());
   if (used_ > kFlushBytes) Flush();
   return Status::Ok();
-}
-
-void CsvStepWriter::Reserve(std::size_t n) {
-  if (buffer_.size() < used_ + n) buffer_.resize(used_ + n);
 }
 
 void CsvStepWriter::Flush() {

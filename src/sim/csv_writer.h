@@ -22,8 +22,10 @@ class CsvStepWriter : public StepObserver {
   Status Commit();           // the CSV appears under its name
 
  private:
-  void Reserve(std::size_t n);  // room for n more bytes after the used ones
-  void Flush();                 // the used bytes to the file
+  void Reserve(std::size_t n) {  // room for n more bytes after the used ones
+    if (buffer_.size() < used_ + n) buffer_.resize(used_ + n);
+  }
+  void Flush();  // the used bytes to the file
   AtomicFile file_;
   int every_;
   long count_ = 0;  // steps seen (only counted when every_ > 1)
@@ -38,7 +40,7 @@ class CsvStepWriter : public StepObserver {
   static constexpr std::size_t kFlushBytes = 64 * 1024;
   std::vector<char> buffer_;
   std::size_t used_ = 0;
-  // Each numeric column's last value and its text.
+  // Each numeric column's last value and its text (a count's: the integer's bits).
   struct Column {
     std::uint64_t bits = 0;  // of the double
     std::uint8_t len = 0;    // 0: none yet

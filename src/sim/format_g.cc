@@ -12,6 +12,10 @@
 #include "common/decimal_digits.h"
 
 namespace recruit::sim {
+using format_g_detail::FixedForm;
+using format_g_detail::kDigitPairs;
+using format_g_detail::RoundByScaling;
+
 namespace {
 
 // s / 10^K for each K: division by a constant compiles to a multiply, not a divide.
@@ -33,11 +37,6 @@ std::uint64_t DivPow10(std::uint64_t s, int k, std::uint64_t* r) {
   return q;
 }
 
-constexpr char kDigitPairs[] =
-    "00010203040506070809101112131415161718192021222324252627282930313233343536373839"
-    "40414243444546474849505152535455565758596061626364656667686970717273747576777879"
-    "8081828384858687888990919293949596979899";
-
 // The n decimal digits of v (v < 10^n) at p[0..n), leading zeros included. Most values have at
 // most 9 digits: their pairs come from 32-bit divisions, cheaper than 64-bit ones.
 void WriteDigits(std::uint64_t v, int n, char* p) {
@@ -56,84 +55,6 @@ void WriteDigits(std::uint64_t v, int n, char* p) {
   if (end > p) *--end = static_cast<char>('0' + w);
 }
 
-constexpr double kExactPow10[] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,
-                                  1e8,  1e9,  1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
-                                  1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
-
-// x > 0 (normal) rounded to `precision` <= 9 significant digits as s 10^e, s of `precision`
-// digits, without Dragonbox: y = x 10^k in one correctly rounded operation (10^k exact for |k| <=
-// 22) is within 2^-24 of the exact product (y < 2^30), so rounding y to an integer rounds the exact
-// product the same way unless y is within 1e-6 of a midpoint (then false: the caller decides).
-bool RoundByScaling(double x, int precision, std::uint64_t* s, int* e) {
-  if (precision > 9) return false;
-  std::uint64_t bits;
-  std::memcpy(&bits, &x, sizeof bits);
-  const int e2 = static_cast<int>((bits >> 52) & 0x7ff) - 1023;
-  int X = (e2 * 1233) >> 12;  // ~ floor(e2 log10 2): the leading digit's exponent or one below
-  for (int attempt = 0; attempt < 3; ++attempt) {
-    const int k = precision - 1 - X;
-    if (k < -22 || k > 22) return false;
-    const double y = k >= 0 ? x * kExactPow10[k] : x / kExactPow10[-k];
-    // y < 10^(precision + 1) (X is the leading digit's exponent or one below): truncation is
-    // floor, one instruction where std::floor is a libm call on the portable instruction set.
-    const auto whole = static_cast<std::uint64_t>(static_cast<std::int64_t>(y));
-    if (whole < kPow10[precision - 1]) {  // X too high
-      --X;
-      continue;
-    }
-    if (whole >= kPow10[precision]) {  // X too low
-      ++X;
-      continue;
-    }
-    const double frac = y - static_cast<double>(whole);  // exact
-    if (std::abs(frac - 0.5) < 1e-6) return false;
-    std::uint64_t q = whole + (frac > 0.5 ? 1 : 0);
-    if (q == kPow10[precision]) {  // rounded up into the next decade
-      q = kPow10[precision - 1];
-      ++X;
-    }
-    *s = q;
-    *e = X - (precision - 1);
-    return true;
-  }
-  return false;
-}
-
-// The 9 decimal digits of v < 10^9, leading zeros included, at p[0..9). Each pair comes from v by
-// its own constant division: independent of the others, so they overlap in the pipeline where a
-// chain of divisions by 100 waits for each step (the formatter is latency-bound, not
-// instruction-bound).
-void NineDigits(std::uint32_t v, char* p) {
-  p[0] = static_cast<char>('0' + v / 100000000);
-  std::memcpy(p + 1, kDigitPairs + 2 * (v / 1000000 % 100), 2);
-  std::memcpy(p + 3, kDigitPairs + 2 * (v / 10000 % 100), 2);
-  std::memcpy(p + 5, kDigitPairs + 2 * (v / 100 % 100), 2);
-  std::memcpy(p + 7, kDigitPairs + 2 * (v % 100), 2);
-}
-
-// s (exactly `precision` <= 9 digits) x 10^e in %g's fixed form, if its leading digit's exponent
-// X is in -4..precision-1 (else nullptr): the digits, trailing zeros dropped, around the point.
-// Moves are 16 bytes of constant size (one instruction each); out has kFormatGMax bytes.
-char* FixedForm(std::uint64_t s, int e, int precision, char* out) {
-  const int X = e + precision - 1;
-  if (X < -4 || X >= precision) return nullptr;
-  char buf[32] = {};
-  NineDigits(static_cast<std::uint32_t>(s), buf);
-  const char* d = buf + 9 - precision;
-  int n = precision;
-  while (n > 1 && d[n - 1] == '0') --n;  // %g drops trailing zeros
-  if (X < 0) {                           // 0.000ddd
-    std::memcpy(out, "0.000000", 8);
-    std::memcpy(out + 1 - X, d, 16);
-    return out + 1 - X + n;
-  }
-  std::memcpy(out, d, 16);
-  if (n <= X + 1) return out + X + 1;  // an integer (its zeros are digits of s)
-  out[X + 1] = '.';
-  std::memcpy(out + X + 2, d + X + 1, 16);
-  return out + n + 1;
-}
-
 // The general case (and the rare ones the fast path leaves): fmt, which follows printf.
 char* Slow(double x, int precision, char* out) {
   return fmt::format_to(out, "{:.{}g}", x, precision);
@@ -141,13 +62,13 @@ char* Slow(double x, int precision, char* out) {
 
 }  // namespace
 
-// Most doubles at precision <= 9: RoundByScaling. Else the shortest decimal S that reads back as
-// x (Dragonbox), of n digits. If n <= precision, S is
-// also x rounded to `precision` digits: x is within half an ulp of S, far less than half a unit
-// in the precision-th digit. If n >= precision + 2, rounding S gives the rounding of x: a
-// rounding midpoint (precision + 1 digits) between x and S would be a shorter decimal that reads
-// back as x. With n == precision + 1, S itself can be a midpoint: fmt decides.
-char* FormatG(double x, int precision, char* out) {
+// Every case (FormatG calls it for what its fast path leaves). Most doubles at precision <= 9:
+// RoundByScaling. Else the shortest decimal S that reads back as x (Dragonbox), of n digits. If
+// n <= precision, S is also x rounded to `precision` digits: x is within half an ulp of S, far less
+// than half a unit in the precision-th digit. If n >= precision + 2, rounding S gives the rounding
+// of x: a rounding midpoint (precision + 1 digits) between x and S would be a shorter decimal that
+// reads back as x. With n == precision + 1, S itself can be a midpoint: fmt decides.
+char* FormatGGeneral(double x, int precision, char* out) {
   if (!std::isfinite(x) || precision < 1 || precision > 15) return Slow(x, precision, out);
   // (Subnormals too: their ulp is not small against the digits kept.)
   if (x != 0 && std::abs(x) < 2.2250738585072014e-308) return Slow(x, precision, out);
@@ -161,7 +82,7 @@ char* FormatG(double x, int precision, char* out) {
   }
   std::uint64_t s;
   int e;
-  const bool scaled = RoundByScaling(x, precision, &s, &e);
+  const bool scaled = precision <= 9 && RoundByScaling(x, precision, &s, &e);
   if (scaled) {
     if (char* end = FixedForm(s, e, precision, out)) return end;
   } else {

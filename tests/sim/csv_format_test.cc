@@ -65,6 +65,26 @@ TEST(FormatG, EqualsPrintfGNearRoundingMidpointsAndDecades) {
   }
 }
 
+TEST(FormatG, EqualsPrintfGOnARunsTimeGridAndEveryLeadingDigitPattern) {
+  // The fast path's digits come from one fixed-point product (NineDigits): every time on the
+  // 2 ms grid of a 2000 s run as MuJoCo accumulates it, and integers and decimals whose digits
+  // sweep every value at every position, with their trailing zeros dropped.
+  double t = 0;
+  for (int k = 0; k < 1000000; ++k) {
+    t += 0.002;
+    for (int p : {6, 9}) ASSERT_EQ(Fast(t, p), fmt::format("{:.{}g}", t, p)) << k;
+  }
+  std::mt19937_64 rng(5);
+  for (int i = 0; i < 300000; ++i) {
+    const double q = static_cast<double>(rng() % 1000000000ull + 1);
+    for (double v : {q, q / 1e4, q / 1e9, q / 1e12}) {
+      for (int p = 1; p <= 9; ++p) {
+        ASSERT_EQ(Fast(v, p), fmt::format("{:.{}g}", v, p)) << fmt::format("{:.17g} p={}", v, p);
+      }
+    }
+  }
+}
+
 TEST(FormatG, EqualsPrintfGAtTheEdges) {
   const double inf = std::numeric_limits<double>::infinity();
   for (double x : {0.0,
