@@ -243,7 +243,11 @@ void JointLoops::Step(double t, const Plant& plant, std::vector<double>& force_r
   }
   Eigen::VectorXd present_force(nb);
   for (int i = 0; i < nb; ++i) present_force[i] = on_unit_force_[i](plant.UnitLength(i));
-  const Eigen::VectorXd held = HeldTensions(p, holding, feedforward, trial);
+  // The tensions that hold the reference pose: the static torque plus the integral, without the
+  // loop's transient share (kp e - kd qdot).
+  control::AllocationProblem hold = p;
+  hold.torque = feedforward + trial;
+  const Eigen::VectorXd held = AllocateHolding(hold, holding);
   const Eigen::VectorXd aimed = DeliveredAtPresentPose(held, continuous, unit_force, present_force);
   // Whole units: each bundle's controller holds whole on-counts, so the demand is met by the
   // combination of counts that comes nearest it (control::RoundToUnits).
@@ -257,15 +261,6 @@ void JointLoops::Step(double t, const Plant& plant, std::vector<double>& force_r
     const double count = unit_force[i] > 0 ? tensions[i] / unit_force[i] : 0.0;
     force_ref[i] = count * present_force[i];
   }
-}
-
-Eigen::VectorXd JointLoops::HeldTensions(const control::AllocationProblem& p,
-                                         const std::vector<const JointHolding*>& holding,
-                                         const Eigen::VectorXd& feedforward,
-                                         const Eigen::VectorXd& integral) {
-  control::AllocationProblem hold = p;
-  hold.torque = feedforward + integral;
-  return AllocateHolding(hold, holding);
 }
 
 Eigen::VectorXd DeliveredAtPresentPose(const Eigen::VectorXd& held, const Eigen::VectorXd& demanded,

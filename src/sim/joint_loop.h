@@ -82,13 +82,6 @@ class JointLoops {
   JointHolding HoldingAt(const Plant& plant, int j, const Eigen::VectorXd& r) const;
 
  private:
-  // The tensions that hold the reference pose: the allocation of the static torque plus the
-  // integral, without the loop's transient share (kp e - kd qdot).
-  static Eigen::VectorXd HeldTensions(const control::AllocationProblem& p,
-                                      const std::vector<const JointHolding*>& holding,
-                                      const Eigen::VectorXd& feedforward,
-                                      const Eigen::VectorXd& integral);
-
   const Task* task_ = nullptr;
   std::vector<control::ActuatorResponse> responses_;
   std::vector<UnitForce> on_unit_force_;
