@@ -34,8 +34,10 @@ struct SizingLimits {
   int max_units_fast = 300;
   double min_segment_length = 0.03;  // m
   // Resolution: at least this many units' force in the load the bundle holds
-  // (SizingInput::holding_force), up to max_units_resolution units.
-  int units_per_holding_force = 50;
+  // (SizingInput::holding_force), up to max_units_resolution units. 150: one unit then moves a
+  // joint held by its weight about 0.4 deg, so that the count errors of several bundles on one
+  // joint stay inside a settling band of a few degrees (docs/sma-units.md, "Resolution").
+  int units_per_holding_force = 150;
   int max_units_resolution = 1000;
   // A bundle that holds no weight (a limb moving in a horizontal plane) is held by the
   // co-contraction the self-tuned loop keeps, this fraction of its peak force (the task's

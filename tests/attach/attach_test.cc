@@ -313,16 +313,18 @@ TEST(Sizing, TheStrokeRuleSetsTheBundlesForceLengthSlope) {
   }
 }
 
-// Resolution: a bundle gets enough units that one is 1/50 of the force holding its limb's
+// Resolution: a bundle gets enough units that one is 1/50 (here) of the force holding its limb's
 // weight, by fewer wires per unit (the same wires: the force is unchanged), never past the cap.
 TEST(Sizing, ResolutionGivesMoreSmallerUnitsForTheSameForce) {
   SizingInput in{"b", 900, 0.04, 0.1, 0.14, 0.12};
   SizingLimits off;
   off.units_per_holding_force = 0;  // the rule off
+  SizingLimits fifty;
+  fifty.units_per_holding_force = 50;
   auto coarse = SizeBundle(in, off);
   ASSERT_TRUE(coarse.ok()) << coarse.error();
   in.holding_force = 60;  // 50 units per 60 N: 750 units of 1.2 N
-  auto fine = SizeBundle(in);
+  auto fine = SizeBundle(in, fifty);
   ASSERT_TRUE(fine.ok()) << fine.error();
   const int wires = coarse->units * coarse->unit.parallel;
   const int fine_wires = fine->units * fine->unit.parallel;
@@ -333,9 +335,18 @@ TEST(Sizing, ResolutionGivesMoreSmallerUnitsForTheSameForce) {
   EXPECT_LT(fine_wires, wires + fine->unit.parallel);
   EXPECT_NEAR(fine->force_mid / coarse->force_mid, double(fine_wires) / wires, 1e-9);
   EXPECT_THAT(fine->notes, testing::Not(testing::Contains(testing::HasSubstr("resolution"))));
+  // The default asks for 150 units in it, 2250 here: one wire per unit, at least as many units
+  // as 1/50 gave, and a note that the rule stopped short.
+  auto finer = SizeBundle(in);
+  ASSERT_TRUE(finer.ok()) << finer.error();
+  EXPECT_EQ(SizingLimits{}.units_per_holding_force, 150);
+  EXPECT_EQ(finer->unit.parallel, 1);
+  EXPECT_GE(finer->units, fine->units);
+  EXPECT_LT(finer->units, 2250);
+  EXPECT_THAT(finer->notes, testing::Contains(testing::HasSubstr("resolution")));
   // Asking for 45,000 units: the cap (or one wire per unit) stops it, and a note says so.
   in.holding_force = 1;
-  auto capped = SizeBundle(in);
+  auto capped = SizeBundle(in, fifty);
   ASSERT_TRUE(capped.ok()) << capped.error();
   EXPECT_LT(capped->units, 2 * SizingLimits{}.max_units_resolution);
   EXPECT_THAT(capped->notes, testing::Contains(testing::HasSubstr("resolution")));
@@ -343,7 +354,7 @@ TEST(Sizing, ResolutionGivesMoreSmallerUnitsForTheSameForce) {
   // loop holds, 5 % of the peak force: 50 units in 45 N, i.e. 1000 units wanted (the cap):
   // one wire per unit, as with a 60 N weight.
   in.holding_force = 0;
-  auto weightless = SizeBundle(in);
+  auto weightless = SizeBundle(in, fifty);
   ASSERT_TRUE(weightless.ok()) << weightless.error();
   EXPECT_EQ(weightless->unit.parallel, 1);
   EXPECT_EQ(weightless->units, wires);
@@ -810,7 +821,9 @@ TEST(Sizing, ResolutionTakesThinnerWireWhenOneWirePerUnitIsNotEnough) {
   ASSERT_TRUE(coarse.ok()) << coarse.error();
   in.holding_force = 4;  // 50 units per 4 N: 500 units wanted, more than its wires
   ASSERT_LT(coarse->units * coarse->unit.parallel, 500);
-  auto fine = SizeBundle(in);
+  SizingLimits fifty;
+  fifty.units_per_holding_force = 50;
+  auto fine = SizeBundle(in, fifty);
   ASSERT_TRUE(fine.ok()) << fine.error();
   EXPECT_LT(fine->unit.wire_diameter, coarse->unit.wire_diameter);
   EXPECT_GT(fine->units, coarse->units);
