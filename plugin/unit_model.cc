@@ -418,9 +418,10 @@ inline void UnitModel::Update(const Cohorts& c, int n, double stretch, double de
   // costs 0.81-0.83x the AVX-512 one's half-empty block; from five on they cost about the same,
   // 0.96x for eight (plugin_bench BM_KernelAvx512OverAvx2: thread CPU time, transforming cohorts).
   const bool few = n <= 4 && isa == Isa::kAuto && UseAvx2(isa);
-  if (UseAvx512(isa) && !few) {
-    return batch_avx512::AdvanceCohorts(bp, bc, n, stretch, decay, obs);
-  }
+  // The AVX-512 update gives no telemetry (its 8-lane fold was never run on a machine with
+  // AVX-512): the run loop then sums as it did before (ReadTelemetry).
+  if (UseAvx512(isa) && !few)
+    return batch_avx512::AdvanceCohorts(bp, bc, n, stretch, decay, nullptr);
 #endif
 #ifdef RECRUIT_SMA_AVX2_CLONE
   if (UseAvx2(isa)) return batch_avx2::AdvanceCohorts(bp, bc, n, stretch, decay, obs);
