@@ -150,7 +150,7 @@ Status SmaBundle::Broadcast(double* s, double p_on, double p_off, double stretch
   if (!(p_on >= 0 && p_on <= 1) || !(p_off >= 0 && p_off <= 1)) {
     return Error{"actuator '" + config_.actuator + "': broadcast probabilities must be in [0, 1]"};
   }
-  DropKept(s);
+  DropAllKept(s);
   Flush(s, stretch);  // time not yet integrated ran with the old on/off states
   Rng rng = LoadRng(s + kRngSlot);
   const int k0 = NumCohorts(s);
@@ -214,7 +214,7 @@ Status SmaBundle::StartCensus(double* s, double stretch) const {
                  "': no census: give a census key (census_on, census_off, census_noise)"};
   }
   if (CensusRunning(s)) return Error{"actuator '" + config_.actuator + "': a census is running"};
-  DropKept(s);
+  DropAllKept(s);
   Flush(s, stretch);  // pending time ran with the latched heaters
   double* c = CensusBlock(s);
   c[kCensusOnLeftSlot] = config_.census.on;
@@ -280,17 +280,27 @@ void SmaBundle::AdvanceCensus(double* s, double stretch, double dt) const {
   }
 }
 
-void SmaBundle::Advance(double* s, double stretch, double dt) const {
-  DropKept(s);
+void SmaBundle::Advance(double* s, double stretch, double dt, double observe_stretch) const {
+  DropAllKept(s);
+  const bool observe = s[kObserveSlot] == 1 && !std::isnan(observe_stretch);
+  // The update's own pass gives the telemetry when it is the last change of the step (failures
+  // may change the cohorts after it).
+  BatchObserve obs;  // out[] written by the update
+  obs.count = Field(s, kCount);
+  obs.stretch = observe_stretch;
+  obs.done = false;
+  BatchObserve* fused = observe && !failures_ ? &obs : nullptr;
   if (census_ && CensusRunning(s)) {
     AdvanceCensus(s, stretch, dt);
   } else if (config_.update_period <= 0) {
-    Integrate(s, stretch, dt);
+    Integrate(s, stretch, dt, nullptr, fused);
   } else {
     s[kPendingSlot] += dt;
     if (s[kPendingSlot] >= config_.update_period - 0.5 * dt) Flush(s, stretch);
   }
   if (failures_) StepFailures(s, stretch, dt);
+  // Otherwise ReadTelemetry sums afresh when it is read.
+  if (obs.done) KeepTelemetry(s, observe_stretch, &obs);
 }
 
 void SmaBundle::FailUnits(double* s, const std::vector<int>& units, int mode) const {
@@ -398,7 +408,8 @@ void SmaBundle::Flush(double* s, double stretch) const {
   if (t > 0) Integrate(s, stretch, t);
 }
 
-void SmaBundle::Integrate(double* s, double stretch, double dt, const double* heater) const {
+void SmaBundle::Integrate(double* s, double stretch, double dt, const double* heater,
+                          BatchObserve* obs) const {
   double decay;
   if (dt == dt_) {
     decay = decay_;
@@ -414,12 +425,15 @@ void SmaBundle::Integrate(double* s, double stretch, double dt, const double* he
                              Field(s, kTeff),
                              Field(s, kHeatScale),
                              Field(s, kCoolScale)};
-  unit_.AdvanceCohorts(c, k, stretch, decay);
+  unit_.AdvanceCohorts(c, k, stretch, decay, UnitModel::Isa::kAuto, obs);
   s[kCounterSlot] += 1;
   // The counter is a whole number: integer modulo instead of a libm fmod call.
   if (k > 1 && static_cast<long long>(s[kCounterSlot]) % kMergeEvery == 0) {
     Merge(s);
     if (config_.unit_model == UnitModelKind::kBinned && NumCohorts(s) > config_.bins) Bin(s);
+    // A merge leaves fewer cohorts (merged ones are compacted away): the update's telemetry was
+    // of the cohorts before it.
+    if (obs != nullptr && NumCohorts(s) != k) obs->done = false;
   }
 }
 
@@ -662,7 +676,7 @@ SmaBundle::Summary SmaBundle::FromSums(const double* sum, int k) const {
   return r;
 }
 
-SmaBundle::Telemetry SmaBundle::ReadTelemetry(const double* s, double stretch) const {
+SmaBundle::Telemetry SmaBundle::SumTelemetryNow(const double* s, double stretch) const {
   const int k = NumCohorts(s);
   const double* v[3] = {Field(s, kOn), Field(s, kTemp), Field(s, kXi)};
   double sum[5];
@@ -674,6 +688,39 @@ SmaBundle::Telemetry SmaBundle::ReadTelemetry(const double* s, double stretch) c
   r.max_temperature = MaxTemperature(s);
   r.max_wire_stress = unit_.WireStress(sum[4]);
   return r;
+}
+
+SmaBundle::Telemetry SmaBundle::KeptTelemetry(const double* s) {
+  const double* v = s + kTelemetrySlot + 2;
+  Telemetry r;
+  r.on_count = static_cast<int>(v[0]);
+  r.tension = v[1];
+  r.mean_temperature = v[2];
+  r.mean_xi = v[3];
+  r.max_temperature = v[4];
+  r.max_wire_stress = v[5];
+  return r;
+}
+
+void SmaBundle::KeepTelemetry(double* s, double stretch, const BatchObserve* obs) const {
+  Telemetry r;
+  if (obs != nullptr) {
+    // The values SumTelemetryNow gives, from the same sums and maxima.
+    static_cast<Summary&>(r) = FromSums(obs->out, NumCohorts(s));
+    r.max_temperature = obs->out[5];
+    r.max_wire_stress = unit_.WireStress(obs->out[4]);
+  } else {
+    r = SumTelemetryNow(s, stretch);
+  }
+  double* v = s + kTelemetrySlot;
+  v[0] = 1;
+  v[1] = stretch;
+  v[2] = r.on_count;
+  v[3] = r.tension;
+  v[4] = r.mean_temperature;
+  v[5] = r.mean_xi;
+  v[6] = r.max_temperature;
+  v[7] = r.max_wire_stress;
 }
 
 SmaBundle::Summary SmaBundle::SummarizeAndKeep(double* s, double stretch) const {

@@ -8,6 +8,7 @@
 // unit_model=binned the nearest are merged further until at most `bins` remain (Bin).
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -51,8 +52,15 @@ class SmaBundle {
 
   // Advances every cohort by dt at unit extension `stretch` (m); with update_period > 0 the
   // units are integrated once the accumulated time reaches it (exact thermal step, implicit
-  // phase solve: both stay accurate for long steps).
-  void Advance(double* s, double stretch, double dt) const;
+  // phase solve: both stay accurate for long steps). When the block asks for it
+  // (ObserveEachStep) and `observe_stretch` is a number, the bundle's telemetry at that
+  // extension is kept in the block for ReadTelemetry, from the update's own pass over the
+  // cohorts where it can (UnitModel::AdvanceCohorts with BatchObserve).
+  void Advance(double* s, double stretch, double dt, double observe_stretch = NAN) const;
+  // Asks each Advance of this block for its telemetry (a run loop that reads it after every
+  // step: the engine plugin gives the extension at the tendon's length as it then is). Reset
+  // clears the request.
+  static void ObserveEachStep(double* s, bool on) { s[kObserveSlot] = on ? 1 : 0; }
 
   // The broadcast census (CensusConfig): from the next Advance, every heater forced on for
   // census.on s, then off for census.off s, then back to its latch. Pending time (update_period)
@@ -98,11 +106,15 @@ class SmaBundle {
   Summary Summarize(const double* s, double stretch) const;
   // What a run loop reads after each step, in one pass over the cohorts: each value the same,
   // bit for bit, as OnCount, Tension, MeanTemperature, MeanXi, MaxTemperature and MaxWireStress
-  // give (one tension evaluation per cohort serves the sum and the maximum).
+  // give (one tension evaluation per cohort serves the sum and the maximum). The values the last
+  // Advance kept (ObserveEachStep) when `stretch` is their extension, else summed now.
   struct Telemetry : Summary {
     double max_temperature, max_wire_stress;
   };
-  Telemetry ReadTelemetry(const double* s, double stretch) const;
+  Telemetry ReadTelemetry(const double* s, double stretch) const {
+    if (s[kTelemetrySlot] == 1 && s[kTelemetrySlot + 1] == stretch) return KeptTelemetry(s);
+    return SumTelemetryNow(s, stretch);
+  }
 
   // The plugin's sensor and actuator force in one mj_forward (the sensor runs first, at the
   // position stage): SummarizeAndKeep is Summarize and also keeps the tension with its extension
@@ -138,14 +150,23 @@ class SmaBundle {
  private:
   // Summary from the sums of UnitModel::SumTelemetry (on, temperature, xi, tension) over k cohorts.
   Summary FromSums(const double* sum, int k) const;
+  // ReadTelemetry's pass over the cohorts; the telemetry the block keeps.
+  Telemetry SumTelemetryNow(const double* s, double stretch) const;
+  static Telemetry KeptTelemetry(const double* s);
+  // Keeps the telemetry at `stretch` after an Advance: from the update's pass (obs, when done)
+  // or summed now.
+  void KeepTelemetry(double* s, double stretch, const BatchObserve* obs) const;
   // Header: magic, the random stream's 4 words as 8 exact 32-bit halves (low, high), cohort
   // count, update counter, pending time (s), the kept tension (flag 1 when kept, extension (m),
-  // tension (N); all 0 when none), 1 reserved (so that the cohort fields start 128 bytes after
-  // the block). Every slot is a finite number.
-  static constexpr int kHeader = 16;
+  // tension (N); all 0 when none), the telemetry request (ObserveEachStep: 1 or 0), the kept
+  // telemetry (flag 1 when kept, extension (m), on count, tension (N), mean temperature (C), mean
+  // xi, max temperature (C), max wire stress (Pa); all 0 when none), so that the cohort fields
+  // start 192 bytes after the block. Every slot is a finite number.
+  static constexpr int kHeader = 24;
   static constexpr int kMagicSlot = 0, kRngSlot = 1, kCohortCountSlot = 9, kCounterSlot = 10,
                        kPendingSlot = 11, kKeptSlot = 12, kKeptStretchSlot = 13,
-                       kKeptTensionSlot = 14;
+                       kKeptTensionSlot = 14, kObserveSlot = 15, kTelemetrySlot = 16;
+  static constexpr int kTelemetrySlots = 8;
   // Cohorts as a structure of arrays: field f of cohort j at kHeader + f * N + j (N = units,
   // the most cohorts there can be), so the batched update loads four cohorts' values at once.
   static constexpr int kFields = 7;
@@ -205,13 +226,21 @@ class SmaBundle {
   // temperature, xi, branch constants and force scale in units of the merge tolerances), until at
   // most config().bins cohorts remain (or one per on/off state and failure mode).
   void Bin(double* s) const;
-  // Forgets a kept tension (SummarizeAndKeep): the units are about to change.
+  // Forgets a kept tension (SummarizeAndKeep).
   static void DropKept(double* s) {
     s[kKeptSlot] = 0, s[kKeptStretchSlot] = 0, s[kKeptTensionSlot] = 0;
   }
+  // Forgets the kept tension and telemetry: the units are about to change.
+  static void DropAllKept(double* s) {
+    DropKept(s);
+    for (int i = 0; i < kTelemetrySlots; ++i) s[kTelemetrySlot + i] = 0;
+  }
   void Flush(double* s, double stretch) const;
   // heater: per cohort 0/1, the heaters' state over dt; null = the latches (kOn).
-  void Integrate(double* s, double stretch, double dt, const double* heater = nullptr) const;
+  // With obs (count and stretch set, heater null): the update's telemetry, not done when a merge
+  // changed the cohorts after it.
+  void Integrate(double* s, double stretch, double dt, const double* heater = nullptr,
+                 BatchObserve* obs = nullptr) const;
   // Drops cohorts with count 0 and relabels units; forward[j] >= 0 sends the units of an
   // emptied cohort j to cohort forward[j] (k entries); remap: k ints of scratch.
   void Compact(double* s, const int* forward, int* remap) const;

@@ -83,6 +83,10 @@ class SmaHost {
   SmaBundle::Telemetry ReadTelemetry(const mjData* d, int b) const {
     return bundle(b).ReadTelemetry(State(d, b), Stretch(d, b));
   }
+  // Has each mj_step keep bundle b's telemetry (SmaBundle::ObserveEachStep), so that
+  // ReadTelemetry after the step reads it instead of summing the cohorts again: for a run loop
+  // that reads it after every step. Until the bundle's next reset (which clears the request).
+  void ObserveEachStep(mjData* d, int b) const { SmaBundle::ObserveEachStep(State(d, b), true); }
   double MeanTemperature(const mjData* d, int b) const {
     return bundle(b).MeanTemperature(State(d, b));
   }

@@ -473,7 +473,9 @@ void SmaInstance::Advance(const mjModel* m, mjData* d) const {
                  ? (std::floor((t + 0.5 * h) / broadcast_period_) + 1) * broadcast_period_
                  : t + h;
     }
-    act.model.Advance(s, stretch, h);
+    // The telemetry a host asked for (ObserveEachStep) is read after mj_step, at the tendon's
+    // length as it is until the next mj_forward.
+    act.model.Advance(s, stretch, h, Stretch(k, d->actuator_length[out]));
   }
 }
 

@@ -479,10 +479,69 @@ __attribute__((always_inline)) inline Solved FinishSolve(const Consts& k, const 
   return {L.tth + k.latent * (x - L.xi0), x, t_eff, h, cl};
 }
 
+// The telemetry of one block's `count` updated cohorts (BatchObserve) from the update's
+// registers. The same products as ObservePass's (count times on, temperature, xi and the tension
+// at obs->stretch), each added to +0 like the first of its partial sum there, the lanes past
+// `count` +0 (ObservePass's masked tail adds +0, which changes no sum: none is -0), lanes l and
+// l + 4 of an 8-lane block added into partial sum l as ObservePass adds cohorts l and l + 4, and
+// the partial sums added as (s0 + s1) + (s2 + s3): bit for bit SumTelemetry's values, whose few-
+// cohort scalar path keeps the same four partial sums. The maxima do not depend on the order
+// (no value is NaN; a tension is never -0).
+inline void ObserveBlock(const BatchParams& p, BatchObserve* obs, Vd on, Vd T, Vd xi, int count) {
+  const Consts kt = MakeConsts(p, obs->stretch);
+  const Mask valid = ValidLanes(count);
+  const Vd c = LoadLanes(obs->count, count);
+#if defined(__AVX__) && !defined(RECRUIT_SMA_LANES8)
+  // Four lanes, one per partial sum: in registers, (a0 + a1) + (a2 + a3) by a horizontal add
+  // (two fields' a0 + a1 low, a2 + a3 high) and an add of the halves, as ObservePass does.
+  {
+    const Vd t = And(TensionOnly(kt, xi), valid);
+    const Vd a0 = Splat(0) + And(c * on, valid), a1 = Splat(0) + And(c * T, valid);
+    const Vd a2 = Splat(0) + And(c * xi, valid), a3 = Splat(0) + c * t;
+    const __m256d h01 = _mm256_hadd_pd(a0, a1), h23 = _mm256_hadd_pd(a2, a3);
+    _mm_storeu_pd(obs->out, _mm_add_pd(_mm256_castpd256_pd128(h01), _mm256_extractf128_pd(h01, 1)));
+    _mm_storeu_pd(obs->out + 2,
+                  _mm_add_pd(_mm256_castpd256_pd128(h23), _mm256_extractf128_pd(h23, 1)));
+    // Maxima: lanes swapped in pairs, then halves (no value is NaN: the order does not matter).
+    const Vd hot = Sel(valid, T, Splat(-HUGE_VAL));
+    Vd mt = _mm256_max_pd(t, _mm256_permute_pd(t, 5));
+    Vd mh = _mm256_max_pd(hot, _mm256_permute_pd(hot, 5));
+    mt = _mm256_max_pd(mt, _mm256_permute2f128_pd(mt, mt, 1));
+    mh = _mm256_max_pd(mh, _mm256_permute2f128_pd(mh, mh, 1));
+    obs->out[4] = _mm256_cvtsd_f64(mt);
+    obs->out[5] = _mm256_cvtsd_f64(mh);
+    obs->done = true;
+    return;
+  }
+#endif
+  alignas(64) double a[4][8] = {}, top[8], hot[8];
+  Store(a[0], Splat(0) + And(c * on, valid));
+  Store(a[1], Splat(0) + And(c * T, valid));
+  Store(a[2], Splat(0) + And(c * xi, valid));
+  const Vd t = And(TensionOnly(kt, xi), valid);
+  Store(a[3], Splat(0) + c * t);
+  Store(top, t);
+  Store(hot, Sel(valid, T, Splat(-HUGE_VAL)));
+  for (int f = 0; f < 4; ++f) {
+    double q[4] = {a[f][0], a[f][1], a[f][2], a[f][3]};
+    for (int l = 4; l < kLanes; ++l) q[l - 4] = q[l - 4] + a[f][l];
+    obs->out[f] = (q[0] + q[1]) + (q[2] + q[3]);
+  }
+  double peak = 0, hottest = hot[0];
+  for (int l = 0; l < kLanes; ++l) {
+    peak = top[l] > peak ? top[l] : peak;
+    hottest = hot[l] > hottest ? hot[l] : hottest;
+  }
+  obs->out[4] = peak;
+  obs->out[5] = hottest;
+  obs->done = true;
+}
+
 // All n <= kLanes cohorts in one block (an arm's bundle has about four): phase A's values stay in
 // registers and the transforming lanes are solved where they are, the others stopped, without
 // the gather through memory that batches many cohorts. Lane by lane the same operations.
-inline void AdvanceOneBlock(const StepConsts& sc, const Block& b, int count) {
+inline void AdvanceOneBlock(const StepConsts& sc, const BatchParams& p, BatchObserve* obs,
+                            const Block& b, int count) {
   const PhaseA a = BlockStepAndTest(sc, b, count);
   Solved out{a.t_th + sc.k.latent * (a.x - a.xi0), a.x, a.te0, a.h, a.cl};
   // The lanes past `count` hold zeros: they must not keep the solve going.
@@ -498,6 +557,7 @@ inline void AdvanceOneBlock(const StepConsts& sc, const Block& b, int count) {
   StoreLanes(b.t_eff, out.t_eff, count);
   StoreLanes(b.heat_scale, out.hs, count);
   StoreLanes(b.cool_scale, out.cs, count);
+  if (obs != nullptr) ObserveBlock(p, obs, LoadLanes(b.on, count), out.T, out.xi, count);
 }
 
 #pragma GCC diagnostic pop
@@ -511,14 +571,15 @@ inline void AdvanceOneBlock(const StepConsts& sc, const Block& b, int count) {
 // all, kLanes at a time; cohorts that do not transform are finished there. (B) The phase solves
 // of those that do, gathered kLanes at a time.
 void AdvanceCohorts(const BatchParams& p, const BatchCohorts& c, int n, double stretch,
-                    double decay) {
+                    double decay, BatchObserve* obs) {
   constexpr int kChunk = 64;
   const StepConsts sc{MakeConsts(p, stretch), Splat(p.ambient), Splat(p.rise_A), Splat(p.rise_dM),
                       Splat(decay)};
   const Consts& k = sc.k;
   if (n <= kLanes) {
     if (n > 0) {
-      AdvanceOneBlock(sc, Block{c.on, c.temperature, c.xi, c.t_eff, c.heat_scale, c.cool_scale}, n);
+      AdvanceOneBlock(sc, p, obs,
+                      Block{c.on, c.temperature, c.xi, c.t_eff, c.heat_scale, c.cool_scale}, n);
     }
     return;
   }

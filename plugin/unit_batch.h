@@ -22,6 +22,17 @@ struct BatchCohorts {
   double *temperature, *xi, *t_eff, *heat_scale, *cool_scale;
 };
 
+// The telemetry an update can give on its way (AdvanceCohorts with `obs`, UnitModel's): over the
+// updated cohorts, out[0..4] as SumTelemetry of count and (on, temperature, xi) with `peak` at
+// extension `stretch`, bit for bit, and out[5] the largest temperature. `done` is false when the
+// kernel left them to the caller (UnitModel::AdvanceCohorts then sums afresh).
+struct BatchObserve {
+  const double* count;
+  double stretch;
+  double out[6];
+  bool done;
+};
+
 // Kernels: AdvanceCohorts and SumTension as UnitModel's; WeightedSums sets out[f] to the sum
 // over j < n of count[j] * v[f][j] for f < nf <= 3, in four partial sums (lane j mod 4) added as
 // (s0 + s1) + (s2 + s3): the same in both clones, exact for one cohort. SumTelemetry is
@@ -29,7 +40,7 @@ struct BatchCohorts {
 // `peak` also out[4] = the largest Tension(xi[j], stretch), 0 for none.
 namespace batch_base {
 void AdvanceCohorts(const BatchParams& p, const BatchCohorts& c, int n, double stretch,
-                    double decay);
+                    double decay, BatchObserve* obs = nullptr);
 double SumTension(const BatchParams& p, const double* count, const double* xi, int n,
                   double stretch);
 void WeightedSums(const double* count, const double* const* v, int nf, int n, double* out);
@@ -44,7 +55,7 @@ bool MergeOrder(const double* on, const double* temp, int n, int* order, double*
 #ifdef RECRUIT_SMA_AVX2_CLONE
 namespace batch_avx2 {
 void AdvanceCohorts(const BatchParams& p, const BatchCohorts& c, int n, double stretch,
-                    double decay);
+                    double decay, BatchObserve* obs = nullptr);
 double SumTension(const BatchParams& p, const double* count, const double* xi, int n,
                   double stretch);
 void WeightedSums(const double* count, const double* const* v, int nf, int n, double* out);
@@ -60,7 +71,7 @@ bool MergeOrder(const double* on, const double* temp, int n, int* order, double*
 // sums (AVX2).
 namespace batch_avx512 {
 void AdvanceCohorts(const BatchParams& p, const BatchCohorts& c, int n, double stretch,
-                    double decay);
+                    double decay, BatchObserve* obs = nullptr);
 bool MergeOrder(const double* on, const double* temp, int n, int* order, double* t, int* idx);
 }  // namespace batch_avx512
 #endif

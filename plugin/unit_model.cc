@@ -402,8 +402,8 @@ int UnitModel::Lanes(Isa isa) {
 #endif
 }
 
-void UnitModel::AdvanceCohorts(const Cohorts& c, int n, double stretch, double decay,
-                               Isa isa) const {
+inline void UnitModel::Update(const Cohorts& c, int n, double stretch, double decay, Isa isa,
+                              BatchObserve* obs) const {
   if (n == 1 && isa == Isa::kAuto) {  // one cohort (units switched together): the scalar update
     UnitState s{c.temperature[0], c.xi[0], c.t_eff[0], c.heat_scale[0], c.cool_scale[0]};
     AdvanceUnitWithDecay(*this, s, c.on[0] != 0, stretch, decay);
@@ -418,12 +418,21 @@ void UnitModel::AdvanceCohorts(const Cohorts& c, int n, double stretch, double d
   // costs 0.81-0.83x the AVX-512 one's half-empty block; from five on they cost about the same,
   // 0.96x for eight (plugin_bench BM_KernelAvx512OverAvx2: thread CPU time, transforming cohorts).
   const bool few = n <= 4 && isa == Isa::kAuto && UseAvx2(isa);
-  if (UseAvx512(isa) && !few) return batch_avx512::AdvanceCohorts(bp, bc, n, stretch, decay);
+  // The AVX-512 update gives no telemetry (its 8-lane fold was never run on a machine with
+  // AVX-512): the run loop then sums as it did before (ReadTelemetry).
+  if (UseAvx512(isa) && !few)
+    return batch_avx512::AdvanceCohorts(bp, bc, n, stretch, decay, nullptr);
 #endif
 #ifdef RECRUIT_SMA_AVX2_CLONE
-  if (UseAvx2(isa)) return batch_avx2::AdvanceCohorts(bp, bc, n, stretch, decay);
+  if (UseAvx2(isa)) return batch_avx2::AdvanceCohorts(bp, bc, n, stretch, decay, obs);
 #endif
-  batch_base::AdvanceCohorts(bp, bc, n, stretch, decay);
+  batch_base::AdvanceCohorts(bp, bc, n, stretch, decay, obs);
+}
+
+void UnitModel::AdvanceCohorts(const Cohorts& c, int n, double stretch, double decay, Isa isa,
+                               BatchObserve* obs) const {
+  if (obs != nullptr) obs->done = false;
+  Update(c, n, stretch, decay, isa, obs);
 }
 
 double UnitModel::SumTension(const double* count, const double* xi, int n, double stretch,

@@ -140,8 +140,11 @@ class UnitModel {
   // AVX2, else the build's own instruction set (kBase).
   // kAvx512 uses AVX2 for the sums. Tests run each.
   enum class Isa { kAuto, kBase, kAvx2, kAvx512 };
-  void AdvanceCohorts(const Cohorts& c, int n, double stretch, double decay,
-                      Isa isa = Isa::kAuto) const;
+  // With `obs` (count and stretch set) the update also gives the updated cohorts' telemetry
+  // (BatchObserve: SumTelemetry's five values with the peak, bit for bit, and the largest
+  // temperature), from its registers when they fit one SIMD block, else in a pass of its own.
+  void AdvanceCohorts(const Cohorts& c, int n, double stretch, double decay, Isa isa = Isa::kAuto,
+                      BatchObserve* obs = nullptr) const;
   // Sum over n cohorts of count[j] * Tension(xi[j], stretch), in SIMD lanes.
   double SumTension(const double* count, const double* xi, int n, double stretch,
                     Isa isa = Isa::kAuto) const;
@@ -177,6 +180,9 @@ class UnitModel {
   double k_s_ = 0;                            // series spring of the unit (N/m), 0 = rigid
   // Unit stiffness at xi (wire in series with the coupling spring) and its xi-derivative.
   double Stiffness(double xi, double* dk) const;
+  // AdvanceCohorts' update; the kernel may fill `obs` (then obs->done).
+  void Update(const Cohorts& c, int n, double stretch, double decay, Isa isa,
+              BatchObserve* obs) const;
   double stress_per_newton_ = 0;
   double heat_rate_ = 0, cool_rate_ = 0;  // pi / (Af - As), pi / (Ms - Mf)
   double latent_rise_ = 0, heat_shift_per_newton_ = 0, cool_shift_per_newton_ = 0;

@@ -459,6 +459,9 @@ void Plant::Reset(std::uint64_t seed) {
   pushed_ = false;  // xfrc_applied zeroed
   ApplyPayloads();
   host_->Reset(data_.get(), seed);
+  // TrackPeaks reads every bundle's telemetry after every step: each step keeps it from the
+  // units' update (bit for bit the values a separate pass gives).
+  for (int b : bundles_) host_->ObserveEachStep(data_.get(), b);
   mj_forward(m, data_.get());
   peak_temperature_.assign(bundles_.size(), -std::numeric_limits<double>::infinity());
   peak_stress_.assign(bundles_.size(), 0.0);

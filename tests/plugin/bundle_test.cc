@@ -50,6 +50,56 @@ struct PerUnit {
   }
 };
 
+// A block that keeps its telemetry at each Advance (ObserveEachStep) steps exactly as one that
+// does not, and ReadTelemetry gives from it, bit for bit, what the other block's separate pass
+// over the cohorts gives: at the observed extension (kept) and at another (summed afresh), with
+// broadcasts, merges and few and many cohorts along the way.
+TEST(SmaBundleTelemetry, KeptTelemetryIsTheSeparatePassBitForBit) {
+  for (const char* text : {"units=60", "units=60 merge_temperature=0 merge_xi=0",
+                           "units=12 unit_model=binned bins=3", "units=40 update_period=0.004"}) {
+    auto c = BundleConfig::FromText("b", text);
+    ASSERT_TRUE(c.ok()) << c.error();
+    auto b = SmaBundle::Create(*c, 2e-3);
+    ASSERT_TRUE(b.ok()) << b.error();
+    const double e0 = b->config().unit.prestretch;
+    std::vector<double> kept(b->state_size()), plain(b->state_size());
+    b->Reset(kept.data(), 5, e0);
+    b->Reset(plain.data(), 5, e0);
+    SmaBundle::ObserveEachStep(kept.data(), true);
+    Rng rng(3);
+    auto same = [](const SmaBundle::Telemetry& x, const SmaBundle::Telemetry& y) {
+      auto eq = [](double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; };
+      return x.on_count == y.on_count && eq(x.tension, y.tension) &&
+             eq(x.mean_temperature, y.mean_temperature) && eq(x.mean_xi, y.mean_xi) &&
+             eq(x.max_temperature, y.max_temperature) && eq(x.max_wire_stress, y.max_wire_stress);
+    };
+    int most = 0;
+    for (int step = 0; step < 3000; ++step) {
+      const double stretch = e0 * (1 + 0.05 * std::sin(step * 1e-3));
+      if (step % 100 == 0) {
+        const double p_on = 0.4 * rng.Uniform(), p_off = 0.3 * rng.Uniform();
+        ASSERT_TRUE(b->Broadcast(kept.data(), p_on, p_off, stretch).ok());
+        ASSERT_TRUE(b->Broadcast(plain.data(), p_on, p_off, stretch).ok());
+      }
+      const double seen = stretch + 1e-6 * (rng.Uniform() - 0.5);
+      b->Advance(kept.data(), stretch, 2e-3, seen);
+      b->Advance(plain.data(), stretch, 2e-3, seen);
+      // The blocks differ only in the telemetry slots of the header (15 .. 23).
+      for (size_t i = 0; i < kept.size(); ++i) {
+        if (i >= 15 && i < 24) continue;
+        ASSERT_TRUE(std::memcmp(&kept[i], &plain[i], sizeof(double)) == 0)
+            << text << " step " << step << " slot " << i;
+      }
+      for (double at : {seen, stretch}) {
+        ASSERT_TRUE(same(b->ReadTelemetry(kept.data(), at), b->ReadTelemetry(plain.data(), at)))
+            << text << " step " << step << " at " << at;
+      }
+      most = std::max(most, b->NumCohorts(kept.data()));
+    }
+    EXPECT_GT(most, 1) << text;
+  }
+}
+
 void RunAgainstReference(int units, double merge_t, double merge_xi, double tol_force,
                          double tol_unit) {
   const SmaBundle b = MakeBundle(units, merge_t, merge_xi);
