@@ -300,7 +300,7 @@ void SmaBundle::Advance(double* s, double stretch, double dt, double observe_str
   }
   if (failures_) StepFailures(s, stretch, dt);
   // Otherwise ReadTelemetry sums afresh when it is read.
-  if (obs.done) KeepTelemetry(s, observe_stretch, &obs);
+  if (obs.done) KeepTelemetry(s, observe_stretch, obs);
 }
 
 void SmaBundle::FailUnits(double* s, const std::vector<int>& units, int mode) const {
@@ -702,16 +702,12 @@ SmaBundle::Telemetry SmaBundle::KeptTelemetry(const double* s) {
   return r;
 }
 
-void SmaBundle::KeepTelemetry(double* s, double stretch, const BatchObserve* obs) const {
+void SmaBundle::KeepTelemetry(double* s, double stretch, const BatchObserve& obs) const {
+  // The values SumTelemetryNow gives, from the same sums and maxima.
   Telemetry r;
-  if (obs != nullptr) {
-    // The values SumTelemetryNow gives, from the same sums and maxima.
-    static_cast<Summary&>(r) = FromSums(obs->out, NumCohorts(s));
-    r.max_temperature = obs->out[5];
-    r.max_wire_stress = unit_.WireStress(obs->out[4]);
-  } else {
-    r = SumTelemetryNow(s, stretch);
-  }
+  static_cast<Summary&>(r) = FromSums(obs.out, NumCohorts(s));
+  r.max_temperature = obs.out[5];
+  r.max_wire_stress = unit_.WireStress(obs.out[4]);
   double* v = s + kTelemetrySlot;
   v[0] = 1;
   v[1] = stretch;

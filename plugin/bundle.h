@@ -153,9 +153,8 @@ class SmaBundle {
   // ReadTelemetry's pass over the cohorts; the telemetry the block keeps.
   Telemetry SumTelemetryNow(const double* s, double stretch) const;
   static Telemetry KeptTelemetry(const double* s);
-  // Keeps the telemetry at `stretch` after an Advance: from the update's pass (obs, when done)
-  // or summed now.
-  void KeepTelemetry(double* s, double stretch, const BatchObserve* obs) const;
+  // Keeps the telemetry at `stretch` after an Advance, from the update's pass (obs, done).
+  void KeepTelemetry(double* s, double stretch, const BatchObserve& obs) const;
   // Header: magic, the random stream's 4 words as 8 exact 32-bit halves (low, high), cohort
   // count, update counter, pending time (s), the kept tension (flag 1 when kept, extension (m),
   // tension (N); all 0 when none), the telemetry request (ObserveEachStep: 1 or 0), the kept
