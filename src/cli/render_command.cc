@@ -155,7 +155,8 @@ void AddRenderCommand(CLI::App& app, int& exit_code) {
       ->capture_default_str();
   cmd->add_option("--crf", a->video.h264.crf, "x264 constant rate factor, 0..51 (lower = better)")
       ->capture_default_str();
-  cmd->add_option("--encoder-threads", a->video.h264.threads, "x264 threads (0 = automatic)")
+  cmd->add_option("--encoder-threads", a->video.h264.threads,
+                  "x264 threads (0 = 1.5 per core: the video then depends on the machine)")
       ->capture_default_str();
   cmd->add_option("--gl", a->gl,
                   "OpenGL back end: osmesa (software, no display) or egl (GPU driver) "

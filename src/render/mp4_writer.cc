@@ -30,7 +30,7 @@ Status H264Options::Validate() const {
   if (!known) return Error{"x264 preset '" + preset + "' is unknown; allowed: " + PresetList()};
   if (crf < 0 || crf > 51) return Error{"x264 crf must be in [0, 51], got " + std::to_string(crf)};
   if (threads < 0 || threads > 64) {
-    return Error{"encoder threads must be in [0, 64] (0 = automatic), got " +
+    return Error{"encoder threads must be in [0, 64] (0 = one and a half per core), got " +
                  std::to_string(threads)};
   }
   return Status::Ok();

@@ -19,8 +19,11 @@ struct H264Options {
   // x264 preset. "veryfast" by default: about 2-3 ms of CPU per 640x480 frame against ~30 ms to
   // render it, and files 2.5 times smaller than "ultrafast" (docs/benchmarks.md).
   std::string preset = "veryfast";
-  int crf = 23;     // constant rate factor, 0 (lossless) .. 51; 23 is x264's default
-  int threads = 0;  // x264 threads; 0 = libavcodec's choice (one per core)
+  int crf = 23;  // constant rate factor, 0 (lossless) .. 51; 23 is x264's default
+  // x264 threads. A fixed count by default: x264's decoded frames depend on its thread count,
+  // and 0 (libavcodec's choice, 1.5 per core) would make the same run's video differ from one
+  // machine to the next.
+  int threads = 4;
 
   Status Validate() const;
 };
