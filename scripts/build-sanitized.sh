@@ -1,38 +1,50 @@
 #!/usr/bin/env bash
-# Configures and builds the sanitized tree (build-asan/) that CI's tests and fuzzers share: clang,
-# AddressSanitizer + UndefinedBehaviorSanitizer with no recovery, and libFuzzer's coverage
-# instrumentation (fuzzer-no-link) in every library, so that scripts/sanitize.sh (the suite) and
-# scripts/fuzz.sh (the libFuzzer targets) need one build, not two. -O1 -DNDEBUG: -O3 with the
-# sanitizers compiles 2.5-3.4 times slower (docs/reliability.md "Sanitizers"). No LTO (pybind11
-# adds -flto to the Python module unless told; with the coverage instrumentation GNU ld then
-# rejects the module's constructors).
+# Configures and builds a sanitized tree: AddressSanitizer + UndefinedBehaviorSanitizer with no
+# recovery, -O1 -DNDEBUG (-O3 with the sanitizers compiles 2.5-3.4 times slower; docs/reliability.md
+# "Sanitizers"). Two kinds:
+#   - the suite (default, build-asan/): every test program, the recruit program, the plugin and the
+#     Python module; the tests and the module as unity batches (RECRUIT_UNITY_TESTS), which halves
+#     a build from scratch. scripts/sanitize.sh runs it.
+#   - COVERAGE=ON (clang only; scripts/fuzz.sh, build-fuzz/): the libFuzzer targets of the input
+#     parsers and the libraries they link, with libFuzzer's coverage instrumentation
+#     (fuzzer-no-link) in every library. Not in the suite's tree: its comparison callbacks made the
+#     suite's Monte Carlo tests 2.7 times slower (docs/reliability.md "CI").
+# No LTO (pybind11 adds -flto to the Python module unless told; with the coverage instrumentation GNU
+# ld then rejects the module's constructors).
 # Usage:
-#   scripts/build-sanitized.sh [target...]     (default: every target but the benchmarks)
-# Environment: BUILD_DIR (default build-asan), JOBS (default nproc), OPT (default -O1),
-# BENCH=ON to build the benchmarks too, CC/CXX (default clang/clang++; with gcc the fuzz targets
-# are not built).
+#   scripts/build-sanitized.sh [target...]     (default: every target of the tree's kind)
+# Environment: BUILD_DIR (default build-asan, with COVERAGE=ON build-fuzz), JOBS (default nproc),
+# OPT (default -O1), COVERAGE (OFF), BENCH=ON to build the benchmarks too (suite only), CC/CXX
+# (default clang/clang++).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-BUILD_DIR=${BUILD_DIR:-build-asan}
+COVERAGE=${COVERAGE:-OFF}
+if [ "$COVERAGE" = ON ]; then BUILD_DIR=${BUILD_DIR:-build-fuzz}; else BUILD_DIR=${BUILD_DIR:-build-asan}; fi
 JOBS=${JOBS:-$(nproc)}
 CC=${CC:-clang}
 CXX=${CXX:-clang++}
 SAN="address,undefined"
-FUZZ=OFF
 LINK="-fsanitize=address,undefined"
 if "$CXX" --version | grep -q clang; then
-  SAN="$SAN,fuzzer-no-link"
-  FUZZ=ON
   # The shared ASan runtime in every program, as GCC does: the Python tests preload it into the
   # interpreter, and the recruit programs they start must not carry a second, static copy
   # ("linked against incompatible ASan runtimes").
   LINK="$LINK -shared-libasan -Wl,-rpath,$("$CXX" -print-runtime-dir)"
+elif [ "$COVERAGE" = ON ]; then
+  echo "build-sanitized: COVERAGE=ON needs clang (libFuzzer), CXX=$CXX" >&2
+  exit 2
+fi
+KIND=(-DRECRUIT_BUILD_PYTHON=ON -DRECRUIT_UNITY_TESTS=ON -DRECRUIT_BUILD_FUZZ=OFF
+  -DRECRUIT_BUILD_BENCH="${BENCH:-OFF}")
+if [ "$COVERAGE" = ON ]; then
+  SAN="$SAN,fuzzer-no-link"
+  KIND=(-DRECRUIT_BUILD_PYTHON=OFF -DRECRUIT_BUILD_TESTS=OFF -DRECRUIT_BUILD_FUZZ=ON
+    -DRECRUIT_BUILD_BENCH=OFF)
 fi
 FLAGS="-fsanitize=$SAN -fno-sanitize-recover=all -fno-omit-frame-pointer"
-cmake -G Ninja -S . -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release -DRECRUIT_BUILD_PYTHON=ON \
+cmake -G Ninja -S . -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release "${KIND[@]}" \
   -DCMAKE_C_COMPILER="$CC" -DCMAKE_CXX_COMPILER="$CXX" \
   -DCMAKE_C_FLAGS_RELEASE="${OPT:--O1} -DNDEBUG" -DCMAKE_CXX_FLAGS_RELEASE="${OPT:--O1} -DNDEBUG" \
-  -DRECRUIT_BUILD_BENCH="${BENCH:-OFF}" -DRECRUIT_BUILD_FUZZ="$FUZZ" \
   -DCMAKE_INTERPROCEDURAL_OPTIMIZATION=OFF \
   -DCMAKE_C_FLAGS="$FLAGS" -DCMAKE_CXX_FLAGS="$FLAGS" -DCMAKE_EXE_LINKER_FLAGS="$LINK" \
   -DCMAKE_SHARED_LINKER_FLAGS="$LINK" -DCMAKE_MODULE_LINKER_FLAGS="$LINK" >/dev/null

@@ -1,21 +1,21 @@
 #!/usr/bin/env bash
-# Builds the libFuzzer targets of the input parsers (tests/fuzz) in the sanitized tree that the
-# suite uses (scripts/build-sanitized.sh: clang, AddressSanitizer + UndefinedBehaviorSanitizer with
-# no recovery, coverage instrumentation in every library; build-asan/), then runs each for a fixed
-# time from its checked-in seed corpus with a fixed seed. Fails if any target crashes, hangs
-# (-timeout), leaks or trips a sanitizer; the input that did it is written to
-# build-asan/artifacts/.
+# Builds the libFuzzer targets of the input parsers (tests/fuzz) in their own sanitized tree
+# (scripts/build-sanitized.sh with COVERAGE=ON: clang, AddressSanitizer + UndefinedBehaviorSanitizer
+# with no recovery, coverage instrumentation in every library they link; build-fuzz/), then runs
+# each for a fixed time from its checked-in seed corpus with a fixed seed. Fails if any target
+# crashes, hangs (-timeout), leaks or trips a sanitizer; the input that did it is written to
+# build-fuzz/artifacts/.
 # Usage:
 #   scripts/fuzz.sh [target...]     targets: task filter_model filter_log bundle_config mjcf_config
 #                                   sil_packet
 #                                   (default: all)
 # Environment: FUZZ_SECONDS per target (default 30), FUZZ_SEED (default 1), BUILD_DIR (default
-# build-asan), JOBS (default: nproc). Reproduce a crash: build-asan/tests/fuzz/fuzz_<target> FILE.
+# build-fuzz), JOBS (default: nproc). Reproduce a crash: build-fuzz/tests/fuzz/fuzz_<target> FILE.
 # Keep one found crash as a regression test: copy it to tests/fuzz/corpus/<target>/regress-<what>
 # (ctest's fuzz_<target>_corpus replays every corpus file with the normal build).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-BUILD_DIR=${BUILD_DIR:-build-asan}
+BUILD_DIR=${BUILD_DIR:-build-fuzz}
 JOBS=${JOBS:-$(nproc)}
 FUZZ_SECONDS=${FUZZ_SECONDS:-30}
 FUZZ_SEED=${FUZZ_SEED:-1}
@@ -27,7 +27,7 @@ if ! "${CXX:-clang++}" --version | grep -q clang; then
   echo "fuzz: libFuzzer needs clang (CXX=${CXX:-clang++})" >&2
   exit 2
 fi
-./scripts/build-sanitized.sh "${TARGETS[@]/#/fuzz_}"
+COVERAGE=ON ./scripts/build-sanitized.sh "${TARGETS[@]/#/fuzz_}"
 
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
 # libFuzzer's link puts libstdc++ before the shared ASan runtime (scripts/build-sanitized.sh), which
