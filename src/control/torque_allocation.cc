@@ -95,6 +95,10 @@ Eigen::VectorXd AllocateTensions(const AllocationProblem& p, double eps) {
     int release = -1;
     double best = 0;
     for (int i = 0; i < nb; ++i) {
+      // A bundle held at floor == cap is never released: freed, its first step would be blocked
+      // at once and it would be held again, at its floor, the same release chosen on every pass
+      // and the others never freed (they stayed at their floors until the iterations ran out).
+      if (!(p.floor[i] < p.cap[i])) continue;
       const double into = state[i] == kLower ? -grad[i] : state[i] == kUpper ? grad[i] : 0;
       if (into > best * (1 + 1e-12) && into > 1e-14 * std::abs(c[i]) + 1e-300) {
         best = into, release = i;

@@ -13,8 +13,10 @@ struct AllocationProblem {
   // present pose (MuJoCo's actuator moment arm, sign included).
   Eigen::MatrixXd arms;
   Eigen::VectorXd torque;  // per joint, N m: the demand
-  Eigen::VectorXd floor;   // per bundle, N: least tension (co-contraction), 0 <= floor <= cap
-  Eigen::VectorXd cap;     // per bundle, N: capacity, > 0
+  // per bundle, N: least tension (co-contraction), 0 <= floor <= cap; a bundle whose floor is
+  // its cap is held there (its tension is given, the others share what it leaves).
+  Eigen::VectorXd floor;
+  Eigen::VectorXd cap;  // per bundle, N: capacity, > 0
   // per bundle, > 0 (empty: all 1): the price of its share; a slower bundle priced higher is
   // left the smaller share of a demand the others can meet.
   Eigen::VectorXd price;

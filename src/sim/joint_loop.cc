@@ -23,6 +23,50 @@ constexpr double kCrossedJointPrice = 10;
 
 }  // namespace
 
+std::vector<bool> HeldOnlyBundles(const Eigen::MatrixXd& arms) {
+  const int nj = static_cast<int>(arms.rows()), nb = static_cast<int>(arms.cols());
+  const double tiny = 1e-9 * arms.cwiseAbs().maxCoeff();
+  std::vector<int> crossed(nb, 0);
+  for (int i = 0; i < nb; ++i) {
+    for (int j = 0; j < nj; ++j) crossed[i] += std::abs(arms(j, i)) > tiny;
+  }
+  // Per joint, whether a bundle that crosses it alone pulls it each way.
+  std::vector<bool> both_ways(nj);
+  for (int j = 0; j < nj; ++j) {
+    bool up = false, down = false;
+    for (int i = 0; i < nb; ++i) {
+      if (crossed[i] != 1) continue;
+      up |= arms(j, i) > tiny;
+      down |= arms(j, i) < -tiny;
+    }
+    both_ways[j] = up && down;
+  }
+  std::vector<bool> out(nb, false);
+  for (int i = 0; i < nb; ++i) {
+    if (crossed[i] < 2) continue;
+    out[i] = true;
+    for (int j = 0; j < nj; ++j) {
+      if (std::abs(arms(j, i)) > tiny && !both_ways[j]) out[i] = false;
+    }
+  }
+  return out;
+}
+
+Eigen::VectorXd AllocateTransient(const control::AllocationProblem& p,
+                                  const std::vector<const JointHolding*>& holding,
+                                  const Eigen::VectorXd& held, const std::vector<bool>& held_only) {
+  if (std::find(held_only.begin(), held_only.end(), true) == held_only.end()) {
+    return AllocateHolding(p, holding);
+  }
+  control::AllocationProblem q = p;
+  for (int i = 0; i < static_cast<int>(held_only.size()); ++i) {
+    if (!held_only[i]) continue;
+    // Held: floor and cap at its tension (control::AllocationProblem::floor), a cap above 0.
+    q.floor[i] = q.cap[i] = std::max(held[i], 1e-9);
+  }
+  return AllocateHolding(q, holding);
+}
+
 Eigen::VectorXd BundlePrices(const std::vector<control::ActuatorResponse>& responses,
                              const Eigen::MatrixXd& arms) {
   double fastest = std::numeric_limits<double>::infinity();
@@ -84,7 +128,9 @@ Result<JointLoops> JointLoops::Create(const Task& task, const Plant& plant,
   loops.last_target_.assign(plant.num_joints(), std::nan(""));
   loops.settings_.resize(plant.num_joints());
   loops.integral_.assign(plant.num_joints(), 0.0);
-  loops.price_ = BundlePrices(loops.responses_, plant.MomentArmsAt(loops.LoopReference(plant, 0)));
+  const Eigen::MatrixXd arms = plant.MomentArmsAt(loops.LoopReference(plant, 0));
+  loops.price_ = BundlePrices(loops.responses_, arms);
+  loops.held_only_ = HeldOnlyBundles(arms);
   return loops;
 }
 
@@ -248,7 +294,11 @@ void JointLoops::Step(double t, const Plant& plant, std::vector<double>& force_r
   control::AllocationProblem hold = p;
   hold.torque = feedforward + trial;
   const Eigen::VectorXd held = AllocateHolding(hold, holding);
-  const Eigen::VectorXd aimed = DeliveredAtPresentPose(held, continuous, unit_force, present_force);
+  // The loop's transient share moves the one-joint bundles only (HeldOnlyBundles). The
+  // anti-windup above stays on the whole demand: the integral is how a bundle that is held
+  // takes up a lasting demand (through `held`), so it grows while all the bundles can deliver it.
+  const Eigen::VectorXd moving = AllocateTransient(p, holding, held, held_only_);
+  const Eigen::VectorXd aimed = DeliveredAtPresentPose(held, moving, unit_force, present_force);
   // Whole units: each bundle's controller holds whole on-counts, so the demand is met by the
   // combination of counts that comes nearest it (control::RoundToUnits).
   control::AllocationProblem whole = p;

@@ -61,6 +61,8 @@ class JointLoops {
 
   // Each bundle's price in the allocation (BundlePrices).
   const Eigen::VectorXd& prices() const { return price_; }
+  // Per bundle: whether it takes no share of the loop's transient terms (HeldOnlyBundles).
+  const std::vector<bool>& held_only() const { return held_only_; }
   // Per joint, the PID's integral term (N m): the sum of ki e dT over the instants the bundles
   // could deliver it, each with the gain of its own design.
   const std::vector<double>& integral() const { return integral_; }
@@ -94,6 +96,7 @@ class JointLoops {
   };
   std::vector<std::map<double, Setting>> settings_;
 
+  std::vector<bool> held_only_;      // per bundle: HeldOnlyBundles at the first reference pose
   std::vector<double> integral_;     // N m, per joint: the sum of ki e dT
   std::vector<double> last_target_;  // rad, per joint: NaN before the first instant
   Eigen::VectorXd price_;            // per bundle: its time to 63 % over the fastest bundle's
@@ -108,6 +111,22 @@ class JointLoops {
 // cancelling its torque on the other joint with bundles of another speed makes that joint jump.
 Eigen::VectorXd BundlePrices(const std::vector<control::ActuatorResponse>& responses,
                              const Eigen::MatrixXd& arms);
+
+// The bundles that take no share of the loop's transient terms (kp e - kd qdot): those that cross
+// more than one driven joint (`arms`: joints x bundles; an arm below 1e-9 of the largest is not a
+// crossing) where every joint they cross has a bundle that crosses it alone pulling each way.
+// Moving one joint with such a bundle moves the other too, and the other's bundles, of another
+// speed, cancel that first: the two-joint arm's elbow, thrown 20 deg one way and then to its
+// limit by the shoulder's share of its biarticular flexor (seed 602 at 80 s).
+std::vector<bool> HeldOnlyBundles(const Eigen::MatrixXd& arms);
+
+// The tensions that meet the demand `p` (with the stiffness rows of `holding`, AllocateHolding)
+// when the bundles marked `held_only` keep their tensions `held` (the allocation of the static
+// torque and the integral alone): the others take all of the loop's transient share.
+// AllocateHolding(p, holding) when none is marked.
+Eigen::VectorXd AllocateTransient(const control::AllocationProblem& p,
+                                  const std::vector<const JointHolding*>& holding,
+                                  const Eigen::VectorXd& held, const std::vector<bool>& held_only);
 
 // The tensions (at the reference pose's unit forces) whose counts deliver `demanded` where the
 // limb is. A count pulls its unit force at the present length, which far from the reference can

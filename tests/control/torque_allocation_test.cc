@@ -44,7 +44,8 @@ Eigen::VectorXd Exhaustive(const AllocationProblem& p, double eps) {
       a.setZero();
       for (int k = 0; k < nf; ++k) {
         a.col(k).head(p.arms.rows()) = w.asDiagonal() * p.arms.col(free[k]);
-        a(p.arms.rows() + k, k) = std::sqrt(eps) / p.cap[free[k]];
+        const double price = p.price.size() > 0 ? p.price[free[k]] : 1.0;
+        a(p.arms.rows() + k, k) = std::sqrt(eps) * price / p.cap[free[k]];
       }
       const Eigen::VectorXd sol = a.colPivHouseholderQr().solve(rhs);
       bool inside = true;
@@ -88,6 +89,63 @@ TEST(TorqueAllocation, MatchesTheExhaustiveSolverOnRandomLimbs) {
       EXPECT_LE(got[b], p.cap[b]);
     }
   }
+}
+
+// Bundles whose floor is their capacity (held at a given tension): the exhaustive solver needs
+// nothing special for them (floor and capacity are the same choice).
+TEST(TorqueAllocation, HeldBundlesMatchTheExhaustiveSolverOnRandomLimbs) {
+  std::mt19937_64 gen(20261127);
+  std::uniform_real_distribution<double> u(-1, 1), pos(0.1, 1);
+  for (int trial = 0; trial < 300; ++trial) {
+    const int nj = 1 + trial % 2, nb = 2 + trial % 5;
+    AllocationProblem p;
+    p.arms = Eigen::MatrixXd(nj, nb);
+    for (int j = 0; j < nj; ++j) {
+      for (int b = 0; b < nb; ++b) p.arms(j, b) = 0.02 * u(gen);
+    }
+    p.cap = Eigen::VectorXd(nb);
+    p.floor = Eigen::VectorXd(nb);
+    p.price = Eigen::VectorXd(nb);
+    for (int b = 0; b < nb; ++b) {
+      p.cap[b] = 50 * pos(gen);
+      p.floor[b] = 0.05 * p.cap[b];
+      p.price[b] = b % 2 ? 10 : 1;
+      if (b % 3 == trial % 3) p.floor[b] = p.cap[b] = 20 * pos(gen);  // held
+    }
+    p.torque = Eigen::VectorXd(nj);
+    for (int j = 0; j < nj; ++j) p.torque[j] = 0.8 * u(gen);
+    const Eigen::VectorXd got = AllocateTensions(p);
+    const Eigen::VectorXd want = Exhaustive(p, 1e-8);
+    ASSERT_EQ(got.size(), nb);
+    EXPECT_NEAR(AllocationCost(p, got), AllocationCost(p, want), 1e-12) << "trial " << trial;
+    for (int b = 0; b < nb; ++b) {
+      EXPECT_NEAR(got[b], want[b], 1e-6 * p.cap[b]) << "trial " << trial << " bundle " << b;
+      if (p.floor[b] == p.cap[b]) EXPECT_EQ(got[b], p.cap[b]);
+    }
+  }
+}
+
+// The case that stalled the two-joint arm's shoulder: a held biarticular flexor that both joints'
+// demands would raise (its gradient points into the box the most). Solved by hand: it gives
+// 0.015 x 9.26 N m on each joint, the extensors stay at their floors (the share term only lowers
+// them), the one-joint flexors make up the rest.
+TEST(TorqueAllocation, AHeldBundleLeavesTheRestOfTheDemandToTheOthers) {
+  AllocationProblem p;
+  p.arms = Eigen::MatrixXd(2, 5);  // bundles SF, SE, BF, EF, EE; joints shoulder, elbow
+  p.arms << 0.02, -0.02, 0.015, 0, 0, 0, 0, 0.015, 0.015, -0.015;
+  p.torque = Eigen::Vector2d(0.5, 0.2);
+  p.cap = Eigen::VectorXd(5);
+  p.cap << 42.73, 51.59, 9.26, 23.16, 21.10;
+  p.floor = 0.05 * p.cap;
+  p.floor[2] = p.cap[2];  // BF held at 9.26 N
+  p.price = Eigen::VectorXd(5);
+  p.price << 1, 1, 10, 1, 0.125;
+  const Eigen::VectorXd t = AllocateTensions(p);
+  EXPECT_EQ(t[2], 9.26);
+  EXPECT_EQ(t[1], p.floor[1]);
+  EXPECT_EQ(t[4], p.floor[4]);
+  EXPECT_NEAR(t[0], (0.5 - 0.015 * 9.26 + 0.02 * p.floor[1]) / 0.02, 1e-5);
+  EXPECT_NEAR(t[3], (0.2 - 0.015 * 9.26 + 0.015 * p.floor[4]) / 0.015, 1e-5);
 }
 
 TEST(TorqueAllocation, AnAntagonistPairMeetsAReachableDemandWithTheExtensorAtItsFloor) {

@@ -327,6 +327,49 @@ TEST(JointLoop, BundlePricesChargeSlowAndMultiJointBundles) {
   EXPECT_NEAR(p[2], 1.5 * 10, 1e-12);
 }
 
+// Bundles held out of the transient share: those crossing two driven joints, while each joint
+// they cross has a one-joint bundle pulling each way.
+TEST(JointLoop, HeldOnlyBundlesAreTheMultiJointOnesWhereOneJointBundlesMoveEachJointBothWays) {
+  // Bundles SF, SE, BF, BE, EF, EE; joints shoulder, elbow (EF's shoulder arm is rounding).
+  Eigen::MatrixXd arms(2, 6);
+  arms << 0.02, -0.02, 0.01, -0.01, 1e-14, 0, 0, 0, 0.012, -0.012, 0.015, -0.015;
+  EXPECT_EQ(HeldOnlyBundles(arms), (std::vector<bool>{false, false, true, true, false, false}));
+  arms(1, 5) = 0;  // the elbow has no one-joint extensor: BE and BF must move it
+  EXPECT_EQ(HeldOnlyBundles(arms), std::vector<bool>(6, false));
+  EXPECT_EQ(HeldOnlyBundles(arms.topRows(1)), std::vector<bool>(6, false));  // one joint
+}
+
+// The transient share goes to the one-joint bundles: the held ones keep `held`, and each joint's
+// agonist makes up its demand less the held bundles' torque with its antagonist at its floor
+// (solved by hand; the share term only lowers the antagonist). With no bundle held it is
+// AllocateHolding's answer.
+TEST(JointLoop, TheTransientShareGoesToTheOneJointBundles) {
+  control::AllocationProblem p;
+  p.arms.resize(2, 6);  // bundles SF, SE, BF, BE, EF, EE; joints shoulder, elbow
+  p.arms << 0.02, -0.02, 0.01, -0.01, 0, 0, 0, 0, 0.012, -0.012, 0.015, -0.015;
+  p.cap.resize(6);
+  p.cap << 40, 50, 100, 30, 20, 10;
+  p.floor = 0.05 * p.cap;
+  p.price.resize(6);
+  p.price << 1, 1, 10, 10, 1, 0.125;
+  p.torque = Eigen::Vector2d(0.6, -0.05);
+  const std::vector<const JointHolding*> none(2, nullptr);
+  const std::vector<bool> held_only = {false, false, true, true, false, false};
+  Eigen::VectorXd held(6);
+  held << 10, 2.5, 6, 1.5, 3, 4;
+  const Eigen::VectorXd t = AllocateTransient(p, none, held, held_only);
+  ASSERT_EQ(t.size(), 6);
+  EXPECT_EQ(t[2], held[2]);
+  EXPECT_EQ(t[3], held[3]);
+  const double bi0 = 0.01 * held[2] - 0.01 * held[3], bi1 = 0.012 * held[2] - 0.012 * held[3];
+  EXPECT_EQ(t[1], p.floor[1]);  // shoulder: flexing demand
+  EXPECT_NEAR(t[0], (0.6 - bi0 + 0.02 * p.floor[1]) / 0.02, 1e-5);
+  EXPECT_EQ(t[4], p.floor[4]);  // elbow: extending demand
+  EXPECT_NEAR(t[5], (bi1 + 0.05 + 0.015 * p.floor[4]) / 0.015, 1e-5);
+  EXPECT_EQ(AllocateTransient(p, none, held, std::vector<bool>(6, false)),
+            AllocateHolding(p, none));
+}
+
 // The loop's transient share of each bundle's tension, turned into units, pulls where the limb is
 // what it was designed to pull at the reference pose: (count - held count) x present unit force
 // equals demanded - held wherever the present unit force is the larger; elsewhere, and at the
