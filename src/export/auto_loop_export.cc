@@ -66,6 +66,7 @@ Result<FrozenAutoLoop> FreezeAutoLoop(const sim::Task& task, const sim::RunOptio
   const Eigen::VectorXd& price = loops->prices();  // the allocation's (sim::BundlePrices)
   for (int i = 0; i < nb; ++i) {
     out.price.push_back(price[i]);
+    out.held_only.push_back(loops->held_only()[i] ? 1 : 0);
     out.units.push_back(plant.num_units(i));
   }
   for (int j = 0; j < nj; ++j) {
@@ -278,7 +279,9 @@ static void allocate_tensions(const alloc_problem *p, double *x) {
       grad[i] = g - c[i];
     }
     for (i = 0; i < NB; ++i) { /* release the held one pointing most into the box */
-      const double into = state[i] == LOWER ? -grad[i] : state[i] == UPPER ? grad[i] : 0.0;
+      double into;
+      if (!(p->floor[i] < p->cap[i])) continue; /* held at floor == cap: never released */
+      into = state[i] == LOWER ? -grad[i] : state[i] == UPPER ? grad[i] : 0.0;
       if (into > best * (1.0 + 1e-12) && into > 1e-14 * fabs(c[i]) + 1e-300) {
         best = into, release = i;
       }
@@ -394,7 +397,8 @@ static void force_references(recruit_controller *c, const recruit_input *in, rec
   double r[NJ], trial[NJ], tension[NB], whole[NB], held[NB], present[NB], achieved;
   const recruit_pose *pose;
   alloc_problem p, held_problem;
-  int j, b;
+  int j, b, any_held_only = 0;
+  for (b = 0; b < NB; ++b) any_held_only |= recruit_held_only[b];
   for (j = 0; j < NJ; ++j) {
     r[j] = (double)in->reference[j];
     if (recruit_joint_limited[j]) r[j] = clampd(r[j], recruit_joint_lo[j], recruit_joint_hi[j]);
@@ -433,6 +437,13 @@ static void force_references(recruit_controller *c, const recruit_input *in, rec
   held_problem = p;
   for (j = 0; j < NJ; ++j) held_problem.torque[j] = pose->feedforward[j] + trial[j];
   allocate_holding(&held_problem, pose, held);
+  if (any_held_only) { /* sim::AllocateTransient: those bundles keep their held tension */
+    alloc_problem q = p;
+    for (b = 0; b < NB; ++b) {
+      if (recruit_held_only[b]) q.floor[b] = q.cap[b] = held[b] > 1e-9 ? held[b] : 1e-9;
+    }
+    allocate_holding(&q, pose, tension);
+  }
   for (b = 0; b < NB; ++b) {
     const double u = pose->unit_force[b];
     if (present[b] > u && u > 0) tension[b] = held[b] + (tension[b] - held[b]) * u / present[b];
@@ -536,6 +547,7 @@ LoopCode AutoLoopCode(const FrozenAutoLoop& loop, const Writer& package) {
   s += "static const double recruit_joint_hi[RECRUIT_NUM_JOINTS] = " + w.List(loop.hi) + ";\n";
   s += "static const double recruit_price[RECRUIT_NUM_BUNDLES] = " + w.List(loop.price) + ";\n";
   s += "static const int recruit_units[RECRUIT_NUM_BUNDLES] = " + Ints(loop.units) + ";\n";
+  s += "static const int recruit_held_only[RECRUIT_NUM_BUNDLES] = " + Ints(loop.held_only) + ";\n";
   s += "static const double co_contraction = " + w.Num(loop.co_contraction) +
        ", dT = " + w.Num(loop.dT) + ";\n";
   s += kAutoLoopC;

@@ -49,6 +49,7 @@ struct FrozenAutoLoop {
   std::vector<int> limited;           // per joint: its reference is clamped to [lo, hi]
   std::vector<double> lo, hi;         // rad, the range less the loop's margin
   std::vector<double> price;          // per bundle (JointLoops' allocation prices)
+  std::vector<int> held_only;         // per bundle: no transient share (JointLoops::held_only)
   std::vector<int> units;             // per bundle
   double co_contraction = 0, dT = 0;  // fraction of capacity; s
   std::vector<FrozenPose> poses;      // in the order the schedule reaches them
