@@ -15,7 +15,7 @@
 #include "common/exit_codes.h"
 
 namespace recruit {
-namespace {
+namespace file_atomic_file_test {
 
 namespace fs = std::filesystem;
 
@@ -153,5 +153,5 @@ TEST(ReadFile, AMissingFileIsBadInputAndAnUnopenableOneIo) {
   fs::remove_all(dir);
 }
 
-}  // namespace
+}  // namespace file_atomic_file_test
 }  // namespace recruit

@@ -20,7 +20,7 @@
 #include "plugin/sma_host.h"
 
 namespace recruit {
-namespace {
+namespace file_compiled_model_cache_test {
 
 namespace fs = std::filesystem;
 
@@ -290,5 +290,5 @@ TEST_F(CompiledModelCache, ConcurrentThreadsAndProcessesLeaveOneWholeEntry) {
   mj_deleteModel(direct);
 }
 
-}  // namespace
+}  // namespace file_compiled_model_cache_test
 }  // namespace recruit

@@ -3,7 +3,7 @@
 #include <gtest/gtest.h>
 
 namespace recruit {
-namespace {
+namespace file_cpu_features_test {
 
 // The C library's record of the CPU's features agrees with GCC's own CPUID-based check, feature
 // by feature, on whatever CPU runs the test.
@@ -19,5 +19,5 @@ TEST(CpuFeatures, AgreeWithTheCompilersOwnCheck) {
 #endif
 }
 
-}  // namespace
+}  // namespace file_cpu_features_test
 }  // namespace recruit

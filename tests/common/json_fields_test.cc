@@ -8,7 +8,7 @@
 #include <vector>
 
 namespace recruit::json_fields {
-namespace {
+namespace file_json_fields_test {
 
 using nlohmann::json;
 
@@ -153,5 +153,5 @@ TEST(JsonFields, LongValuesAreShortenedInMessages) {
   EXPECT_LT(s.error().size(), 120u) << s.error();
 }
 
-}  // namespace
+}  // namespace file_json_fields_test
 }  // namespace recruit::json_fields

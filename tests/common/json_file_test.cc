@@ -5,7 +5,7 @@
 #include <string>
 
 namespace recruit {
-namespace {
+namespace file_json_file_test {
 
 TEST(JsonFile, ParsesPlainJsonAndSkipsAByteOrderMark) {
   auto j = ParseJsonText("\xEF\xBB\xBF{\"a\": [1, 2.5]}", "t.json");
@@ -58,5 +58,5 @@ TEST(JsonFile, AMissingFileIsBadInput) {
   EXPECT_EQ(j.code(), ErrorCode::kBadInput);
 }
 
-}  // namespace
+}  // namespace file_json_file_test
 }  // namespace recruit

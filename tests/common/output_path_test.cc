@@ -15,7 +15,7 @@
 #include "common/short_text.h"
 
 namespace recruit {
-namespace {
+namespace file_output_path_test {
 namespace fs = std::filesystem;
 
 TEST(OutputPath, NamesThatWouldLeaveTheOutputFolderAreRefused) {
@@ -118,5 +118,5 @@ TEST(ContentHash, FieldsAreDelimitedAndAnyByteChangesTheHash) {
   EXPECT_STRNE(CodeVersion(), "");
 }
 
-}  // namespace
+}  // namespace file_output_path_test
 }  // namespace recruit

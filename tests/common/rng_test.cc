@@ -5,7 +5,7 @@
 #include <cmath>
 
 namespace recruit {
-namespace {
+namespace file_rng_test {
 
 // Reference outputs of xoshiro256** from state {1, 2, 3, 4}, worked from the published
 // algorithm: rotl(2 * 5, 7) * 9 = 11520, then 0, ...
@@ -49,5 +49,5 @@ TEST(Rng, DerivedSeedsDifferPerIndex) {
   EXPECT_EQ(Rng::DeriveSeed(5, 3), Rng::DeriveSeed(5, 3));
 }
 
-}  // namespace
+}  // namespace file_rng_test
 }  // namespace recruit

@@ -2,6 +2,6 @@
 // `recruit` sets it (common/data_path.h), before any test runs.
 #include "common/data_path.h"
 
-namespace {
+namespace file_test_data_dir {
 const bool kDataDirSet = (recruit::SetDataDir(RECRUIT_SOURCE_DIR), true);
-}  // namespace
+}  // namespace file_test_data_dir

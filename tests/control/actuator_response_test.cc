@@ -11,7 +11,7 @@
 #include "common/rng.h"
 
 namespace recruit::control {
-namespace {
+namespace file_actuator_response_test {
 
 // With the two-state chain (no thermal lag) the expected on-count closes lambda of its gap each
 // period, so the tension's step response is 1 - (1 - lambda)^k exactly.
@@ -189,5 +189,5 @@ TEST(ActuatorResponse, BadInputsAreRefused) {
   EXPECT_FALSE(PredictActuatorResponse(chain, {0.0, 0.0}, 0.2).ok());
 }
 
-}  // namespace
+}  // namespace file_actuator_response_test
 }  // namespace recruit::control

@@ -16,7 +16,7 @@
 #include "plugin/sma_host.h"
 
 namespace recruit::control {
-namespace {
+namespace file_closed_loop_bench_test {
 
 struct LoopResult {
   double max_force = 0;   // N
@@ -146,5 +146,5 @@ TEST(ClosedLoopBench, OutputOnlyCountingIsSmoothAtTwoSeconds) {
   EXPECT_LT(r.late_error, 0.45);
 }
 
-}  // namespace
+}  // namespace file_closed_loop_bench_test
 }  // namespace recruit::control

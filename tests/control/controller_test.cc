@@ -9,7 +9,7 @@
 #include "control/recruitment_controller.h"
 
 namespace recruit::control {
-namespace {
+namespace file_controller_test {
 
 TEST(OutputOnlyEstimator, CountIsForceOverUnitForceClampedToFeasible) {
   OutputOnlyEstimator e(60, 0.5);
@@ -91,5 +91,5 @@ TEST(EstimatorSpec, DefaultModelFileNamesTheSamplingPeriod) {
   EXPECT_EQ(DefaultModelFile(0.25, 8), "models/identified/bench_n60_dt0.25_m8.json");
 }
 
-}  // namespace
+}  // namespace file_controller_test
 }  // namespace recruit::control

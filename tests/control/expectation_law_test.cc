@@ -10,7 +10,7 @@
 #include "control/broadcast.h"
 
 namespace recruit::control {
-namespace {
+namespace file_expectation_law_test {
 
 TEST(ExpectationLaw, RecruitsLambdaTimesMissingUnitsFromTheOffUnits) {
   // N = 60, 20 on, target 30: 10 missing, 40 off, lambda 0.2 -> 0.2 * 10 / 40 = 0.05.
@@ -146,5 +146,5 @@ TEST(ExplorationLaw, CapsAndGuards) {
   }
 }
 
-}  // namespace
+}  // namespace file_expectation_law_test
 }  // namespace recruit::control

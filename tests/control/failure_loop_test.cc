@@ -12,7 +12,7 @@
 #include "control/recruitment_controller.h"
 
 namespace recruit::control {
-namespace {
+namespace file_failure_loop_test {
 
 namespace fl = failure_loop;
 
@@ -291,5 +291,5 @@ TEST(FailureLoop, ACensusEndingAtEveryInstantKeepsTheWholeRunHonest) {
   }
 }
 
-}  // namespace
+}  // namespace file_failure_loop_test
 }  // namespace recruit::control

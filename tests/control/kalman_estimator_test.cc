@@ -18,7 +18,7 @@
 #include "tests/common/malloc_counter.h"
 
 namespace recruit::control {
-namespace {
+namespace file_kalman_estimator_test {
 
 TEST(KalmanTwoState, PredictionIsTheBinomialAndUpdateTheScalarKalmanGain) {
   const int N = 60;
@@ -191,5 +191,5 @@ TEST(ModelExport, FilterModelFileRoundTripsTheChain) {
   EXPECT_DOUBLE_EQ(back->x0[0], 60.0);
 }
 
-}  // namespace
+}  // namespace file_kalman_estimator_test
 }  // namespace recruit::control

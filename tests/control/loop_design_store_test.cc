@@ -13,7 +13,7 @@
 #include "control/loop_design.h"
 
 namespace recruit::control {
-namespace {
+namespace file_loop_design_store_test {
 
 namespace fs = std::filesystem;
 
@@ -132,5 +132,5 @@ TEST(LoopDesignStore, OffStoresNothing) {
   EXPECT_TRUE(folder.Entries().empty());
 }
 
-}  // namespace
+}  // namespace file_loop_design_store_test
 }  // namespace recruit::control

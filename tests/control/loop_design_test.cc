@@ -5,7 +5,7 @@
 #include <cmath>
 
 namespace recruit::control {
-namespace {
+namespace file_loop_design_test {
 
 ActuatorResponse TwoState(double dT, double lambda) {
   return *PredictActuatorResponse(estimation::BroadcastTransitionModel::TwoState(dT), {0, 1},
@@ -225,5 +225,5 @@ TEST(LoopDesign, BadInputsAreRefused) {
   EXPECT_FALSE(DesignJointLoop({0.1, 0.1, 0.1}, act, 1.0, target).ok());
 }
 
-}  // namespace
+}  // namespace file_loop_design_test
 }  // namespace recruit::control

@@ -11,7 +11,7 @@
 #include <random>
 
 namespace recruit::control {
-namespace {
+namespace file_torque_allocation_test {
 
 Eigen::VectorXd Exhaustive(const AllocationProblem& p, double eps) {
   const int n = static_cast<int>(p.cap.size());
@@ -177,5 +177,5 @@ TEST(TorqueAllocation, AnUnreachableDemandSaturatesAtCapacity) {
   EXPECT_DOUBLE_EQ(t[1], 0);
 }
 
-}  // namespace
+}  // namespace file_torque_allocation_test
 }  // namespace recruit::control

@@ -13,7 +13,7 @@
 #include "plugin/sma_host.h"
 
 namespace recruit::control {
-namespace {
+namespace file_unit_force_map_test {
 
 constexpr double kDeg = M_PI / 180.0;
 
@@ -130,5 +130,5 @@ TEST(UnitForceMap, FromForcesInvertsTheForceLawWhereTaut) {
   EXPECT_FALSE(UnitForceMap::FromFractions(g, Eigen::Vector2d(0.5, 1.5)).ok());
 }
 
-}  // namespace
+}  // namespace file_unit_force_map_test
 }  // namespace recruit::control

@@ -12,7 +12,7 @@
 #include "test_util.h"
 
 namespace recruit {
-namespace {
+namespace file_baselines_test {
 
 using testing_util::ThreeStateModel;
 
@@ -160,5 +160,5 @@ TEST(EstimationBaselines, ThreeStatesKalmanWithinFivePercentOfExact) {
   EXPECT_LE(c.rmse_exact, c.rmse_kalman * 1.001);
 }
 
-}  // namespace
+}  // namespace file_baselines_test
 }  // namespace recruit

@@ -16,7 +16,7 @@
 #include "estimation/population_chain.h"
 
 namespace recruit {
-namespace {
+namespace file_failure_filter_test {
 
 // An 8-state heating chain with a force per state (0.45 N settled on), N units, noise 0.2 N.
 estimation::FilterModel ChainModel(int N, double noise = 0.2) {
@@ -435,11 +435,11 @@ TEST(EstimationFailureFilter, ForceScaleEstimateIsUnbiasedAndHonest) {
   EXPECT_LE(mean_z2, 2.0);
 }
 
-}  // namespace
+}  // namespace file_failure_filter_test
 }  // namespace recruit
 
 namespace recruit {
-namespace {
+namespace file_failure_filter_test {
 
 // The heated units of a 24-entry (working, open, stuck) vector of the 8-state chain: the working
 // units in heater-on states and every stuck unit.
@@ -548,5 +548,5 @@ TEST(EstimationFailureCensus, TheFirstCensusAfterALossPlacesItAndStaysHonest) {
   EXPECT_LE(nees / n_nees, 1.5);
 }
 
-}  // namespace
+}  // namespace file_failure_filter_test
 }  // namespace recruit

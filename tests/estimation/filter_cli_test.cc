@@ -20,7 +20,7 @@
 #include "estimation/population_kalman_filter.h"
 
 namespace recruit {
-namespace {
+namespace file_filter_cli_test {
 
 namespace fs = std::filesystem;
 
@@ -328,5 +328,5 @@ TEST_F(EstimationCli, StreamedRunMatchesTheDenseFilter) {
   }
 }
 
-}  // namespace
+}  // namespace file_filter_cli_test
 }  // namespace recruit

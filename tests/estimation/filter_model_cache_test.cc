@@ -18,7 +18,7 @@
 #include "common/json_file.h"
 
 namespace recruit {
-namespace {
+namespace file_filter_model_cache_test {
 
 namespace fs = std::filesystem;
 using estimation::FilterModel;
@@ -155,5 +155,5 @@ TEST_F(FilterModelCache, ThreadsLoadingMoreFilesThanItHoldsGetTheirOwn) {
   for (int w = 0; w < 4; ++w) EXPECT_EQ(wrong[w], 0) << "thread " << w;
 }
 
-}  // namespace
+}  // namespace file_filter_model_cache_test
 }  // namespace recruit

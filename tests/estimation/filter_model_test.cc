@@ -18,7 +18,7 @@
 #include "estimation/population_chain.h"
 
 namespace recruit {
-namespace {
+namespace file_filter_model_test {
 
 TEST(EstimationBroadcast, TwoStateMatrixIsTheClosedForm) {
   const auto b = estimation::BroadcastTransitionModel::TwoState(0.5);
@@ -349,5 +349,5 @@ TEST(EstimationFilterLog, FileStreamMatchesInMemoryText) {
   std::remove(path.c_str());
 }
 
-}  // namespace
+}  // namespace file_filter_model_test
 }  // namespace recruit

@@ -6,7 +6,7 @@
 #include "test_util.h"
 
 namespace recruit {
-namespace {
+namespace file_kalman_filter_test {
 
 // m = 2, r = 1: X^ = (6, 4), P = 2 [1 -1; -1 1], N = 10,
 // A = [0.9 0.3; 0.1 0.7], H = [0 1], R = 0.5, y = 4.
@@ -271,5 +271,5 @@ TEST(EstimationKalman, ZeroTransitNoiseIsTheConstantFilterBitForBit) {
   EXPECT_GT((a->estimate() - c->estimate()).cwiseAbs().maxCoeff(), 1e-6);
 }
 
-}  // namespace
+}  // namespace file_kalman_filter_test
 }  // namespace recruit

@@ -12,7 +12,7 @@
 #include "estimation/population_kalman_filter.h"
 
 namespace recruit {
-namespace {
+namespace file_kalman_sparse_test {
 
 // m states, N = 60, a force sensor (state i gives 0.45 i / (m - 1) per unit), P0 a random
 // PSD matrix (projected onto 1^T P0 = 0 by the filter), x0 a random point of the simplex.
@@ -189,11 +189,11 @@ TEST(EstimationKalmanSparse, IdentifiedBroadcastModels) {
   }
 }
 
-}  // namespace
+}  // namespace file_kalman_sparse_test
 }  // namespace recruit
 
 namespace recruit {
-namespace {
+namespace file_kalman_sparse_test {
 
 // The heating / cooling chain: valid, column-stochastic for any (p_on, p_off), at most 3
 // nonzeros per column, and its sparse pattern holds every nonzero of the dense matrix.
@@ -393,5 +393,5 @@ TEST(EstimationKalmanSparse, CreatedFiltersCopyAndMove) {
   EXPECT_NEAR(e.estimate().sum(), 60.0, 1e-9);
 }
 
-}  // namespace
+}  // namespace file_kalman_sparse_test
 }  // namespace recruit

@@ -12,7 +12,7 @@
 #include "test_util.h"
 
 namespace recruit {
-namespace {
+namespace file_kalman_statistics_test {
 
 using testing_util::ThreeStateModel;
 
@@ -277,5 +277,5 @@ TEST(EstimationKalmanStatistics, MillionStepsKeepSumSymmetryAndPsd) {
   EXPECT_TRUE(kf->estimate().allFinite());
 }
 
-}  // namespace
+}  // namespace file_kalman_statistics_test
 }  // namespace recruit

@@ -10,7 +10,7 @@
 #include "test_util.h"
 
 namespace recruit {
-namespace {
+namespace file_population_chain_test {
 
 Eigen::Matrix3d A3() {
   Eigen::Matrix3d A;
@@ -229,5 +229,5 @@ TEST(EstimationChain, CountStateVectors) {
   EXPECT_EQ(estimation::CountStateVectors(1000, 10, 200000), 200001u);      // saturates
 }
 
-}  // namespace
+}  // namespace file_population_chain_test
 }  // namespace recruit

@@ -14,7 +14,7 @@
 #include <string>
 
 namespace recruit {
-namespace {
+namespace file_shortest_double_test {
 
 std::string Reference(double v) {
   char buf[64];
@@ -88,5 +88,5 @@ TEST(EstimationShortestDouble, MatchesToCharsOnSpecialValues) {
   }
 }
 
-}  // namespace
+}  // namespace file_shortest_double_test
 }  // namespace recruit

@@ -30,7 +30,7 @@
 #include "tests/export/package_loader.h"
 
 namespace recruit::exporter {
-namespace {
+namespace file_auto_loop_test {
 
 using testing::FloatDeviation;
 using testing::FreshDir;
@@ -588,5 +588,5 @@ TEST(ExportAutoLoopM4, CrossCompilesAndReplaysUnderQemu) {
   }
 }
 
-}  // namespace
+}  // namespace file_auto_loop_test
 }  // namespace recruit::exporter

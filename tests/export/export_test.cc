@@ -22,7 +22,7 @@
 #include "tests/export/package_loader.h"
 
 namespace recruit::exporter {
-namespace {
+namespace file_export_test {
 
 using testing::FloatDeviation;
 using testing::FreshDir;
@@ -501,11 +501,11 @@ TEST(ExportM4, TransitNoiseReplaysUnderQemuAsOnTheHost) {
   EXPECT_GE(target.identical, 0);
 }
 
-}  // namespace
+}  // namespace file_export_test
 }  // namespace recruit::exporter
 
 namespace recruit::exporter {
-namespace {
+namespace file_export_test {
 
 // The C controller has no census: a task that asks for one is refused, naming the key, rather
 // than exported without it.
@@ -520,5 +520,5 @@ TEST(ExportRefuses, ATaskWithACensus) {
   EXPECT_TRUE(ExportController(task, sim::RunOptions{}, Precision::kDouble).ok());
 }
 
-}  // namespace
+}  // namespace file_export_test
 }  // namespace recruit::exporter

@@ -16,7 +16,7 @@ extern "C" {
 }
 
 namespace recruit::exporter {
-namespace {
+namespace file_unit_package_test {
 
 TEST(UnitPackage, IsTheTemplateCompiledHere) {
   const std::vector<ExportedFile> files = UnitPackage();
@@ -141,5 +141,5 @@ TEST(UnitPackage, TheNumberSwitchingIsBinomialWithTheBroadcastProbability) {
   for (int k = 0; k < 100; ++k) EXPECT_EQ(recruit_pcg32_next(&a.rng), recruit_pcg32_next(&b.rng));
 }
 
-}  // namespace
+}  // namespace file_unit_package_test
 }  // namespace recruit::exporter

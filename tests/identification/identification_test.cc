@@ -19,7 +19,7 @@
 #include "tests/plugin/mujoco_util.h"
 
 namespace recruit::identification {
-namespace {
+namespace file_identification_test {
 
 TransientChain KnownChain() {
   // K = 3 (m = 8): a delayed rise over heat1..3 and a slower fall over cool1..3.
@@ -218,11 +218,11 @@ TEST(Identification, RejectsTooShortLogsAndBadOptions) {
   EXPECT_FALSE(IdentifyTransientModel(log, opt).ok());
 }
 
-}  // namespace
+}  // namespace file_identification_test
 }  // namespace recruit::identification
 
 namespace recruit::identification {
-namespace {
+namespace file_identification_test {
 
 std::string TempPath(const std::string& name) {
   return (std::filesystem::temp_directory_path() / ("recruit_control_" + name)).string();
@@ -316,5 +316,5 @@ TEST(Identification, BenchFitPredictsHeldOutForceBetterThanTheTwoStateModel) {
   EXPECT_NEAR(fit->chain.force[fit->chain.cold()], 0.0, 0.02);
 }
 
-}  // namespace
+}  // namespace file_identification_test
 }  // namespace recruit::identification

@@ -18,7 +18,7 @@
 #include "identification/transient_chain.h"
 
 namespace recruit::identification {
-namespace {
+namespace file_length_model_test {
 
 using namespace ::recruit::control;  // NOLINT: the controller side these tests check against
 
@@ -160,5 +160,5 @@ TEST(LengthModel, AFixedOutputModelIsInconsistentOnTheSameMovingTendon) {
   EXPECT_GT(worst, 0.21);
 }
 
-}  // namespace
+}  // namespace file_length_model_test
 }  // namespace recruit::identification

@@ -10,7 +10,7 @@
 #include "identification/plant_record.h"
 
 namespace recruit::identification {
-namespace {
+namespace file_model_cache_test {
 
 namespace fs = std::filesystem;
 
@@ -109,5 +109,5 @@ TEST(ModelCache, ACachedModelIsTheLimbsItWasIdentifiedOn) {
   fs::remove_all(dir);
 }
 
-}  // namespace
+}  // namespace file_model_cache_test
 }  // namespace recruit::identification

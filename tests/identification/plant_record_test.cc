@@ -14,7 +14,7 @@
 #include "control/on_count_estimator.h"
 
 namespace recruit::identification {
-namespace {
+namespace file_plant_record_test {
 
 using namespace ::recruit::control;  // NOLINT: the controller side these tests check against
 
@@ -76,5 +76,5 @@ TEST(PlantRecord, FactoryRefusesAModelOfAnotherPlantAndAcceptsOneWithoutARecord)
   std::remove(tmp.c_str());
 }
 
-}  // namespace
+}  // namespace file_plant_record_test
 }  // namespace recruit::identification

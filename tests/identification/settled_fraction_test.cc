@@ -12,7 +12,7 @@
 #include "plugin/unit_model.h"
 
 namespace recruit::identification {
-namespace {
+namespace file_settled_fraction_test {
 
 // At steady state no phase changes, so latent heat drops out: an on unit heated from rest sits
 // on the major heating branch at the temperature its Joule power holds, shifted by its stress:
@@ -116,5 +116,5 @@ TEST(SettledFraction, IdentifiedHotStatePullsWhatTheBenchsSettledUnitsPull) {
   EXPECT_NEAR(H[0], log.force[2 * settle] / log.num_units, 1e-3 * measured);
 }
 
-}  // namespace
+}  // namespace file_settled_fraction_test
 }  // namespace recruit::identification

@@ -13,7 +13,7 @@
 #include "plot/stability_map.h"
 
 namespace recruit::plot {
-namespace {
+namespace file_column_figure_test {
 
 namespace fs = std::filesystem;
 
@@ -168,5 +168,5 @@ TEST(StabilityMap, ParsesSweepsDatAndColoursEachCellByItsOvershoot) {
   EXPECT_FALSE(ParseStabilityDat("", "s.dat").ok());
 }
 
-}  // namespace
+}  // namespace file_column_figure_test
 }  // namespace recruit::plot

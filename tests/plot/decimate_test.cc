@@ -11,7 +11,7 @@
 #include "common/rng.h"
 
 namespace recruit::plot {
-namespace {
+namespace file_decimate_test {
 
 TEST(Decimate, KeepsEachBucketsExtremesAndEnds) {
   Rng rng(5);
@@ -64,5 +64,5 @@ TEST(Decimate, BandKeepsItsEnvelope) {
   EXPECT_EQ(d.x.back(), 19999);
 }
 
-}  // namespace
+}  // namespace file_decimate_test
 }  // namespace recruit::plot

@@ -8,7 +8,7 @@
 #include <string>
 
 namespace recruit::plot {
-namespace {
+namespace file_layout_test {
 
 // Data that end in the top right corner: where a legend inside the axes would usually sit.
 Axes RampToTopRight(int n = 500) {
@@ -166,5 +166,5 @@ TEST(Layout, TextAndLinesScaleWithTheCanvas) {
   EXPECT_FALSE(big.legend_below);
 }
 
-}  // namespace
+}  // namespace file_layout_test
 }  // namespace recruit::plot

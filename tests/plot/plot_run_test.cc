@@ -11,7 +11,7 @@
 #include "common/atomic_file.h"
 
 namespace recruit::plot {
-namespace {
+namespace file_plot_run_test {
 
 namespace fs = std::filesystem;
 
@@ -100,5 +100,5 @@ TEST(PlotRun, BadInputIsNamedAndWritesNothing) {
   }
 }
 
-}  // namespace
+}  // namespace file_plot_run_test
 }  // namespace recruit::plot

@@ -12,7 +12,7 @@
 #include <vector>
 
 namespace recruit::plot {
-namespace {
+namespace file_render_test {
 
 Figure BandFigure(double mean, double sd) {
   Axes a;
@@ -243,5 +243,5 @@ TEST(Render, CurvesSitWhereTheirTickLabelsSayOverChangingRanges) {
   }
 }
 
-}  // namespace
+}  // namespace file_render_test
 }  // namespace recruit::plot

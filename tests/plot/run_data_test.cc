@@ -11,7 +11,7 @@
 #include "plot/run_figures.h"
 
 namespace recruit::plot {
-namespace {
+namespace file_run_data_test {
 
 const char* kHeader =
     "time,reference,measured,angle,b.force,b.force_reference,b.true_on,b.estimated_on,"
@@ -143,5 +143,5 @@ TEST(RunData, BadCsvIsNamed) {
   }
 }
 
-}  // namespace
+}  // namespace file_run_data_test
 }  // namespace recruit::plot

@@ -12,7 +12,7 @@
 #include "common/rng.h"
 
 namespace recruit::plot {
-namespace {
+namespace file_ticks_test {
 
 // The mantissa of a 1-2-5 step, recomputed from its decimal digits (not from NiceStep's code).
 bool IsOneTwoFive(double step) {
@@ -92,5 +92,5 @@ TEST(Ticks, DegenerateAndNonFiniteRangesStillGiveAnAxis) {
   EXPECT_EQ(nan.hi, 1);
 }
 
-}  // namespace
+}  // namespace file_ticks_test
 }  // namespace recruit::plot

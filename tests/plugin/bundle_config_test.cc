@@ -6,7 +6,7 @@
 #include <gtest/gtest.h>
 
 namespace recruit::sma {
-namespace {
+namespace file_bundle_config_test {
 
 using ::testing::HasSubstr;
 
@@ -147,5 +147,5 @@ TEST(BundleConfig, KeysListsEveryDocumentedKey) {
   }
 }
 
-}  // namespace
+}  // namespace file_bundle_config_test
 }  // namespace recruit::sma

@@ -14,7 +14,7 @@
 #include "common/rng.h"
 
 namespace recruit::sma {
-namespace {
+namespace file_bundle_test {
 
 SmaBundle MakeBundle(int units, double merge_t, double merge_xi) {
   auto c = BundleConfig::FromText("b", "units=" + std::to_string(units));
@@ -548,5 +548,5 @@ TEST(SmaBundle, RejectsProbabilitiesOutsideUnitInterval) {
   EXPECT_EQ(b.OnCount(s.data()), 0);
 }
 
-}  // namespace
+}  // namespace file_bundle_test
 }  // namespace recruit::sma

@@ -13,7 +13,7 @@
 #include "plugin/bundle.h"
 
 namespace recruit::sma {
-namespace {
+namespace file_census_test {
 
 using ::testing::HasSubstr;
 
@@ -212,5 +212,5 @@ TEST(Census, ABlockCopiedMidPulseContinuesExactly) {
   EXPECT_EQ(b.LastCensus(s.data()).number, 1);
 }
 
-}  // namespace
+}  // namespace file_census_test
 }  // namespace recruit::sma

@@ -17,7 +17,7 @@
 #include "plugin/unit_model.h"
 
 namespace recruit::sma {
-namespace {
+namespace file_cohort_batch_test {
 
 UnitModel MakeModel(const std::string& text) {
   auto c = BundleConfig::FromText("b", text);
@@ -418,5 +418,5 @@ TEST(MergeOrder, IsStdSortsOrderForDistinctKeysAndGivesUpOnTies) {
   EXPECT_GT(gave_up, 1000);
 }
 
-}  // namespace
+}  // namespace file_cohort_batch_test
 }  // namespace recruit::sma

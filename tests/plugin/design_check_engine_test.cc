@@ -13,7 +13,7 @@
 #include "tests/plugin/mujoco_util.h"
 
 namespace recruit::sma {
-namespace {
+namespace file_design_check_engine_test {
 
 using testing::Bench;
 using testing::BenchXml;
@@ -84,5 +84,5 @@ TEST(DesignCheck, ShippedModelsLoadWithoutDesignWarnings) {
   }
 }
 
-}  // namespace
+}  // namespace file_design_check_engine_test
 }  // namespace recruit::sma

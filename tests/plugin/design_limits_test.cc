@@ -14,7 +14,7 @@
 #include "plugin/unit_model.h"
 
 namespace recruit::sma {
-namespace {
+namespace file_design_limits_test {
 
 using ::testing::HasSubstr;
 
@@ -208,5 +208,5 @@ TEST(DesignLimits, GoodConfigurationsLoad) {
   EXPECT_THAT(DesignWarning(*hard), HasSubstr("above Dynalloy's long-life 172 MPa"));
 }
 
-}  // namespace
+}  // namespace file_design_limits_test
 }  // namespace recruit::sma

@@ -18,7 +18,7 @@
 #include "tests/plugin/mujoco_util.h"
 
 namespace recruit::sma {
-namespace {
+namespace file_engine_plugin_test {
 
 using ::testing::AllOf;
 using testing::Bench;
@@ -549,5 +549,5 @@ TEST(EnginePlugin, HeldCtrlBroadcastsAtThePeriodWithBinomialCounts) {
   check(c3, 1 - 0.7 * 0.7 * 0.7);
 }
 
-}  // namespace
+}  // namespace file_engine_plugin_test
 }  // namespace recruit::sma

@@ -8,7 +8,7 @@
 #include "tests/plugin/mujoco_util.h"
 
 namespace recruit::sma {
-namespace {
+namespace file_failure_engine_test {
 
 using testing::Bench;
 using testing::BenchXml;
@@ -87,5 +87,5 @@ TEST(EngineFailures, CopyAndResetStayExactWithHazardsAndFatigue) {
   for (size_t i = 0; i < first.size(); ++i) ASSERT_EQ(first[i], again[i]) << "step " << i;
 }
 
-}  // namespace
+}  // namespace file_failure_engine_test
 }  // namespace recruit::sma

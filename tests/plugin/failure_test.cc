@@ -13,7 +13,7 @@
 #include "plugin/bundle.h"
 
 namespace recruit::sma {
-namespace {
+namespace file_failure_test {
 
 using ::testing::HasSubstr;
 
@@ -301,5 +301,5 @@ TEST(Failures, BlockCopyContinuesExactlyAndResetRestores) {
   EXPECT_EQ(std::memcmp(s.data(), fresh.data(), s.size() * sizeof(double)), 0);
 }
 
-}  // namespace
+}  // namespace file_failure_test
 }  // namespace recruit::sma

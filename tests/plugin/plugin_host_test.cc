@@ -17,7 +17,7 @@
 #include "tests/plugin/mujoco_util.h"
 
 namespace recruit::sma {
-namespace {
+namespace file_plugin_host_test {
 
 using testing::DataPtr;
 using ::testing::HasSubstr;
@@ -374,7 +374,7 @@ TEST(FitCheck, FindsAnExtremeInsideTheRangeOfOneJoint) {
   EXPECT_NEAR(fits[0].length_min, length(180 - 70), 1e-12);
 }
 
-}  // namespace
+}  // namespace file_plugin_host_test
 // The fit warning's lists are cut between entries, never inside a joint's range.
 TEST(FitCheck, WarningListsAreCutBetweenEntries) {
   const std::string ranges = "shoulder 0..111.8 deg, elbow 0..114.4 deg, wrist -70..70 deg";

@@ -16,7 +16,7 @@
 #include "tests/plugin/mujoco_util.h"
 
 namespace recruit::sma {
-namespace {
+namespace file_plugin_state_test {
 
 using testing::DataPtr;
 using testing::Load;
@@ -131,5 +131,5 @@ TEST(PluginStateIsFinite, TextRoundTripOfTheStateContinuesBitForBit) {
   EXPECT_TRUE(SameBits(d->actuator_force, copy->actuator_force, m->nu));
 }
 
-}  // namespace
+}  // namespace file_plugin_state_test
 }  // namespace recruit::sma

@@ -14,7 +14,7 @@
 #include "plugin/bundle.h"
 
 namespace recruit::sma {
-namespace {
+namespace file_unit_model_accuracy_test {
 
 struct Errors {
   double force_units = 0;  // worst |bundle - reference| tension, in units' settled on-tension
@@ -220,5 +220,5 @@ TEST(UnitModelAccuracy, BinnedKeepsFailureModesApart) {
   EXPECT_GT(f.working, 0);
 }
 
-}  // namespace
+}  // namespace file_unit_model_accuracy_test
 }  // namespace recruit::sma

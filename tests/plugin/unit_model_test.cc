@@ -10,7 +10,7 @@
 #include <string>
 
 namespace recruit::sma {
-namespace {
+namespace file_unit_model_test {
 
 constexpr double kPi = 3.14159265358979323846;
 
@@ -557,5 +557,5 @@ TEST(UnitModelCreate, RejectsInconsistentTransformationTemperatures) {
   EXPECT_FALSE(UnitModel::Create(p).ok());
 }
 
-}  // namespace
+}  // namespace file_unit_model_test
 }  // namespace recruit::sma

@@ -13,7 +13,7 @@
 #include "test_model.h"
 
 namespace recruit::render {
-namespace {
+namespace file_gl_backend_test {
 
 using ::testing::HasSubstr;
 
@@ -72,5 +72,5 @@ TEST(GlBackendTest, EglRendersANonBlankFrameWhenAvailable) {
   std::cout << out.substr(0, out.find('\n', out.find("EGL renderer")) + 1);
 }
 
-}  // namespace
+}  // namespace file_gl_backend_test
 }  // namespace recruit::render

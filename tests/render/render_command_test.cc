@@ -12,7 +12,7 @@
 #include <string>
 
 namespace recruit::render {
-namespace {
+namespace file_render_command_test {
 
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
@@ -135,5 +135,5 @@ TEST_F(RenderCommandTest, CameraAndFreeCameraOptionsExcludeEachOther) {
   EXPECT_THAT(r.text, HasSubstr("excludes"));
 }
 
-}  // namespace
+}  // namespace file_render_command_test
 }  // namespace recruit::render

@@ -12,7 +12,7 @@
 #include "test_model.h"
 
 namespace recruit::render {
-namespace {
+namespace file_scene_renderer_test {
 
 using testing::DataPtr;
 using ::testing::HasSubstr;
@@ -272,5 +272,5 @@ TEST(HeatColourTest, BlueWhenColdRedWhenHotMonotoneBetween) {
   EXPECT_EQ(HeatColour(std::nan("")), cold);  // NaN reads as cold
 }
 
-}  // namespace
+}  // namespace file_scene_renderer_test
 }  // namespace recruit::render

@@ -20,7 +20,7 @@
 #include "test_model.h"
 
 namespace recruit::render {
-namespace {
+namespace file_telemetry_plots_pixels_test {
 
 struct Image {
   int w = 0, h = 0;
@@ -286,5 +286,5 @@ TEST(TelemetryPlotsPixelsTest, CurvesSitWhereTheirTickLabelsSayAtEveryStill) {
   EXPECT_GT(forces_checked, 0);  // the 4K frame shows all three panels
 }
 
-}  // namespace
+}  // namespace file_telemetry_plots_pixels_test
 }  // namespace recruit::render

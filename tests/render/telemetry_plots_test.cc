@@ -15,7 +15,7 @@
 #include "test_model.h"
 
 namespace recruit::render {
-namespace {
+namespace file_telemetry_plots_test {
 
 // A stand-in for MuJoCo's font: about what mjr_makeContext gives at `scale` percent (16 px high
 // at 100 % is about 17 px; 18 keeps the test conservative), 0.55 em per character.
@@ -279,5 +279,5 @@ TEST(FontScaleTest, GrowsWithTheFrameFrom50To300Percent) {
   }
 }
 
-}  // namespace
+}  // namespace file_telemetry_plots_test
 }  // namespace recruit::render

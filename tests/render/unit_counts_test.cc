@@ -15,7 +15,7 @@
 #include "render/telemetry_plots.h"
 
 namespace recruit::render {
-namespace {
+namespace file_unit_counts_test {
 
 std::string Bench(const std::string& config) {
   std::ifstream in(RECRUIT_SOURCE_DIR "/models/isometric_bench.xml");
@@ -101,5 +101,5 @@ TEST(UnitCounts, UnitsPanelShowsWorkingAgainstTotal) {
   EXPECT_EQ(lines.back().style, LineStyle::kStairs);
 }
 
-}  // namespace
+}  // namespace file_unit_counts_test
 }  // namespace recruit::render

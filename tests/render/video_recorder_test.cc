@@ -17,7 +17,7 @@
 #include "test_model.h"
 
 namespace recruit::render {
-namespace {
+namespace file_video_recorder_test {
 
 namespace fs = std::filesystem;
 using testing::DataPtr;
@@ -274,5 +274,5 @@ TEST(PaletteTest, ReservedAndDominantColoursMapExactly) {
   }
 }
 
-}  // namespace
+}  // namespace file_video_recorder_test
 }  // namespace recruit::render

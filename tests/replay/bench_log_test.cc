@@ -4,7 +4,7 @@
 #include <gtest/gtest.h>
 
 namespace recruit {
-namespace {
+namespace file_bench_log_test {
 
 constexpr char kHeader[] =
     "time,reference,angle,a.force,a.p_on,a.p_off,b.p_on,b.p_off,control_instant,a.sensed_force,"
@@ -81,5 +81,5 @@ TEST(BenchLog, SelectsABundleByName) {
   EXPECT_NE(wrong.error().find("no bundle 'c' in the log; it has a, b"), std::string::npos);
 }
 
-}  // namespace
+}  // namespace file_bench_log_test
 }  // namespace recruit

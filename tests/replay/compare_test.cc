@@ -7,7 +7,7 @@
 #include <random>
 
 namespace recruit::replay {
-namespace {
+namespace file_compare_test {
 
 TEST(ReplayLag, RecoversAKnownShiftOfASmoothSignal) {
   // b(t) = sin(0.3 t); a(t) = b(t - lag): the parabola through the three best shifts finds a lag
@@ -85,5 +85,5 @@ TEST(ReplayCriterion, NeedsThreeRunsOfTheLogsLength) {
   EXPECT_FALSE(CompareSignal({1, 2}, {{1, 2}, {1, 2}, {1}}, 1, 1, Criterion{}).ok());
 }
 
-}  // namespace
+}  // namespace file_compare_test
 }  // namespace recruit::replay

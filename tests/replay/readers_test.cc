@@ -17,7 +17,7 @@
 #include "sim/run_task.h"
 
 namespace recruit {
-namespace {
+namespace file_readers_test {
 
 namespace fs = std::filesystem;
 const std::string kRoot = RECRUIT_SOURCE_DIR;
@@ -93,5 +93,5 @@ TEST(BenchLogReaders, IdentifyReadsItAsASwitchingLog) {
   fs::remove(older);
 }
 
-}  // namespace
+}  // namespace file_readers_test
 }  // namespace recruit

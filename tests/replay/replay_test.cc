@@ -17,7 +17,7 @@
 #include "sim/run_task.h"
 
 namespace recruit::replay {
-namespace {
+namespace file_replay_test {
 
 const std::string kRoot = RECRUIT_SOURCE_DIR;
 namespace fs = std::filesystem;
@@ -113,5 +113,5 @@ TEST(Replay, ALogWithoutTheTasksBundlesIsRefused) {
       << plan.error();
 }
 
-}  // namespace
+}  // namespace file_replay_test
 }  // namespace recruit::replay

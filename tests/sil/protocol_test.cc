@@ -12,7 +12,7 @@
 #include <random>
 
 namespace recruit::sil {
-namespace {
+namespace file_protocol_test {
 
 std::string Hex(const std::vector<std::uint8_t>& b) {
   std::string s;
@@ -201,5 +201,5 @@ TEST(SilProtocol, StreamDeframerRecoversFramesFromJunkAndSplitReads) {
   }
 }
 
-}  // namespace
+}  // namespace file_protocol_test
 }  // namespace recruit::sil

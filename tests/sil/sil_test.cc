@@ -17,7 +17,7 @@
 #include <string>
 #include <thread>
 
-namespace {
+namespace file_sil_test {
 
 namespace fs = std::filesystem;
 const std::string kRecruit = RECRUIT_BIN;
@@ -290,4 +290,4 @@ TEST(Sil, BadOptionsExitTwo) {
   EXPECT_EQ(Shell(base + "--bind 999.0.0.1 --connect-timeout 0.2 2>/dev/null"), 4);
 }
 
-}  // namespace
+}  // namespace file_sil_test

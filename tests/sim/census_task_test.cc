@@ -16,7 +16,7 @@
 #include "sim/task.h"
 
 namespace recruit::sim {
-namespace {
+namespace file_census_task_test {
 
 namespace fs = std::filesystem;
 const std::string kModel = std::string(RECRUIT_SOURCE_DIR) + "/models/isometric_bench.xml";
@@ -195,5 +195,5 @@ TEST(CensusTask, BadCensusPeriodsAreNamed) {
   EXPECT_NE(refused.error().find("kalman-failures"), std::string::npos) << refused.error();
 }
 
-}  // namespace
+}  // namespace file_census_task_test
 }  // namespace recruit::sim

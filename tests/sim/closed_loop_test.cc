@@ -20,7 +20,7 @@
 #include "tests/plugin/mujoco_util.h"
 
 namespace recruit::sim {
-namespace {
+namespace file_closed_loop_test {
 
 namespace fs = std::filesystem;
 using namespace ::recruit::sweep;  // NOLINT: the sweep code under test (src/sweep)
@@ -622,5 +622,5 @@ TEST(ClosedLoop, AnObserverThatDrawsGetsTheFullModel) {
   mj_deleteModel(m);
 }
 
-}  // namespace
+}  // namespace file_closed_loop_test
 }  // namespace recruit::sim

@@ -16,7 +16,7 @@
 #include "sim/format_g.h"
 
 namespace recruit::sim {
-namespace {
+namespace file_csv_format_test {
 
 std::string Fast(double x, int precision) {
   char buf[kFormatGMax];
@@ -195,5 +195,5 @@ TEST(CsvStepWriter, WritesThePreviousWritersRowsByteForByte) {
   std::filesystem::remove(path);
 }
 
-}  // namespace
+}  // namespace file_csv_format_test
 }  // namespace recruit::sim

@@ -12,7 +12,7 @@
 #include "sim/task.h"
 
 namespace recruit::sim {
-namespace {
+namespace file_failure_task_test {
 
 namespace fs = std::filesystem;
 const std::string kRoot = RECRUIT_SOURCE_DIR;
@@ -149,5 +149,5 @@ TEST(FailureTask, BadKeysAreNamedWithTheirValueAndWhatIsAllowed) {
   }
 }
 
-}  // namespace
+}  // namespace file_failure_task_test
 }  // namespace recruit::sim

@@ -8,7 +8,7 @@
 #include <cmath>
 
 namespace recruit::sim {
-namespace {
+namespace file_force_sensor_test {
 
 struct Moments {
   double mean = 0, var = 0;
@@ -105,5 +105,5 @@ TEST(SensorParams, FromJsonValidates) {
   EXPECT_FALSE(SensorParams::FromJson(nlohmann::json::array(), "t.json.sensor").ok());
 }
 
-}  // namespace
+}  // namespace file_force_sensor_test
 }  // namespace recruit::sim

@@ -15,7 +15,7 @@
 #include "tests/plugin/mujoco_util.h"
 
 namespace recruit::sim {
-namespace {
+namespace file_holding_test {
 
 const std::string kRoot = RECRUIT_SOURCE_DIR;
 namespace fs = std::filesystem;
@@ -161,5 +161,5 @@ TEST(Holding, StiffnessIsMinusTheTorqueSlopeAtHeldCounts) {
   EXPECT_GT(geometric, 0.01);
 }
 
-}  // namespace
+}  // namespace file_holding_test
 }  // namespace recruit::sim

@@ -17,7 +17,7 @@
 #include "tests/plugin/mujoco_util.h"
 
 namespace recruit::sim {
-namespace {
+namespace file_joint_loop_test {
 
 namespace fs = std::filesystem;
 const std::string kRoot = RECRUIT_SOURCE_DIR;
@@ -307,7 +307,7 @@ TEST(JointLoop, TheSummaryCarriesWhatLoadingTheModelWarnedOf) {
   fs::remove_all(dir);
 }
 
-}  // namespace
+}  // namespace file_joint_loop_test
 // Prices: the response time ratio to the fastest, times 10 per further driven joint crossed.
 TEST(JointLoop, BundlePricesChargeSlowAndMultiJointBundles) {
   auto response = [](double t63) {

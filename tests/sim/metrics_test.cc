@@ -9,7 +9,7 @@
 #include "sim/metrics_stream.h"
 
 namespace recruit::sim {
-namespace {
+namespace file_metrics_test {
 
 std::vector<double> Times(double dt, double T) {
   std::vector<double> t;
@@ -142,11 +142,11 @@ TEST(Metrics, NeesOfGaussianErrorsWithTrueVarianceIsNearOne) {
   EXPECT_NEAR(ScoreEstimator(est, truth, var).mean_nees, 1.0, 0.01);
 }
 
-}  // namespace
+}  // namespace file_metrics_test
 }  // namespace recruit::sim
 
 namespace recruit::sim {
-namespace {
+namespace file_metrics_test {
 
 // The streaming accumulators against the pure functions on the same signals, to the bit: noisy
 // step responses that ring through the band (so settling is decided late), a step with no
@@ -205,7 +205,7 @@ TEST(MetricsStream, AccumulatorsEqualThePureFunctionsExactly) {
   EXPECT_EQ(sw.Rate(60, 250.0), SwitchingRate(on, 60, 250.0));
 }
 
-}  // namespace
+}  // namespace file_metrics_test
 // A push inside a step's hold ends the step's scored window there; the push is scored from its
 // start to the next event. A first-order step (tau 1 s) with a push at t = 10 that deflects it by
 // 0.3 exp(-(t - 10)) afterwards: the step settles (no overshoot, tau ln 10), and the push's peak

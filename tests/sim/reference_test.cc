@@ -3,7 +3,7 @@
 #include <gtest/gtest.h>
 
 namespace recruit::sim {
-namespace {
+namespace file_reference_test {
 
 TEST(Reference, StepsHoldEachValueFromItsTime) {
   auto r = Reference::Steps(1.0, {2.0, 5.0}, {3.0, -1.0});
@@ -74,5 +74,5 @@ TEST(Reference, BadInputsNameTheField) {
   EXPECT_NE(d.error().find("f.end"), std::string::npos) << d.error();
 }
 
-}  // namespace
+}  // namespace file_reference_test
 }  // namespace recruit::sim

@@ -9,7 +9,7 @@
 #include <string>
 
 namespace recruit::sim {
-namespace {
+namespace file_response_store_test {
 
 // The two-state chain (broadcast_transition_model.h): A = [[1 - p_on, p_off], [p_on, 1 - p_off]].
 estimation::BroadcastTransitionModel TwoState() {
@@ -70,5 +70,5 @@ TEST(ResponseStore, GivesThePredictionBitForBitAndMissesOnAnyChangedInput) {
   std::filesystem::remove_all(folder);
 }
 
-}  // namespace
+}  // namespace file_response_store_test
 }  // namespace recruit::sim

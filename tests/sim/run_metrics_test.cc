@@ -19,7 +19,7 @@
 #include "sweep/table.h"
 
 namespace recruit::sim {
-namespace {
+namespace file_run_metrics_test {
 
 namespace fs = std::filesystem;
 using namespace ::recruit::sweep;  // NOLINT: the sweep code under test (src/sweep)
@@ -205,5 +205,5 @@ TEST(RunMetricsTable, SweepTableHasEveryTabledMetricsMean) {
   fs::remove_all(dir);
 }
 
-}  // namespace
+}  // namespace file_run_metrics_test
 }  // namespace recruit::sim

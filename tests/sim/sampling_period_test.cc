@@ -16,7 +16,7 @@
 #include "sweep/sweep_file.h"
 
 namespace recruit {
-namespace {
+namespace file_sampling_period_test {
 
 std::string Number(double x) {
   if (std::isnan(x)) return "NaN";  // not JSON: the task's parser refuses it anyway
@@ -63,5 +63,5 @@ TEST(SamplingPeriod, EveryPlaceAcceptsTheSameDt) {
   EXPECT_EQ(control::ControllerParams{}.dT, control::kDefaultDT);
 }
 
-}  // namespace
+}  // namespace file_sampling_period_test
 }  // namespace recruit

@@ -10,7 +10,7 @@
 #include "sim/task.h"
 
 namespace recruit::sim {
-namespace {
+namespace file_saturation_test {
 
 namespace fs = std::filesystem;
 const std::string kRoot = RECRUIT_SOURCE_DIR;
@@ -63,5 +63,5 @@ TEST(Saturation, OutOfReachIsReportedAndTheLoopRecovers) {
   EXPECT_TRUE(whole->steps[1].settled);  // 60 units reach 24 N
 }
 
-}  // namespace
+}  // namespace file_saturation_test
 }  // namespace recruit::sim

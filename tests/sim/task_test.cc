@@ -8,7 +8,7 @@
 #include <fstream>
 
 namespace recruit::sim {
-namespace {
+namespace file_task_test {
 
 namespace fs = std::filesystem;
 
@@ -175,5 +175,5 @@ TEST_F(TaskFileTest, SameAgonistAndAntagonist) {
               {".antagonist", "must differ"});
 }
 
-}  // namespace
+}  // namespace file_task_test
 }  // namespace recruit::sim

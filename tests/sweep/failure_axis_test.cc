@@ -11,7 +11,7 @@
 #include "sweep/sweep_report.h"
 
 namespace recruit::sweep {
-namespace {
+namespace file_failure_axis_test {
 
 namespace fs = std::filesystem;
 
@@ -91,5 +91,5 @@ TEST(FailureAxis, TrackingFigureGivesTheRecommendedCellsRmse) {
   EXPECT_EQ(tracking->panels[0].y_label, "tracking RMSE at dT (N)");
 }
 
-}  // namespace
+}  // namespace file_failure_axis_test
 }  // namespace recruit::sweep

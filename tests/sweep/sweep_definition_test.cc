@@ -9,7 +9,7 @@
 #include "sweep/sweep.h"
 
 namespace recruit::sweep {
-namespace {
+namespace file_sweep_definition_test {
 
 namespace fs = std::filesystem;
 
@@ -79,5 +79,5 @@ TEST(SweepDefinition, AShardRunsAndWritesItsManifest) {
   fs::remove_all(out);
 }
 
-}  // namespace
+}  // namespace file_sweep_definition_test
 }  // namespace recruit::sweep

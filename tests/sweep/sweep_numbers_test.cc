@@ -20,7 +20,7 @@
 #include "sweep/table.h"
 
 namespace recruit::sweep {
-namespace {
+namespace file_sweep_numbers_test {
 
 namespace fs = std::filesystem;
 using namespace ::recruit::sim;  // NOLINT: tasks and runs the sweeps are made of
@@ -225,5 +225,5 @@ TEST(SweepReportLinks, NoStabilityMapNoLink) {
   EXPECT_NE(md.find("| 0 | 0.29 | kalman | 0.29 | 0.30000000000000004 |"), std::string::npos) << md;
 }
 
-}  // namespace
+}  // namespace file_sweep_numbers_test
 }  // namespace recruit::sweep

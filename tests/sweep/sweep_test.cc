@@ -29,7 +29,7 @@
 #include "sweep/table.h"
 
 namespace recruit::sweep {
-namespace {
+namespace file_sweep_test {
 
 namespace fs = std::filesystem;
 using namespace ::recruit::sim;  // NOLINT: tasks and runs the sweeps are made of
@@ -711,5 +711,5 @@ TEST(SweepSensitivity, SyntheticPlantGivesItsClosedFormElasticities) {
   fs::remove_all(dir);
 }
 
-}  // namespace
+}  // namespace file_sweep_test
 }  // namespace recruit::sweep

@@ -11,7 +11,7 @@
 #include <random>
 
 namespace recruit::sweep {
-namespace {
+namespace file_tune_search_test {
 
 TEST(TuneWilson, MatchesItsClosedForms) {
   const double z = NormalQuantile(0.95);
@@ -272,5 +272,5 @@ TEST(TuneSearch, NothingMeetsEndsWithNoWindow) {
   EXPECT_EQ(t.size(), static_cast<size_t>(s.initial_points));
 }
 
-}  // namespace
+}  // namespace file_tune_search_test
 }  // namespace recruit::sweep

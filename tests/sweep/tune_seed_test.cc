@@ -11,7 +11,7 @@
 #include "sweep/tune.h"
 
 namespace recruit::sweep {
-namespace {
+namespace file_tune_seed_test {
 
 sim::RunSummary FakeRun(std::vector<double> step_overshoots, double settled, double peak_c = 50) {
   sim::RunSummary r;
@@ -195,5 +195,5 @@ TEST(TuneReport, SaysWhatLiesBeyondAnEdgeAndWhyNothingMeets) {
       << md;
 }
 
-}  // namespace
+}  // namespace file_tune_seed_test
 }  // namespace recruit::sweep
