@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <iterator>
@@ -117,6 +119,30 @@ TEST(FormatG, EqualsPrintfGAtTheEdges) {
   }
 }
 
+TEST(FormatG, DigitWordsMatchPrintf) {
+  // The CSV writer's tail digits (CsvStepWriter::Step): every 4-digit value, and 8-digit values
+  // (every one below 10^6, a stride through the rest and random ones; every v < 10^8 was checked
+  // once when they were written).
+  char ref[16];
+  for (std::uint32_t v = 0; v < 10000; ++v) {
+    const std::uint32_t w = format_g_detail::FourDigits(v);
+    std::snprintf(ref, sizeof ref, "%04u", v);
+    ASSERT_EQ(std::memcmp(&w, ref, 4), 0) << v;
+  }
+  std::mt19937_64 rng(3);
+  auto check8 = [&](std::uint32_t v) {
+    const std::uint64_t w = format_g_detail::EightDigits(v);
+    std::snprintf(ref, sizeof ref, "%08u", v);
+    return std::memcmp(&w, ref, 8) == 0;
+  };
+  for (std::uint32_t v = 0; v < 1000000; ++v) ASSERT_TRUE(check8(v)) << v;
+  for (std::uint32_t v = 1000000; v < 100000000; v += 37) ASSERT_TRUE(check8(v)) << v;
+  for (int i = 0; i < 1000000; ++i) {
+    const auto v = static_cast<std::uint32_t>(rng() % 100000000);
+    ASSERT_TRUE(check8(v)) << v;
+  }
+}
+
 // The row the previous writer formatted (fmt format strings), the reference.
 std::string ReferenceRow(const TelemetrySample& s) {
   std::string row;
@@ -192,6 +218,81 @@ TEST(CsvStepWriter, WritesThePreviousWritersRowsByteForByte) {
   auto text = ReadFile(path.string());
   ASSERT_TRUE(text.ok());
   EXPECT_TRUE(*text == expected);
+  std::filesystem::remove(path);
+}
+
+TEST(CsvStepWriter, SlowlyChangingValuesGiveThePreviousWritersRows) {
+  // Values that change a little each step, as a run's do (the writer then rewrites only a
+  // value's last digits): random walks of every relative step size, crossing zero (a sign
+  // change), decades (the point moves) and values whose digits end in zeros; values near the
+  // rounding midpoints of both precisions; the time on the 2 ms grid past 100 s; columns that
+  // change only at instants, NaN estimates among them.
+  const auto path = std::filesystem::temp_directory_path() / "recruit_csv_format_test_slow.csv";
+  CsvStepWriter writer(path.string());
+  TelemetrySample s;
+  s.bundles.resize(2);
+  s.bundles[0].actuator = "a";
+  s.bundles[1].actuator = "b";
+  std::mt19937_64 rng(17);
+  std::normal_distribution<double> n(0, 1);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::string expected =
+      "time,reference,measured,angle,a.force,a.force_reference,a.true_on,a.estimated_on,"
+      "a.estimated_on_std,a.p_on,a.p_off,a.mean_temperature,b.force,b.force_reference,"
+      "b.true_on,b.estimated_on,b.estimated_on_std,b.p_on,b.p_off,b.mean_temperature,"
+      "control_instant,a.sensed_force,b.sensed_force\n";
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  // The walks' values and step sizes (relative to a scale that changes now and then).
+  double walk[6] = {10.7, -0.003, 57.9, 0.5, 99.99, 1e-4};
+  double size[6] = {1e-6, 1e-5, 1e-4, 1e-3, 1e-7, 1e-2};
+  s.time = 97.5;
+  for (int step = 0; step < 40000; ++step) {
+    s.time += 0.002;
+    if (step % 500 == 0) {
+      for (double& z : size) z = std::pow(10.0, -1 - 8 * u(rng));
+    }
+    for (int i = 0; i < 6; ++i) {
+      walk[i] += size[i] * (std::abs(walk[i]) + 1e-3) * n(rng);
+      // Now and then a value with trailing zeros, or one at or next to a rounding midpoint.
+      if (rng() % 50 == 0) walk[i] = std::round(walk[i] * 100) / 100;
+      if (rng() % 200 == 0) {
+        const double scale =
+            std::pow(10.0, (rng() % 2 ? 5 : 8) - std::floor(std::log10(std::abs(walk[i]) + 1e-9)));
+        const double mid = (std::floor(walk[i] * scale) + 0.5) / scale;
+        walk[i] = rng() % 2 ? mid : std::nextafter(mid, rng() % 2 ? 1e300 : -1e300);
+      }
+    }
+    s.control_instant = step % 500 == 0;
+    s.measured = walk[0];
+    s.angle = walk[1];
+    s.reference = walk[3];
+    for (int k = 0; k < 2; ++k) {
+      auto& b = s.bundles[k];
+      b.force = k == 0 ? walk[0] : walk[4];
+      b.mean_temperature = k == 0 ? walk[2] : walk[5] + 20;
+      if (s.control_instant) {
+        b.force_reference = walk[3] * 10;
+        b.true_on = static_cast<int>(rng() % 61);
+        b.estimated_on = step % 1500 == 0 ? nan : 30 * u(rng);
+        b.estimated_on_std = 0.01 * u(rng);
+        b.p_on = u(rng) / 10;
+        b.p_off = step % 1000 ? 0.0 : -0.0;
+        b.sensed_force = 0.0125 * std::round(walk[0] / 0.0125);
+      }
+    }
+    ASSERT_TRUE(writer.OnStep(nullptr, nullptr, s).ok());
+    expected += ReferenceRow(s);
+  }
+  ASSERT_TRUE(writer.Finish().ok());
+  ASSERT_TRUE(writer.Commit().ok());
+  auto text = ReadFile(path.string());
+  ASSERT_TRUE(text.ok());
+  ASSERT_EQ(text->size(), expected.size());
+  // The first differing row, if any (a whole-file EXPECT_EQ would print 40,000 rows).
+  std::size_t at = 0;
+  while (at < expected.size() && (*text)[at] == expected[at]) ++at;
+  EXPECT_EQ(at, expected.size()) << "differs in row: "
+                                 << expected.substr(expected.rfind('\n', at) + 1, 200);
   std::filesystem::remove(path);
 }
 
