@@ -61,6 +61,20 @@ Eigen::VectorXd Exhaustive(const AllocationProblem& p, double eps) {
   return best;
 }
 
+// The active-set solution against the exhaustive one: the same cost and tensions, inside the box
+// (so exactly the tension of a held bundle, whose floor is its capacity).
+void ExpectMatchesExhaustive(const AllocationProblem& p, int trial) {
+  const Eigen::VectorXd got = AllocateTensions(p);
+  const Eigen::VectorXd want = Exhaustive(p, 1e-8);
+  ASSERT_EQ(got.size(), p.cap.size());
+  EXPECT_NEAR(AllocationCost(p, got), AllocationCost(p, want), 1e-12) << "trial " << trial;
+  for (int b = 0; b < got.size(); ++b) {
+    EXPECT_NEAR(got[b], want[b], 1e-6 * p.cap[b]) << "trial " << trial << " bundle " << b;
+    EXPECT_GE(got[b], p.floor[b]);
+    EXPECT_LE(got[b], p.cap[b]);
+  }
+}
+
 TEST(TorqueAllocation, MatchesTheExhaustiveSolverOnRandomLimbs) {
   std::mt19937_64 gen(20261126);
   std::uniform_real_distribution<double> u(-1, 1), pos(0.1, 1);
@@ -79,15 +93,7 @@ TEST(TorqueAllocation, MatchesTheExhaustiveSolverOnRandomLimbs) {
     }
     p.torque = Eigen::VectorXd(nj);
     for (int j = 0; j < nj; ++j) p.torque[j] = 0.8 * u(gen);
-    const Eigen::VectorXd got = AllocateTensions(p);
-    const Eigen::VectorXd want = Exhaustive(p, 1e-8);
-    ASSERT_EQ(got.size(), nb);
-    EXPECT_NEAR(AllocationCost(p, got), AllocationCost(p, want), 1e-12) << "trial " << trial;
-    for (int b = 0; b < nb; ++b) {
-      EXPECT_NEAR(got[b], want[b], 1e-6 * p.cap[b]) << "trial " << trial << " bundle " << b;
-      EXPECT_GE(got[b], p.floor[b]);
-      EXPECT_LE(got[b], p.cap[b]);
-    }
+    ExpectMatchesExhaustive(p, trial);
   }
 }
 
@@ -114,14 +120,7 @@ TEST(TorqueAllocation, HeldBundlesMatchTheExhaustiveSolverOnRandomLimbs) {
     }
     p.torque = Eigen::VectorXd(nj);
     for (int j = 0; j < nj; ++j) p.torque[j] = 0.8 * u(gen);
-    const Eigen::VectorXd got = AllocateTensions(p);
-    const Eigen::VectorXd want = Exhaustive(p, 1e-8);
-    ASSERT_EQ(got.size(), nb);
-    EXPECT_NEAR(AllocationCost(p, got), AllocationCost(p, want), 1e-12) << "trial " << trial;
-    for (int b = 0; b < nb; ++b) {
-      EXPECT_NEAR(got[b], want[b], 1e-6 * p.cap[b]) << "trial " << trial << " bundle " << b;
-      if (p.floor[b] == p.cap[b]) EXPECT_EQ(got[b], p.cap[b]);
-    }
+    ExpectMatchesExhaustive(p, trial);
   }
 }
 
