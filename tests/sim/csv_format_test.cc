@@ -164,6 +164,22 @@ std::string ReferenceRow(const TelemetrySample& s) {
   return row;
 }
 
+// The writer, finished and committed, wrote exactly `expected` to path (removed afterwards); on
+// a difference, the first differing row (a whole-file EXPECT_EQ would print every row).
+void ExpectWrites(CsvStepWriter& writer, const std::filesystem::path& path,
+                  const std::string& expected) {
+  ASSERT_TRUE(writer.Finish().ok());
+  ASSERT_TRUE(writer.Commit().ok());
+  auto text = ReadFile(path.string());
+  ASSERT_TRUE(text.ok());
+  ASSERT_EQ(text->size(), expected.size());
+  std::size_t at = 0;
+  while (at < expected.size() && (*text)[at] == expected[at]) ++at;
+  EXPECT_EQ(at, expected.size()) << "differs in row: "
+                                 << expected.substr(expected.rfind('\n', at) + 1, 200);
+  std::filesystem::remove(path);
+}
+
 TEST(CsvStepWriter, WritesThePreviousWritersRowsByteForByte) {
   // Two bundles; values that hold for a few steps (the writer reuses a column's text), change,
   // and turn NaN (empty cells) and back.
@@ -213,12 +229,7 @@ TEST(CsvStepWriter, WritesThePreviousWritersRowsByteForByte) {
     ASSERT_TRUE(writer.OnStep(nullptr, nullptr, s).ok());
     expected += ReferenceRow(s);
   }
-  ASSERT_TRUE(writer.Finish().ok());
-  ASSERT_TRUE(writer.Commit().ok());
-  auto text = ReadFile(path.string());
-  ASSERT_TRUE(text.ok());
-  EXPECT_TRUE(*text == expected);
-  std::filesystem::remove(path);
+  ExpectWrites(writer, path, expected);
 }
 
 TEST(CsvStepWriter, SlowlyChangingValuesGiveThePreviousWritersRows) {
@@ -283,17 +294,7 @@ TEST(CsvStepWriter, SlowlyChangingValuesGiveThePreviousWritersRows) {
     ASSERT_TRUE(writer.OnStep(nullptr, nullptr, s).ok());
     expected += ReferenceRow(s);
   }
-  ASSERT_TRUE(writer.Finish().ok());
-  ASSERT_TRUE(writer.Commit().ok());
-  auto text = ReadFile(path.string());
-  ASSERT_TRUE(text.ok());
-  ASSERT_EQ(text->size(), expected.size());
-  // The first differing row, if any (a whole-file EXPECT_EQ would print 40,000 rows).
-  std::size_t at = 0;
-  while (at < expected.size() && (*text)[at] == expected[at]) ++at;
-  EXPECT_EQ(at, expected.size()) << "differs in row: "
-                                 << expected.substr(expected.rfind('\n', at) + 1, 200);
-  std::filesystem::remove(path);
+  ExpectWrites(writer, path, expected);
 }
 
 }  // namespace file_csv_format_test
