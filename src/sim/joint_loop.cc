@@ -297,7 +297,10 @@ void JointLoops::Step(double t, const Plant& plant, std::vector<double>& force_r
   // The loop's transient share moves the one-joint bundles only (HeldOnlyBundles). The
   // anti-windup above stays on the whole demand: the integral is how a bundle that is held
   // takes up a lasting demand (through `held`), so it grows while all the bundles can deliver it.
-  const Eigen::VectorXd moving = AllocateTransient(p, holding, held, held_only_);
+  const bool any_held_only =
+      std::find(held_only_.begin(), held_only_.end(), true) != held_only_.end();
+  const Eigen::VectorXd moving =
+      any_held_only ? AllocateTransient(p, holding, held, held_only_) : continuous;
   const Eigen::VectorXd aimed = DeliveredAtPresentPose(held, moving, unit_force, present_force);
   // Whole units: each bundle's controller holds whole on-counts, so the demand is met by the
   // combination of counts that comes nearest it (control::RoundToUnits).
