@@ -409,6 +409,20 @@ inline void UnitModel::Update(const Cohorts& c, int n, double stretch, double de
     AdvanceUnitWithDecay(*this, s, c.on[0] != 0, stretch, decay);
     c.temperature[0] = s.temperature, c.xi[0] = s.xi, c.t_eff[0] = s.t_eff;
     c.heat_scale[0] = s.heat_scale, c.cool_scale[0] = s.cool_scale;
+    if (obs != nullptr) {
+      // SumTelemetry's few-cohort path for this one cohort, from the values just computed: each
+      // sum (+0 + count v) + +0 as its four partial sums add, the peak max(0, tension).
+      const double cnt = obs->count[0], t = Tension(s.xi, obs->stretch);
+      const double terms[4] = {cnt * c.on[0], cnt * s.temperature, cnt * s.xi, cnt * t};
+      for (int f = 0; f < 4; ++f) {
+        double a[4] = {0, 0, 0, 0};
+        a[0] += terms[f];
+        obs->out[f] = (a[0] + a[1]) + (a[2] + a[3]);
+      }
+      obs->out[4] = std::max(0.0, t);
+      obs->out[5] = s.temperature;
+      obs->done = true;
+    }
     return;
   }
   const BatchParams& bp = batch_;
