@@ -782,6 +782,18 @@ void AdvanceCohorts(const BatchParams& p, const BatchCohorts& c, int n, double s
 
 // The sums keep four partial sums (lane j mod 4), so the 8-lane clone has none of them.
 #ifndef RECRUIT_SMA_LANES8
+void AdvanceBlockBeforeUpdatedTail(const BatchParams& p, const BatchCohorts& c, int n,
+                                   double stretch, double decay, BatchObserve* obs) {
+  const StepConsts sc{MakeConsts(p, stretch), Splat(p.ambient), Splat(p.rise_A), Splat(p.rise_dM),
+                      Splat(decay)};
+  const Solved a = UpdateBlock(
+      sc, Block{c.on, c.temperature, c.xi, c.t_eff, c.heat_scale, c.cool_scale}, kLanes);
+  if (obs == nullptr) return;
+  const int rest = n - kLanes;  // updated by the caller
+  ObserveTwoBlocks(p, obs, Load(c.on), a.T, a.xi, LoadLanes(c.on + kLanes, rest),
+                   LoadLanes(c.temperature + kLanes, rest), LoadLanes(c.xi + kLanes, rest), rest);
+}
+
 double SumTension(const BatchParams& p, const double* count, const double* xi, int n,
                   double stretch) {
   // Four partial sums (cohort j mod 4; one register with AVX, two with SSE2), added as
