@@ -537,11 +537,12 @@ inline void ObserveBlock(const BatchParams& p, BatchObserve* obs, Vd on, Vd T, V
   obs->done = true;
 }
 
-// All n <= kLanes cohorts in one block (an arm's bundle has about four): phase A's values stay in
-// registers and the transforming lanes are solved where they are, the others stopped, without
-// the gather through memory that batches many cohorts. Lane by lane the same operations.
-inline void AdvanceOneBlock(const StepConsts& sc, const BatchParams& p, BatchObserve* obs,
-                            const Block& b, int count) {
+// The update of one block's `count` cohorts: phase A's values stay in registers and the
+// transforming lanes are solved where they are, the others stopped, without the gather through
+// memory that batches many cohorts. Lane by lane the same operations. The new fields are stored
+// and returned.
+__attribute__((always_inline)) inline Solved UpdateBlock(const StepConsts& sc, const Block& b,
+                                                         int count) {
   const PhaseA a = BlockStepAndTest(sc, b, count);
   Solved out{a.t_th + sc.k.latent * (a.x - a.xi0), a.x, a.te0, a.h, a.cl};
   // The lanes past `count` hold zeros: they must not keep the solve going.
@@ -557,7 +558,100 @@ inline void AdvanceOneBlock(const StepConsts& sc, const BatchParams& p, BatchObs
   StoreLanes(b.t_eff, out.t_eff, count);
   StoreLanes(b.heat_scale, out.hs, count);
   StoreLanes(b.cool_scale, out.cs, count);
+  return out;
+}
+
+// All n <= kLanes cohorts in one block (an arm's bundle has about four).
+inline void AdvanceOneBlock(const StepConsts& sc, const BatchParams& p, BatchObserve* obs,
+                            const Block& b, int count) {
+  const Solved out = UpdateBlock(sc, b, count);
   if (obs != nullptr) ObserveBlock(p, obs, LoadLanes(b.on, count), out.T, out.xi, count);
+}
+
+// The telemetry of two blocks' n (kLanes < n <= 2 kLanes) updated cohorts, block a full and b's
+// first n - kLanes lanes real (BatchObserve), bit for bit SumTelemetry's values as ObserveBlock's:
+// ObservePass adds cohorts l and l + 4 into partial sum l (with four lanes: lane l of a, then lane
+// l of b; with two: cohorts 0..3 are the partial sums themselves, b's lanes the last two), each
+// product added to +0 first (so that none is -0; b's masked lanes add +0, which changes no sum).
+inline void ObserveTwoBlocks(const BatchParams& p, BatchObserve* obs, Vd on_a, Vd T_a, Vd xi_a,
+                             Vd on_b, Vd T_b, Vd xi_b, int count_b) {
+  const Consts kt = MakeConsts(p, obs->stretch);
+  const Mask valid = ValidLanes(count_b);
+  const Vd c_a = Load(obs->count), c_b = LoadLanes(obs->count + kLanes, count_b);
+  const Vd t_a = TensionOnly(kt, xi_a), t_b = And(TensionOnly(kt, xi_b), valid);
+  const Vd z = Splat(0);
+#if defined(__AVX__) && !defined(RECRUIT_SMA_LANES8)
+  // Partial sum l = (+0 + a's lane l) + (+0 + b's lane l), then (s0 + s1) + (s2 + s3) by a
+  // horizontal add and an add of the halves, as ObserveBlock.
+  const Vd s0 = (z + c_a * on_a) + (z + And(c_b * on_b, valid));
+  const Vd s1 = (z + c_a * T_a) + (z + And(c_b * T_b, valid));
+  const Vd s2 = (z + c_a * xi_a) + (z + And(c_b * xi_b, valid));
+  const Vd s3 = (z + c_a * t_a) + (z + c_b * t_b);
+  const __m256d h01 = _mm256_hadd_pd(s0, s1), h23 = _mm256_hadd_pd(s2, s3);
+  _mm_storeu_pd(obs->out, _mm_add_pd(_mm256_castpd256_pd128(h01), _mm256_extractf128_pd(h01, 1)));
+  _mm_storeu_pd(obs->out + 2,
+                _mm_add_pd(_mm256_castpd256_pd128(h23), _mm256_extractf128_pd(h23, 1)));
+  // Maxima (no value is NaN, a tension is never -0: the order does not matter).
+  Vd mt = _mm256_max_pd(t_a, t_b);
+  Vd mh = _mm256_max_pd(T_a, Sel(valid, T_b, Splat(-HUGE_VAL)));
+  mt = _mm256_max_pd(mt, _mm256_permute_pd(mt, 5));
+  mh = _mm256_max_pd(mh, _mm256_permute_pd(mh, 5));
+  mt = _mm256_max_pd(mt, _mm256_permute2f128_pd(mt, mt, 1));
+  mh = _mm256_max_pd(mh, _mm256_permute2f128_pd(mh, mh, 1));
+  obs->out[4] = _mm256_cvtsd_f64(mt);
+  obs->out[5] = _mm256_cvtsd_f64(mh);
+#else
+  // Cohort j's products in a[f][j] (b's masked lanes +0), folded as ObservePass adds them.
+  alignas(64) double a[4][2 * kLanes], top[2 * kLanes], hot[2 * kLanes];
+  Store(a[0], z + c_a * on_a);
+  Store(a[0] + kLanes, z + And(c_b * on_b, valid));
+  Store(a[1], z + c_a * T_a);
+  Store(a[1] + kLanes, z + And(c_b * T_b, valid));
+  Store(a[2], z + c_a * xi_a);
+  Store(a[2] + kLanes, z + And(c_b * xi_b, valid));
+  Store(a[3], z + c_a * t_a);
+  Store(a[3] + kLanes, z + c_b * t_b);
+  Store(top, t_a);
+  Store(top + kLanes, t_b);
+  Store(hot, T_a);
+  Store(hot + kLanes, Sel(valid, T_b, Splat(-HUGE_VAL)));
+  for (int f = 0; f < 4; ++f) {
+    double q[4] = {0, 0, 0, 0};
+    for (int l = 0; l < 2 * kLanes; ++l) q[l % 4] = l < 4 ? a[f][l] : q[l % 4] + a[f][l];
+    obs->out[f] = (q[0] + q[1]) + (q[2] + q[3]);
+  }
+  double peak = 0, hottest = hot[0];
+  for (int l = 0; l < 2 * kLanes; ++l) {
+    peak = top[l] > peak ? top[l] : peak;
+    hottest = hot[l] > hottest ? hot[l] : hottest;
+  }
+  obs->out[4] = peak;
+  obs->out[5] = hottest;
+#endif
+  obs->done = true;
+}
+
+// kLanes < n <= 2 kLanes cohorts (5-8 with AVX2: a bundle switched a few units at a time keeps
+// that many): each block updated as one block is (UpdateBlock: phase A's values in registers, the
+// transforming lanes solved where they are), without the two-phase path's stores, gathers and
+// scatters, and the telemetry from the registers that hold both blocks' new fields. Lane by lane
+// the same operations. (Both blocks' phase A at once and the solves of both through Newton2 kept
+// too many values live for the registers: it cost more than the two-phase path.)
+inline void AdvanceTwoBlocks(const StepConsts& sc, const BatchParams& p, BatchObserve* obs,
+                             const Block& ba, const Block& bb, int count_b) {
+  const Solved a = UpdateBlock(sc, ba, kLanes);
+  const Solved b = UpdateBlock(sc, bb, count_b);
+#if !defined(RECRUIT_SMA_LANES8)
+  // (The 8-lane update is given no `obs`: UnitModel::Update.)
+  if (obs != nullptr) {
+    ObserveTwoBlocks(p, obs, Load(ba.on), a.T, a.xi, LoadLanes(bb.on, count_b), b.T, b.xi, count_b);
+  }
+#else
+  (void)p;
+  (void)obs;
+  (void)a;
+  (void)b;
+#endif
 }
 
 #pragma GCC diagnostic pop
@@ -581,6 +675,14 @@ void AdvanceCohorts(const BatchParams& p, const BatchCohorts& c, int n, double s
       AdvanceOneBlock(sc, p, obs,
                       Block{c.on, c.temperature, c.xi, c.t_eff, c.heat_scale, c.cool_scale}, n);
     }
+    return;
+  }
+  if (n <= 2 * kLanes) {
+    AdvanceTwoBlocks(sc, p, obs,
+                     Block{c.on, c.temperature, c.xi, c.t_eff, c.heat_scale, c.cool_scale},
+                     Block{c.on + kLanes, c.temperature + kLanes, c.xi + kLanes, c.t_eff + kLanes,
+                           c.heat_scale + kLanes, c.cool_scale + kLanes},
+                     n - kLanes);
     return;
   }
   alignas(32) double tth[kChunk], g0[kChunk], dg0[kChunk], heat[kChunk];
@@ -680,6 +782,18 @@ void AdvanceCohorts(const BatchParams& p, const BatchCohorts& c, int n, double s
 
 // The sums keep four partial sums (lane j mod 4), so the 8-lane clone has none of them.
 #ifndef RECRUIT_SMA_LANES8
+void AdvanceBlockBeforeUpdatedTail(const BatchParams& p, const BatchCohorts& c, int n,
+                                   double stretch, double decay, BatchObserve* obs) {
+  const StepConsts sc{MakeConsts(p, stretch), Splat(p.ambient), Splat(p.rise_A), Splat(p.rise_dM),
+                      Splat(decay)};
+  const Solved a = UpdateBlock(
+      sc, Block{c.on, c.temperature, c.xi, c.t_eff, c.heat_scale, c.cool_scale}, kLanes);
+  if (obs == nullptr) return;
+  const int rest = n - kLanes;  // updated by the caller
+  ObserveTwoBlocks(p, obs, Load(c.on), a.T, a.xi, LoadLanes(c.on + kLanes, rest),
+                   LoadLanes(c.temperature + kLanes, rest), LoadLanes(c.xi + kLanes, rest), rest);
+}
+
 double SumTension(const BatchParams& p, const double* count, const double* xi, int n,
                   double stretch) {
   // Four partial sums (cohort j mod 4; one register with AVX, two with SSE2), added as

@@ -33,7 +33,9 @@ struct BatchObserve {
   bool done;
 };
 
-// Kernels: AdvanceCohorts and SumTension as UnitModel's; WeightedSums sets out[f] to the sum
+// Kernels: AdvanceCohorts and SumTension as UnitModel's; AdvanceBlockBeforeUpdatedTail is
+// AdvanceCohorts for kLanes < n <= 2 kLanes cohorts of which the caller has already updated those
+// past the first kLanes (the telemetry, with obs, of all n); WeightedSums sets out[f] to the sum
 // over j < n of count[j] * v[f][j] for f < nf <= 3, in four partial sums (lane j mod 4) added as
 // (s0 + s1) + (s2 + s3): the same in both clones, exact for one cohort. SumTelemetry is
 // WeightedSums of v[0..2] and SumTension of xi = v[2] in one pass, bit for bit, out[0..3]; with
@@ -41,6 +43,8 @@ struct BatchObserve {
 namespace batch_base {
 void AdvanceCohorts(const BatchParams& p, const BatchCohorts& c, int n, double stretch,
                     double decay, BatchObserve* obs = nullptr);
+void AdvanceBlockBeforeUpdatedTail(const BatchParams& p, const BatchCohorts& c, int n,
+                                   double stretch, double decay, BatchObserve* obs);
 double SumTension(const BatchParams& p, const double* count, const double* xi, int n,
                   double stretch);
 void WeightedSums(const double* count, const double* const* v, int nf, int n, double* out);
@@ -56,6 +60,8 @@ bool MergeOrder(const double* on, const double* temp, int n, int* order, double*
 namespace batch_avx2 {
 void AdvanceCohorts(const BatchParams& p, const BatchCohorts& c, int n, double stretch,
                     double decay, BatchObserve* obs = nullptr);
+void AdvanceBlockBeforeUpdatedTail(const BatchParams& p, const BatchCohorts& c, int n,
+                                   double stretch, double decay, BatchObserve* obs);
 double SumTension(const BatchParams& p, const double* count, const double* xi, int n,
                   double stretch);
 void WeightedSums(const double* count, const double* const* v, int nf, int n, double* out);

@@ -142,7 +142,8 @@ class UnitModel {
   enum class Isa { kAuto, kBase, kAvx2, kAvx512 };
   // With `obs` (count and stretch set) the update also gives the updated cohorts' telemetry
   // (BatchObserve: SumTelemetry's five values with the peak, bit for bit, and the largest
-  // temperature), from its registers when they fit one SIMD block, else in a pass of its own.
+  // temperature), from its registers when they fit two SIMD blocks (one cohort: from the scalar
+  // update's values); otherwise obs->done stays false and the caller sums.
   void AdvanceCohorts(const Cohorts& c, int n, double stretch, double decay, Isa isa = Isa::kAuto,
                       BatchObserve* obs = nullptr) const;
   // Sum over n cohorts of count[j] * Tension(xi[j], stretch), in SIMD lanes.

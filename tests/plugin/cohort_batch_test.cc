@@ -276,6 +276,104 @@ TEST_P(BatchedCohorts, ObservedUpdateGivesTheSeparatePassValuesBitForBit) {
   }
 }
 
+// More cohorts than one SIMD block holds but at most two (5-8 with AVX2, 3-4 with the portable
+// SSE2 kernel, 9-16 with AVX-512), the count a bundle switched a few units at a time keeps: the
+// update solves both blocks where they are. Random states and random switching trajectories
+// against the scalar update of every cohort, and the telemetry the update gives on its way
+// against a plain scalar sum in the kernels' order (partial sum j mod 4, added as
+// (s0 + s1) + (s2 + s3)) of count * (on, T, xi, UnitModel::Tension at the observed extension),
+// and plain maxima of Tension and T.
+// Under kAuto one cohort more than a block (5 with AVX2) has its last cohort updated by the scalar
+// update and the block by the kernel, the telemetry of both folded as for two blocks.
+void CheckTwoBlocks(const std::string& config, UnitModel::Isa isa) {
+  const UnitModel m = MakeModel(config);
+  const double e0 = m.params().prestretch;
+  const int lanes = UnitModel::Lanes(isa);
+  Rng rng(2029);
+  int given = 0, trials = 0, moved[2] = {0, 0};
+  for (int n = lanes + 1; n <= 2 * lanes; ++n) {
+    Soa soa(n);
+    std::vector<double> count(n);
+    for (int trial = 0; trial < 400; ++trial) {
+      // A fresh random state every 50 steps; otherwise the last step's cohorts, switched at random
+      // (minor loops, cohorts in and out of the transformation windows).
+      for (int j = 0; j < n; ++j) {
+        if (trial % 50 == 0) {
+          count[j] = 1 + static_cast<int>(20 * rng.Uniform());
+          soa.temperature[j] = 15 + 130 * rng.Uniform();
+          const double u = rng.Uniform();
+          soa.xi[j] = u < 0.2 ? 1 : u < 0.4 ? 0 : u < 0.45 ? 1 - 1e-13 : rng.Uniform();
+          soa.t_eff[j] = soa.temperature[j] + 20 * (rng.Uniform() - 0.5);
+          soa.heat_scale[j] = rng.Uniform() < 0.3 ? 1 : rng.Uniform();
+          soa.cool_scale[j] = rng.Uniform() < 0.3 ? 1 : rng.Uniform();
+        }
+        if (trial % 50 == 0 || rng.Uniform() < 0.05) soa.on[j] = rng.Uniform() < 0.5 ? 1 : 0;
+      }
+      const double stretch = e0 * (0.5 + rng.Uniform());
+      const double seen = trial % 3 == 0 ? stretch : 1.5 * e0 * rng.Uniform() - 0.1 * e0;
+      const double decay = m.DecayFactor(trial % 2 == 0 ? 1e-3 : 0.02);
+      const std::string where = "n " + std::to_string(n) + " trial " + std::to_string(trial);
+      std::vector<UnitState> ref(n);
+      for (int j = 0; j < n; ++j) {
+        ref[j] = soa.Get(j);
+        AdvanceUnitWithDecay(m, ref[j], soa.on[j] != 0, stretch, decay);
+      }
+      const std::vector<double> xi_before = soa.xi;
+      BatchObserve obs;
+      obs.count = count.data();
+      obs.stretch = seen;
+      for (double& x : obs.out) x = -7;
+      m.AdvanceCohorts(soa.View(), n, stretch, decay, isa, &obs);
+      ++trials;
+      for (int j = 0; j < n; ++j) {
+        const UnitState b = soa.Get(j);
+        ASSERT_TRUE(SameBits(b.temperature, ref[j].temperature) && SameBits(b.xi, ref[j].xi) &&
+                    SameBits(b.t_eff, ref[j].t_eff) && SameBits(b.heat_scale, ref[j].heat_scale) &&
+                    SameBits(b.cool_scale, ref[j].cool_scale))
+            << where << " cohort " << j;
+        moved[j < lanes ? 0 : 1] += soa.xi[j] != xi_before[j];
+      }
+      if (!obs.done) continue;
+      ++given;
+      double s[4][4] = {};
+      double peak = 0, hottest = soa.temperature[0];
+      for (int j = 0; j < n; ++j) {
+        const double t = m.Tension(soa.xi[j], seen);
+        const double terms[4] = {count[j] * soa.on[j], count[j] * soa.temperature[j],
+                                 count[j] * soa.xi[j], count[j] * t};
+        for (int f = 0; f < 4; ++f) s[f][j % 4] += terms[f];
+        peak = std::max(peak, t);
+        hottest = std::max(hottest, soa.temperature[j]);
+      }
+      for (int f = 0; f < 4; ++f) {
+        const double sum = (s[f][0] + s[f][1]) + (s[f][2] + s[f][3]);
+        EXPECT_TRUE(SameBits(obs.out[f], sum))
+            << where << " value " << f << ": " << obs.out[f] << " vs " << sum;
+      }
+      EXPECT_TRUE(SameBits(obs.out[4], peak)) << where << ": " << obs.out[4] << " vs " << peak;
+      EXPECT_TRUE(SameBits(obs.out[5], hottest)) << where;
+    }
+  }
+  EXPECT_GT(moved[0], trials / 8);  // the phase solves ran, in both blocks
+  EXPECT_GT(moved[1], trials / 8);
+  // The AVX-512 update gives no telemetry (UnitModel::Update); the others always do here.
+  const bool avx512 =
+      isa == UnitModel::Isa::kAvx512 || (isa == UnitModel::Isa::kAuto && UnitModel::HasAvx512());
+  EXPECT_EQ(given, avx512 ? 0 : trials);
+}
+
+TEST_P(BatchedCohorts, TwoBlocksOfCohortsAreTheScalarUpdateAndTheScalarSums) {
+  CheckTwoBlocks(config(), isa());
+}
+
+TEST(BatchedCohortsAuto, TwoBlocksOfCohortsAreTheScalarUpdateAndTheScalarSums) {
+  for (const char* config : {"", "series_spring=0", "law=spring current=0.235",
+                             "parallel=2 series=3", "latent_heat=0"}) {
+    SCOPED_TRACE(config);
+    CheckTwoBlocks(config, UnitModel::Isa::kAuto);
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(
     Units, BatchedCohorts,
     ::testing::Combine(::testing::Values("",                          // datasheet wire unit
@@ -284,6 +382,49 @@ INSTANTIATE_TEST_SUITE_P(
                                          "parallel=2 series=3", "latent_heat=0"),
                        ::testing::Values(UnitModel::Isa::kBase, UnitModel::Isa::kAvx2,
                                          UnitModel::Isa::kAvx512)));
+
+// One cohort (units switched together) takes the scalar update under kAuto; asked for its
+// telemetry it gives SumTelemetry's values for that cohort (the run loop's separate pass) and its
+// temperature, bit for bit, from the values it computed: random states, taut and slack.
+TEST(BatchedCohorts, OneCohortsObservedUpdateGivesTheSeparatePassValues) {
+  for (const char* config : {"", "series_spring=0", "law=spring current=0.235"}) {
+    const UnitModel m = MakeModel(config);
+    const double e0 = m.params().prestretch;
+    Rng rng(31);
+    for (int trial = 0; trial < 500; ++trial) {
+      Soa soa(1);
+      double count = 1 + static_cast<int>(50 * rng.Uniform());
+      soa.on[0] = rng.Uniform() < 0.5 ? 1 : 0;
+      soa.temperature[0] = 15 + 130 * rng.Uniform();
+      soa.xi[0] = rng.Uniform() < 0.3 ? 1 : rng.Uniform() < 0.3 ? 0 : rng.Uniform();
+      soa.t_eff[0] = soa.temperature[0] + 20 * (rng.Uniform() - 0.5);
+      soa.heat_scale[0] = rng.Uniform() < 0.3 ? 1 : rng.Uniform();
+      soa.cool_scale[0] = rng.Uniform() < 0.3 ? 1 : rng.Uniform();
+      const double stretch = 1.5 * e0 * rng.Uniform();
+      const double seen = trial % 4 == 0 ? stretch : 1.5 * e0 * rng.Uniform() - 0.1 * e0;
+      UnitState ref = soa.Get(0);
+      AdvanceUnitWithDecay(m, ref, soa.on[0] != 0, stretch, m.DecayFactor(1e-3));
+      BatchObserve obs;
+      obs.count = &count;
+      obs.stretch = seen;
+      m.AdvanceCohorts(soa.View(), 1, stretch, m.DecayFactor(1e-3), UnitModel::Isa::kAuto, &obs);
+      const UnitState b = soa.Get(0);
+      ASSERT_TRUE(SameBits(b.temperature, ref.temperature) && SameBits(b.xi, ref.xi) &&
+                  SameBits(b.t_eff, ref.t_eff) && SameBits(b.heat_scale, ref.heat_scale) &&
+                  SameBits(b.cool_scale, ref.cool_scale))
+          << config << " trial " << trial;
+      ASSERT_TRUE(obs.done);
+      const double* v[3] = {soa.on.data(), soa.temperature.data(), soa.xi.data()};
+      double sep[5];
+      m.SumTelemetry(&count, v, 1, seen, true, sep);
+      for (int f = 0; f < 5; ++f) {
+        EXPECT_TRUE(SameBits(obs.out[f], sep[f])) << config << " trial " << trial << " f " << f;
+      }
+      EXPECT_TRUE(SameBits(obs.out[3], count * m.Tension(b.xi, seen)));
+      EXPECT_TRUE(SameBits(obs.out[5], b.temperature));
+    }
+  }
+}
 
 // The tension sum over cohorts against the scalar sum of count * Tension: the same to rounding
 // of the summation order (four partial sums), exactly for one cohort.
