@@ -4,7 +4,9 @@
 # "Sanitizers"). Two kinds:
 #   - the suite (default, build-asan/): every test program, the recruit program, the plugin and the
 #     Python module; the tests and the module as unity batches (RECRUIT_UNITY_TESTS), which halves
-#     a build from scratch. scripts/sanitize.sh runs it.
+#     a build from scratch; the targets the tests spend little time in (RECRUIT_COLD_TARGETS and
+#     the test programs not marked HOT, CMakeLists.txt) with COLD_OPT (default -O0), about half
+#     the compile CPU of -O1. scripts/sanitize.sh runs it.
 #   - COVERAGE=ON (clang only; scripts/fuzz.sh, build-fuzz/): the libFuzzer targets of the input
 #     parsers and the libraries they link, with libFuzzer's coverage instrumentation
 #     (fuzzer-no-link) in every library. Not in the suite's tree: its comparison callbacks made the
@@ -14,8 +16,8 @@
 # Usage:
 #   scripts/build-sanitized.sh [target...]     (default: every target of the tree's kind)
 # Environment: BUILD_DIR (default build-asan, with COVERAGE=ON build-fuzz), JOBS (default nproc),
-# OPT (default -O1), COVERAGE (OFF), BENCH=ON to build the benchmarks too (suite only), CC/CXX
-# (default clang/clang++).
+# OPT (default -O1), COLD_OPT (suite only, default -O0; "" = OPT everywhere), COVERAGE (OFF),
+# BENCH=ON to build the benchmarks too (suite only), CC/CXX (default clang/clang++).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 COVERAGE=${COVERAGE:-OFF}
@@ -35,11 +37,11 @@ elif [ "$COVERAGE" = ON ]; then
   exit 2
 fi
 KIND=(-DRECRUIT_BUILD_PYTHON=ON -DRECRUIT_UNITY_TESTS=ON -DRECRUIT_BUILD_FUZZ=OFF
-  -DRECRUIT_BUILD_BENCH="${BENCH:-OFF}")
+  -DRECRUIT_BUILD_BENCH="${BENCH:-OFF}" -DRECRUIT_COLD_OPT="${COLD_OPT--O0}")
 if [ "$COVERAGE" = ON ]; then
   SAN="$SAN,fuzzer-no-link"
   KIND=(-DRECRUIT_BUILD_PYTHON=OFF -DRECRUIT_BUILD_TESTS=OFF -DRECRUIT_BUILD_FUZZ=ON
-    -DRECRUIT_BUILD_BENCH=OFF)
+    -DRECRUIT_BUILD_BENCH=OFF -DRECRUIT_COLD_OPT=)
 fi
 FLAGS="-fsanitize=$SAN -fno-sanitize-recover=all -fno-omit-frame-pointer"
 cmake -G Ninja -S . -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release "${KIND[@]}" \

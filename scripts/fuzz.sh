@@ -2,15 +2,16 @@
 # Builds the libFuzzer targets of the input parsers (tests/fuzz) in their own sanitized tree
 # (scripts/build-sanitized.sh with COVERAGE=ON: clang, AddressSanitizer + UndefinedBehaviorSanitizer
 # with no recovery, coverage instrumentation in every library they link; build-fuzz/), then runs
-# each for a fixed time from its checked-in seed corpus with a fixed seed. Fails if any target
-# crashes, hangs (-timeout), leaks or trips a sanitizer; the input that did it is written to
-# build-fuzz/artifacts/.
+# each for a fixed time from its checked-in seed corpus with a fixed seed, JOBS targets at a time.
+# Fails if any target crashes, hangs (-timeout), leaks or trips a sanitizer; the input that did it
+# is written to build-fuzz/artifacts/.
 # Usage:
 #   scripts/fuzz.sh [target...]     targets: task filter_model filter_log bundle_config mjcf_config
 #                                   sil_packet
 #                                   (default: all)
 # Environment: FUZZ_SECONDS per target (default 30), FUZZ_SEED (default 1), BUILD_DIR (default
-# build-fuzz), JOBS (default: nproc). Reproduce a crash: build-fuzz/tests/fuzz/fuzz_<target> FILE.
+# build-fuzz), JOBS (default: nproc; also the targets fuzzing at once). Reproduce a crash:
+# build-fuzz/tests/fuzz/fuzz_<target> FILE.
 # Keep one found crash as a regression test: copy it to tests/fuzz/corpus/<target>/regress-<what>
 # (ctest's fuzz_<target>_corpus replays every corpus file with the normal build).
 set -euo pipefail
@@ -34,21 +35,35 @@ export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
 # must come first: preload it.
 ASAN_RUNTIME="$("${CXX:-clang++}" -print-runtime-dir)/libclang_rt.asan-x86_64.so"
 mkdir -p "$BUILD_DIR/artifacts"
-failed=()
-for t in "${TARGETS[@]}"; do
+# One target: exit status 0 when it ran its time without a finding; its log in artifacts/.
+fuzz_one() {
+  local t=$1 work="$BUILD_DIR/corpus/$1"
   # New inputs go to a scratch corpus (first folder); the checked-in seeds are only read.
-  work="$BUILD_DIR/corpus/$t"
   mkdir -p "$work"
-  echo "fuzz: $t for ${FUZZ_SECONDS}s (seed $FUZZ_SEED)"
-  if ! LD_PRELOAD="$ASAN_RUNTIME" "$BUILD_DIR/tests/fuzz/fuzz_$t" -seed="$FUZZ_SEED" -max_total_time="$FUZZ_SECONDS" \
-      -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
-      -artifact_prefix="$BUILD_DIR/artifacts/$t-" "$work" "tests/fuzz/corpus/$t" \
-      >"$BUILD_DIR/artifacts/$t.log" 2>&1; then
-    failed+=("$t")
-    tail -n 60 "$BUILD_DIR/artifacts/$t.log"
-  fi
-  grep -E '^stat::(number_of_executed_units|new_units_added)|^Done ' "$BUILD_DIR/artifacts/$t.log" \
-    | sed "s/^/fuzz: $t: /" || true
+  LD_PRELOAD="$ASAN_RUNTIME" "$BUILD_DIR/tests/fuzz/fuzz_$t" -seed="$FUZZ_SEED" \
+    -max_total_time="$FUZZ_SECONDS" -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
+    -artifact_prefix="$BUILD_DIR/artifacts/$t-" "$work" "tests/fuzz/corpus/$t" \
+    >"$BUILD_DIR/artifacts/$t.log" 2>&1
+}
+# JOBS targets at a time (each is one process on one core), reported in the order given.
+failed=()
+for ((i = 0; i < ${#TARGETS[@]}; i += JOBS)); do
+  batch=("${TARGETS[@]:i:JOBS}")
+  pids=()
+  for t in "${batch[@]}"; do
+    echo "fuzz: $t for ${FUZZ_SECONDS}s (seed $FUZZ_SEED)"
+    fuzz_one "$t" &
+    pids+=($!)
+  done
+  for k in "${!batch[@]}"; do
+    t=${batch[$k]}
+    if ! wait "${pids[$k]}"; then
+      failed+=("$t")
+      tail -n 60 "$BUILD_DIR/artifacts/$t.log"
+    fi
+    grep -E '^stat::(number_of_executed_units|new_units_added)|^Done ' "$BUILD_DIR/artifacts/$t.log" \
+      | sed "s/^/fuzz: $t: /" || true
+  done
 done
 if [ ${#failed[@]} -gt 0 ]; then
   echo "fuzz: FAILED: ${failed[*]}; inputs in $BUILD_DIR/artifacts/ (see docs/reliability.md)" >&2

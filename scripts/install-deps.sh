@@ -73,5 +73,8 @@ PY
   echo "install-deps: .venv has mujoco ${MUJOCO_VERSION} and ${#PY_PACKAGES[@]} Python packages"
 else
   echo "install-deps: installing ${PY_PACKAGES[*]} into .venv"
-  .venv/bin/python -m pip install -q --disable-pip-version-check "${PY_PACKAGES[@]}"
+  # --no-compile: no byte-code for the ~6700 modules installed (scipy, matplotlib, ...); Python
+  # writes it for the few the tests import, when they import them. Half pip's CPU time
+  # (docs/reliability.md "CI").
+  .venv/bin/python -m pip install -q --no-compile --disable-pip-version-check "${PY_PACKAGES[@]}"
 fi
