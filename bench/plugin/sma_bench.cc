@@ -192,6 +192,21 @@ BENCHMARK(BM_SmaOverMuscle)
 
 // The cohort update's kernels side by side on n cohorts that transform at every step (each
 // switched every 1.5 s, 0.7 s apart), interleaved in blocks of 1000 steps: counter "ratio" =
+// n cohorts' fields, every cohort at `rest`, with the view AdvanceCohorts takes.
+struct CohortFields {
+  std::vector<double> on, T, xi, te, hs, cs;
+  CohortFields(int n, const recruit::sma::UnitState& rest)
+      : on(n, 0),
+        T(n, rest.temperature),
+        xi(n, rest.xi),
+        te(n, rest.t_eff),
+        hs(n, rest.heat_scale),
+        cs(n, rest.cool_scale) {}
+  recruit::sma::UnitModel::Cohorts View() {
+    return {on.data(), T.data(), xi.data(), te.data(), hs.data(), cs.data()};
+  }
+};
+
 // AVX-512 CPU time / AVX2 CPU time (UnitModel::AdvanceCohorts takes AVX2 for up to 4 cohorts).
 void BM_KernelAvx512OverAvx2(benchmark::State& state) {
   using recruit::sma::UnitModel;
@@ -201,25 +216,14 @@ void BM_KernelAvx512OverAvx2(benchmark::State& state) {
   auto model = UnitModel::Create(params);
   const double stretch = params.prestretch, decay = model->DecayFactor(1e-3);
   const recruit::sma::UnitState rest = recruit::sma::RestState(*model, stretch);
-  struct Fields {
-    std::vector<double> on, T, xi, te, hs, cs;
-  } f[2];
-  for (Fields& x : f) {
-    x.on.assign(n, 0);
-    x.T.assign(n, rest.temperature);
-    x.xi.assign(n, rest.xi);
-    x.te.assign(n, rest.t_eff);
-    x.hs.assign(n, rest.heat_scale);
-    x.cs.assign(n, rest.cool_scale);
-  }
+  CohortFields f[2] = {CohortFields(n, rest), CohortFields(n, rest)};
   const UnitModel::Isa isa[2] = {UnitModel::Isa::kAvx2, UnitModel::Isa::kAvx512};
   double t[2] = {0, 0};
   long i0 = 0;
   for (auto _ : state) {
     for (int k = 0; k < 2; ++k) {
-      Fields& x = f[k];
-      const UnitModel::Cohorts c{x.on.data(), x.T.data(),  x.xi.data(),
-                                 x.te.data(), x.hs.data(), x.cs.data()};
+      CohortFields& x = f[k];
+      const UnitModel::Cohorts c = x.View();
       const double start = ThreadCpuSeconds();
       for (long i = i0; i < i0 + 1000; ++i) {
         for (int j = 0; j < n; ++j) x.on[j] = ((i + 700 * j) / 1500) % 2;
@@ -250,27 +254,18 @@ void BM_ObservedUpdateOverSeparatePass(benchmark::State& state) {
   auto model = UnitModel::Create(params);
   const double stretch = params.prestretch, decay = model->DecayFactor(1e-3);
   const recruit::sma::UnitState rest = recruit::sma::RestState(*model, stretch);
-  struct Fields {
-    std::vector<double> on, T, xi, te, hs, cs;
+  struct Fields : CohortFields {
+    using CohortFields::CohortFields;
     double out[6];
-  } f[2];
+  } f[2] = {Fields(n, rest), Fields(n, rest)};
   std::vector<double> count(n);
   for (int j = 0; j < n; ++j) count[j] = 1 + (7 * j) % 11;
-  for (Fields& x : f) {
-    x.on.assign(n, 0);
-    x.T.assign(n, rest.temperature);
-    x.xi.assign(n, rest.xi);
-    x.te.assign(n, rest.t_eff);
-    x.hs.assign(n, rest.heat_scale);
-    x.cs.assign(n, rest.cool_scale);
-  }
   double t[2] = {0, 0};
   long i0 = 0, given = 0;
   for (auto _ : state) {
     for (int k = 0; k < 2; ++k) {
       Fields& x = f[k];
-      const UnitModel::Cohorts c{x.on.data(), x.T.data(),  x.xi.data(),
-                                 x.te.data(), x.hs.data(), x.cs.data()};
+      const UnitModel::Cohorts c = x.View();
       const double* v[3] = {x.on.data(), x.T.data(), x.xi.data()};
       const double start = ThreadCpuSeconds();
       for (long i = i0; i < i0 + 1000; ++i) {
