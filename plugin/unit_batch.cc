@@ -383,11 +383,22 @@ struct Block {
   double *temperature, *xi, *t_eff, *heat_scale, *cool_scale;
 };
 
+// The block of cohorts from cohort `first` on.
+inline Block BlockAt(const BatchCohorts& c, int first) {
+  return {c.on + first,    c.temperature + first, c.xi + first,
+          c.t_eff + first, c.heat_scale + first,  c.cool_scale + first};
+}
+
 // The thermal step and the constants of the update, broadcast to every lane.
 struct StepConsts {
   Consts k;
   Vd amb, rise_A, rise_dM, decay;
 };
+
+inline StepConsts MakeStepConsts(const BatchParams& p, double stretch, double decay) {
+  return {MakeConsts(p, stretch), Splat(p.ambient), Splat(p.rise_A), Splat(p.rise_dM),
+          Splat(decay)};
+}
 
 // (A) for one block of cohorts: the thermal step, the branch, the residual at xi_n, whether
 // the cohort transforms, and its values if it does not.
@@ -667,22 +678,16 @@ inline void AdvanceTwoBlocks(const StepConsts& sc, const BatchParams& p, BatchOb
 void AdvanceCohorts(const BatchParams& p, const BatchCohorts& c, int n, double stretch,
                     double decay, BatchObserve* obs) {
   constexpr int kChunk = 64;
-  const StepConsts sc{MakeConsts(p, stretch), Splat(p.ambient), Splat(p.rise_A), Splat(p.rise_dM),
-                      Splat(decay)};
+  const StepConsts sc = MakeStepConsts(p, stretch, decay);
   const Consts& k = sc.k;
   if (n <= kLanes) {
     if (n > 0) {
-      AdvanceOneBlock(sc, p, obs,
-                      Block{c.on, c.temperature, c.xi, c.t_eff, c.heat_scale, c.cool_scale}, n);
+      AdvanceOneBlock(sc, p, obs, BlockAt(c, 0), n);
     }
     return;
   }
   if (n <= 2 * kLanes) {
-    AdvanceTwoBlocks(sc, p, obs,
-                     Block{c.on, c.temperature, c.xi, c.t_eff, c.heat_scale, c.cool_scale},
-                     Block{c.on + kLanes, c.temperature + kLanes, c.xi + kLanes, c.t_eff + kLanes,
-                           c.heat_scale + kLanes, c.cool_scale + kLanes},
-                     n - kLanes);
+    AdvanceTwoBlocks(sc, p, obs, BlockAt(c, 0), BlockAt(c, kLanes), n - kLanes);
     return;
   }
   alignas(32) double tth[kChunk], g0[kChunk], dg0[kChunk], heat[kChunk];
@@ -784,10 +789,8 @@ void AdvanceCohorts(const BatchParams& p, const BatchCohorts& c, int n, double s
 #ifndef RECRUIT_SMA_LANES8
 void AdvanceBlockBeforeUpdatedTail(const BatchParams& p, const BatchCohorts& c, int n,
                                    double stretch, double decay, BatchObserve* obs) {
-  const StepConsts sc{MakeConsts(p, stretch), Splat(p.ambient), Splat(p.rise_A), Splat(p.rise_dM),
-                      Splat(decay)};
-  const Solved a = UpdateBlock(
-      sc, Block{c.on, c.temperature, c.xi, c.t_eff, c.heat_scale, c.cool_scale}, kLanes);
+  const StepConsts sc = MakeStepConsts(p, stretch, decay);
+  const Solved a = UpdateBlock(sc, BlockAt(c, 0), kLanes);
   if (obs == nullptr) return;
   const int rest = n - kLanes;  // updated by the caller
   ObserveTwoBlocks(p, obs, Load(c.on), a.T, a.xi, LoadLanes(c.on + kLanes, rest),

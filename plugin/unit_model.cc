@@ -416,14 +416,11 @@ inline void UnitModel::Update(const Cohorts& c, int n, double stretch, double de
     const UnitState s = scalar(0);
     if (obs != nullptr) {
       // SumTelemetry's few-cohort path for this one cohort, from the values just computed: each
-      // sum (+0 + count v) + +0 as its four partial sums add, the peak max(0, tension).
+      // sum is +0 + count v (its partial sums start at +0: never -0; the other three add +0),
+      // the peak max(0, tension).
       const double cnt = obs->count[0], t = Tension(s.xi, obs->stretch);
       const double terms[4] = {cnt * c.on[0], cnt * s.temperature, cnt * s.xi, cnt * t};
-      for (int f = 0; f < 4; ++f) {
-        double a[4] = {0, 0, 0, 0};
-        a[0] += terms[f];
-        obs->out[f] = (a[0] + a[1]) + (a[2] + a[3]);
-      }
+      for (int f = 0; f < 4; ++f) obs->out[f] = 0.0 + terms[f];
       obs->out[4] = std::max(0.0, t);
       obs->out[5] = s.temperature;
       obs->done = true;
