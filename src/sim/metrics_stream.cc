@@ -10,8 +10,39 @@ namespace recruit::sim {
 SignalMetrics::SignalMetrics(std::vector<ReferenceStep> steps, double band,
                              std::vector<DisturbanceWindow> disturbances)
     : band_(band) {
-  for (const ReferenceStep& s : steps) steps_.push_back({s});
+  for (const ReferenceStep& s : steps) {
+    const double size = std::abs(s.to - s.from);
+    steps_.push_back({s, s.to > s.from ? 1.0 : -1.0, band * size});
+  }
   for (const DisturbanceWindow& w : disturbances) disturbances_.push_back({w});
+  // Room for every window: FindWindows never allocates.
+  open_steps_.reserve(steps_.size());
+  open_disturbances_.reserve(disturbances_.size());
+}
+
+void SignalMetrics::FindWindows(double t) {
+  from_ = t;
+  until_ = std::numeric_limits<double>::infinity();
+  // Open at t: !(t < start || t >= end), as a window held a sample before. For later times the
+  // set stays until a window ahead opens or an open one closes. (A NaN t is in every window, and
+  // as from_ it keeps nothing: the next sample finds its windows afresh.)
+  auto open = [&](double start, double end) {
+    if (t < start) {
+      until_ = std::min(until_, start);
+    } else if (t < end) {
+      until_ = std::min(until_, end);
+    }
+    return !(t < start || t >= end);
+  };
+  open_steps_.clear();
+  for (size_t k = 0; k < steps_.size(); ++k) {
+    if (open(steps_[k].step.time, steps_[k].step.end)) open_steps_.push_back(static_cast<int>(k));
+  }
+  open_disturbances_.clear();
+  for (size_t k = 0; k < disturbances_.size(); ++k) {
+    const DisturbanceWindow& w = disturbances_[k].window;
+    if (open(w.start, w.end)) open_disturbances_.push_back(static_cast<int>(k));
+  }
 }
 
 void SignalMetrics::Add(double t, double r, double y) {
@@ -23,18 +54,17 @@ void SignalMetrics::Add(double t, double r, double y) {
   sq_ += (y - r) * (y - r);
   ++n_;
   prev_t_ = t, prev_r_ = r, prev_y_ = y, prev_abs_ = std::abs(y - r);
-  for (StepState& s : steps_) {
-    if (t < s.step.time || t >= s.step.end) continue;
-    const double size = std::abs(s.step.to - s.step.from);
-    const double dir = s.step.to > s.step.from ? 1.0 : -1.0;
-    s.peak = std::max(s.peak, dir * (y - s.step.to));
+  if (!(t >= from_ && t < until_)) FindWindows(t);
+  for (int k : open_steps_) {
+    StepState& s = steps_[k];
+    s.peak = std::max(s.peak, s.dir * (y - s.step.to));
     if (s.last_was_out) s.t_after_out = t;
-    s.last_was_out = std::abs(y - s.step.to) > band_ * size;
+    s.last_was_out = std::abs(y - s.step.to) > s.tolerance;
     s.out_seen = s.out_seen || s.last_was_out;
     s.any = true;
   }
-  for (DisturbanceResponse& d : disturbances_) {
-    if (t < d.window.start || t >= d.window.end) continue;
+  for (int k : open_disturbances_) {
+    DisturbanceResponse& d = disturbances_[k];
     d.peak_deviation = std::max(d.peak_deviation, std::abs(y - r));
     d.final_deviation = std::abs(y - r);
   }

@@ -25,14 +25,24 @@ class SignalMetrics {
  private:
   struct StepState {
     ReferenceStep step;
+    double dir = 0;        // +1 up, -1 down
+    double tolerance = 0;  // band * |to - from|
     double peak = 0;
     bool any = false;           // a sample fell in [time, end)
     bool out_seen = false;      // some sample was out of the band
     bool last_was_out = false;  // the window's latest sample was out of the band
     double t_after_out = 0;     // time of the sample after the latest out-of-band one
   };
+  // The windows (steps' and disturbances') holding t, and the stretch of time [from_, until_)
+  // in which they stay the same: a sample finds its windows with two comparisons, not one test of
+  // every window (the windows change a few times a run).
+  void FindWindows(double t);
+
   std::vector<StepState> steps_;
   std::vector<DisturbanceResponse> disturbances_;  // accumulated as the samples come
+  // The indices of those whose window holds from_ (indices, so that a copy is right).
+  std::vector<int> open_steps_, open_disturbances_;
+  double from_ = 0, until_ = 0;  // empty until the first sample
   double band_ = 0;
   long n_ = 0;
   double sq_ = 0, iae_ = 0, tv_r_ = 0, tv_y_ = 0;

@@ -179,6 +179,34 @@ double Reference::operator()(double t) const {
   return a.v + (b.v - a.v) * (t - a.t) / (b.t - a.t);
 }
 
+double ReferenceCursor::Seek(double t) {
+  const std::vector<Knot>& k = ref_->knots();
+  const double first = k.front().t, last = k.back().t;
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  // The stretches of Reference::operator()'s branches: before the first knot, past the last one,
+  // and between two knots. A time at the first knot (where a jump there takes the value after it)
+  // or a NaN is read from the Reference and kept nowhere.
+  const double after_first = std::nextafter(first, kInf);  // the least time > first
+  constant_ = true;
+  if (t < first) {
+    lo_ = -kInf, hi_ = first, v0_ = k.front().v;
+  } else if (t >= last && t > first) {
+    lo_ = std::max(last, after_first), hi_ = kInf, v0_ = k.back().v;
+  } else if (t > first && t < last) {
+    // upper_bound's knot b and the one before it, a: a.t <= t < b.t.
+    auto b = std::upper_bound(k.begin(), k.end(), t,
+                              [](double x, const Knot& knot) { return x < knot.t; });
+    const Knot& a = *(b - 1);
+    lo_ = std::max(a.t, after_first), hi_ = b->t;
+    constant_ = false;
+    v0_ = a.v, t0_ = a.t, dv_ = b->v - a.v, dt_ = b->t - a.t;
+  } else {
+    lo_ = kInf, hi_ = 0;
+    return (*ref_)(t);
+  }
+  return Value(t);
+}
+
 std::vector<ReferenceStep> Reference::Steps(double duration) const {
   std::vector<ReferenceStep> steps;
   for (size_t i = 0; i + 1 < knots_.size(); ++i) {

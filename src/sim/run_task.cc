@@ -370,8 +370,12 @@ void FillTelemetry(const Plant& plant, double reference, double measured, bool h
     const int b = plant.bundle_index(i);
     BundleTelemetry& bt = sample.bundles[i];
     bt.force = plant.Force(i);
-    bt.true_on = channels[i].switches.last();
-    bt.on_fraction = static_cast<double>(bt.true_on) / plant.num_units(i);
+    // Units switch only when a broadcast reaches them: the on-count is the one counted at the
+    // last control instant (RunTask), and its fraction is worked out only then (~20 instructions).
+    if (sample.control_instant) {
+      bt.true_on = channels[i].switches.last();
+      bt.on_fraction = static_cast<double>(bt.true_on) / plant.num_units(i);
+    }
     bt.mean_temperature = plant.MeanTemperature(i);
     if (heat) bt.heat = plant.host().Heat(plant.data(), b);
   }
@@ -810,6 +814,13 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
   auto measured = [&]() {
     return task.tracked == Tracked::kForce ? plant.Force(0) : plant.angle();
   };
+  // The references read after every step, at increasing times: each cursor keeps the segment
+  // the last read fell in (the same values as the references give).
+  ReferenceCursor reference(task.reference);
+  std::vector<ReferenceCursor> joint_references;
+  for (int j = 1; j < plant.num_joints(); ++j) {
+    joint_references.emplace_back(task.joints[j].reference);
+  }
 
   const bool census = settings.census_period > 0;
   long control_instants = 0;
@@ -845,11 +856,11 @@ Result<RunSummary> RunTask(const Task& task, const RunOptions& options,
     plant.Step();
 
     const double y = measured();
-    const double r = task.reference(plant.time());
+    const double r = reference(plant.time());
     sig.Add(plant.time(), r, y);
     for (int j = 1; j < plant.num_joints(); ++j) {
       JointTelemetry& jt = sample.joints[j - 1];
-      jt.reference = task.joints[j].reference(plant.time());
+      jt.reference = joint_references[j - 1](plant.time());
       jt.angle = plant.JointAngle(j);
       more_joints[j - 1].Add(plant.time(), jt.reference, jt.angle);
     }

@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "common/rng.h"
@@ -140,6 +141,65 @@ TEST(Metrics, NeesOfGaussianErrorsWithTrueVarianceIsNearOne) {
     var.push_back(9.0);
   }
   EXPECT_NEAR(ScoreEstimator(est, truth, var).mean_nees, 1.0, 0.01);
+}
+
+// Windows in any arrangement: steps' windows that overlap, nest, hold no sample, open before the
+// first sample or after the last, and disturbance windows across them. The stream against the
+// pure StepResponses and the disturbances' definition (the largest and the last |y - r| of the
+// samples in [start, end)), to the bit; a copy made halfway goes on as the original does.
+TEST(MetricsStream, WindowsInAnyArrangementEqualThePureFunctions) {
+  Rng rng(7);
+  auto uniform = [&rng](double lo, double hi) { return lo + (hi - lo) * rng.Uniform(); };
+  for (int trial = 0; trial < 60; ++trial) {
+    std::vector<ReferenceStep> steps;
+    for (int k = 0, n = 1 + static_cast<int>(6 * rng.Uniform()); k < n; ++k) {
+      const double time = std::round(uniform(-1, 13)), from = uniform(-2, 2);
+      const double to = rng.Uniform() < 0.15 ? from : uniform(-2, 2);       // some of size 0
+      steps.push_back({time, from, to, time + std::round(uniform(0, 6))});  // some empty
+    }
+    std::vector<DisturbanceWindow> pushes;
+    for (int k = 0, n = static_cast<int>(4 * rng.Uniform()); k < n; ++k) {
+      const double start = std::round(uniform(0, 12));
+      pushes.push_back({start, start + std::round(uniform(0, 5))});
+    }
+    SignalMetrics stream(steps, 0.1, pushes);
+    std::vector<SignalMetrics> copy;
+    std::vector<double> t, r, y;
+    const double h = 0.01 + 0.02 * rng.Uniform();
+    double time = 0;
+    for (int k = 0; time < 12; ++k, time += h) {
+      const double ref = std::sin(0.7 * time),
+                   meas = ref + 0.3 * std::sin(3 * time) * uniform(0, 1);
+      t.push_back(time), r.push_back(ref), y.push_back(meas);
+      stream.Add(time, ref, meas);
+      if (k == 300) copy.push_back(stream);
+      if (k > 300) copy[0].Add(time, ref, meas);
+    }
+    ASSERT_EQ(copy.size(), 1u);
+    const auto want = StepResponses(t, y, steps, 0.1);
+    for (const SignalMetrics* m : {&stream, &copy[0]}) {
+      const auto got = m->StepResponses();
+      ASSERT_EQ(got.size(), want.size()) << "trial " << trial;
+      for (size_t i = 0; i < got.size(); ++i) {
+        EXPECT_EQ(got[i].overshoot, want[i].overshoot) << "trial " << trial << " step " << i;
+        EXPECT_EQ(got[i].settling_time, want[i].settling_time) << "trial " << trial;
+        EXPECT_EQ(got[i].settled, want[i].settled) << "trial " << trial;
+      }
+      const auto d = m->DisturbanceResponses();
+      ASSERT_EQ(d.size(), pushes.size());
+      for (size_t i = 0; i < d.size(); ++i) {
+        double peak = 0, final = 0;
+        for (size_t k = 0; k < t.size(); ++k) {
+          if (t[k] < pushes[i].start || t[k] >= pushes[i].end) continue;
+          peak = std::max(peak, std::abs(y[k] - r[k]));
+          final = std::abs(y[k] - r[k]);
+        }
+        EXPECT_EQ(d[i].peak_deviation, peak) << "trial " << trial << " push " << i;
+        EXPECT_EQ(d[i].final_deviation, final) << "trial " << trial << " push " << i;
+      }
+      EXPECT_EQ(m->TrackingRmse(), TrackingRmse(r, y));
+    }
+  }
 }
 
 }  // namespace file_metrics_test

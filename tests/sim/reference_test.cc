@@ -2,6 +2,13 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <vector>
+
+#include "common/rng.h"
+
 namespace recruit::sim {
 namespace file_reference_test {
 
@@ -72,6 +79,59 @@ TEST(Reference, BadInputsNameTheField) {
                                "f");
   ASSERT_FALSE(d.ok());
   EXPECT_NE(d.error().find("f.end"), std::string::npos) << d.error();
+}
+
+// The same double, bit for bit (so a -0 is not a 0, and a NaN equals a NaN).
+bool SameBits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+// A random reference: 1-8 knots at times on a coarse grid (so that some share a time: jumps,
+// also at the first time), values from a small set with 0 and -0 among them (holds, ramps up
+// and down, a -0 the interpolation must not turn into 0).
+Reference RandomReference(Rng& rng) {
+  const double values[] = {0.0, -0.0, 1.0, -2.5, 12.0, 24.0, 8.0, 1e-3};
+  std::vector<Knot> knots;
+  double t = -1 + 3 * std::floor(2 * rng.Uniform());  // -1 or 2
+  const int n = 1 + static_cast<int>(8 * rng.Uniform());
+  for (int i = 0; i < n; ++i) {
+    const bool jump = i > 0 && rng.Uniform() < 0.4 &&
+                      (i < 2 || knots[i - 1].t != knots[i - 2].t);  // at most two at a time
+    if (!jump) t += 0.25 * std::ceil(8 * rng.Uniform());
+    knots.push_back({t, values[static_cast<int>(8 * rng.Uniform())]});
+  }
+  return std::move(Reference::Piecewise(knots)).value();
+}
+
+// The cursor against the plain evaluation at every read, to the bit: on random references, at a
+// run's accumulated physics-step times (t += h, as MuJoCo's clock goes), at every knot's time
+// and its neighbouring doubles (reached from either side), then at random times in any order (going
+// back, too), at the infinities and at NaN.
+TEST(ReferenceCursor, EqualsThePlainEvaluationAtEveryRead) {
+  Rng rng(19);
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  long reads = 0;
+  for (int trial = 0; trial < 400; ++trial) {
+    const Reference r = RandomReference(rng);
+    const double first = r.knots().front().t, last = r.knots().back().t;
+    ReferenceCursor cursor(r);
+    auto check = [&](double t) {
+      const double want = r(t), got = cursor(t);
+      ++reads;
+      ASSERT_TRUE(SameBits(got, want))
+          << "trial " << trial << " t " << t << ": " << got << " != " << want;
+    };
+    const double h = 0.002 + 0.01 * rng.Uniform();
+    for (double t = first - 1; t < last + 1; t += h) check(t);
+    for (const Knot& k : r.knots()) {  // each knot approached from below, then from above
+      for (double side : {-kInf, kInf}) {
+        check(std::nextafter(k.t, side));
+        check(k.t);
+        check(std::nextafter(k.t, -side));
+      }
+    }
+    for (int k = 0; k < 200; ++k) check(first - 2 + (last - first + 4) * rng.Uniform());
+    for (double t : {kInf, -kInf, std::nan(""), first, last, 0.0, -0.0}) check(t);
+  }
+  EXPECT_GT(reads, 100000);
 }
 
 }  // namespace file_reference_test
