@@ -22,6 +22,12 @@ constexpr int kSubsteps = 20;  // mechanics steps per sampling period
 // reference stiffness times the step (measured on the elbow arm's reach-and-hold over 6 seeds at
 // dT 1 and 0.5: 0.25 settled 63 % of steps, 0.5 87-90 %).
 constexpr double kFeedforwardError = 0.5;
+// Settling sooner than this share of the hold earns a design nothing: among the designs that
+// settle by then, the one whose predictions with slower bundles and a higher gain, and with the
+// feedforward off, do best. The fastest design recruits the most units in the first sampling
+// periods of a step, before their force shows, and the count's binomial excess is what overshoots
+// (docs/controller.md, "Unhurried").
+constexpr double kUnhurried = 0.35;
 
 // Exact discretisation of I qddot + b qdot + k q = tau over h with tau held: z' = Phi z + Gam tau.
 struct Discrete {
@@ -56,16 +62,26 @@ void Score(const std::vector<double>& t, const std::vector<double>& y, const Loo
   out.final_error = y.empty() || !std::isfinite(y.back()) ? 1e9 : std::abs(y.back() - 1);
 }
 
+// The nominal prediction's settling time as the choice counts it.
+double CountedSettling(const PredictedStep& p, const LoopTarget& target) {
+  return std::max(p.settling_time, kUnhurried * target.hold);
+}
+
 // One prediction's share of a design's penalty (>= 0).
-double StepPenalty(const PredictedStep& p, double allowed, const LoopTarget& target) {
-  return p.settling_time + (p.settled ? 0 : target.hold) +
-         target.hold * std::min(p.final_error, 1e6) +
+double StepPenalty(const PredictedStep& p, double allowed, const LoopTarget& target,
+                   double settling) {
+  return settling + (p.settled ? 0 : target.hold) + target.hold * std::min(p.final_error, 1e6) +
          10 * target.hold * std::max(0.0, p.overshoot - allowed);
 }
 
+double NominalPenalty(const PredictedStep& p, const LoopTarget& target) {
+  return StepPenalty(p, target.overshoot, target, CountedSettling(p, target));
+}
+
 double Penalty(const LoopDesign& d, const LoopTarget& target) {
-  return StepPenalty(d.nominal, target.overshoot, target) +
-         0.25 * StepPenalty(d.robust, 0.25, target) + 0.25 * StepPenalty(d.offset, 0.25, target);
+  return NominalPenalty(d.nominal, target) +
+         0.25 * StepPenalty(d.robust, 0.25, target, d.robust.settling_time) +
+         0.25 * StepPenalty(d.offset, 0.25, target, d.offset.settling_time);
 }
 
 // Designs already made in this process, keyed by the exact bits of every input: a sweep's runs
@@ -235,8 +251,8 @@ LoopDesign SearchGrid(const JointDynamics& joint, const ActuatorResponse& act, d
         // penalty, or keep a design that meets at its settling time): when that is no better
         // than the best so far, they are not made; the choice is the same.
         const bool nominal_meets = d.nominal.settled && d.nominal.overshoot <= target.overshoot;
-        const double least = nominal_meets ? d.nominal.settling_time
-                                           : 1e6 + StepPenalty(d.nominal, target.overshoot, target);
+        const double least = nominal_meets ? CountedSettling(d.nominal, target)
+                                           : 1e6 + NominalPenalty(d.nominal, target);
         if (!(least < best_penalty - 1e-9)) continue;
         d.robust = PredictStep(joint, act, dT, d.gains, target, 1.5, 1.5);
         d.offset = PredictStep(joint, act, dT, d.gains, target, 1, 1,
@@ -244,9 +260,10 @@ LoopDesign SearchGrid(const JointDynamics& joint, const ActuatorResponse& act, d
         d.meets = d.nominal.settled && d.nominal.overshoot <= target.overshoot &&
                   d.robust.settled && d.robust.overshoot <= 0.25 && d.offset.settled &&
                   d.offset.overshoot <= 0.25;
-        // Among designs that meet the target the fastest; ties to the smaller gains (the grid
-        // runs from small to large, and only a strictly better one replaces).
-        const double penalty = d.meets ? d.nominal.settling_time : 1e6 + Penalty(d, target);
+        // Designs that meet the target before any that does not; among them the least penalty
+        // (ties to the smaller gains: the grid runs from small to large, and only a strictly
+        // better one replaces).
+        const double penalty = (d.meets ? 0 : 1e6) + Penalty(d, target);
         if (penalty < best_penalty - 1e-9) best_penalty = penalty, best = d;
       }
     }
