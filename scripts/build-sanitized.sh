@@ -11,7 +11,8 @@
 #     (fuzzer-no-link) only in the fuzz targets' objects and the parsers' own sources
 #     (tests/fuzz/coverage_allowlist.txt, each library's parsers in a unity batch of their own):
 #     everywhere, its comparison callbacks made the suite's Monte Carlo tests 2.7 times slower.
-#     scripts/sanitize.sh runs it.
+#     The headers the test programs share precompiled once per level (RECRUIT_PCH_TESTS,
+#     tests/CMakeLists.txt). scripts/sanitize.sh runs it.
 #   - COVERAGE=ON (clang only, build-fuzz/): the libFuzzer targets and the libraries they link
 #     alone, with the coverage instrumentation in every library (a second tree: CI does not build
 #     it; docs/reliability.md "CI").
@@ -21,7 +22,8 @@
 #   scripts/build-sanitized.sh [target...]     (default: every target of the tree's kind)
 # Environment: BUILD_DIR (default build-asan, with COVERAGE=ON build-fuzz), JOBS (default nproc),
 # OPT (default -O1), COLD_OPT (suite only, default -O0; "" = OPT everywhere), COVERAGE (OFF),
-# BENCH=ON to build the benchmarks too (suite only), CC/CXX (default clang/clang++).
+# BENCH=ON to build the benchmarks too (suite only), PCH (suite only, default ON), CC/CXX (default
+# clang/clang++).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 COVERAGE=${COVERAGE:-OFF}
@@ -48,7 +50,8 @@ if "$CXX" --version | grep -q clang; then
   COV="-fsanitize-coverage-allowlist=$PWD/tests/fuzz/coverage_allowlist.txt"
 fi
 KIND=(-DRECRUIT_BUILD_PYTHON=ON -DRECRUIT_UNITY_TESTS=ON -DRECRUIT_BUILD_FUZZ="$FUZZ"
-  -DRECRUIT_BUILD_BENCH="${BENCH:-OFF}" -DRECRUIT_COLD_OPT="${COLD_OPT--O0}")
+  -DRECRUIT_BUILD_BENCH="${BENCH:-OFF}" -DRECRUIT_COLD_OPT="${COLD_OPT--O0}"
+  -DRECRUIT_PCH_TESTS="${PCH:-ON}")
 if [ "$COVERAGE" = ON ]; then
   COV=""
   KIND=(-DRECRUIT_BUILD_PYTHON=OFF -DRECRUIT_BUILD_TESTS=OFF -DRECRUIT_BUILD_FUZZ=ON
