@@ -1,34 +1,37 @@
 #!/usr/bin/env bash
-# Builds the libFuzzer targets of the input parsers (tests/fuzz) in their own sanitized tree
-# (scripts/build-sanitized.sh with COVERAGE=ON: clang, AddressSanitizer + UndefinedBehaviorSanitizer
-# with no recovery, coverage instrumentation in every library they link; build-fuzz/), then runs
-# each for a fixed time from its checked-in seed corpus with a fixed seed, JOBS targets at a time.
+# Builds the libFuzzer targets of the input parsers (tests/fuzz) in the suite's sanitized tree
+# (scripts/build-sanitized.sh: clang, AddressSanitizer + UndefinedBehaviorSanitizer with no
+# recovery, libFuzzer's coverage instrumentation in the targets and the parsers' own sources;
+# build-asan/, where scripts/sanitize.sh has built them already), then runs each for a fixed time
+# from its checked-in seed corpus with a fixed seed, JOBS targets at a time.
 # Fails if any target crashes, hangs (-timeout), leaks or trips a sanitizer; the input that did it
-# is written to build-fuzz/artifacts/.
+# is written to <build>/artifacts/.
 # Usage:
 #   scripts/fuzz.sh [target...]     targets: task filter_model filter_log bundle_config mjcf_config
 #                                   sil_packet
 #                                   (default: all)
-# Environment: FUZZ_SECONDS per target (default 30), FUZZ_SEED (default 1), BUILD_DIR (default
-# build-fuzz), JOBS (default: nproc; also the targets fuzzing at once). Reproduce a crash:
-# build-fuzz/tests/fuzz/fuzz_<target> FILE.
+# Environment: FUZZ_SECONDS per target (default 30), FUZZ_SEED (default 1), COVERAGE=ON for the
+# targets' own tree with the coverage instrumentation in every library they link (build-fuzz/),
+# BUILD_DIR (default build-asan, with COVERAGE=ON build-fuzz), JOBS (default: nproc; also the
+# targets fuzzing at once). Reproduce a crash: <build>/tests/fuzz/fuzz_<target> FILE.
 # Keep one found crash as a regression test: copy it to tests/fuzz/corpus/<target>/regress-<what>
 # (ctest's fuzz_<target>_corpus replays every corpus file with the normal build).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-BUILD_DIR=${BUILD_DIR:-build-fuzz}
+COVERAGE=${COVERAGE:-OFF}
+if [ "$COVERAGE" = ON ]; then BUILD_DIR=${BUILD_DIR:-build-fuzz}; else BUILD_DIR=${BUILD_DIR:-build-asan}; fi
 JOBS=${JOBS:-$(nproc)}
 FUZZ_SECONDS=${FUZZ_SECONDS:-30}
 FUZZ_SEED=${FUZZ_SEED:-1}
 TARGETS=("$@")
 if [ ${#TARGETS[@]} -eq 0 ]; then TARGETS=(task filter_model filter_log bundle_config mjcf_config sil_packet); fi
 
-export BUILD_DIR JOBS
+export BUILD_DIR JOBS COVERAGE
 if ! "${CXX:-clang++}" --version | grep -q clang; then
   echo "fuzz: libFuzzer needs clang (CXX=${CXX:-clang++})" >&2
   exit 2
 fi
-COVERAGE=ON ./scripts/build-sanitized.sh "${TARGETS[@]/#/fuzz_}"
+./scripts/build-sanitized.sh "${TARGETS[@]/#/fuzz_}"
 
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
 # libFuzzer's link puts libstdc++ before the shared ASan runtime (scripts/build-sanitized.sh), which

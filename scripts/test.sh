@@ -3,7 +3,7 @@
 #   bash scripts/test.sh             the README's command and CI's (.ci/run): the whole suite (C++
 #                                    and Python) built with AddressSanitizer + UndefinedBehavior-
 #                                    Sanitizer in build-asan/, then each parser's libFuzzer target
-#                                    for FUZZ_SECONDS (default 10), built in build-fuzz/
+#                                    for FUZZ_SECONDS (default 10), built in the same tree
 #   bash scripts/test.sh --release   the same suite in the Release build (build/), no fuzzing
 set -euo pipefail
 cd "$(dirname "$0")/.."
