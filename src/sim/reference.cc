@@ -166,7 +166,7 @@ Result<Reference> Reference::FromJson(const nlohmann::json& j, const std::string
 }
 
 double Reference::operator()(double t) const {
-  if (t <= knots_.front().t) {
+  if (!(t > knots_.front().t)) {  // NaN too: no knot to search for it
     // At a jump at the first time, the value after the jump.
     if (knots_.size() > 1 && knots_[1].t == knots_[0].t && t == knots_[0].t) return knots_[1].v;
     return knots_.front().v;
