@@ -26,12 +26,13 @@ void PrintDesign(const sim::JointDesignRecord& r, bool response) {
       "%.2f s\n"
       "%-14s %8s  kp %.4g N m/rad, ki %.4g N m/(rad s), kd %.4g N m s/rad\n"
       "%-14s %8s  predicted: overshoot %.1f %%, settles in %.1f s%s; 1.5x slower bundles and "
-      "1.5x gain: overshoot %.1f %%, %s%s\n",
+      "1.5x gain: overshoot %.1f %%, %s; one sampling period late: overshoot %.1f %%, %s%s\n",
       r.joint.c_str(), r.reference * 180 / M_PI, r.dynamics.inertia, r.dynamics.damping,
       r.dynamics.stiffness, r.bundle_stiffness, r.actuator_t63, "", "", d.gains.kp, d.gains.ki,
       d.gains.kd, "", "", 100 * d.nominal.overshoot, d.nominal.settling_time,
       d.nominal.settled ? "" : " (not settled)", 100 * d.robust.overshoot,
-      d.robust.settled ? "settles" : "does not settle",
+      d.robust.settled ? "settles" : "does not settle", 100 * d.delayed.overshoot,
+      d.delayed.settled ? "settles" : "does not settle",
       d.meets ? "" : ("  [" + d.note + "]").c_str());
   // The same gains as the joint will move the demand: each way through the bundles that move
   // it that way, rising or releasing (JointLoops::BothWays).

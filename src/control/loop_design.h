@@ -59,6 +59,7 @@ struct LoopDesign {
   PredictedStep nominal;  // the design model
   PredictedStep robust;   // actuator 1.5x slower, loop gain 1.5x
   PredictedStep offset;   // the feedforward off by half the step's static torque
+  PredictedStep delayed;  // every change of the demand shown one sampling period late
   bool meets = false;     // both meet the target (else the best found, with a reason)
   std::string note;
 };
@@ -67,11 +68,11 @@ struct LoopDesign {
 // taken off every demand from the step on. Each rise of the demand moves the actuator's torque
 // along act.s, each fall along its release response (ActuatorResponse::Released, s when it has
 // none): the torque is the sum of the demand's increments, each through its own direction's
-// response.
+// response, which starts `delay` s after the change (a dead time on top of the response's own).
 PredictedStep PredictStep(const JointDynamics& joint, const ActuatorResponse& act, double dT,
                           const LoopGains& gains, const LoopTarget& target,
                           double actuator_slowdown = 1, double gain_scale = 1,
-                          double feedforward_error = 0);
+                          double feedforward_error = 0, double delay = 0);
 
 // The exact bits of every input of DesignJointLoop: the key its designs are kept under, in this
 // process and between processes (control/loop_design_store.h).

@@ -59,6 +59,7 @@ std::optional<LoopDesign> Load(const std::vector<std::uint64_t>& key) {
   d.nominal = GetStep(r);
   d.robust = GetStep(r);
   d.offset = GetStep(r);
+  d.delayed = GetStep(r);
   d.meets = r.Word() != 0;
   d.note = r.Text();
   if (!r.ok() || !r.AtEnd()) return std::nullopt;
@@ -75,6 +76,7 @@ void Save(const std::vector<std::uint64_t>& key, const LoopDesign& design) {
   PutStep(w, design.nominal);
   PutStep(w, design.robust);
   PutStep(w, design.offset);
+  PutStep(w, design.delayed);
   w.Word(design.meets);
   w.Text(design.note);
   SaveEntry(folder, Identity(key), ".design", w.bytes());

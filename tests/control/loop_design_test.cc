@@ -77,6 +77,27 @@ TEST(LoopDesign, PredictionMatchesAFineRk4IntegrationOfTheSameLoop) {
   for (int n = 0; n < 30; ++n) EXPECT_NEAR(q[n], p.angle[n], 2e-3) << "instant " << n;
 }
 
+// A dead time: every change of the demand moving the torque 1.5 s late, against the RK4
+// integration of the loop with the response shifted by 1.5 s (zero before).
+TEST(LoopDesign, ADelayedPredictionMatchesAFineRk4IntegrationOfTheDelayedLoop) {
+  const ActuatorResponse act = TwoState(1.0, 0.2);
+  const JointDynamics joint{0.003, 0.02, 0.1};
+  const LoopGains g{0.1, 0.02, 0.03};
+  LoopTarget target;
+  target.hold = 30;
+  const PredictedStep p = PredictStep(joint, act, 1.0, g, target, 1, 1, 0, 1.5);
+  const PredictedStep on_time = PredictStep(joint, act, 1.0, g, target);
+  const std::vector<double> q = Rk4Angles(joint, g, 30, [&](double change, double t) {
+    return t < 1.5 ? 0.0 : change * act.At(t - 1.5);
+  });
+  double apart = 0;
+  for (int n = 0; n < 30; ++n) {
+    EXPECT_NEAR(q[n], p.angle[n], 2e-3) << "instant " << n;
+    apart = std::max(apart, std::abs(p.angle[n] - on_time.angle[n]));
+  }
+  EXPECT_GT(apart, 0.05) << "the delay must change the step";
+}
+
 // Bundles that rise with one first-order lag and release with another (closed form at the
 // samples: FirstOrderActuatorResponse with lambda 1 is 1 - exp(-k dT / tau)).
 ActuatorResponse UpDown(double dT, double tau_up, double tau_down) {
@@ -163,8 +184,9 @@ TEST(LoopDesign, TheDesignMeetsItsTargetInItsOwnPredictionAndBeatsNoFeedback) {
 // The choice as docs/controller.md states it, made by predicting every design of the grid one by
 // one (the search itself skips predictions that cannot win): designs that meet all three targets
 // first, then the least penalty, the nominal step's settling counted from 0.35 of the hold
-// ("Unhurried"). On these joints the fastest design settles far sooner than that, so the choice
-// is made by the other two predictions.
+// ("Unhurried") and the step with every change one sampling period late in the penalty ("One
+// period late"). On these joints the fastest design settles far sooner than that, so the choice
+// is made by the other three predictions.
 TEST(LoopDesign, TheChoiceIsTheGridsLeastPenaltyWithSettlingCountedFromAThirdOfTheHold) {
   struct Case {
     JointDynamics joint;
@@ -195,19 +217,21 @@ TEST(LoopDesign, TheChoiceIsTheGridsLeastPenaltyWithSettlingCountedFromAThirdOfT
     LoopGains best_gains;
     for (double a : {0.0, 0.125, 0.25, 0.5, 1.0, 2.0, 4.0, 8.0}) {
       for (double b : {0.02, 0.04, 0.08, 0.15, 0.3, 0.6, 1.2, 2.4}) {
-        for (double c : {0.0, 0.05, 0.2}) {
+        for (double c : {0.0, 0.05, 0.2, 0.5, 1.0}) {
           const LoopGains g{a * k_ref, b * k_ref / t63, c * k_ref * t63};
           const PredictedStep n = PredictStep(k.joint, act, k.dT, g, target);
           const PredictedStep r = PredictStep(k.joint, act, k.dT, g, target, 1.5, 1.5);
           const PredictedStep o =
               PredictStep(k.joint, act, k.dT, g, target, 1, 1, 0.5 * k_ref + k.torque_error);
+          const PredictedStep late = PredictStep(k.joint, act, k.dT, g, target, 1, 1, 0, k.dT);
           const bool meets = n.settled && n.overshoot <= target.overshoot && r.settled &&
                              r.overshoot <= 0.25 && o.settled && o.overshoot <= 0.25;
           const double penalty =
               (meets ? 0 : 1e6) +
               step_penalty(n, target.overshoot, std::max(n.settling_time, 0.35 * target.hold)) +
               0.25 * step_penalty(r, 0.25, r.settling_time) +
-              0.25 * step_penalty(o, 0.25, o.settling_time);
+              0.25 * step_penalty(o, 0.25, o.settling_time) +
+              0.25 * step_penalty(late, 0.25, late.settling_time);
           if (penalty < best - 1e-9) best = penalty, best_gains = g;
           if (n.settled && n.overshoot <= target.overshoot) {
             fastest = std::min(fastest, n.settling_time);
