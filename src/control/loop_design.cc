@@ -78,13 +78,6 @@ double NominalPenalty(const PredictedStep& p, const LoopTarget& target) {
   return StepPenalty(p, target.overshoot, target, CountedSettling(p, target));
 }
 
-double Penalty(const LoopDesign& d, const LoopTarget& target) {
-  return NominalPenalty(d.nominal, target) +
-         0.25 * StepPenalty(d.robust, 0.25, target, d.robust.settling_time) +
-         0.25 * StepPenalty(d.offset, 0.25, target, d.offset.settling_time) +
-         0.25 * StepPenalty(d.delayed, 0.25, target, d.delayed.settling_time);
-}
-
 // Designs already made in this process, keyed by the exact bits of every input: a sweep's runs
 // of one task design the same loops again (the design is a sixth of a short auto-loop run), and
 // a design is a pure function of its inputs, so a stored one is the one a new search would make.
@@ -257,12 +250,6 @@ LoopDesign SearchGrid(const JointDynamics& joint, const ActuatorResponse& act, d
                                            : 1e6 + NominalPenalty(d.nominal, target);
         if (!(least < best_penalty - 1e-9)) continue;
         d.robust = PredictStep(joint, act, dT, d.gains, target, 1.5, 1.5);
-        // A recruitment shows in the force a sampling period later than the chain's expected
-        // response says on the limbs (the units heat first, and the estimate learns the
-        // binomial count only from the force): a design whose step falls apart then is
-        // penalised like one that needs the bundles it was designed for (docs/controller.md,
-        // "One period late"). Not a target: the penalty only.
-        d.delayed = PredictStep(joint, act, dT, d.gains, target, 1, 1, 0, dT);
         d.offset = PredictStep(joint, act, dT, d.gains, target, 1, 1,
                                kFeedforwardError * k_ref + target.torque_error);
         d.meets = d.nominal.settled && d.nominal.overshoot <= target.overshoot &&
@@ -270,8 +257,19 @@ LoopDesign SearchGrid(const JointDynamics& joint, const ActuatorResponse& act, d
                   d.offset.overshoot <= 0.25;
         // Designs that meet the target before any that does not; among them the least penalty
         // (ties to the smaller gains: the grid runs from small to large, and only a strictly
-        // better one replaces).
-        const double penalty = (d.meets ? 0 : 1e6) + Penalty(d, target);
+        // better one replaces). The late prediction below only adds to it.
+        const double known = (d.meets ? 0 : 1e6) + NominalPenalty(d.nominal, target) +
+                             0.25 * StepPenalty(d.robust, 0.25, target, d.robust.settling_time) +
+                             0.25 * StepPenalty(d.offset, 0.25, target, d.offset.settling_time);
+        if (!(known < best_penalty - 1e-9)) continue;
+        // A recruitment shows in the force a sampling period later than the chain's expected
+        // response says on the limbs (the units heat first, and the estimate learns the
+        // binomial count only from the force): a design whose step falls apart then is
+        // penalised like one that needs the bundles it was designed for (docs/controller.md,
+        // "One period late"). Not a target: the penalty only.
+        d.delayed = PredictStep(joint, act, dT, d.gains, target, 1, 1, 0, dT);
+        const double penalty =
+            known + 0.25 * StepPenalty(d.delayed, 0.25, target, d.delayed.settling_time);
         if (penalty < best_penalty - 1e-9) best_penalty = penalty, best = d;
       }
     }
