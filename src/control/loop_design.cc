@@ -264,9 +264,9 @@ LoopDesign SearchGrid(const JointDynamics& joint, const ActuatorResponse& act, d
         if (!(known < best_penalty - 1e-9)) continue;
         // A recruitment shows in the force a sampling period later than the chain's expected
         // response says on the limbs (the units heat first, and the estimate learns the
-        // binomial count only from the force): a design whose step falls apart then is
-        // penalised like one that needs the bundles it was designed for (docs/controller.md,
-        // "One period late"). Not a target: the penalty only.
+        // binomial count only from the force): a design whose step overshoots or does not
+        // settle then pays for it in the choice (docs/controller.md, "One period late"). Not a
+        // target: the penalty only.
         d.delayed = PredictStep(joint, act, dT, d.gains, target, 1, 1, 0, dT);
         const double penalty =
             known + 0.25 * StepPenalty(d.delayed, 0.25, target, d.delayed.settling_time);
