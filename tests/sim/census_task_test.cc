@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -99,7 +100,7 @@ int InstantsToFind(const Run& r) {
 }
 
 TEST(CensusTask, ACensusEvery2p5sFindsA10PercentLossWithin10Instants) {
-  int misses_without = 0;
+  int misses_without = 0, runs_without = 0;
   for (std::uint64_t seed : {1, 2, 3, 4, 5, 6}) {
     auto with = RunCensusTask(CensusTask(R"(, "census_period": 2.5)"), seed);
     ASSERT_TRUE(with.ok()) << with.error();
@@ -113,14 +114,18 @@ TEST(CensusTask, ACensusEvery2p5sFindsA10PercentLossWithin10Instants) {
     ASSERT_TRUE(with->summary.bundles[0].censuses.has_value());
     EXPECT_EQ(*with->summary.bundles[0].censuses, 19);
     EXPECT_EQ(with->summary.ToJson()["bundles"][0]["censuses"], 19);
+    // The same run without a census, until one misses the loss (the check below needs one).
+    if (misses_without > 0) continue;
     auto without = RunCensusTask(CensusTask(""), seed);
     ASSERT_TRUE(without.ok()) << without.error();
+    ++runs_without;
     EXPECT_FALSE(without->summary.bundles[0].censuses.has_value());
     EXPECT_FALSE(without->summary.ToJson()["bundles"][0].contains("censuses"));
     const int k0 = InstantsToFind(*without);
     misses_without += k0 < 0 || k0 > 10;
   }
   // The check can fail: without a census the force alone misses a loss of off units.
+  std::printf("without a census: %d of %d runs missed the loss\n", misses_without, runs_without);
   EXPECT_GT(misses_without, 0);
 }
 
