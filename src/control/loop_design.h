@@ -60,7 +60,7 @@ struct LoopDesign {
   PredictedStep robust;   // actuator 1.5x slower, loop gain 1.5x
   PredictedStep offset;   // the feedforward off by half the step's static torque
   PredictedStep delayed;  // every change of the demand shown one sampling period late
-  bool meets = false;     // nominal, robust and offset meet the target (else the closest, with a note)
+  bool meets = false;     // nominal, robust and offset meet the target (else the closest)
   std::string note;
 };
 
