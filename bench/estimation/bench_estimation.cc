@@ -467,7 +467,7 @@ BENCHMARK(BM_EstimatorParticle)
     ->Unit(benchmark::kMicrosecond);
 
 void BM_ParseFilterModel(benchmark::State& state) {
-  std::ifstream in(RECRUIT_SOURCE_DIR "/models/identified/flexor_4b2b9e8fdcf19d9b_dt1_m20.json");
+  std::ifstream in(RECRUIT_SOURCE_DIR "/models/identified/flexor_104229eb693169de_dt1_m20.json");
   std::stringstream text;
   text << in.rdbuf();
   const std::string json = text.str();

@@ -78,7 +78,7 @@ TEST(UnitForceMap, SettledOnForceFollowsTheTendonLengthLikeThePlugin) {
     const double plugin = arm.ForcePerUnit();
     const double predicted = map->Force(0, arm.length());
     SCOPED_TRACE(deg);
-    EXPECT_GT(plugin, 0.3);
+    EXPECT_GT(plugin, 0.2);  // a hot unit pulls 0.45 N at 0 deg, 0.24 N at 80 deg
     EXPECT_NEAR(predicted, plugin, 0.02 * plugin);
   }
 }

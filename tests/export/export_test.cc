@@ -185,7 +185,7 @@ std::string ArmTransitModels() {
     const auto dir = FreshDir("models_arm_transit");
     const std::string shipped = std::string(RECRUIT_SOURCE_DIR) + "/models/identified/";
     for (const auto& [bundle, file] :
-         {std::pair<std::string, std::string>{"flexor", "flexor_4b2b9e8fdcf19d9b_dt1_m20.json"},
+         {std::pair<std::string, std::string>{"flexor", "flexor_104229eb693169de_dt1_m20.json"},
           {"extensor", "extensor_748ab7310148dd2a_dt1_m20.json"}}) {
       std::ifstream in(shipped + file);
       nlohmann::json j = nlohmann::json::parse(in);

@@ -34,7 +34,7 @@ def variant_task(root, out, task, variant):
     j = json.load(open(path))
     model = os.path.normpath(os.path.join(os.path.dirname(path), j["model"]))
     text = open(model).read()
-    text = re.sub(r'(<config key="units" value="60"/>)', rf'\1<config key="{key}" value="{value}"/>', text)
+    text = re.sub(r'(<config key="units" value="[0-9]+"/>)', rf'\1<config key="{key}" value="{value}"/>', text)
     os.makedirs(f"{out}/models", exist_ok=True)
     j["model"] = f"{out}/models/{key}{value}_{os.path.basename(model)}"
     open(j["model"], "w").write(text)

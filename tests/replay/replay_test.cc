@@ -33,7 +33,7 @@ sim::Task WithUnitParameter(sim::Task task, const std::string& key, const std::s
   auto text = ReadFile(task.model_path);
   EXPECT_TRUE(text.ok());
   const std::string changed =
-      std::regex_replace(*text, std::regex("(<config key=\"units\" value=\"60\"/>)"),
+      std::regex_replace(*text, std::regex("(<config key=\"units\" value=\"[0-9]+\"/>)"),
                          "$1<config key=\"" + key + "\" value=\"" + value + "\"/>");
   EXPECT_NE(changed, *text);
   const fs::path dir = fs::temp_directory_path() / "recruit_replay_test";
