@@ -1,10 +1,11 @@
-"""The numbers of docs/howto-own-model.md: models/elbow_arm.xml as shipped, with the fit check's
-series/prestretch, and with more force (parallel=3). The flexor is held at ctrl = 1 from t = 1 s,
-the extensor at 0; prints the elbow angle and both tensions at t = 8 s.
-
+"""The numbers of docs/howto-own-model.md, "The elbow arm, before and after": models/elbow_arm.xml
+with its bundles as first drafted (60 default units each, prestretch 12 mm / 1 mm), with the fit
+check's series/prestretch, with more force (parallel=3), and as shipped. The flexor is held at
+ctrl = 1 from t = 1 s, the extensor at 0; prints the elbow angle and both tensions at t = 8 s.
 Usage: .venv/bin/python plugin/examples/fit_elbow.py build/plugin/librecruit_sma.so
 """
 import math
+import re
 import sys
 
 import mujoco
@@ -14,21 +15,26 @@ XML = open("models/elbow_arm.xml").read()
 
 
 def variant(flexor, extensor):
-    x = XML.replace('<config key="prestretch" value="0.012"/>', flexor)
-    return x.replace('<config key="prestretch" value="0.001"/>', extensor)
+    """The shipped model with each instance's configuration replaced by the given keys."""
+    def block(name, keys):
+        body = "".join('<config key="%s" value="%s"/>' % kv for kv in keys.items())
+        return '<instance name="%s">%s</instance>' % (name, body)
+    x = XML
+    for name, keys in (("flexor_units", flexor), ("extensor_units", extensor)):
+        x, n = re.subn(r'<instance name="%s">.*?</instance>' % name, block(name, keys), x,
+                       flags=re.S)
+        assert n == 1, name
+    return x
 
 
+FIT_EXTENSOR = {"units": 60, "series": 4, "prestretch": 0.00204}
 CASES = {
-    "as shipped": XML,
-    "series=4 (fit)": variant(
-        '<config key="series" value="4"/><config key="prestretch" value="0.016"/>',
-        '<config key="series" value="4"/><config key="prestretch" value="0.00204"/>'),
+    "first draft": variant({"units": 60, "prestretch": 0.012}, {"units": 60, "prestretch": 0.001}),
+    "series=4 (fit)": variant({"units": 60, "series": 4, "prestretch": 0.016}, FIT_EXTENSOR),
     "series=4 parallel=3": variant(
-        '<config key="series" value="4"/><config key="parallel" value="3"/>'
-        '<config key="prestretch" value="0.016"/>',
-        '<config key="series" value="4"/><config key="prestretch" value="0.00204"/>'),
+        {"units": 60, "series": 4, "parallel": 3, "prestretch": 0.016}, FIT_EXTENSOR),
+    "as shipped": XML,
 }
-
 for name, xml in CASES.items():
     m = mujoco.MjModel.from_xml_string(xml)
     d = mujoco.MjData(m)
