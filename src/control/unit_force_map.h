@@ -7,10 +7,10 @@
 //   h_i(L) = T(xi_i, s(L)) >= 0.
 // While the limb moves a unit keeps its fraction (the phase changes with temperature, slowly), so
 // its force follows the tendon through T at that fraction: this is what a fixed H cannot do (a hot
-// flexor unit of the elbow arm pulls 0.89 N at 0 deg and 0.53 N at 70 deg). The fractions are
+// flexor unit of the elbow arm pulls 0.45 N at 0 deg and 0.27 N at 70 deg). The fractions are
 // found from the forces a model was identified with at one extension (FromForces), where every
 // state whose fraction is below s / s_L is taut, so identification is done at the longest tendon
-// length of the working range (control/bench_recorder.h).
+// length of the working range (identification/bench_recorder.h).
 #pragma once
 
 #include <Eigen/Core>
