@@ -37,6 +37,7 @@
 #include <cmath>
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 #ifdef __SSE2__
 #include <emmintrin.h>

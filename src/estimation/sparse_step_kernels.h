@@ -219,7 +219,8 @@ struct Kernels {
                                            const int* ptr, const int* col, const double* val,
                                            const double* ax, const double* gqg) {
     if constexpr (Len != Eigen::Dynamic && Len <= 16 * kRound) {
-      UpperGroups<Len, 0>(P, Bt, ptr, col, val, ax, gqg);
+      UpperGroups<Len>(P, Bt, ptr, col, val, ax, gqg,
+                       std::make_integer_sequence<int, (Len + kRound - 1) / kRound>());
     } else {
       for (Eigen::Index j = 0; j < m; ++j) {
         const Eigen::Index len = std::min<Eigen::Index>(m, (j + kRound) & ~(kRound - 1));
@@ -247,14 +248,19 @@ struct Kernels {
     }
   }
 
-  // Group G of kRound columns of pass 2 for the fixed size M, then the groups after it.
-  template <int M, int G>
+  // The groups G... of kRound columns of pass 2 for the fixed size M, one after another, each
+  // on rows 0..min(M, (G + 1) kRound). A fold over the group indices, not a recursion (group G
+  // calling group G + 1): inlined recursively, every group's function held all the groups after
+  // it, and the compile time was quadratic in the number of groups (the AVX copy for m = 50:
+  // 91 groups' code for 13). The same operations in the same order: the same results.
+  template <int M, int... G>
   RECRUIT_KF_INLINE static void UpperGroups(double* P, const double* Bt, const int* ptr,
                                             const int* col, const double* val, const double* ax,
-                                            const double* gqg) {
-    constexpr int kLen = std::min<int>(M, (G + 1) * kRound);
-    UpperColumns<kLen>(P, Bt, M, G * kRound, kLen, kLen, ptr, col, val, ax, gqg);
-    if constexpr (kLen < M) UpperGroups<M, G + 1>(P, Bt, ptr, col, val, ax, gqg);
+                                            const double* gqg, std::integer_sequence<int, G...>) {
+    (UpperColumns<std::min<int>(M, (G + 1) * kRound)>(
+         P, Bt, M, G * kRound, std::min<int>(M, (G + 1) * kRound),
+         std::min<int>(M, (G + 1) * kRound), ptr, col, val, ax, gqg),
+     ...);
   }
 
   // out = P h for the m x m column-major P: the combination of all of P's columns (iota = 0,
