@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "identification/nelder_mead.h"
+#include "identification/nonnegative_qp.h"
 
 namespace recruit::identification {
 namespace {
@@ -46,11 +47,42 @@ Eigen::MatrixXd ChainDifferences(const TransientChain& c) {
   return d;
 }
 
+// H = B z in the transient's order: z = (cold force, the K + 1 rises along cold, heat1.., hot,
+// the K + 1 falls along hot, cool1.., cold), every rise and fall >= 0. Cooling states sit above
+// cold by the falls still to come; the loop closes (rises sum to falls) by a penalty.
+Eigen::MatrixXd OrderedBasis(const TransientChain& c) {
+  const int K = c.chain_length;
+  Eigen::MatrixXd B = Eigen::MatrixXd::Zero(c.num_states(), 2 * K + 3);
+  B.col(0).setOnes();
+  for (int j = 0; j <= K; ++j) {
+    for (int i = j + 1; i <= K; ++i) B(c.heat(i), 1 + j) = 1;
+    B(c.hot(), 1 + j) = 1;
+    for (int i = 1; i <= j; ++i) B(c.cool(i), K + 2 + j) = 1;
+  }
+  return B;
+}
+
+// min h^T N h / 2 - b^T h over the ordered forces (OrderedBasis).
+Eigen::VectorXd OrderedSolve(const Eigen::MatrixXd& B, const Eigen::MatrixXd& normal,
+                             const Eigen::VectorXd& b) {
+  const int K1 = (static_cast<int>(B.cols()) - 1) / 2;  // K + 1
+  Eigen::MatrixXd Q = B.transpose() * normal * B;
+  Eigen::VectorXd closure = Eigen::VectorXd::Zero(B.cols());
+  closure.segment(1, K1).setOnes();
+  closure.tail(K1).setConstant(-1);
+  Q += 1e6 * std::max(Q.trace() / Q.rows(), 1e-300) * closure * closure.transpose();
+  std::vector<bool> free(B.cols(), false);
+  free[0] = true;
+  return B * NonNegativeQp(Q, B.transpose() * b, free);
+}
+
 class Problem {
  public:
-  Problem(const SwitchingLog& log, int train, const FitOptions& opt, TransientChain shape)
-      : log_(log), train_(train), opt_(opt), shape_(std::move(shape)) {
+  Problem(const SwitchingLog& log, int train, const FitOptions& opt, TransientChain shape,
+          bool ordered)
+      : log_(log), train_(train), opt_(opt), shape_(std::move(shape)), ordered_(ordered) {
     D_ = ChainDifferences(shape_);
+    if (ordered_) B_ = OrderedBasis(shape_);
     y_ = Eigen::Map<const Eigen::VectorXd>(log.force.data(), train_);
     advance_weight_ = std::sqrt(opt.advance_prior * y_.squaredNorm() / train_);
   }
@@ -80,7 +112,8 @@ class Problem {
     // A tiny ridge keeps states the data never reach (and the regularisation does not pin)
     // well-defined.
     normal.diagonal().array() += 1e-12 * std::max(normal.trace() / normal.rows(), 1e-300);
-    const Eigen::VectorXd h = normal.ldlt().solve(X.transpose() * y_);
+    const Eigen::VectorXd b = X.transpose() * y_;
+    const Eigen::VectorXd h = ordered_ ? OrderedSolve(B_, normal, b) : normal.ldlt().solve(b);
     const int K = c.chain_length;
     Eigen::VectorXd r(train_ + D_.rows() + 2 * K);
     r.head(train_) = y_ - X * h;
@@ -98,7 +131,8 @@ class Problem {
   int train_;
   FitOptions opt_;
   TransientChain shape_;
-  Eigen::MatrixXd D_;
+  bool ordered_;
+  Eigen::MatrixXd D_, B_;
   Eigen::VectorXd y_;
   double advance_weight_ = 0;
 };
@@ -326,7 +360,76 @@ Eigen::VectorXd TwoStatePrediction(const SwitchingLog& log, int train) {
   return X * h;
 }
 
+// Start from the deterministic chain (each state = k periods since the switch) with the
+// heat-level targets; alternate the switching targets (greedy) and the advance probabilities
+// (Levenberg-Marquardt) until the targets settle. Two schedules, the better kept: targets
+// first (when the heat-level targets are far off, fitting the advance probabilities to them
+// would bend the chains) and advance probabilities first (when they are right, a greedy step
+// taken with all a = 1 can move a target to compensate for the wrong a).
+IdentificationResult FitChain(const SwitchingLog& log, int train, const FitOptions& opt,
+                              bool ordered) {
+  IdentificationResult best;
+  best.cost = std::numeric_limits<double>::infinity();
+  for (bool targets_first : {true, false}) {
+    Problem problem(log, train, opt, TransientChain::Uniform(opt.num_states, 1.0), ordered);
+    Eigen::VectorXd a = Eigen::VectorXd::Ones(problem.num_params());
+    int total_iters = 0;
+    for (int round = 0; round < opt.max_rounds; ++round) {
+      bool changed = false;
+      if (targets_first || round > 0) {
+        for (int sweep = 0; sweep < 3 && RefineTargets(problem, a); ++sweep) changed = true;
+        if (round > 0 && !changed) break;
+      }
+      double cost = 0;
+      int iters = 0;
+      a = FitAdvance(problem, a, opt.min_advance, opt.max_iterations, &cost, &iters);
+      total_iters += iters;
+    }
+    Eigen::VectorXd h;
+    const double cost = problem.Residual(a, &h).squaredNorm();
+    if (cost < best.cost) {
+      best.cost = cost;
+      best.iterations = total_iters;
+      best.chain = problem.WithParams(a);
+      best.chain.force = h;
+    }
+  }
+  return best;
+}
+
+// `loose`'s targets kept, its advance probabilities refitted with H in order.
+IdentificationResult Reorder(const SwitchingLog& log, int train, const FitOptions& opt,
+                             const IdentificationResult& loose) {
+  Problem problem(log, train, opt, loose.chain, true);
+  Eigen::VectorXd a(problem.num_params());
+  a << loose.chain.heat_advance, loose.chain.cool_advance;
+  IdentificationResult fit;
+  int iters = 0;
+  a = FitAdvance(problem, a, opt.min_advance, opt.max_iterations, &fit.cost, &iters);
+  Eigen::VectorXd h;
+  fit.cost = problem.Residual(a, &h).squaredNorm();
+  fit.iterations = loose.iterations + iters;
+  fit.chain = problem.WithParams(a);
+  fit.chain.force = h;
+  return fit;
+}
+
 }  // namespace
+
+double OrderViolation(const TransientChain& c) {
+  const int K = c.chain_length;
+  const Eigen::VectorXd& h = c.force;
+  double worst = 0;
+  int prev_heat = c.cold(), prev_cool = c.hot();
+  for (int i = 1; i <= K + 1; ++i) {
+    const int heat = i <= K ? c.heat(i) : c.hot();
+    const int cool = i <= K ? c.cool(i) : c.cold();
+    worst = std::max({worst, h[prev_heat] - h[heat], h[cool] - h[prev_cool]});
+    prev_heat = heat;
+    prev_cool = cool;
+  }
+  return worst;
+}
 
 Eigen::VectorXd PredictMeanForce(const TransientChain& chain, const SwitchingLog& log) {
   return MeanTrajectory(chain, log, log.size()) * chain.force;
@@ -369,37 +472,13 @@ Result<IdentificationResult> IdentifyTransientModel(const SwitchingLog& log,
     return Error{"identify: " + std::to_string(train) + " training samples are too few for " +
                  std::to_string(opt.num_states) + " states (need at least 3 per state)"};
   }
-  // Start from the deterministic chain (each state = k periods since the switch) with the
-  // heat-level targets; alternate the switching targets (greedy) and the advance probabilities
-  // (Levenberg-Marquardt) until the targets settle. Two schedules, the better kept: targets
-  // first (when the heat-level targets are far off, fitting the advance probabilities to them
-  // would bend the chains) and advance probabilities first (when they are right, a greedy step
-  // taken with all a = 1 can move a target to compensate for the wrong a).
-  IdentificationResult best;
-  best.cost = std::numeric_limits<double>::infinity();
-  for (bool targets_first : {true, false}) {
-    Problem problem(log, train, opt, TransientChain::Uniform(opt.num_states, 1.0));
-    Eigen::VectorXd a = Eigen::VectorXd::Ones(problem.num_params());
-    int total_iters = 0;
-    for (int round = 0; round < opt.max_rounds; ++round) {
-      bool changed = false;
-      if (targets_first || round > 0) {
-        for (int sweep = 0; sweep < 3 && RefineTargets(problem, a); ++sweep) changed = true;
-        if (round > 0 && !changed) break;
-      }
-      double cost = 0;
-      int iters = 0;
-      a = FitAdvance(problem, a, opt.min_advance, opt.max_iterations, &cost, &iters);
-      total_iters += iters;
-    }
-    Eigen::VectorXd h;
-    const double cost = problem.Residual(a, &h).squaredNorm();
-    if (cost < best.cost) {
-      best.cost = cost;
-      best.iterations = total_iters;
-      best.chain = problem.WithParams(a);
-      best.chain.force = h;
-    }
+  IdentificationResult best = FitChain(log, train, opt, opt.monotone);
+  if (opt.monotone) {
+    // The loose fit sometimes finds advance probabilities and targets the ordered schedules
+    // miss; refitted in order from there, it competes on the same cost.
+    IdentificationResult loose = FitChain(log, train, opt, false);
+    if (OrderViolation(loose.chain) > 0) loose = Reorder(log, train, opt, loose);
+    if (loose.cost < best.cost) best = loose;
   }
 
   const Eigen::VectorXd pred = PredictMeanForce(best.chain, log);

@@ -8,6 +8,9 @@
 // alternating with a greedy least-squares choice of the mid-transient switching targets.
 // D takes differences between neighbouring states along each chain (heat1.., hot) and
 // (cool1.., cold), so states the data barely separate get a force between their neighbours.
+// With FitOptions::monotone, H is the exact minimiser under the transient's order (force never
+// falls along cold, heat1.., hot nor rises along hot, cool1.., cold): a sign-constrained
+// quadratic programme (nonnegative_qp.h).
 #pragma once
 
 #include "common/result.h"
@@ -29,6 +32,10 @@ struct FitOptions {
   // R is fitted by maximum likelihood under the population Kalman filter, searched in
   // [noise_floor * (settled unit force)^2, variance of the force].
   double noise_floor = 1e-4;
+  // Keep the transient's order in H (OrderViolation 0): a unit heating pulls no less the longer
+  // it has been on, a unit cooling no more. Without it, states the data leave loose can take
+  // forces no wire has (zero mid-heating, full force one state after the switch).
+  bool monotone = true;
 };
 
 struct FitMetrics {
@@ -83,6 +90,10 @@ double NoiseNegLogLikelihood(const TransientChain& chain, const SwitchingLog& lo
 // constant model (constant, 0) when the fit does not beat it.
 NoiseModel MaxLikelihoodNoiseModel(const TransientChain& chain, const SwitchingLog& log, int rows,
                                    double constant, double lo, double hi);
+
+// The largest step of `chain.force` against the transient's order, N: max over the heating path
+// (cold, heat1.., hot) of a fall and over the cooling path (hot, cool1.., cold) of a rise.
+double OrderViolation(const TransientChain& chain);
 
 // RMSE and R^2 of `predicted` against log.force over samples [begin, end).
 FitMetrics Score(const Eigen::VectorXd& predicted, const SwitchingLog& log, int begin, int end);
