@@ -10,6 +10,7 @@
 #include "identification/bench_recorder.h"
 #include "identification/excitation.h"
 #include "identification/model_export.h"
+#include "identification/ordered_fractions.h"
 #include "identification/settled_fraction.h"
 
 namespace recruit::identification {
@@ -51,12 +52,14 @@ FitMetrics CheckAtLength(const TransientChain& chain, const control::UnitForceMa
 // The fractions that best fit the first `fraction` of every recording, the chain fixed:
 // bounded Gauss-Newton (Levenberg-Marquardt damping) on sum_k (y_k - sum_i x_ki T(xi_i, s_k))^2
 // from xi0. Recordings at several lengths and in motion pin what one length cannot: states
-// slack at the longest tendon, and the stress each state's transformation sees in use. The
-// states where `fixed` is true keep their fraction of xi0 (the settled ones, settled_fraction.h).
+// slack at the longest tendon, and the stress each state's transformation sees in use. Cold and
+// hot keep their fractions of xi0 (the settled ones, settled_fraction.h); every other state
+// stays between them in the transient's order (OrderedFractions).
 Eigen::VectorXd RefineFractions(const TransientChain& chain, const control::UnitForceMap& map0,
-                                const std::vector<BenchRecording>& recs, double fraction,
-                                const std::vector<bool>& fixed) {
+                                const std::vector<BenchRecording>& recs, double fraction) {
   const int m = chain.num_states();
+  std::vector<bool> fixed(m, false);
+  fixed[chain.cold()] = fixed[chain.hot()] = true;
   const sma::UnitModel& unit = map0.unit();
   std::vector<Eigen::MatrixXd> X;
   for (const auto& r : recs) X.push_back(MeanCounts(chain, r.log));
@@ -87,7 +90,9 @@ Eigen::VectorXd RefineFractions(const TransientChain& chain, const control::Unit
     }
     return cost;
   };
-  Eigen::VectorXd xi = map0.fractions();
+  // Projected onto the order first (the identity metric), so every trial below keeps it.
+  Eigen::VectorXd xi = OrderedFractions(chain, map0.fractions(), Eigen::MatrixXd::Identity(m, m),
+                                        Eigen::VectorXd::Zero(m));
   Eigen::MatrixXd JtJ;
   Eigen::VectorXd g;
   double cost = cost_and_normal(xi, &JtJ, &g), damping = 1e-3;
@@ -99,7 +104,7 @@ Eigen::VectorXd RefineFractions(const TransientChain& chain, const control::Unit
       for (int i = 0; i < m; ++i) {
         if (fixed[i]) M(i, i) = 1;  // its row and gradient are 0: the step leaves it
       }
-      const Eigen::VectorXd trial = (xi - M.ldlt().solve(g)).cwiseMax(0.0).cwiseMin(1.0);
+      const Eigen::VectorXd trial = OrderedFractions(chain, xi, M, g);
       const double c = cost_and_normal(trial, nullptr, nullptr);
       if (c < cost) {
         const bool converged = cost - c < 1e-10 * cost;
@@ -222,15 +227,13 @@ Result<PlantIdentification> IdentifyOnPlant(const std::string& model_path,
     // The settled states: a settled unit's fraction over the extensions recorded, not fitted.
     const std::vector<double> stretches = StretchGrid(*map, recordings, 5);
     Eigen::VectorXd xi0 = map->fractions();
-    std::vector<bool> fixed(c.num_states(), false);
     xi0[c.hot()] = SettledStateFraction(map->unit(), stretches, true);
     xi0[c.cold()] = SettledStateFraction(map->unit(), stretches, false);
-    fixed[c.hot()] = fixed[c.cold()] = true;
     auto settled = control::UnitForceMap::FromFractions(rec->geometry, xi0);
     if (!settled) return Error{"identify: " + settled.error(), settled.code()};
     const double train = 1.0 - o.holdout;
     auto refined = control::UnitForceMap::FromFractions(
-        rec->geometry, RefineFractions(c, *settled, recordings, train, fixed));
+        rec->geometry, RefineFractions(c, *settled, recordings, train));
     if (!refined) return Error{"identify: " + refined.error(), refined.code()};
     map = std::move(refined);
   }

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <iostream>
 
+#include "identification/ordered_fractions.h"
 #include "identification/plant_identification.h"
 #include "plugin/unit_model.h"
 
@@ -114,6 +115,13 @@ TEST(SettledFraction, IdentifiedHotStatePullsWhatTheBenchsSettledUnitsPull) {
   // Cold: martensite, and the force at the end of the all-off hold that follows (sample 2 settle).
   EXPECT_EQ(xi[0], 1.0);
   EXPECT_NEAR(H[0], log.force[2 * settle] / log.num_units, 1e-3 * measured);
+  // The fractions refined over the recordings keep the transient's order, and so does H.
+  const TransientChain& chain = id->fit.chain;
+  EXPECT_LE(FractionOrderViolation(chain, Eigen::Map<const Eigen::VectorXd>(xi.data(), xi.size())),
+            1e-9);
+  TransientChain exported = chain;
+  exported.force = Eigen::Map<const Eigen::VectorXd>(H.data(), H.size());
+  EXPECT_LE(OrderViolation(exported), 1e-9 * measured);
 }
 
 }  // namespace file_settled_fraction_test
