@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "identification/identification.h"
 #include "identification/nonnegative_qp.h"
 
 namespace recruit::identification {
@@ -36,17 +37,9 @@ Eigen::VectorXd OrderedFractions(const TransientChain& c, const Eigen::VectorXd&
 }
 
 double FractionOrderViolation(const TransientChain& c, const Eigen::VectorXd& xi) {
-  const int K = c.chain_length;
-  double worst = 0;
-  int prev_heat = c.cold(), prev_cool = c.hot();
-  for (int i = 1; i <= K + 1; ++i) {
-    const int heat = i <= K ? c.heat(i) : c.hot();
-    const int cool = i <= K ? c.cool(i) : c.cold();
-    worst = std::max({worst, xi[heat] - xi[prev_heat], xi[prev_cool] - xi[cool]});
-    prev_heat = heat;
-    prev_cool = cool;
-  }
-  return worst;
+  TransientChain reversed = c;  // the fraction's order is the force's, reversed
+  reversed.force = -xi;
+  return OrderViolation(reversed);
 }
 
 }  // namespace recruit::identification
