@@ -3,6 +3,7 @@
 #include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <utility>
 
@@ -285,33 +286,41 @@ double NoiseNegLogLikelihood(const TransientChain& c, const SwitchingLog& log, i
   return nll;
 }
 
-// R by maximum likelihood: golden-section search on log R in [lo, hi].
-double MaxLikelihoodNoise(const TransientChain& c, const SwitchingLog& log, int rows, double lo,
-                          double hi) {
-  auto NegLogLikelihood = [](const TransientChain& c, const SwitchingLog& log, int rows, double R) {
-    return NoiseNegLogLikelihood(c, log, rows, {R, 0.0});
-  };
-  double a = std::log(lo), b = std::log(hi);
+namespace {
+
+// The minimiser of a unimodal f on [a, b]: golden-section search to an interval below `tol` (at
+// most 40 steps), its midpoint.
+double GoldenMinimum(const std::function<double(double)>& f, double a, double b, double tol) {
   const double g = (std::sqrt(5.0) - 1) / 2;
   double x1 = b - g * (b - a), x2 = a + g * (b - a);
-  double f1 = NegLogLikelihood(c, log, rows, std::exp(x1));
-  double f2 = NegLogLikelihood(c, log, rows, std::exp(x2));
-  for (int it = 0; it < 40 && b - a > 1e-3; ++it) {
+  double f1 = f(x1), f2 = f(x2);
+  for (int it = 0; it < 40 && b - a > tol; ++it) {
     if (f1 < f2) {
       b = x2;
       x2 = x1;
       f2 = f1;
       x1 = b - g * (b - a);
-      f1 = NegLogLikelihood(c, log, rows, std::exp(x1));
+      f1 = f(x1);
     } else {
       a = x1;
       x1 = x2;
       f1 = f2;
       x2 = a + g * (b - a);
-      f2 = NegLogLikelihood(c, log, rows, std::exp(x2));
+      f2 = f(x2);
     }
   }
-  return std::exp((a + b) / 2);
+  return (a + b) / 2;
+}
+
+}  // namespace
+
+// R by maximum likelihood: golden-section search on log R in [lo, hi].
+double MaxLikelihoodNoise(const TransientChain& c, const SwitchingLog& log, int rows, double lo,
+                          double hi) {
+  auto nll = [&](double log_r) {
+    return NoiseNegLogLikelihood(c, log, rows, {std::exp(log_r), 0.0});
+  };
+  return std::exp(GoldenMinimum(nll, std::log(lo), std::log(hi), 1e-3));
 }
 
 NoiseModel MaxLikelihoodNoiseModel(const TransientChain& c, const SwitchingLog& log, int rows,
@@ -337,6 +346,64 @@ NoiseModel MaxLikelihoodNoiseModel(const TransientChain& c, const SwitchingLog& 
   const NelderMeadResult best =
       NelderMead(nll, start, Eigen::Vector2d::Constant(std::log(10.0)), 1e-4, 1e-3, 200);
   return best.value < NoiseNegLogLikelihood(c, log, rows, flat) ? model_at(best.x) : flat;
+}
+
+namespace {
+
+// The median of |v - median(v)| (v not empty; reordered).
+double MedianAbsoluteDeviation(std::vector<double>& v) {
+  auto median = [](std::vector<double>& w) {
+    const size_t mid = w.size() / 2;
+    std::nth_element(w.begin(), w.begin() + mid, w.end());
+    const double upper = w[mid];
+    if (w.size() % 2 == 1) return upper;
+    return 0.5 * (upper + *std::max_element(w.begin(), w.begin() + mid));
+  };
+  const double center = median(v);
+  for (double& x : v) x = std::abs(x - center);
+  return median(v);
+}
+
+}  // namespace
+
+std::vector<int> ForceSettledSamples(const TransientChain& c, const SwitchingLog& log, int rows) {
+  const Eigen::VectorXd& h = c.force;
+  const double cold = h[c.cold()], hot = h[c.hot()], tol = 0.01 * std::abs(hot - cold);
+  Eigen::VectorXd moving(c.num_states());
+  for (int j = 0; j < c.num_states(); ++j) {
+    moving[j] = std::min(std::abs(h[j] - cold), std::abs(h[j] - hot)) > tol ? 1.0 : 0.0;
+  }
+  const Eigen::VectorXd in_moving = MeanTrajectory(c, log, rows) * moving;
+  std::vector<int> settled;
+  for (int k = 0; k < rows; ++k) {
+    if (in_moving[k] < 0.5) settled.push_back(k);
+  }
+  return settled;
+}
+
+NoiseModel SettledNoiseModel(const TransientChain& c, const SwitchingLog& log, int rows,
+                             double constant, double lo, double hi) {
+  const std::vector<int> settled =
+      log.has_realized() ? ForceSettledSamples(c, log, rows) : std::vector<int>();
+  if (settled.size() < 20) return MaxLikelihoodNoiseModel(c, log, rows, constant, lo, hi);
+  // A robust scale (1.4826 x the median absolute deviation: the standard deviation of Gaussian
+  // noise): a settled sample now and then follows a pulse the chain takes for settled (a unit
+  // switched back on after one period is at the hot state's force in the chain, tens of N short
+  // of it on the plant), whose error is the transit's, not the sensor's.
+  const Eigen::VectorXd predicted = PredictMeanForce(c, log);
+  std::vector<double> residual;
+  for (int k : settled) residual.push_back(log.force[k] - predicted[k]);
+  const double sd = 1.4826 * MedianAbsoluteDeviation(residual);
+  const double r0 = std::clamp(sd * sd, lo, hi);
+  const double transit = (MeanTrajectory(c, log, rows) * TransitMask(c)).mean();
+  if (!(transit > 1e-9)) return {r0, 0.0};
+  // r_transit from 1e-6 of the floor per unit (below that its term is nothing) to the whole
+  // force variance spread over the mean units in transit.
+  auto nll = [&](double log_rt) {
+    return NoiseNegLogLikelihood(c, log, rows, {r0, std::exp(log_rt)});
+  };
+  const double rt = std::exp(GoldenMinimum(nll, std::log(lo * 1e-6), std::log(hi / transit), 1e-3));
+  return {r0, rt};
 }
 
 namespace {
@@ -452,6 +519,33 @@ FitMetrics Score(const Eigen::VectorXd& predicted, const SwitchingLog& log, int 
   return m;
 }
 
+namespace {
+
+// The search range of R: [noise_floor * (settled unit force)^2, the force's variance] (at least
+// 100 floors wide).
+std::pair<double, double> NoiseRange(const TransientChain& c, const SwitchingLog& log, int rows,
+                                     const FitOptions& opt) {
+  const double unit = c.force[c.hot()] - c.force[c.cold()];
+  const double floor = std::max(opt.noise_floor * unit * unit, 1e-12);
+  const Eigen::VectorXd y = Eigen::Map<const Eigen::VectorXd>(log.force.data(), rows);
+  const double var_y = (y.array() - y.mean()).square().mean();
+  return {floor, std::max(var_y, 100 * floor)};
+}
+
+}  // namespace
+
+double ConstantNoise(const TransientChain& c, const SwitchingLog& log, int rows,
+                     const FitOptions& opt) {
+  const auto [lo, hi] = NoiseRange(c, log, rows, opt);
+  return MaxLikelihoodNoise(c, log, rows, lo, hi);
+}
+
+NoiseModel FitNoiseModel(const TransientChain& c, const SwitchingLog& log, int rows,
+                         double constant, const FitOptions& opt) {
+  const auto [lo, hi] = NoiseRange(c, log, rows, opt);
+  return SettledNoiseModel(c, log, rows, constant, lo, hi);
+}
+
 Result<IdentificationResult> IdentifyTransientModel(const SwitchingLog& log,
                                                     const FitOptions& opt) {
   if (Status s = log.Validate("switching log"); !s) return Error{s.error(), s.code()};
@@ -486,22 +580,8 @@ Result<IdentificationResult> IdentifyTransientModel(const SwitchingLog& log,
   best.holdout = Score(pred, log, train, n);
   best.two_state_holdout = Score(TwoStatePrediction(log, train), log, train, n);
 
-  // R by maximum likelihood of the training forces under the population Kalman filter: the
-  // measurement variance (sensor noise and per-unit model error) that the population's own
-  // spread, which the filter carries in P, does not explain.
-  const double unit = best.chain.force[best.chain.hot()] - best.chain.force[best.chain.cold()];
-  const double floor = std::max(opt.noise_floor * unit * unit, 1e-12);
-  double var_y = 0;
-  {
-    const Eigen::VectorXd y = Eigen::Map<const Eigen::VectorXd>(log.force.data(), train);
-    var_y = (y.array() - y.mean()).square().mean();
-  }
-  const double ceiling = std::max(var_y, 100 * floor);
-  best.force_noise_var = MaxLikelihoodNoise(best.chain, log, train, floor, ceiling);
-  // The same likelihood with R growing with the units in transit, whose spread about the mean
-  // the chain's geometric dwell times model least exactly.
-  best.noise =
-      MaxLikelihoodNoiseModel(best.chain, log, train, best.force_noise_var, floor, ceiling);
+  best.force_noise_var = ConstantNoise(best.chain, log, train, opt);
+  best.noise = FitNoiseModel(best.chain, log, train, best.force_noise_var, opt);
   return best;
 }
 

@@ -13,6 +13,8 @@
 // quadratic programme (nonnegative_qp.h).
 #pragma once
 
+#include <vector>
+
 #include "common/result.h"
 #include "identification/switching_log.h"
 #include "identification/transient_chain.h"
@@ -90,6 +92,36 @@ double NoiseNegLogLikelihood(const TransientChain& chain, const SwitchingLog& lo
 // constant model (constant, 0) when the fit does not beat it.
 NoiseModel MaxLikelihoodNoiseModel(const TransientChain& chain, const SwitchingLog& log, int rows,
                                    double constant, double lo, double hi);
+
+// The samples of log[0, rows) at which the chain's mean counts hold less than half a unit in
+// states whose force is neither the cold nor the hot state's (within 1 % of a settled unit's
+// force): every unit's force is a settled one, so only the sensor and the settled forces' error
+// are left in the residual.
+std::vector<int> ForceSettledSamples(const TransientChain& chain, const SwitchingLog& log,
+                                     int rows);
+
+// R(x) for a log with realized switching fractions (the bench's): r0 the square of a robust
+// scale (1.4826 MAD) of the mean prediction's residual over the force-settled samples (at least
+// `lo`), r_transit by
+// maximum likelihood with r0 fixed (golden section on log r_transit). A joint likelihood over
+// (r0, r_transit) puts the transit's error into r0 when units are almost always in transit
+// (a random excitation), and the filter then doubts its holds. Falls back to
+// MaxLikelihoodNoiseModel without realized fractions (the residual would hold the broadcasts'
+// binomial spread) or with fewer than 20 settled samples.
+NoiseModel SettledNoiseModel(const TransientChain& chain, const SwitchingLog& log, int rows,
+                             double constant, double lo, double hi);
+
+// R by maximum likelihood of log.force[0, rows) under the population Kalman filter on `chain`
+// (MaxLikelihoodNoise), searched in [opt.noise_floor * (settled unit force)^2, the force's
+// variance]: the measurement variance (sensor noise and per-unit model error) that the
+// population's own spread, which the filter carries in P, does not explain.
+double ConstantNoise(const TransientChain& chain, const SwitchingLog& log, int rows,
+                     const FitOptions& opt);
+// R growing with the units in transit (SettledNoiseModel) in the same range, `constant` the
+// ConstantNoise: what IdentifyTransientModel reports, and what a limb's identification fits
+// again once its forces are final.
+NoiseModel FitNoiseModel(const TransientChain& chain, const SwitchingLog& log, int rows,
+                         double constant, const FitOptions& opt);
 
 // The largest step of `chain.force` against the transient's order, N: max over the heating path
 // (cold, heat1.., hot) of a fall and over the cooling path (hot, cool1.., cold) of a rise.

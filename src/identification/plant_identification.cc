@@ -5,7 +5,7 @@
 #include <cstdio>
 #include <limits>
 
-#include "control/kalman_estimator.h"
+#include "control/sampling_period.h"
 #include "control/unit_force_map.h"
 #include "identification/bench_recorder.h"
 #include "identification/excitation.h"
@@ -134,51 +134,6 @@ std::vector<double> StretchGrid(const control::UnitForceMap& map,
   return grid;
 }
 
-// Negative log-likelihood of recordings under the length-aware filter with the model's R and
-// R_transit and rho: R(x^-) = R + R_transit TransitCount(x^-) + rho^2 (H x^-)^2 (the filter's own
-// innovation and its variance), the filter driven by the broadcasts as in operation.
-double NegLogLikelihood(const estimation::FilterModel& model, const control::UnitForceMap& map,
-                        const std::vector<BenchRecording>& recs, double rho) {
-  double total = 0;
-  for (const BenchRecording& rec : recs) {
-    auto est = control::KalmanOnCountEstimator::Create(model, estimation::CovarianceMode::kExtended,
-                                                       map, rho);
-    if (!est) return std::numeric_limits<double>::infinity();
-    control::KalmanOnCountEstimator& e = **est;
-    const SwitchingLog& log = rec.log;
-    for (int k = 0; k < log.size(); ++k) {
-      e.UpdateWithMeasurement(log.force[k], rec.lengths[k]);
-      const double s = e.filter().innovation_covariance()(0, 0);
-      const double innovation = e.filter().innovation()(0);
-      total += std::log(s) + innovation * innovation / s;
-      e.Broadcasted({log.p_on[k], log.p_off[k]});
-    }
-  }
-  return total;
-}
-
-// The rho in [0, 0.5] of the largest likelihood (golden section), the model's R and R_transit
-// given: the part of the force model's error that grows with the force, seen when it is carried
-// to other lengths.
-double FitRelativeNoise(const estimation::FilterModel& model, const control::UnitForceMap& map,
-                        const std::vector<BenchRecording>& recs) {
-  auto nll = [&](double rho) { return NegLogLikelihood(model, map, recs, rho); };
-  double a = 0, b = 0.5;
-  const double g = (std::sqrt(5.0) - 1) / 2;
-  double x1 = b - g * (b - a), x2 = a + g * (b - a);
-  double f1 = nll(x1), f2 = nll(x2);
-  for (int it = 0; it < 40 && b - a > 1e-4; ++it) {
-    if (f1 < f2) {
-      b = x2, x2 = x1, f2 = f1, x1 = b - g * (b - a);
-      f1 = nll(x1);
-    } else {
-      a = x1, x1 = x2, f1 = f2, x2 = a + g * (b - a);
-      f2 = nll(x2);
-    }
-  }
-  return (a + b) / 2;
-}
-
 }  // namespace
 
 nlohmann::json MetricsJson(const FitMetrics& m) {
@@ -253,13 +208,16 @@ Result<PlantIdentification> IdentifyOnPlant(const std::string& model_path,
   // The exported H: the forces of the fractions at the recorded pose (>= 0, on the force law).
   TransientChain exported = c;
   map->Forces(rec->tendon_length, exported.force);
+  // R with the forces the filter will use: a limb's settled forces are the force law's, not
+  // the fit's (whose cold and hot states may sit a newton off to fit the transients better).
+  if (!rec->pose.empty()) {
+    const int train = static_cast<int>(std::lround(rec->log.size() * (1 - o.holdout)));
+    out.fit.noise = FitNoiseModel(exported, rec->log, train, fit->force_noise_var, fo);
+  }
+  const NoiseModel& noise = out.fit.noise;
   const estimation::FilterModel model =
-      ToFilterModel(exported, rec->log.num_units, rec->log.dT, fit->noise.r0, fit->noise.r_transit);
+      ToFilterModel(exported, rec->log.num_units, rec->log.dT, noise.r0, noise.r_transit);
   if (Status s = model.Validate("identified model"); !s) return Error{s.error(), s.code()};
-  // 4. R's part that grows with the force, by maximum likelihood over every recording (R0 and
-  // R_transit those of the held pose).
-  const double rho = FitRelativeNoise(model, *map, recordings);
-
   const Eigen::VectorXd& xi = map->fractions();
   nlohmann::json j = model.ToJson();
   j["identification"] = {
@@ -281,10 +239,9 @@ Result<PlantIdentification> IdentifyOnPlant(const std::string& model_path,
       {"holdout", MetricsJson(fit->holdout)},
       {"two_state_holdout", MetricsJson(fit->two_state_holdout)},
       {"length_checks", checks},
-      {"R_N2", fit->noise.r0},
-      {"R_transit_N2", fit->noise.r_transit},
+      {"R_N2", noise.r0},
+      {"R_transit_N2", noise.r_transit},
       {"R_constant_N2", fit->force_noise_var},
-      {"relative_noise", rho},
       {"plant", rec->plant}};
   out.model = std::move(j);
   return out;
