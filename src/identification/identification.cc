@@ -580,6 +580,7 @@ Result<IdentificationResult> IdentifyTransientModel(const SwitchingLog& log,
   best.holdout = Score(pred, log, train, n);
   best.two_state_holdout = Score(TwoStatePrediction(log, train), log, train, n);
 
+  if (!opt.fit_noise) return best;
   best.force_noise_var = ConstantNoise(best.chain, log, train, opt);
   best.noise = FitNoiseModel(best.chain, log, train, best.force_noise_var, opt);
   return best;

@@ -38,6 +38,9 @@ struct FitOptions {
   // it has been on, a unit cooling no more. Without it, states the data leave loose can take
   // forces no wire has (zero mid-heating, full force one state after the switch).
   bool monotone = true;
+  // Fit R (force_noise_var and the noise model; most of a small log's identification time).
+  // false leaves them 0: for callers that use only the chain and H.
+  bool fit_noise = true;
 };
 
 struct FitMetrics {
