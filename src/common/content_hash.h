@@ -9,8 +9,8 @@
 
 namespace recruit {
 
-// Version of the code that made a result; set by CMake (project version and git commit at
-// configure time). Results made by another version are not reused.
+// Version of the code that made a result (common/version.h: project version, git commit, source
+// hash). Results made by another version are not reused.
 const char* CodeVersion();  // version.cc
 
 class ContentHash {

@@ -1,5 +1,5 @@
-// Compiled alone with RECRUIT_VERSION_STRING (src/common/CMakeLists.txt), so a new commit
-// recompiles this file only.
+// Compiled alone with RECRUIT_VERSION_STRING and the generated source hash
+// (src/common/CMakeLists.txt), so a new commit or an edited source recompiles this file only.
 #include "common/version.h"
 
 #include <string>
@@ -9,9 +9,15 @@
 #ifndef RECRUIT_VERSION_STRING
 #define RECRUIT_VERSION_STRING "unknown"
 #endif
+#if __has_include("source_hash.h")
+#include "source_hash.h"
+#endif
+#ifndef RECRUIT_SOURCE_HASH
+#define RECRUIT_SOURCE_HASH "unknown"
+#endif
 
 namespace recruit {
-const char* CodeVersion() { return RECRUIT_VERSION_STRING; }
+const char* CodeVersion() { return RECRUIT_VERSION_STRING "." RECRUIT_SOURCE_HASH; }
 
 // RECRUIT_VERSION_STRING is "<project version>+<commit>": the part before '+'.
 const char* ProjectVersion() {
