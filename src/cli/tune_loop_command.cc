@@ -37,7 +37,7 @@ void PrintDesign(const sim::JointDesignRecord& r, bool response) {
   // The same gains as the joint will move the demand: each way through the bundles that move
   // it that way, rising or releasing (JointLoops::BothWays).
   const control::PredictedStep w =
-      control::PredictStep(r.dynamics, r.both_ways, r.dT, d.gains, r.target, 1, 1, 0, 0, &d.model);
+      control::PredictStep(r.dynamics, r.both_ways, r.dT, d.gains, r.target);
   std::printf(
       "%-14s %8s  each way through its bundles' rise or release (t63 %.2f s the step's way, "
       "%.2f s back): overshoot %.1f %%, ",

@@ -116,7 +116,7 @@ std::vector<std::uint64_t> LoopDesignKey(const JointDynamics& j, const ActuatorR
 PredictedStep PredictStep(const JointDynamics& joint, const ActuatorResponse& act, double dT,
                           const LoopGains& gains, const LoopTarget& target,
                           double actuator_slowdown, double gain_scale, double feedforward_error,
-                          double delay, const std::vector<double>* model) {
+                          double delay) {
   const double h = dT / kSubsteps;
   const Discrete dis = Discretise(joint, h);
   const int instants = static_cast<int>(std::ceil(target.hold / dT - 1e-9));
@@ -148,7 +148,7 @@ PredictedStep PredictStep(const JointDynamics& joint, const ActuatorResponse& ac
   double tau[kSubsteps];
   for (int n = 0; n < instants; ++n) {
     const double e = -z[0];
-    integral += (model != nullptr ? ModelAngle(*model, n) - (z[0] + 1) : e) * dT;
+    integral += e * dT;
     u.push_back(gain_scale * (gains.kp * e + gains.ki * integral - gains.kd * z[1]) -
                 feedforward_error);
     change.push_back(u[n + 1] - u[n]);
@@ -241,11 +241,7 @@ LoopDesign SearchGrid(const JointDynamics& joint, const ActuatorResponse& act, d
       for (double c : {0.0, 0.05, 0.2, 0.5, 1.0}) {
         LoopDesign d;
         d.gains = {a * k_ref, b * k_ref / t63, c * k_ref * t63};
-        // The model the integral follows (LoopDesign::model).
-        d.model =
-            PredictStep(joint, act, dT, {d.gains.kp, 0, d.gains.kd}, target, 1, 1, 0, dT).angle;
-        const std::vector<double>* model = &d.model;
-        d.nominal = PredictStep(joint, act, dT, d.gains, target, 1, 1, 0, 0, model);
+        d.nominal = PredictStep(joint, act, dT, d.gains, target);
         // The least penalty the other three predictions could leave it (they only add to the
         // penalty, or keep a design that meets at its settling time): when that is no better
         // than the best so far, they are not made; the choice is the same.
@@ -253,9 +249,9 @@ LoopDesign SearchGrid(const JointDynamics& joint, const ActuatorResponse& act, d
         const double least = nominal_meets ? CountedSettling(d.nominal, target)
                                            : 1e6 + NominalPenalty(d.nominal, target);
         if (!(least < best_penalty - 1e-9)) continue;
-        d.robust = PredictStep(joint, act, dT, d.gains, target, 1.5, 1.5, 0, 0, model);
+        d.robust = PredictStep(joint, act, dT, d.gains, target, 1.5, 1.5);
         d.offset = PredictStep(joint, act, dT, d.gains, target, 1, 1,
-                               kFeedforwardError * k_ref + target.torque_error, 0, model);
+                               kFeedforwardError * k_ref + target.torque_error);
         d.meets = d.nominal.settled && d.nominal.overshoot <= target.overshoot &&
                   d.robust.settled && d.robust.overshoot <= 0.25 && d.offset.settled &&
                   d.offset.overshoot <= 0.25;
@@ -271,7 +267,7 @@ LoopDesign SearchGrid(const JointDynamics& joint, const ActuatorResponse& act, d
         // binomial count only from the force): a design whose step overshoots or does not
         // settle then pays for it in the choice (docs/controller.md, "One period late"). Not a
         // target: the penalty only.
-        d.delayed = PredictStep(joint, act, dT, d.gains, target, 1, 1, 0, dT, model);
+        d.delayed = PredictStep(joint, act, dT, d.gains, target, 1, 1, 0, dT);
         const double penalty =
             known + 0.25 * StepPenalty(d.delayed, 0.25, target, d.delayed.settling_time);
         if (penalty < best_penalty - 1e-9) best_penalty = penalty, best = d;

@@ -2,15 +2,9 @@
 // (docs/controller.md, "The self-tuned outer loop").
 //
 // Each control instant (every dT) the joint's torque demand is
-//   tau = tau_static(r) + kp e + ki sum(e_m dT) - kd qdot,   e = r - q,   e_m = q_m - q,
+//   tau = tau_static(r) + kp e + ki sum(e dT) - kd qdot,   e = r - q,
 // with tau_static(r) the torque that holds the limb still at the reference (MuJoCo's inverse
-// dynamics: gravity, payload, passive springs) and q_m the design model's step response without
-// the integral, one sampling period late (LoopDesign::model): the integral sums what the limb
-// does apart from the designed transient, so it removes a feedforward error without winding up
-// over the step, and a limb a period behind the model (units heat before their force shows)
-// adds nothing to it (docs/controller.md, "The integral on the model's step"). In the run the
-// integral also ignores model errors within half an on-unit's angle (sim/joint_loop.h). The
-// design model about the reference is the
+// dynamics: gravity, payload, passive springs). The design model about the reference is the
 // joint's linearised mechanics  I qddot + b qdot + k q = tau_act  and the bundles' tension
 // response (control/actuator_response.h) between the demand and tau_act. The gains are chosen
 // on a grid by simulating that model: the fastest settling into the band with the stated
@@ -66,10 +60,7 @@ struct LoopDesign {
   PredictedStep robust;   // actuator 1.5x slower, loop gain 1.5x
   PredictedStep offset;   // the feedforward off by half the step's static torque
   PredictedStep delayed;  // every change of the demand shown one sampling period late
-  // The angle the integral follows at each control instant of a step, as a fraction of the step:
-  // the design model's step with kp and kd alone, every change of the demand a period late.
-  std::vector<double> model;
-  bool meets = false;  // nominal, robust and offset meet the target (else the closest)
+  bool meets = false;     // nominal, robust and offset meet the target (else the closest)
   std::string note;
 };
 
@@ -78,19 +69,10 @@ struct LoopDesign {
 // along act.s, each fall along its release response (ActuatorResponse::Released, s when it has
 // none): the torque is the sum of the demand's increments, each through its own direction's
 // response, which starts `delay` s after the change (a dead time on top of the response's own).
-// The integral sums `model`[n] - angle at instant n (fractions of the step; 1 past its end, and
-// everywhere without a model: then it is the plain error's integral). With a design's model,
-// the prediction is the run loop's (without its dead zone).
 PredictedStep PredictStep(const JointDynamics& joint, const ActuatorResponse& act, double dT,
                           const LoopGains& gains, const LoopTarget& target,
                           double actuator_slowdown = 1, double gain_scale = 1,
-                          double feedforward_error = 0, double delay = 0,
-                          const std::vector<double>* model = nullptr);
-
-// The model's angle at instant n after a step (fraction of the step), 1 past its end.
-inline double ModelAngle(const std::vector<double>& model, long n) {
-  return n >= 0 && n < static_cast<long>(model.size()) ? model[n] : 1.0;
-}
+                          double feedforward_error = 0, double delay = 0);
 
 // The exact bits of every input of DesignJointLoop: the key its designs are kept under, in this
 // process and between processes (control/loop_design_store.h).

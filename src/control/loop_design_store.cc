@@ -8,7 +8,7 @@ namespace recruit::control::design_store {
 namespace {
 
 // The entry's first line; raise its number when the layout below changes.
-std::string Header() { return std::string("recruit loop design 2\n") + CodeVersion() + "\n"; }
+std::string Header() { return std::string("recruit loop design 1\n") + CodeVersion() + "\n"; }
 
 void PutStep(ByteWriter& w, const PredictedStep& p) {
   w.Real(p.overshoot);
@@ -60,7 +60,6 @@ std::optional<LoopDesign> Load(const std::vector<std::uint64_t>& key) {
   d.robust = GetStep(r);
   d.offset = GetStep(r);
   d.delayed = GetStep(r);
-  d.model = r.Reals();
   d.meets = r.Word() != 0;
   d.note = r.Text();
   if (!r.ok() || !r.AtEnd()) return std::nullopt;
@@ -78,7 +77,6 @@ void Save(const std::vector<std::uint64_t>& key, const LoopDesign& design) {
   PutStep(w, design.robust);
   PutStep(w, design.offset);
   PutStep(w, design.delayed);
-  w.Reals(design.model);
   w.Word(design.meets);
   w.Text(design.note);
   SaveEntry(folder, Identity(key), ".design", w.bytes());

@@ -32,8 +32,6 @@ FrozenJointSetting Setting(const sim::JointDesignRecord* rec, int nb) {
   s.holds = true;
   s.coef.assign(rec->holding.coef.data(), rec->holding.coef.data() + nb);
   s.limb_stiffness = rec->holding.limb_stiffness;
-  s.model = rec->design.model;
-  s.dead_zone = 0.5 * rec->resolution;
   return s;
 }
 
@@ -410,25 +408,11 @@ static void force_references(recruit_controller *c, const recruit_input *in, rec
   p.rows = NJ;
   for (j = 0; j < NJ; ++j) {
     const double e = r[j] - (double)in->angle[j];
-    double frac, model_error;
-    if (!c->started || !(r[j] == c->last_reference[j])) { /* a new step */
-      c->step_from[j] = c->started ? c->last_reference[j] : (double)in->angle[j];
-      c->step_instants[j] = 0;
-    } else {
-      ++c->step_instants[j];
-    }
-    c->last_reference[j] = r[j];
-    /* JointLoops::ModelError: the model's angle less the limb's, ignored within the dead zone */
-    frac = c->step_instants[j] < RECRUIT_MODEL_LENGTH ? pose->model[j][c->step_instants[j]] : 1.0;
-    model_error = c->step_from[j] + (r[j] - c->step_from[j]) * frac - (double)in->angle[j];
-    trial[j] = fabs(model_error) <= pose->dead_zone[j]
-                   ? c->integral[j]
-                   : c->integral[j] + pose->ki[j] * model_error * dT;
+    trial[j] = c->integral[j] + pose->ki[j] * e * dT;
     p.torque[j] = pose->feedforward[j] + pose->kp[j] * e + trial[j] -
                   pose->kd[j] * (double)in->angular_velocity[j];
     for (b = 0; b < NB; ++b) p.arms[j][b] = pose->arms[j][b];
   }
-  c->started = 1;
   for (b = 0; b < NB; ++b) {
     const double cap = (double)recruit_units[b] * pose->unit_force[b];
     p.cap[b] = cap > 1e-9 ? cap : 1e-9;
@@ -482,22 +466,17 @@ std::string Ints(const std::vector<int>& v) {
   return s + "}";
 }
 
-std::string PoseInit(const FrozenPose& p, int nb, size_t model_length, const Writer& w) {
+std::string PoseInit(const FrozenPose& p, int nb, const Writer& w) {
   const int nj = static_cast<int>(p.reference.size());
-  std::vector<double> kp, ki, kd, limb, dead_zone;
+  std::vector<double> kp, ki, kd, limb;
   std::vector<int> holds;
-  std::string arms = "{", coef = "{", model = "{";
+  std::string arms = "{", coef = "{";
   for (int j = 0; j < nj; ++j) {
     const FrozenJointSetting& s = p.joint[j];
-    // Past its end (and without a design) the model's response is the reference itself.
-    std::vector<double> m = s.model;
-    m.resize(model_length, 1.0);
-    model += (j ? ", " : "") + w.List(m);
     kp.push_back(s.kp);
     ki.push_back(s.ki);
     kd.push_back(s.kd);
     limb.push_back(s.limb_stiffness);
-    dead_zone.push_back(s.dead_zone);
     holds.push_back(s.holds ? 1 : 0);
     arms += (j ? ", " : "") +
             w.List(std::vector<double>(p.arms.begin() + j * nb, p.arms.begin() + (j + 1) * nb));
@@ -505,17 +484,7 @@ std::string PoseInit(const FrozenPose& p, int nb, size_t model_length, const Wri
   }
   return "    {" + w.List(p.reference) + ",\n     " + w.List(p.feedforward) + ",\n     " + arms +
          "},\n     " + w.List(p.unit_force) + ",\n     " + w.List(kp) + ", " + w.List(ki) + ", " +
-         w.List(kd) + ",\n     " + Ints(holds) + ", " + coef + "},\n     " + w.List(limb) +
-         ",\n     " + model + "},\n     " + w.List(dead_zone) + "}";
-}
-
-// The longest design model response of the loop's settings (at least 1: a C array's length).
-size_t ModelLength(const FrozenAutoLoop& loop) {
-  size_t n = 1;
-  for (const FrozenPose& p : loop.poses) {
-    for (const FrozenJointSetting& s : p.joint) n = std::max(n, s.model.size());
-  }
-  return n;
+         w.List(kd) + ",\n     " + Ints(holds) + ", " + coef + "},\n     " + w.List(limb) + "}";
 }
 
 }  // namespace
@@ -535,15 +504,8 @@ LoopCode AutoLoopCode(const FrozenAutoLoop& loop, const Writer& package) {
   for (const std::string& j : loop.joints) code.defines += " " + j;
   code.defines += " */\n#define RECRUIT_NUM_POSES " + std::to_string(np) +
                   " /* reference poses of the task's schedule */\n";
-  const size_t model_length = ModelLength(loop);
-  code.defines += "#define RECRUIT_MODEL_LENGTH " + std::to_string(model_length) +
-                  " /* control instants of the longest design model response */\n";
   code.state =
-      "  double integral[RECRUIT_NUM_JOINTS]; /* N m, per driven joint: the sum of ki e_m dT */\n"
-      "  double last_reference[RECRUIT_NUM_JOINTS]; /* rad, the last instant's references */\n"
-      "  double step_from[RECRUIT_NUM_JOINTS];      /* rad, where each joint's step began */\n"
-      "  long step_instants[RECRUIT_NUM_JOINTS];    /* control instants since it began */\n"
-      "  int started;    /* 0 before the first instant */\n"
+      "  double integral[RECRUIT_NUM_JOINTS]; /* N m, per driven joint: the sum of ki e dT */\n"
       "  int pose;       /* the reference pose of the last step (index into the .c's table) */\n"
       "  int pose_exact; /* 1: the references were that pose's; 0: the nearest pose was used */";
   code.input =
@@ -551,11 +513,8 @@ LoopCode AutoLoopCode(const FrozenAutoLoop& loop, const Writer& package) {
       "  recruit_real angle[RECRUIT_NUM_JOINTS];     /* rad, each driven joint's encoder */\n"
       "  recruit_real angular_velocity[RECRUIT_NUM_JOINTS]; /* rad/s */";
   code.init =
-      "  for (i = 0; i < RECRUIT_NUM_JOINTS; ++i) {\n"
-      "    c->integral[i] = c->last_reference[i] = c->step_from[i] = 0.0;\n"
-      "    c->step_instants[i] = 0;\n"
-      "  }\n"
-      "  c->started = 0;\n  c->pose = 0;\n  c->pose_exact = 0;";
+      "  for (i = 0; i < RECRUIT_NUM_JOINTS; ++i) c->integral[i] = 0.0;\n"
+      "  c->pose = 0;\n  c->pose_exact = 0;";
   std::string s =
       "/* The force references: the self-tuned joint loops of src/sim/joint_loop.cc, with what "
       "they compute from\n * the model frozen per reference pose of the task's schedule "
@@ -575,15 +534,12 @@ LoopCode AutoLoopCode(const FrozenAutoLoop& loop, const Writer& package) {
        "  int holds[RECRUIT_NUM_JOINTS]; /* 0: no design (feedforward only, no stiffness row) */\n"
        "  double coef[RECRUIT_NUM_JOINTS][RECRUIT_NUM_BUNDLES]; /* N m/rad per N */\n"
        "  double limb_stiffness[RECRUIT_NUM_JOINTS]; /* N m/rad */\n"
-       "  /* the design model's step response per control instant, as fractions of the step */\n"
-       "  double model[RECRUIT_NUM_JOINTS][RECRUIT_MODEL_LENGTH];\n"
-       "  double dead_zone[RECRUIT_NUM_JOINTS]; /* rad, model errors the integral ignores */\n"
        "} recruit_pose;\n";
   s += "static const recruit_pose recruit_poses[RECRUIT_NUM_POSES] = {\n";
   for (int k = 0; k < np; ++k) {
     char c[96];
     std::snprintf(c, sizeof c, "    /* %d: first at t = %g s */\n", k, loop.poses[k].first_time);
-    s += c + PoseInit(loop.poses[k], nb, model_length, w) + (k + 1 < np ? ",\n" : "\n");
+    s += c + PoseInit(loop.poses[k], nb, w) + (k + 1 < np ? ",\n" : "\n");
   }
   s += "};\n";
   s += "static const int recruit_joint_limited[RECRUIT_NUM_JOINTS] = " + Ints(loop.limited) + ";\n";

@@ -32,8 +32,6 @@ struct FrozenJointSetting {
   bool holds = false;        // false: no bundle crosses the joint (feedforward only)
   std::vector<double> coef;  // per bundle, N m/rad per N (JointHolding::coef)
   double limb_stiffness = 0;
-  std::vector<double> model;  // what the integral follows per instant (control::LoopDesign::model)
-  double dead_zone = 0;       // rad: model errors the integral ignores (half the resolution)
 };
 
 // One reference pose of the schedule (the driven joints' loop references, rad).

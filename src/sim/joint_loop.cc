@@ -128,9 +128,6 @@ Result<JointLoops> JointLoops::Create(const Task& task, const Plant& plant,
   loops.last_target_.assign(plant.num_joints(), std::nan(""));
   loops.settings_.resize(plant.num_joints());
   loops.integral_.assign(plant.num_joints(), 0.0);
-  loops.step_instants_.assign(plant.num_joints(), 0);
-  loops.step_from_.assign(plant.num_joints(), 0.0);
-  loops.step_model_.assign(plant.num_joints(), nullptr);
   const Eigen::MatrixXd arms = plant.MomentArmsAt(loops.LoopReference(plant, 0));
   loops.price_ = BundlePrices(loops.responses_, arms);
   loops.held_only_ = HeldOnlyBundles(arms);
@@ -170,13 +167,6 @@ Result<JointDesignRecord> JointLoops::Design(const Plant& plant, int j, const Ei
     act = side[1];
   }
   if (act == nullptr) return Error{"joint '" + rec.joint + "': no bundle of the task crosses it"};
-  const Eigen::VectorXd lengths = plant.UnitLengthsAt(r);
-  rec.resolution = std::numeric_limits<double>::infinity();
-  for (int i = 0; i < plant.num_bundles(); ++i) {
-    if (std::abs(arms(j, i)) <= tiny) continue;
-    rec.resolution = std::min(rec.resolution, std::abs(arms(j, i)) * on_unit_force_[i](lengths[i]));
-  }
-  rec.resolution /= std::max(std::abs(rec.dynamics.stiffness), 1e-12);
   rec.actuator_t63 = act->TimeTo(0.63);
   control::LoopTarget target = target_;
   target.torque_error = rec.torque_error / rec.step;
@@ -241,31 +231,22 @@ void JointLoops::Step(double t, const Plant& plant, std::vector<double>& force_r
   // Gains for this pose: designed once per reference value (a step's target).
   std::vector<control::LoopGains> gains(nj);
   std::vector<const JointHolding*> holding(nj, nullptr);
-  std::vector<double> dead_zone(nj, 0.0);
   for (int j = 0; j < nj; ++j) {
     // The step a new reference value makes: from the last one, or from the limb at the start.
     const double from = std::isnan(last_target_[j]) ? plant.JointAngle(j) : last_target_[j];
-    dead_zone[j] = 0;
-    const bool new_step = !(r[j] == last_target_[j]);
     last_target_[j] = r[j];
     auto it = settings_[j].find(r[j]);
     if (it == settings_[j].end()) {
       auto rec = Design(plant, j, r, r[j] - from);
       Setting set;  // no bundle crosses the joint: feedforward only
       if (rec.ok()) {
-        set = {rec->design.gains, rec->holding, rec->design.model, 0.5 * rec->resolution};
+        set = {rec->design.gains, rec->holding};
         designs_.push_back(std::move(rec).value());
       }
       it = settings_[j].emplace(r[j], set).first;
     }
     gains[j] = it->second.gains;
-    dead_zone[j] = it->second.dead_zone;
     if (it->second.holding.coef.size() == nb) holding[j] = &it->second.holding;
-    if (new_step) {
-      step_from_[j] = from, step_model_[j] = &it->second.model, step_instants_[j] = 0;
-    } else {
-      ++step_instants_[j];
-    }
   }
   const Eigen::VectorXd feedforward = plant.StaticTorque(r);
   // The bundles are set for the reference pose: arms and unit forces there. Each bundle's
@@ -280,10 +261,8 @@ void JointLoops::Step(double t, const Plant& plant, std::vector<double>& force_r
   for (int j = 0; j < nj; ++j) {
     const double e = r[j] - plant.JointAngle(j);
     // The integral is kept as torque, so a new design's ki takes over what the last one
-    // integrated without a jump (bumpless). It sums the angle's departure from the design
-    // model's step response (control/loop_design.h), not the error of the designed transient.
-    const double em = ModelError(j, plant.JointAngle(j));
-    trial[j] = std::abs(em) <= dead_zone[j] ? integral_[j] : integral_[j] + gains[j].ki * em * dT_;
+    // integrated without a jump (bumpless).
+    trial[j] = integral_[j] + gains[j].ki * e * dT_;
     p.torque[j] =
         feedforward[j] + gains[j].kp * e + trial[j] - gains[j].kd * plant.JointVelocity(j);
   }
@@ -335,12 +314,6 @@ void JointLoops::Step(double t, const Plant& plant, std::vector<double>& force_r
     const double count = unit_force[i] > 0 ? tensions[i] / unit_force[i] : 0.0;
     force_ref[i] = count * present_force[i];
   }
-}
-
-double JointLoops::ModelError(int j, double angle) const {
-  const long n = step_instants_[j];
-  const double frac = step_model_[j] != nullptr ? control::ModelAngle(*step_model_[j], n) : 1.0;
-  return step_from_[j] + (last_target_[j] - step_from_[j]) * frac - angle;
 }
 
 Eigen::VectorXd DeliveredAtPresentPose(const Eigen::VectorXd& held, const Eigen::VectorXd& demanded,

@@ -37,9 +37,6 @@ struct JointDesignRecord {
   double step = 0;          // rad, the step designed for
   double torque_error = 0;  // N m, the feedforward error the integral must remove
   double actuator_t63 = 0;  // s, the design's bundle response: its time to 63 % of a step
-  // rad: the angle one on-unit of the finest bundle crossing the joint moves it at the pose
-  // (|arm| x unit force / stiffness); the integral ignores model errors below half of it.
-  double resolution = 0;
   control::LoopDesign design;
   double dT = 0;               // s, the loop's sampling period
   control::LoopTarget target;  // what the design asked of the step
@@ -66,9 +63,8 @@ class JointLoops {
   const Eigen::VectorXd& prices() const { return price_; }
   // Per bundle: whether it takes no share of the loop's transient terms (HeldOnlyBundles).
   const std::vector<bool>& held_only() const { return held_only_; }
-  // Per joint, the PID's integral term (N m): the sum of ki e_m dT (e_m: the design model's step
-  // response less the angle, control/loop_design.h) over the instants the bundles could deliver
-  // it, each with the gain of its own design.
+  // Per joint, the PID's integral term (N m): the sum of ki e dT over the instants the bundles
+  // could deliver it, each with the gain of its own design.
   const std::vector<double>& integral() const { return integral_; }
   // Every design made so far, in the order made.
   const std::vector<JointDesignRecord>& designs() const { return designs_; }
@@ -86,9 +82,6 @@ class JointLoops {
                                      double step) const;
   // How the bundles hold joint j at pose r (sim/holding.h).
   JointHolding HoldingAt(const Plant& plant, int j, const Eigen::VectorXd& r) const;
-  // Joint j's design model response at this instant of its step (from where the step began to
-  // its reference) less `angle`.
-  double ModelError(int j, double angle) const;
 
  private:
   const Task* task_ = nullptr;
@@ -100,20 +93,13 @@ class JointLoops {
   struct Setting {
     control::LoopGains gains;
     JointHolding holding;
-    std::vector<double> model;  // the design's nominal step response (fractions, per instant)
-    double dead_zone = 0;       // rad: JointDesignRecord::resolution / 2
   };
   std::vector<std::map<double, Setting>> settings_;
 
   std::vector<bool> held_only_;      // per bundle: HeldOnlyBundles at the first reference pose
-  std::vector<double> integral_;     // N m, per joint: the sum of ki e_m dT
+  std::vector<double> integral_;     // N m, per joint: the sum of ki e dT
   std::vector<double> last_target_;  // rad, per joint: NaN before the first instant
-  // Per joint, the step under way: control instants since it began, where from (rad), and its
-  // design's model response.
-  std::vector<long> step_instants_;
-  std::vector<double> step_from_;
-  std::vector<const std::vector<double>*> step_model_;
-  Eigen::VectorXd price_;  // per bundle: its time to 63 % over the fastest bundle's
+  Eigen::VectorXd price_;            // per bundle: its time to 63 % over the fastest bundle's
   std::vector<JointDesignRecord> designs_;
 };
 

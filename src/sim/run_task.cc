@@ -486,7 +486,6 @@ nlohmann::json DesignJson(const JointDesignRecord& r) {
           {"stiffness", r.dynamics.stiffness},
           {"bundle_stiffness", r.bundle_stiffness},
           {"actuator_t63", r.actuator_t63},
-          {"resolution", r.resolution},
           {"kp", d.gains.kp},
           {"ki", d.gains.ki},
           {"kd", d.gains.kd},

@@ -62,10 +62,6 @@ void ExpectSameDesign(const LoopDesign& a, const LoopDesign& b) {
   ExpectSameStep(a.nominal, b.nominal);
   ExpectSameStep(a.robust, b.robust);
   ExpectSameStep(a.offset, b.offset);
-  ExpectSameStep(a.delayed, b.delayed);
-  ASSERT_EQ(a.model.size(), b.model.size());
-  EXPECT_FALSE(a.model.empty());
-  for (size_t i = 0; i < a.model.size(); ++i) EXPECT_TRUE(SameBits(a.model[i], b.model[i]));
   EXPECT_EQ(a.meets, b.meets);
   EXPECT_EQ(a.note, b.note);
 }
@@ -101,7 +97,6 @@ TEST(LoopDesignStore, ADamagedEntryIsAMiss) {
   d.gains = {1.5, 0.25, 0.125};
   d.nominal.time = {0, 1, 2};
   d.nominal.angle = {0, 0.5, 0.9};
-  d.model = {0, 0.25, 0.75};
   d.note = "a note";
   const auto key = LoopDesignKey(c.joint, c.act, c.dT, c.target);
   design_store::Save(key, d);

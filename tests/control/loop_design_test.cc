@@ -30,20 +30,17 @@ TEST(LoopDesign, WithoutFeedbackAQuasiStaticJointFollowsTheBundlesResponse) {
 // The closed loop integrated by fixed-step RK4 (1e-4 s; dT 1 s): q'' = (tau - b q' - k q) / I,
 // tau the demand before the step plus each later change of the demand through
 // `response(change, time since the change)`. The angle (+1: a fraction of the unit step) at each
-// of `instants` control instants. The integral sums the error, or with `model` the model's angle
-// less the limb's (1 past the model's end); every demand less `feedforward_error`.
+// of `instants` control instants.
 template <typename Response>
 std::vector<double> Rk4Angles(const JointDynamics& joint, const LoopGains& g, int instants,
-                              Response response, const std::vector<double>* model = nullptr,
-                              double feedforward_error = 0) {
+                              Response response) {
   const double h = 1e-4;
   double q = -1, v = 0, integral = 0;
   std::vector<double> u{-joint.stiffness}, angles;
   for (int n = 0; n < instants; ++n) {
     angles.push_back(q + 1);
-    const double m = model == nullptr ? 1.0 : n < static_cast<int>(model->size()) ? (*model)[n] : 1;
-    integral += m - (q + 1);
-    u.push_back(g.kp * -q + g.ki * integral - g.kd * v - feedforward_error);
+    integral += -q;
+    u.push_back(g.kp * -q + g.ki * integral - g.kd * v);
     auto tau = [&](double t) {
       double x = u[0];
       for (int i = 1; i <= n + 1; ++i) x += response(u[i] - u[i - 1], t - (i - 1));
@@ -89,45 +86,6 @@ TEST(LoopDesign, PredictionMatchesAFineRk4IntegrationOfTheSameLoop) {
     }
     if (delay > 0) EXPECT_GT(apart, 0.05) << "the delay must change the step";
   }
-}
-
-// The integral on the model's step (control/loop_design.h): a limb that follows the model (here
-// the step with kp and kd alone, on time) leaves the integral exactly 0, so the step is that one
-// whatever ki; with the feedforward off by d it matches a fine RK4 integration of the same loop,
-// and it removes d, where without the integral the limb stays off by d / (k + kp) (the static
-// balance k z = -kp z - d). A design's model is its kp-kd step one period late.
-TEST(LoopDesign, TheIntegralOnTheModelsStepFollowsTheModelAndRemovesAnOffset) {
-  const ActuatorResponse act = TwoState(1.0, 0.2);
-  const JointDynamics joint{0.003, 0.02, 0.1};
-  const LoopGains g{0.1, 0.03, 0.03};
-  LoopTarget target;
-  target.hold = 30;
-  const PredictedStep nominal = PredictStep(joint, act, 1.0, {g.kp, 0, g.kd}, target);
-  const PredictedStep follows = PredictStep(joint, act, 1.0, g, target, 1, 1, 0, 0, &nominal.angle);
-  EXPECT_EQ(follows.angle, nominal.angle);
-  const PredictedStep plain = PredictStep(joint, act, 1.0, g, target);
-  EXPECT_GT(plain.overshoot, nominal.overshoot + 0.05) << "the plain integral winds up";
-
-  const double d = 0.05;
-  const PredictedStep off = PredictStep(joint, act, 1.0, g, target, 1, 1, d, 0, &nominal.angle);
-  const std::vector<double> q = Rk4Angles(
-      joint, g, 30, [&](double change, double t) { return change * act.At(t); }, &nominal.angle, d);
-  for (int n = 0; n < 30; ++n) EXPECT_NEAR(q[n], off.angle[n], 2e-3) << "instant " << n;
-  target.hold = 200;
-  const PredictedStep p_only =
-      PredictStep(joint, act, 1.0, {g.kp, 0, g.kd}, target, 1, 1, d, 0, &nominal.angle);
-  EXPECT_NEAR(p_only.angle.back(), 1 - d / (joint.stiffness + g.kp), 1e-4);
-  const PredictedStep removed = PredictStep(joint, act, 1.0, g, target, 1, 1, d, 0, &nominal.angle);
-  EXPECT_NEAR(removed.angle.back(), 1, 1e-4);
-
-  target.hold = 20;
-  auto design = DesignJointLoop(joint, act, 1.0, target);
-  ASSERT_TRUE(design.ok()) << design.error();
-  const LoopGains& dg = design->gains;
-  EXPECT_EQ(design->model,
-            PredictStep(joint, act, 1.0, {dg.kp, 0, dg.kd}, target, 1, 1, 0, 1.0).angle);
-  EXPECT_EQ(design->nominal.angle,
-            PredictStep(joint, act, 1.0, dg, target, 1, 1, 0, 0, &design->model).angle);
 }
 
 // Bundles that rise with one first-order lag and release with another (closed form at the
@@ -251,14 +209,11 @@ TEST(LoopDesign, TheChoiceIsTheGridsLeastPenaltyWithSettlingCountedFromAThirdOfT
       for (double b : {0.02, 0.04, 0.08, 0.15, 0.3, 0.6, 1.2, 2.4}) {
         for (double c : {0.0, 0.05, 0.2, 0.5, 1.0}) {
           const LoopGains g{a * k_ref, b * k_ref / t63, c * k_ref * t63};
-          const std::vector<double> model =
-              PredictStep(k.joint, act, k.dT, {g.kp, 0, g.kd}, target, 1, 1, 0, k.dT).angle;
-          const std::vector<double>* m = &model;
-          const PredictedStep n = PredictStep(k.joint, act, k.dT, g, target, 1, 1, 0, 0, m);
-          const PredictedStep r = PredictStep(k.joint, act, k.dT, g, target, 1.5, 1.5, 0, 0, m);
+          const PredictedStep n = PredictStep(k.joint, act, k.dT, g, target);
+          const PredictedStep r = PredictStep(k.joint, act, k.dT, g, target, 1.5, 1.5);
           const PredictedStep o =
-              PredictStep(k.joint, act, k.dT, g, target, 1, 1, 0.5 * k_ref + k.torque_error, 0, m);
-          const PredictedStep late = PredictStep(k.joint, act, k.dT, g, target, 1, 1, 0, k.dT, m);
+              PredictStep(k.joint, act, k.dT, g, target, 1, 1, 0.5 * k_ref + k.torque_error);
+          const PredictedStep late = PredictStep(k.joint, act, k.dT, g, target, 1, 1, 0, k.dT);
           const bool meets = n.settled && n.overshoot <= target.overshoot && r.settled &&
                              r.overshoot <= 0.25 && o.settled && o.overshoot <= 0.25;
           const double penalty =
@@ -317,8 +272,7 @@ TEST(LoopDesign, AKeptDesignIsTheOneItsOwnInputsMade) {
   EXPECT_EQ(b1->gains.kp, b2->gains.kp);
   EXPECT_EQ(b1->nominal.angle, b2->nominal.angle);
   // The prediction of the kept design is the one its gains give now.
-  const PredictedStep again =
-      PredictStep(joint, fast, 1.0, b2->gains, target, 1, 1, 0, 0, &b2->model);
+  const PredictedStep again = PredictStep(joint, fast, 1.0, b2->gains, target);
   EXPECT_EQ(again.angle, b2->nominal.angle);
 }
 
@@ -334,8 +288,7 @@ TEST(LoopDesign, AKeptDesignTellsReleasesApart) {
   auto b = DesignJointLoop(joint, slow, 1.0, target);
   ASSERT_TRUE(a.ok() && b.ok());
   EXPECT_NE(a->nominal.angle, b->nominal.angle);
-  EXPECT_EQ(PredictStep(joint, slow, 1.0, b->gains, target, 1, 1, 0, 0, &b->model).angle,
-            b->nominal.angle);
+  EXPECT_EQ(PredictStep(joint, slow, 1.0, b->gains, target).angle, b->nominal.angle);
 }
 
 TEST(LoopDesign, BadInputsAreRefused) {

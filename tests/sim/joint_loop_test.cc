@@ -199,10 +199,7 @@ TEST(JointLoop, OneJointRunTracksAndReportsItsDesigns) {
 
 // The integral term is kept as torque: when a new reference value brings a new design with
 // another ki, the torque integrated so far carries over unchanged and only the new error is
-// integrated with the new gain. The error is the design model's angle (control::LoopDesign::
-// model, from where the step began to its reference) less the limb's, outside half the angle
-// one unit of the finest bundle moves the joint (|arm| x unit force / stiffness). Summed by hand
-// here, the limb held still.
+// integrated with the new gain (summed by hand here, the limb held still).
 TEST(JointLoop, ANewDesignTakesOverTheIntegratedTorqueWithoutAJump) {
   std::string text = ArmTask("\"auto\"");
   text = std::regex_replace(text, std::regex(R"("times": \[5\], "values": \[40\])"),
@@ -221,33 +218,16 @@ TEST(JointLoop, ANewDesignTakesOverTheIntegratedTorqueWithoutAJump) {
   ASSERT_TRUE(loops.ok()) << loops.error();
   std::vector<double> force_ref(pl.num_bundles());
   const double q = pl.JointAngle(0);
-  double sum = 0, from = q, last = std::nan("");
-  size_t n = 0;
+  double sum = 0;
   // The reference steps from 4 to 12 deg at 5 s; the limb is held hanging (0 deg), near enough
   // for the bundles not to saturate, which would hold the integral.
   for (int k = 0; k < 6; ++k) {
     loops->Step(k * dT, pl, force_ref);
-    const Eigen::VectorXd r = loops->LoopReference(pl, k * dT);
-    if (r[0] != last) {
-      from = std::isnan(last) ? q : last;
-      n = 0;
-    } else {
-      ++n;
-    }
-    last = r[0];
+    const double e = loops->LoopReference(pl, k * dT)[0] - q;
     ASSERT_FALSE(loops->designs().empty());
-    const JointDesignRecord& d = loops->designs().back();
-    const Eigen::MatrixXd arms = pl.MomentArmsAt(r);
-    EXPECT_NEAR(
-        d.resolution,
-        std::min(std::abs(arms(0, 0)), std::abs(arms(0, 1))) * 0.5 / std::abs(d.dynamics.stiffness),
-        1e-12 * d.resolution);
-    const double m = n < d.design.model.size() ? d.design.model[n] : 1.0;
-    const double em = from + (r[0] - from) * m - q;
-    if (std::abs(em) > 0.5 * d.resolution) sum += d.design.gains.ki * em * dT;
+    sum += loops->designs().back().design.gains.ki * e * dT;
     EXPECT_NEAR(loops->integral()[0], sum, 1e-12 * (1 + std::abs(sum))) << "instant " << k;
   }
-  EXPECT_NE(sum, 0);
   ASSERT_EQ(loops->designs().size(), 2u);
   const double ki0 = loops->designs()[0].design.gains.ki, ki1 = loops->designs()[1].design.gains.ki;
   EXPECT_GT(std::abs(ki1 - ki0), 0.01 * std::max(ki0, ki1));  // the two designs differ
