@@ -9,12 +9,7 @@
 #ifndef RECRUIT_VERSION_STRING
 #define RECRUIT_VERSION_STRING "unknown"
 #endif
-#if __has_include("source_hash.h")
-#include "source_hash.h"
-#endif
-#ifndef RECRUIT_SOURCE_HASH
-#define RECRUIT_SOURCE_HASH "unknown"
-#endif
+#include "source_hash.h"  // generated: RECRUIT_SOURCE_HASH
 
 namespace recruit {
 const char* CodeVersion() { return RECRUIT_VERSION_STRING "." RECRUIT_SOURCE_HASH; }

@@ -7,7 +7,8 @@ namespace recruit {
 
 // The CMake project version, "major.minor.patch" (project(recruit VERSION ...)).
 const char* ProjectVersion();  // version.cc
-// "<project version>+<git commit>.<source hash>" (also declared in content_hash.h, for resume keys).
+// "<project version>+<git commit>.<source hash>" (also declared in content_hash.h, for resume
+// keys).
 const char* CodeVersion();  // version.cc
 
 }  // namespace recruit

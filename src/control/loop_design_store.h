@@ -4,10 +4,11 @@
 // memo (loop_design.cc) covers the runs of one process.
 //
 // An entry is keyed by the exact bits of every input (LoopDesignKey) and this build's code
-// version (CodeVersion, which changes with any edit of the sources): it holds both in full, compared word for word (no hash is trusted),
-// and the design's every number bit for bit. A missing, damaged or foreign entry is a miss.
-// Entries are written to a temporary sibling and renamed into place (atomic on POSIX), so
-// concurrent runs see a whole entry or none; two writers of one key write the same bytes.
+// version (CodeVersion, which changes with any edit of the sources): it holds both in full,
+// compared word for word (no hash is trusted), and the design's every number bit for bit. A
+// missing, damaged or foreign entry is a miss. Entries are written to a temporary sibling and
+// renamed into place (atomic on POSIX), so concurrent runs see a whole entry or none; two writers
+// of one key write the same bytes.
 //
 // Folder: RECRUIT_DESIGN_CACHE, else $XDG_CACHE_HOME/recruit/designs, else
 // ~/.cache/recruit/designs; RECRUIT_DESIGN_CACHE=off turns it off. File name: the FNV-1a 64 hash
