@@ -173,7 +173,8 @@ Result<BundleDesign> SizeBundle(const SizingInput& in, const SizingLimits& limit
   // Diameter: the thinnest stock wire whose bundle needs at most 2 wires per segment within
   // max_units units (fast cooling, and enough units for the controller's resolution), unless
   // that wire cools slower than max_time_constant: then the thickest wire that does not, with up
-  // to max_parallel wires per segment and max_units_fast units (more wires, the bandwidth kept).
+  // to max_parallel wires per segment and max_units_fast units (more wires, the bandwidth kept),
+  // else up to max_units_resolution units; a slow wire only when no fast one makes the force.
   const std::vector<double>& stock = StockDiameters();
   bool chosen = false, fast_found = false, many_found = false;
   sma::UnitParams fast;  // the thickest fast-enough design so far
@@ -194,7 +195,7 @@ Result<BundleDesign> SizeBundle(const SizingInput& in, const SizingLimits& limit
     p.parallel = parallel;
     const int units = (wires + parallel - 1) / parallel;
     const bool fast_enough = wire->time_constant <= limits.max_time_constant;
-    if (parallel <= 2 && (fast_enough || !fast_found)) {
+    if (parallel <= 2 && (fast_enough || !(fast_found || many_found))) {
       out.unit = p, out.units = units, chosen = true;
       break;
     }

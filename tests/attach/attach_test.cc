@@ -269,6 +269,24 @@ TEST(Sizing, TheBandwidthRuleTakesMoreUnitsBeforeASlowWireAndSaysWhenItCannot) {
   EXPECT_TRUE(slow_note(*slow));
 }
 
+// The same when a thick wire makes the force with two per segment within max_units units: a
+// design of up to max_units_resolution fast units still comes first (arm26's SF, 358 N through
+// a 0.14 gear: 2550 wires of 0.127 mm, nine per unit at 300 units, three at 1000; 0.51 mm takes
+// 159 wires but cools in 13 s).
+TEST(Sizing, ManyFastUnitsComeBeforeAThickWireThatMakesTheForceWithFewWires) {
+  SizingLimits limits;
+  limits.units_per_holding_force = 0;
+  SizingInput sf{"SF", 358, 0.2378, 0.1025, 0.3404, 0.3404};
+  auto d = SizeBundle(sf, limits);
+  ASSERT_TRUE(d.ok()) << d.error();
+  EXPECT_LE(d->time_constant, limits.max_time_constant);
+  EXPECT_GT(d->units, limits.max_units_fast);
+  EXPECT_LE(d->units, limits.max_units_resolution);
+  EXPECT_LE(d->unit.parallel, limits.max_parallel);
+  EXPECT_GE(d->force_mid, 358);
+  for (const std::string& n : d->notes) EXPECT_EQ(n.find("thermal time constant"), n.npos) << n;
+}
+
 TEST(Sizing, MatchesForceWithinLimitsAndCoversTheStroke) {
   for (double force : {5.0, 40.0, 600.0}) {
     for (double excursion : {0.01, 0.03, 0.08}) {
