@@ -55,7 +55,8 @@ std::vector<std::string> NameList(const py::object& o, const std::string& what) 
 py::object Attach(const py::object& model, const py::object& muscles, const py::object& output,
                   const py::object& task, const py::object& report, bool size_only,
                   const py::object& force, bool lengthrange_from_joints, const py::object& lock,
-                  double max_time_constant, double stroke_use, int units_per_holding_force) {
+                  double max_time_constant, double stroke_use, int units_per_holding_force,
+                  double damping_ratio) {
   attach::AttachOptions o;
   o.model = PathArg(model);
   o.muscles = NameList(muscles, "muscles");
@@ -88,6 +89,11 @@ py::object Attach(const py::object& model, const py::object& muscles, const py::
     Fail("units_per_holding_force: value " + std::to_string(units_per_holding_force) +
          " not allowed: must be in 0..1000");
   }
+  if (!(damping_ratio >= 0 && damping_ratio <= 10)) {
+    Fail("damping_ratio: value " + std::to_string(damping_ratio) +
+         " not allowed: must be a ratio in 0..10");
+  }
+  o.limits.damping_ratio = damping_ratio;
   o.limits.max_time_constant = max_time_constant;
   o.limits.stroke_use = stroke_use;
   o.limits.units_per_holding_force = units_per_holding_force;
@@ -112,6 +118,7 @@ void BindAttach(py::module_& mod) {
           py::arg("max_time_constant") = attach::SizingLimits{}.max_time_constant,
           py::arg("stroke_use") = attach::SizingLimits{}.stroke_use,
           py::arg("units_per_holding_force") = attach::SizingLimits{}.units_per_holding_force,
+          py::arg("damping_ratio") = attach::SizingLimits{}.damping_ratio,
           R"doc(Turns a MuJoCo model's muscles into sized recruit.sma bundles, as `recruit attach`.
 
 model: the input MJCF. muscles: actuator names (a list, or one comma-separated string) or
@@ -122,11 +129,12 @@ muscle's F0. lengthrange_from_joints: set the lengthrange of other muscles whose
 computation fails from the joint ranges. lock: joints held at their reference value in the written
 model (a joint equality each) and not driven by the starter task; the muscles kept beside the
 bundles then get the lengthrange MuJoCo computes on the free limb, written explicitly.
-max_time_constant, stroke_use, units_per_holding_force: the sizing options of the same names
+max_time_constant, stroke_use, units_per_holding_force, damping_ratio: the sizing options of the
+same names
 (`recruit attach --help`, docs/sma-units.md "Sizing a bundle").
 
 Returns the report as a dict (what `--report` writes: model, output, task, changes, warnings,
-lengthranges_from_joints, lengthranges_without_locks, bundles). Raises ValueError for bad input and OSError when a file
+lengthranges_from_joints, lengthranges_without_locks, joints, bundles). Raises ValueError for bad input and OSError when a file
 cannot be read or written, with the CLI's message; nothing is written on error.
 docs/howto-own-model.md has the guide. The GIL is released meanwhile.)doc");
 }

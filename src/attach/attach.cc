@@ -87,11 +87,69 @@ std::string FreeJointAbove(const mjModel* m, int j) {
   return "";
 }
 
+// What sizing takes of a probed bundle.
+SizingInput InputOf(const BundleReport& b) {
+  return {b.name,       b.peak_force,     b.length_max - b.length_min, b.length_min, b.length_max,
+          b.ref_length, b.holding.force()};
+}
+
+// At qpos0: each bundle's moment arm about the joints it crosses, and the joints the bundles move
+// (not locked) with their inertia and damping, the replaced actuators' own left out.
+void ProbeArms(const mjModel* m, mjData* d, const std::vector<std::string>& names,
+               const std::vector<std::string>& locked, std::vector<BundleReport>& bundles,
+               std::vector<DampedJoint>* joints) {
+  mju_copy(d->qpos, m->qpos0, m->nq);
+  mj_fwdPosition(m, d);
+  std::vector<int> replaced;
+  for (const std::string& n : names) replaced.push_back(mj_name2id(m, mjOBJ_ACTUATOR, n.c_str()));
+  joints->clear();
+  for (BundleReport& b : bundles) {
+    for (JointUse& u : b.joints) {
+      const int j = mj_name2id(m, mjOBJ_JOINT, u.joint.c_str());
+      if (j < 0) continue;
+      const int dof = m->jnt_dofadr[j];
+      const int t = b.tendon_id;
+      for (int k = m->ten_J_rowadr[t]; k < m->ten_J_rowadr[t] + m->ten_J_rownnz[t]; ++k) {
+        if (m->ten_J_colind[k] == dof) u.arm = d->ten_J[k];
+      }
+      const bool seen = std::any_of(joints->begin(), joints->end(),
+                                    [&](const DampedJoint& x) { return x.joint == u.joint; });
+      const bool held = std::find(locked.begin(), locked.end(), u.joint) != locked.end();
+      if (!seen && !held) joints->push_back(ProbeJoint(m, d, j, replaced));
+    }
+  }
+}
+
+// Every bundle's damper (BundleDesign::damper) for the joints in `joints` (attach/damper.h).
+Status DesignBundleDampers(std::vector<BundleReport>& bundles, std::vector<DampedJoint>& joints,
+                           const SizingLimits& limits) {
+  std::vector<DampedBundle> in;
+  for (const BundleReport& b : bundles) {
+    const SizingInput s = InputOf(b);
+    DampedBundle db;
+    db.stiffness = RestStiffness(b.design, s, RestTension(s, limits));
+    db.arms.assign(joints.size(), 0.0);
+    for (std::size_t j = 0; j < joints.size(); ++j) {
+      for (const JointUse& u : b.joints) {
+        if (u.joint == joints[j].joint) db.arms[j] = u.arm;
+      }
+    }
+    in.push_back(std::move(db));
+  }
+  auto c = DesignDampers(joints, in, limits.damping_ratio);
+  if (!c.ok()) return Error{"dampers: " + c.error(), c.code()};
+  for (std::size_t i = 0; i < bundles.size(); ++i) {
+    bundles[i].design.damper = (*c)[i] / (bundles[i].design.gear * bundles[i].design.gear);
+  }
+  return Status::Ok();
+}
+
 // Probes the original model (compiled without lengthrange computation, which a bundle does not
 // need) for each bundle's force and tendon range.
 // The bundles' tendons, joints and loads, on a copy of the model with the locked joints held.
 Result<std::vector<BundleReport>> Probe(const mjSpec* spec, const std::vector<std::string>& names,
-                                        const AttachOptions& o, std::vector<JointLock>* locks) {
+                                        const AttachOptions& o, std::vector<JointLock>* locks,
+                                        std::vector<DampedJoint>* joints) {
   auto copy = CopySpec(spec);
   if (!copy.ok()) return Error{copy.error(), copy.code()};
   (*copy)->compiler.LRopt.mode = mjLRMODE_NONE;
@@ -143,15 +201,13 @@ Result<std::vector<BundleReport>> Probe(const mjSpec* spec, const std::vector<st
     b.ref_length = d->ten_length[b.tendon_id];
     out.push_back(std::move(b));
   }
+  ProbeArms(m->get(), d.get(), names, o.lock, out, joints);
   return out;
 }
 
 Status Size(std::vector<BundleReport>& bundles, const SizingLimits& limits) {
   for (BundleReport& b : bundles) {
-    SizingInput in{b.name,           b.peak_force, b.length_max - b.length_min,
-                   b.length_min,     b.length_max, b.ref_length,
-                   b.holding.force()};
-    auto design = SizeBundle(in, limits);
+    auto design = SizeBundle(InputOf(b), limits);
     if (!design.ok()) return Error{design.error(), design.code()};
     b.design = std::move(design).value();
   }
@@ -192,16 +248,20 @@ Result<AttachReport> Attach(const AttachOptions& o) {
   auto names = SelectActuators(spec->get(), o);
   if (!names.ok()) return Error{names.error(), names.code()};
   std::vector<JointLock> locks;
-  auto bundles = Probe(spec->get(), *names, o, &locks);
+  std::vector<DampedJoint> joints;
+  auto bundles = Probe(spec->get(), *names, o, &locks, &joints);
   if (!bundles.ok()) return Error{bundles.error(), bundles.code()};
   Status sized = Size(*bundles, o.limits);
   if (!sized.ok()) return Error{sized.error(), sized.code()};
+  Status damped = DesignBundleDampers(*bundles, joints, o.limits);
+  if (!damped.ok()) return Error{damped.error(), damped.code()};
 
   AttachReport report;
   report.model = o.model;
   report.output = o.size_only ? "" : o.output;
   report.bundles = std::move(bundles).value();
   report.locks = locks;
+  report.damped_joints = std::move(joints);
   for (const BundleReport& b : report.bundles) {
     for (const std::string& j : b.jumps) {
       report.warnings.push_back("'" + b.name + "': tendon path jumps at " + j +
@@ -221,8 +281,8 @@ Result<AttachReport> Attach(const AttachOptions& o) {
     for (BundleReport& b : report.bundles) {
       b.instance = UniqueName(s, mjOBJ_PLUGIN, b.name + "_units");
       b.sensor = UniqueName(s, mjOBJ_SENSOR, b.name + "_truth");
-      Status ok = ReplaceWithBundle(
-          s, {b.name, b.instance, b.sensor, b.design.gear, b.design.ConfigPairs()});
+      Status ok = ReplaceWithBundle(s, {b.name, b.instance, b.sensor, b.design.gear,
+                                        b.design.damper, b.design.ConfigPairs()});
       if (!ok.ok()) return Error{ok.error(), ok.code()};
     }
     RebaseAssetDirs(s, o.model, o.output);

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "attach/damper.h"
 #include "attach/holding_load.h"
 #include "attach/joint_lock.h"
 #include "attach/lengthrange.h"
@@ -33,6 +34,7 @@ struct JointUse {  // a joint a bundle's tendon crosses
   bool hinge = true;
   double lo = 0, hi = 0;                // joint range (rad or m)
   double usable_lo = 0, usable_hi = 0;  // cut at tendon-path jumps
+  double arm = 0;                       // m: the tendon's dL/dq at qpos0
 };
 
 struct BundleReport {
@@ -60,6 +62,8 @@ struct AttachReport {
   // before the locks (lengthrange.h, FreezeLengthRanges).
   std::vector<LengthRangeFix> lengthranges_unlocked;
   std::vector<JointLock> locks;
+  // The joints the bundles move (not locked), with the damping their dampers give them.
+  std::vector<DampedJoint> damped_joints;
   std::vector<std::string> changes;  // one line per edit
   std::vector<std::string> warnings;
 };

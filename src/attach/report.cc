@@ -29,7 +29,8 @@ std::vector<std::string> ChangeLines(const AttachReport& r, const mjSpec* spec) 
   for (const BundleReport& b : r.bundles) {
     lines.push_back("actuator '" + b.name + "' (" + b.replaced + " on tendon '" + b.tendon +
                     "') -> recruit.sma bundle, instance '" + b.instance + "', class '" +
-                    kBundleClass + "', gear " + F("%g", b.design.gear) + ", ctrlrange -1 1");
+                    kBundleClass + "', gear " + F("%g", b.design.gear) + ", damping " +
+                    F("%.4g", b.design.damper) + ", ctrlrange -1 1");
     lines.push_back("sensor '" + b.sensor + "' added (count, tension, mean T, mean xi)");
   }
   lines.push_back(std::string("default class '") + kBundleClass +
@@ -75,6 +76,11 @@ std::string DesignTable(const AttachReport& r) {
          F("%.4g", u.series_spring) + " N/m, prestretch " + F("%.4g", 1000 * u.prestretch) +
          " mm, gear " + F("%g", d.gear) + "\n";
     if (!d.transmission.empty()) t += "  transmission: " + d.transmission + "\n";
+    if (d.damper > 0) {
+      t += "  damper: " + F("%.4g", d.damper) +
+           " N s/m beside the units, behind the same lever (actuator damping; " +
+           F("%.4g", d.damper * d.gear * d.gear) + " N s/m at the tendon)\n";
+    }
     if (b.holding.force() > 0) {
       t += "  resolution: one unit " + F("%.3g", d.force_mid / d.units) + " N, " +
            F("%.2g", 100 * d.force_mid / d.units / b.holding.force()) + " % of the " +
@@ -96,6 +102,13 @@ std::string DesignTable(const AttachReport& r) {
          F("%.4g", d.power) + " W all on, thermal tau " + F("%.3g", d.time_constant) +
          " s, cooling " + F("%.3g", d.cooling_time) + " s (datasheet)\n";
   }
+  for (const DampedJoint& j : r.damped_joints) {
+    t += "joint '" + j.joint + "': inertia " + F("%.4g", j.inertia) +
+         " kg m^2, the bundles' stiffness at rest " + F("%.4g", j.stiffness) +
+         " N m/rad; damping " + F("%.4g", j.damping) + " -> " + F("%.4g", j.damping_after) +
+         " N m s/rad (ratio " + F("%.3g", j.ratio_before) + " -> " + F("%.3g", j.ratio_after) +
+         ")\n";
+  }
   for (const std::string& w : r.warnings) t += "warning: " + w + "\n";
   return t;
 }
@@ -114,6 +127,14 @@ nlohmann::json ReportJson(const AttachReport& r) {
   j["lengthranges_without_locks"] = nlohmann::json::array();
   for (const LengthRangeFix& f : r.lengthranges_unlocked) {
     j["lengthranges_without_locks"].push_back({{"actuator", f.actuator}, {"range", {f.lo, f.hi}}});
+  }
+  j["joints"] = nlohmann::json::array();
+  for (const DampedJoint& d : r.damped_joints) {
+    j["joints"].push_back({{"joint", d.joint},
+                           {"inertia", d.inertia},
+                           {"stiffness_at_rest", d.stiffness},
+                           {"damping", {d.damping, d.damping_after}},
+                           {"damping_ratio", {d.ratio_before, d.ratio_after}}});
   }
   j["bundles"] = nlohmann::json::array();
   for (const BundleReport& b : r.bundles) {
@@ -141,6 +162,7 @@ nlohmann::json ReportJson(const AttachReport& r) {
                             {"holding_force", b.holding.force()},
                             {"gear", d.gear},
                             {"transmission", d.transmission},
+                            {"damper", d.damper},
                             {"config", config},
                             {"force_all_on", {d.force_short, d.force_mid, d.force_long}},
                             {"stroke", d.stroke},

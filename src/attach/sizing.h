@@ -43,6 +43,9 @@ struct SizingLimits {
   // co-contraction the self-tuned loop keeps, this fraction of its peak force (the task's
   // default co_contraction): the resolution rule takes that as its load.
   double rest_tension_fraction = 0.05;
+  // Least damping ratio of every joint the bundles move, at their stiffness at rest, that their
+  // dampers give it (attach/damper.h); 0: no dampers.
+  double damping_ratio = 0.5;
 };
 
 // Stock Flexinol diameters (m), thinnest first.
@@ -78,6 +81,9 @@ struct BundleDesign {
   double time_constant = 0;        // s: the wire's thermal time constant
   double cooling_time = 0;         // s: Dynalloy's still-air cooling time for the diameter
   std::vector<std::string> notes;  // choices a reader should know about
+  // N s/m: the damper beside the units, behind the lever (MuJoCo's actuator damping; the tendon
+  // sees gear^2 times it). Set by the limb's damper design (attach/damper.h), 0 when none.
+  double damper = 0;
 
   // The plugin's config keys for this design (value strings).
   std::vector<std::pair<std::string, std::string>> ConfigPairs() const;

@@ -187,6 +187,8 @@ Status ReplaceWithBundle(mjSpec* spec, const BundleEdit& edit) {
   a->actdim = 0;
   a->gear[0] = edit.gear;
   for (int i = 1; i < 6; ++i) a->gear[i] = 0;
+  a->damping[0] = edit.damping;
+  for (int i = 1; i <= mjNPOLY; ++i) a->damping[i] = 0;
   a->lengthrange[0] = a->lengthrange[1] = 0;  // a bundle needs none
   a->ctrllimited = mjLIMITED_TRUE;
   a->ctrlrange[0] = -1;

@@ -46,6 +46,7 @@ struct BundleEdit {
   std::string instance;  // new plugin instance
   std::string sensor;    // new truth sensor
   double gear = 1;
+  double damping = 0;  // N s/m: the actuator's damping (the damper beside the units)
   std::vector<std::pair<std::string, std::string>> config;
 };
 

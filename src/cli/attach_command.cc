@@ -107,6 +107,12 @@ void AddAttachCommand(CLI::App& app, int& exit_code) {
                   "counts' resolution); 0: no such rule")
       ->check(CLI::Range(0, 1000))
       ->capture_default_str();
+  sub->add_option("--damping-ratio", args->options.limits.damping_ratio,
+                  "least damping ratio of every joint the bundles move, at their stiffness at "
+                  "rest, that a damper beside each bundle gives it (a wire does not damp its "
+                  "joint as a muscle does); 0: no dampers")
+      ->check(NumberIn(0, false, 10, "a ratio in 0..10"))
+      ->capture_default_str();
   sub->callback([args, &exit_code] { exit_code = RunAttach(*args); });
 }
 

@@ -149,7 +149,7 @@ Result<JointDesignRecord> JointLoops::Design(const Plant& plant, int j, const Ei
   rec.torque_error = kForceError * rec.holding.torque;
   rec.dynamics.stiffness = rec.holding.limb_stiffness + rec.bundle_stiffness;
   rec.dynamics.inertia = plant.JointInertia(j, r);
-  rec.dynamics.damping = plant.JointDamping(j);
+  rec.dynamics.damping = plant.JointDamping(j, r);
   // The response of the joint's torque: the allocation gives a demand to the fastest bundles
   // that can meet it, so the slower of the fastest bundle on each side sets it.
   // Arms at the reference pose, so the design does not depend on where the limb is; a bundle

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "common/compiled_model_cache.h"
+#include "plugin/joint_damping.h"
 
 namespace recruit::sim {
 namespace {
@@ -448,6 +449,11 @@ double Plant::JointInertia(int j, const Eigen::VectorXd& q) const {
   mj_fullM(m, scratch_.get(), full.data());
   const int dof = m->jnt_dofadr[joints_[j]];
   return full[static_cast<size_t>(dof) * m->nv + dof];
+}
+
+double Plant::JointDamping(int j, const Eigen::VectorXd& q) const {
+  PoseTransmission(q);
+  return sma::JointDamping(model_.get(), scratch_.get(), model_->jnt_dofadr[joints_[j]]);
 }
 
 void Plant::Reset(std::uint64_t seed) {

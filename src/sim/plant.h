@@ -95,7 +95,7 @@ class Plant {
   // dynamics with zero velocity and acceleration and no constraint rows.
   Eigen::VectorXd StaticTorque(const Eigen::VectorXd& q) const;
   // Driven joint j's inertia (mass-matrix diagonal, armature included) with the driven joints at
-  // `q`, and its damping.
+  // `q`.
   double JointInertia(int j, const Eigen::VectorXd& q) const;
   // Driven joint j's range, when it is limited.
   bool JointRange(int j, double* lo, double* hi) const {
@@ -104,7 +104,9 @@ class Plant {
     *hi = model_->jnt_range[2 * joints_[j] + 1];
     return true;
   }
-  double JointDamping(int j) const { return model_->dof_damping[model_->jnt_dofadr[joints_[j]]]; }
+  // Driven joint j's viscous damping with the driven joints at `q`: its own, and the tendons' and
+  // actuators' (the bundles' dampers) through their moment arms there (sma::JointDamping).
+  double JointDamping(int j, const Eigen::VectorXd& q) const;
   // The limb's position at `q`, velocities zero, on the scratch data (for StaticTorque).
   void PoseScratch(const Eigen::VectorXd& q) const;
 

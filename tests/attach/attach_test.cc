@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "attach/damper.h"
 #include "attach/holding_load.h"
 #include "attach/sizing.h"
 #include "common/mujoco_load.h"
@@ -102,6 +103,53 @@ TEST(Attach, TwoJointArmAllMusclesLoadsAndKeepsEverythingElse) {
   ASSERT_TRUE(host.ok()) << host.error();
   EXPECT_EQ((*host)->num_bundles(), 6);
   EXPECT_TRUE(fs::exists(o.task));
+}
+
+// The dampers: MuJoCo's own passive force at a unit joint velocity (qfrc_damper of the written
+// model, at qpos0) is the damping the report gives each joint, and it brings every moved joint to
+// the ratio asked at the bundles' rest stiffness; the ratio 0 writes none.
+TEST(Attach, DampersGiveEveryMovedJointTheRatioAsked) {
+  const std::string in = kSrc + "/models/arm2j_muscle.xml";
+  for (double ratio : {0.0, 0.5, 1.2}) {
+    const std::string dir = TempDir("dampers");
+    AttachOptions o;
+    o.model = in;
+    o.muscles = {"all"};
+    o.output = dir + "/arm2j_sma.xml";
+    o.limits.damping_ratio = ratio;
+    auto r = Attach(o);
+    ASSERT_TRUE(r.ok()) << r.error();
+    ModelPtr m = Load(o.output);
+    ASSERT_TRUE(m);
+    ASSERT_EQ(r->damped_joints.size(), 2u);
+    std::unique_ptr<mjData, void (*)(mjData*)> d(mj_makeData(m.get()), mj_deleteData);
+    for (const DampedJoint& j : r->damped_joints) {
+      const int id = mj_name2id(m.get(), mjOBJ_JOINT, j.joint.c_str());
+      ASSERT_GE(id, 0) << j.joint;
+      mj_resetData(m.get(), d.get());
+      d->qvel[m->jnt_dofadr[id]] = 1;
+      mj_forward(m.get(), d.get());
+      EXPECT_NEAR(-d->qfrc_damper[m->jnt_dofadr[id]], j.damping_after, 1e-5 * j.damping_after)
+          << j.joint << " ratio " << ratio;
+      EXPECT_GE(j.ratio_after, std::max(ratio, j.ratio_before) - 1e-9) << j.joint;
+      EXPECT_EQ(j.damping, m->dof_damping[m->jnt_dofadr[id]]);  // the limb had no other damper
+    }
+    // Some joint is at the ratio exactly (the one that asked most) unless none needed any.
+    double least = 1e9;
+    for (const DampedJoint& j : r->damped_joints) {
+      if (j.ratio_after > j.ratio_before + 1e-12) least = std::min(least, j.ratio_after);
+    }
+    if (least < 1e9) {
+      EXPECT_NEAR(least, ratio, 1e-9);
+    }
+    for (const BundleReport& b : r->bundles) {
+      const int a = mj_name2id(m.get(), mjOBJ_ACTUATOR, b.name.c_str());
+      EXPECT_NEAR(m->actuator_damping[a], b.design.damper, 1e-5 * b.design.damper) << b.name;
+      if (ratio == 0) {
+        EXPECT_EQ(b.design.damper, 0.0);
+      }
+    }
+  }
 }
 
 TEST(Attach, OtherActuatorsKeepTheirParameters) {
@@ -285,6 +333,67 @@ TEST(Sizing, ManyFastUnitsComeBeforeAThickWireThatMakesTheForceWithFewWires) {
   EXPECT_LE(d->unit.parallel, limits.max_parallel);
   EXPECT_GE(d->force_mid, 358);
   for (const std::string& n : d->notes) EXPECT_EQ(n.find("thermal time constant"), n.npos) << n;
+}
+
+// The damper rule's closed forms: one joint, two bundles: the joint lands on the ratio exactly
+// and the bundles share by stiffness; a joint damped enough takes none; a biarticular bundle
+// takes the larger of its joints' shares, so both joints reach at least the ratio.
+TEST(Dampers, ClosedFormsOfTheStiffnessProportionalRule) {
+  std::vector<DampedJoint> one{{"q", 0.2, 0.05}};
+  auto c = DesignDampers(one, {{100, {0.03}}, {50, {-0.02}}}, 0.5);
+  ASSERT_TRUE(c.ok()) << c.error();
+  const double k = 100 * 0.03 * 0.03 + 50 * 0.02 * 0.02;
+  EXPECT_DOUBLE_EQ(one[0].stiffness, k);
+  const double need = 2 * 0.5 * std::sqrt(k * 0.2) - 0.05;
+  EXPECT_NEAR((*c)[0] * 0.03 * 0.03 + (*c)[1] * 0.02 * 0.02, need, 1e-12);
+  EXPECT_NEAR((*c)[0] / (*c)[1], 2.0, 1e-12);
+  EXPECT_NEAR(one[0].ratio_after, 0.5, 1e-12);
+  EXPECT_NEAR(one[0].ratio_before, 0.05 / (2 * std::sqrt(k * 0.2)), 1e-12);
+
+  std::vector<DampedJoint> damped{{"q", 0.2, 10}};
+  c = DesignDampers(damped, {{100, {0.03}}}, 0.5);
+  ASSERT_TRUE(c.ok());
+  EXPECT_EQ((*c)[0], 0.0);
+  EXPECT_EQ(damped[0].damping_after, 10.0);
+
+  std::vector<DampedJoint> two{{"a", 1.0, 0.0}, {"b", 0.1, 0.0}};
+  const std::vector<DampedBundle> bundles{
+      {200, {0.05, 0.0}}, {80, {0.0, 0.03}}, {60, {0.04, 0.02}}};
+  c = DesignDampers(two, bundles, 0.7);
+  ASSERT_TRUE(c.ok());
+  for (const DampedJoint& j : two) EXPECT_GE(j.ratio_after, 0.7 - 1e-12) << j.joint;
+  EXPECT_NEAR(std::min(two[0].ratio_after, two[1].ratio_after), 0.7, 1e-12);
+  // The monoarticular bundles carry their own joint's share; the biarticular one the larger.
+  const double beta_a = 2 * 0.7 * std::sqrt(two[0].stiffness * 1.0) / two[0].stiffness;
+  const double beta_b = 2 * 0.7 * std::sqrt(two[1].stiffness * 0.1) / two[1].stiffness;
+  EXPECT_NEAR((*c)[0], beta_a * 200, 1e-9);
+  EXPECT_NEAR((*c)[1], beta_b * 80, 1e-9);
+  EXPECT_NEAR((*c)[2], std::max(beta_a, beta_b) * 60, 1e-9);
+
+  std::vector<DampedJoint> bad{{"q", 0.0, 0.0}};
+  EXPECT_FALSE(DesignDampers(bad, {{1, {0.01}}}, 0.5).ok());
+  EXPECT_FALSE(DesignDampers(one, {{1, {0.01}}}, -1).ok());
+  EXPECT_FALSE(DesignDampers(one, {{1, {0.01, 0.02}}}, 0.5).ok());
+}
+
+// A bundle's stiffness at rest against a finite difference of the plugin's own tension law: the
+// units on at mid-range that pull the rest tension, moved by a small tendon length.
+TEST(Dampers, RestStiffnessIsTheSlopeOfTheUnitsTension) {
+  SizingInput in{"b", 200, 0.06, 0.20, 0.26, 0.22};
+  auto d = SizeBundle(in);
+  ASSERT_TRUE(d.ok()) << d.error();
+  auto u = sma::UnitModel::Create(d->unit);
+  ASSERT_TRUE(u.ok());
+  const double rest = RestTension(in, SizingLimits{});
+  EXPECT_DOUBLE_EQ(rest, 0.05 * 200);
+  const double l_mid = 0.23, h = 1e-6;
+  auto stretch = [&](double l) { return d->unit.prestretch + d->gear * (l - in.ref_length); };
+  const double per_unit = d->gear * u->Tension(0.0, stretch(l_mid));
+  const double n = rest / per_unit;  // units on (a real number: the slope is linear in it)
+  const double slope = n * d->gear *
+                       (u->Tension(0.0, stretch(l_mid + h)) - u->Tension(0.0, stretch(l_mid - h))) /
+                       (2 * h);
+  EXPECT_NEAR(RestStiffness(*d, in, rest), slope, 1e-6 * slope);
 }
 
 TEST(Sizing, MatchesForceWithinLimitsAndCoversTheStroke) {

@@ -45,7 +45,8 @@ usage_range)  # range errors: exit 2, say what is allowed, never print DBL_MAX
     grep -q "1.79769e+308" err && fail "DBL_MAX printed by identify"
     grep -q "must be a finite number > 0 and <= 1000" err || fail "identify --dt $bad: no rule"
   done
-  for bad in "--stroke-use 0.1" "--stroke-use 1" "--units-per-holding-force -1"; do
+  for bad in "--stroke-use 0.1" "--stroke-use 1" "--units-per-holding-force -1" \
+    "--damping-ratio -0.5" "--damping-ratio nan"; do
     expect 2 "$RECRUIT" attach "$SRC/models/arm2j_muscle.xml" --muscles all $bad -o o
     grep -q "must be\|not in range\|allowed" err || fail "attach $bad: no rule"
   done

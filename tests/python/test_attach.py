@@ -134,6 +134,23 @@ def test_sizing_options_are_the_clis(tmp_path):
     assert [b["config"] for b in report["bundles"]] != [b["config"] for b in default["bundles"]]
 
 
+def test_damping_ratio_is_the_clis(tmp_path):
+    """damping_ratio gives the dampers --damping-ratio gives, bundle by bundle and joint by joint;
+    0 gives none."""
+    rep = tmp_path / "cli.json"
+    subprocess.run([os.environ["RECRUIT_CLI"], "attach", ARM, "--muscles", "all", "--size-only",
+                    "--damping-ratio", "0.9", "--report", str(rep)], check=True,
+                   capture_output=True)
+    with open(rep) as f:
+        cli = json.load(f)
+    report = recruit.attach(ARM, "all", size_only=True, damping_ratio=0.9)
+    assert [b["damper"] for b in report["bundles"]] == [b["damper"] for b in cli["bundles"]]
+    assert report["joints"] == cli["joints"]
+    assert min(j["damping_ratio"][1] for j in report["joints"]) == pytest.approx(0.9)
+    none = recruit.attach(ARM, "all", size_only=True, damping_ratio=0)
+    assert all(b["damper"] == 0 for b in none["bundles"])
+
+
 def test_bad_input_raises_naming_the_muscle_and_writes_nothing(tmp_path):
     out, task, rep = tmp_path / "out.xml", tmp_path / "task.json", tmp_path / "r.json"
     with pytest.raises(ValueError, match="'biceps' does not exist"):
@@ -150,6 +167,8 @@ def test_bad_input_raises_naming_the_muscle_and_writes_nothing(tmp_path):
         recruit.attach(ARM, "all", output=out, stroke_use=1.5)
     with pytest.raises(ValueError, match="units_per_holding_force"):
         recruit.attach(ARM, "all", output=out, units_per_holding_force=-1)
+    with pytest.raises(ValueError, match="damping_ratio"):
+        recruit.attach(ARM, "all", output=out, damping_ratio=-0.1)
     with pytest.raises(ValueError, match="cannot open model"):
         recruit.attach(tmp_path / "missing.xml", "all", output=out)
     assert os.listdir(tmp_path) == []

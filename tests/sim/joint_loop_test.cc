@@ -159,6 +159,47 @@ TEST(JointLoop, MomentArmsAreMinusTheDerivativeOfEachBundlesLength) {
   EXPECT_LT(arms(0, 1), 0);
 }
 
+// The design model's joint damping: the joint's, a tendon's and the bundles' dampers (actuator
+// damping), at a pose, against MuJoCo's own passive force at a unit joint velocity there.
+TEST(JointLoop, JointDampingIsMuJoCosPassiveForceAtAUnitVelocity) {
+  std::ifstream f(kRoot + "/models/elbow_arm.xml");
+  std::string xml((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  xml = std::regex_replace(xml, std::regex(R"(<plugin name="flexor" )"),
+                           R"(<plugin name="flexor" damping="3.5" gear="0.6" )");
+  xml = std::regex_replace(xml, std::regex(R"(<plugin name="extensor" )"),
+                           R"(<plugin name="extensor" damping="1.25" )");
+  xml = std::regex_replace(xml, std::regex(R"(<spatial name="extensor" )"),
+                           R"(<spatial name="extensor" damping="0.7" )");
+  const fs::path dir = fs::temp_directory_path() / "recruit_joint_damping_test";
+  fs::create_directories(dir);
+  std::ofstream(dir / "arm.xml") << xml;
+  std::string task = ArmTask("\"auto\"");
+  task = std::regex_replace(task, std::regex(kRoot + "/models/elbow_arm.xml"),
+                            (dir / "arm.xml").string());
+  auto t = TaskFromText(task, dir.string());
+  ASSERT_TRUE(t.ok()) << t.error();
+  auto p = Plant::Create(*t, false);
+  ASSERT_TRUE(p.ok()) << p.error();
+  Plant& plant = **p;
+  plant.Reset(1);
+  const mjModel* m = plant.model();
+  ASSERT_EQ(m->actuator_damping[0], 3.5);
+  DataPtr d(mj_makeData(m));
+  const int dof = m->jnt_dofadr[mj_name2id(m, mjOBJ_JOINT, "elbow")];
+  const int qadr = m->jnt_qposadr[mj_name2id(m, mjOBJ_JOINT, "elbow")];
+  for (double q : {0.2, 0.9, 1.6}) {
+    mju_copy(d->qpos, plant.data()->qpos, m->nq);
+    d->qpos[qadr] = q;
+    mju_zero(d->qvel, m->nv);
+    d->qvel[dof] = 1;
+    mj_forward(m, d.get());
+    const double b = plant.JointDamping(0, Eigen::VectorXd::Constant(1, q));
+    EXPECT_NEAR(b, -d->qfrc_damper[dof], 1e-12 * b) << q;
+    EXPECT_GT(b - m->dof_damping[dof], 1e-5);  // the dampers count
+  }
+  fs::remove_all(dir);
+}
+
 // A run of the self-tuned loop without identified models (the output estimator, no
 // identification): it reaches toward the reference and its summary has the loop's designs.
 TEST(JointLoop, OneJointRunTracksAndReportsItsDesigns) {
