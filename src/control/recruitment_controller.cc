@@ -123,6 +123,8 @@ Broadcast RecruitmentController::Step(double reference_force, double measured_fo
     last_ = FailureAwareLaw(*f);
     if (params_.exploration.p_on > 0) last_ = Explore(last_, *f);
   } else {
+    // More than every unit asked for: the bundle beyond its capacity (the run's summary says so).
+    saturation_ = target_on_ > params_.num_units ? 1 : 0;
     last_ = ExpectationLaw(target_on_, estimated_on_, params_.num_units, params_.lambda);
   }
   estimator_->Broadcasted(last_);

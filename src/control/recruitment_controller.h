@@ -95,7 +95,8 @@ class RecruitmentController {
   // working units only (stuck ones are on for good and count towards the target, open ones never
   // switch). saturation() at the last Step: +1 when the reference needs more than every working
   // unit (the target is clamped to them: the law asks for all and winds nothing up), -1 when the
-  // stuck units alone exceed it, 0 otherwise (and always 0 without failures).
+  // stuck units alone exceed it, 0 otherwise. Without failures: +1 when the reference needs more
+  // than every unit, 0 otherwise.
   int saturation() const { return saturation_; }
   double estimated_working() const { return estimated_working_; }
   // Whether the last Step's broadcast explored (ControllerParams::exploration).

@@ -72,6 +72,9 @@ JointHolding HoldJoint(const Plant& plant, int j, const Eigen::VectorXd& r,
   h.tensions = AllocateHolding(p, rows);
   h.stiffness = h.coef.dot(h.tensions);
   for (int i = 0; i < nb; ++i) h.torque += std::abs(arms(j, i) * h.tensions[i]);
+  h.static_torque = p.torque[j];
+  h.held_torque = arms.row(j).dot(h.tensions);
+  h.held_tolerance = 1e-3 * arms.row(j).cwiseAbs().dot(p.cap);
   return h;
 }
 

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cmath>
 #include <functional>
 #include <vector>
 
@@ -23,6 +24,12 @@ struct JointHolding {
   Eigen::VectorXd coef;
   double limb_stiffness = 0;  // N m/rad: d tau_static / dq, the limb's own
   Eigen::VectorXd tensions;   // N, per bundle: what holds the pose
+  double static_torque = 0;   // N m: the pose's static torque on the joint (what holds it)
+  // N m: the bundles' torque on the joint with `tensions`; short of static_torque (beyond
+  // held_tolerance) when the pose asks more than the bundles can give, every unit on.
+  double held_torque = 0;
+  double held_tolerance = 0;  // N m: 1e-3 of the joint's torque span, sum_i |A_ji| cap_i
+  bool holds() const { return std::abs(static_torque - held_torque) <= held_tolerance; }
   double total() const { return limb_stiffness + stiffness; }
 };
 

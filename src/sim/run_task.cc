@@ -531,6 +531,16 @@ void SummarizeJoints(const Task& task, const Plant& plant, const SignalMetrics& 
                     r.bundle_stiffness);
       s.warnings.push_back(buf);
     }
+    // A pose whose static torque is beyond the bundles: the loop gets as near as they go.
+    if (!r.holding.holds()) {
+      char buf[320];
+      std::snprintf(buf, sizeof buf,
+                    "joint '%s' at %.4g deg: the bundles cannot hold this pose (its static torque "
+                    "%.3g N m, theirs at most %.3g N m with every unit that helps on)",
+                    r.joint.c_str(), r.reference * 180 / M_PI, r.holding.static_torque,
+                    r.holding.held_torque);
+      s.warnings.push_back(buf);
+    }
   }
   if (plant.num_joints() < 2) return;  // the one joint's metrics are already the run's
   RunMetrics& mt = s.metrics;

@@ -29,7 +29,10 @@ class FixedEstimator final : public OnCountEstimator {
   Eigen::VectorXd StateEstimate() const override { return Eigen::VectorXd::Zero(1); }
   std::vector<std::string> StateNames() const override { return {"x"}; }
   std::vector<bool> OnStates() const override { return {true}; }
-  std::optional<FailureEstimate> Failures() const override { return f; }
+  std::optional<FailureEstimate> Failures() const override {
+    return counts_failures ? std::optional<FailureEstimate>(f) : std::nullopt;
+  }
+  bool counts_failures = true;   // false: an estimator that does not count failed units
   FailureEstimate f;             // what Failures() answers (a test may change it between steps)
   std::vector<double> measured;  // the forces it was given
 
@@ -64,6 +67,24 @@ TEST(FailureAwareLaw, ActsOnTheWorkingUnitsAndCountsTheStuckOnes) {
   b = c.Step(1.0, 0);
   EXPECT_EQ(c.saturation(), -1);
   EXPECT_DOUBLE_EQ(b.p_off, 0.2);
+}
+
+// Without failure counts every unit works: a reference that needs more than all of them is
+// out of reach (+1), one they can give is not; never -1 (no stuck units).
+TEST(FailureAwareLaw, WithoutFailuresAReferenceBeyondEveryUnitIsOutOfReach) {
+  ControllerParams p;
+  p.num_units = 60;
+  p.unit_force = 0.5;
+  p.lambda = 0.2;
+  auto est = std::make_unique<FixedEstimator>(20, FailureEstimate{});
+  est->counts_failures = false;
+  RecruitmentController c = RecruitmentController::Create(p, std::move(est)).value();
+  c.Step(29.9, 0);  // 59.8 units
+  EXPECT_EQ(c.saturation(), 0);
+  c.Step(30.1, 0);  // 60.2 units
+  EXPECT_EQ(c.saturation(), 1);
+  c.Step(0.0, 0);
+  EXPECT_EQ(c.saturation(), 0);
 }
 
 // Exploration: a declaration starts `instants` instants of the exploration broadcast, then none

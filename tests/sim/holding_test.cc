@@ -161,5 +161,47 @@ TEST(Holding, StiffnessIsMinusTheTorqueSlopeAtHeldCounts) {
   EXPECT_GT(geometric, 0.01);
 }
 
+// A pose is held when the bundles can meet its static torque: with the units' own forces every
+// pose is; with every unit's force scaled down until all the units of the bundle that helps
+// give less than the static torque, none is, and the torque they reach is that bundle's every
+// unit on (its capacity times its arm) less the antagonist's co-contraction floor.
+TEST(Holding, APoseBeyondTheBundlesIsNotHeld) {
+  int tested = 0;
+  for (const Case& c : Cases()) {
+    const auto& plant = c.plant;
+    const std::vector<UnitForce> f = PhysicsUnitForces(*plant);
+    for (double deg : c.deg) {
+      const Eigen::VectorXd r = At(deg);
+      const JointHolding hold = HoldJoint(*plant, 0, r, f, 0.05, Eigen::VectorXd());
+      EXPECT_TRUE(hold.holds()) << deg;
+      EXPECT_DOUBLE_EQ(hold.static_torque, plant->StaticTorque(r)[0]);
+      // Scaled so that the helping bundle's capacity is half the static torque.
+      const Eigen::MatrixXd arms = plant->MomentArmsAt(r);
+      const Eigen::VectorXd lengths = plant->UnitLengthsAt(r);
+      const double tau = hold.static_torque;
+      if (std::abs(tau) < 1e-6) continue;
+      int helper = -1;
+      for (int i = 0; i < plant->num_bundles(); ++i) {
+        if (arms(0, i) * tau > 0) helper = i;
+      }
+      ASSERT_GE(helper, 0);
+      const double cap = plant->num_units(helper) * f[helper](lengths[helper]);
+      const double scale = 0.5 * std::abs(tau) / (cap * std::abs(arms(0, helper)));
+      std::vector<UnitForce> weak;
+      for (const UnitForce& g : f) weak.push_back([g, scale](double L) { return scale * g(L); });
+      const JointHolding short_of = HoldJoint(*plant, 0, r, weak, 0.05, Eigen::VectorXd());
+      EXPECT_FALSE(short_of.holds()) << deg;
+      double reach = 0;
+      for (int i = 0; i < plant->num_bundles(); ++i) {
+        const double cap_i = plant->num_units(i) * weak[i](lengths[i]);
+        reach += arms(0, i) * (i == helper ? cap_i : 0.05 * cap_i);
+      }
+      EXPECT_NEAR(short_of.held_torque, reach, 1e-6 * std::abs(tau)) << deg;
+      ++tested;
+    }
+  }
+  EXPECT_GE(tested, 4);  // poses with a static torque on both limbs
+}
+
 }  // namespace file_holding_test
 }  // namespace recruit::sim
