@@ -134,7 +134,7 @@ same names
 (`recruit attach --help`, docs/sma-units.md "Sizing a bundle").
 
 Returns the report as a dict (what `--report` writes: model, output, task, changes, warnings,
-lengthranges_from_joints, lengthranges_without_locks, joints, bundles). Raises ValueError for bad input and OSError when a file
+lengthranges_from_joints, lengthranges_without_locks, joints, holdable, bundles). Raises ValueError for bad input and OSError when a file
 cannot be read or written, with the CLI's message; nothing is written on error.
 docs/howto-own-model.md has the guide. The GIL is released meanwhile.)doc");
 }

@@ -314,6 +314,10 @@ Result<AttachReport> Attach(const AttachOptions& o) {
     if (!xml.ok()) return Error{xml.error(), xml.code()};
     report.changes = ChangeLines(report, s);
     if (!o.task.empty()) {
+      for (const JointUse& j : DrivenJoints(report, o.lock)) {
+        report.holdable.push_back({j.joint, j.usable_lo, j.usable_hi});
+      }
+      FindHoldableRanges(compiled->get(), report.bundles, kStarterCoContraction, report.holdable);
       auto task = StarterTask(report, o.lock, o.task);
       if (!task.ok()) return Error{task.error(), task.code()};
       report.task = o.task;

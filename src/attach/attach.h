@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "attach/damper.h"
+#include "attach/holdable.h"
 #include "attach/holding_load.h"
 #include "attach/joint_lock.h"
 #include "attach/lengthrange.h"
@@ -64,6 +65,9 @@ struct AttachReport {
   std::vector<JointLock> locks;
   // The joints the bundles move (not locked), with the damping their dampers give them.
   std::vector<DampedJoint> damped_joints;
+  // The starter task's driven joints: the part of each usable range the bundles hold
+  // (attach/holdable.h; with --task only).
+  std::vector<HoldableRange> holdable;
   std::vector<std::string> changes;  // one line per edit
   std::vector<std::string> warnings;
 };

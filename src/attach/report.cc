@@ -109,6 +109,13 @@ std::string DesignTable(const AttachReport& r) {
          " N m s/rad (ratio " + F("%.3g", j.ratio_before) + " -> " + F("%.3g", j.ratio_after) +
          ")\n";
   }
+  for (const HoldableRange& h : r.holdable) {
+    if (!h.cut()) continue;
+    t += "starter task: joint '" + h.joint + "' steps within " + F("%.4g", h.hold_lo * 180 / M_PI) +
+         ".." + F("%.4g", h.hold_hi * 180 / M_PI) + " deg of its usable " +
+         F("%.4g", h.lo * 180 / M_PI) + ".." + F("%.4g", h.hi * 180 / M_PI) +
+         " deg: beyond, the bundles cannot hold the limb's static torque\n";
+  }
   for (const std::string& w : r.warnings) t += "warning: " + w + "\n";
   return t;
 }
@@ -135,6 +142,11 @@ nlohmann::json ReportJson(const AttachReport& r) {
                            {"stiffness_at_rest", d.stiffness},
                            {"damping", {d.damping, d.damping_after}},
                            {"damping_ratio", {d.ratio_before, d.ratio_after}}});
+  }
+  j["holdable"] = nlohmann::json::array();
+  for (const HoldableRange& h : r.holdable) {
+    j["holdable"].push_back(
+        {{"joint", h.joint}, {"usable", {h.lo, h.hi}}, {"held", {h.hold_lo, h.hold_hi}}});
   }
   j["bundles"] = nlohmann::json::array();
   for (const BundleReport& b : r.bundles) {

@@ -16,10 +16,8 @@ double Round1(double v) { return std::round(10 * v) / 10; }
 
 }  // namespace
 
-Result<nlohmann::json> StarterTask(const AttachReport& report, const std::vector<std::string>& lock,
-                                   const std::string& task_path) {
-  // Driven joints: the hinges the bundles cross, in first-seen order, with the usable range
-  // common to every bundle that crosses them.
+std::vector<JointUse> DrivenJoints(const AttachReport& report,
+                                   const std::vector<std::string>& lock) {
   std::vector<JointUse> joints;
   for (const BundleReport& b : report.bundles) {
     for (const JointUse& u : b.joints) {
@@ -39,7 +37,18 @@ Result<nlohmann::json> StarterTask(const AttachReport& report, const std::vector
                                 [&](const JointUse& j) { return j.joint == l; }),
                  joints.end());
   }
+  return joints;
+}
+
+Result<nlohmann::json> StarterTask(const AttachReport& report, const std::vector<std::string>& lock,
+                                   const std::string& task_path) {
+  std::vector<JointUse> joints = DrivenJoints(report, lock);
   if (joints.empty()) return Error{"the starter task drives no joint (every one locked or none)"};
+  for (JointUse& j : joints) {  // steps where the bundles hold the limb
+    for (const HoldableRange& h : report.holdable) {
+      if (h.joint == j.joint) j.usable_lo = h.hold_lo, j.usable_hi = h.hold_hi;
+    }
+  }
   nlohmann::json task;
   const std::string stem = fs::path(report.output).stem().string();
   task["name"] = stem + "_steps";
@@ -78,6 +87,7 @@ Result<nlohmann::json> StarterTask(const AttachReport& report, const std::vector
   task["controller"] = {{"estimator", "kalman-augmented"}, {"dT", 1.0}, {"lambda", 0.2}};
   task["sensor"] = {{"noise_std", 0.05}, {"resolution", 0.0125}};
   task["outer_loop"] = "auto";
+  task["co_contraction"] = kStarterCoContraction;
   return task;
 }
 

@@ -23,6 +23,8 @@
 #include "plugin/sma_plugin.h"
 #include "plugin/tendon_range.h"
 #include "sim/csv_writer.h"
+#include "sim/holding.h"
+#include "sim/plant.h"
 #include "sim/run_task.h"
 #include "sim/task.h"
 #include "tests/plugin/mujoco_util.h"
@@ -776,6 +778,63 @@ TEST(StarterTask, RunsThroughTheSeveralJointLoop) {
   std::getline(in, header);
   EXPECT_EQ(header.rfind("time,reference,measured,angle,elbow.reference,elbow.angle,", 0), 0u)
       << header;
+  fs::remove_all(dir);
+}
+
+// MyoSuite's two-joint elbow, all six muscles: its shoulder is crossed by the biceps' and
+// triceps' long heads alone, which cannot hold the arm raised far. The starter task's steps stay
+// where the bundles hold the limb; checked with the run's own holding (sim::HoldJoint on the
+// written model through the plant, the units' own tension laws, the task's co-contraction): every
+// step pose is held, and the step the whole usable range would have asked (80 % of it) is not.
+TEST(StarterTask, StepsWhereTheBundlesHoldTheLimb) {
+  const std::string myo = MyoSimDir();
+  if (myo.empty()) GTEST_SKIP() << "myo_sim not installed (pip install myo-sim==0.2.3)";
+  const fs::path dir = fs::temp_directory_path() / "recruit_attach_holdable";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  AttachOptions o;
+  o.model = myo + "/models/legacy/elbow/myoelbow_2dof6muscles.xml";
+  o.muscles = {"all"};
+  o.output = (dir / "m.xml").string();
+  o.task = (dir / "task.json").string();
+  sma::RegisterSmaPlugin();
+  sma::testing::WarningCapture quiet;
+  auto r = Attach(o);
+  ASSERT_TRUE(r.ok()) << r.error();
+  ASSERT_EQ(r->holdable.size(), 2u);
+  EXPECT_TRUE(r->holdable[0].cut()) << r->holdable[0].joint;  // the shoulder
+  auto task = sim::Task::FromFile(o.task);
+  ASSERT_TRUE(task.ok()) << task.error();
+  auto plant = sim::Plant::Create(*task, false);
+  ASSERT_TRUE(plant.ok()) << plant.error();
+  sim::Plant& p = **plant;
+  p.Reset(1);
+  std::vector<sim::UnitForce> f;
+  for (int i = 0; i < p.num_bundles(); ++i) {
+    const int b = p.bundle_index(i);
+    const sma::UnitModel* unit = &p.host().bundle(b).unit();
+    const double pre = unit->params().prestretch, ref = p.host().unit_ref_length(b);
+    f.push_back([unit, pre, ref](double L) { return unit->Tension(0.0, pre + (L - ref)); });
+  }
+  const int nj = p.num_joints();
+  ASSERT_EQ(nj, 2);
+  std::vector<std::vector<sim::ReferenceStep>> steps;
+  for (int j = 0; j < nj; ++j) steps.push_back(task->joints[j].reference.Steps(task->duration));
+  ASSERT_EQ(steps[0].size(), 4u);
+  for (std::size_t k = 0; k < steps[0].size(); ++k) {
+    Eigen::VectorXd q(nj);
+    for (int j = 0; j < nj; ++j) q[j] = steps[j][k].to;
+    for (int j = 0; j < nj; ++j) {
+      const sim::JointHolding h = sim::HoldJoint(p, j, q, f, task->co_contraction, {});
+      EXPECT_TRUE(h.holds()) << "step " << k << " joint " << j << ": " << h.static_torque << " vs "
+                             << h.held_torque;
+    }
+  }
+  const HoldableRange& s = r->holdable[0];
+  Eigen::VectorXd q(nj);
+  q[0] = s.lo + 0.8 * (s.hi - s.lo);
+  q[1] = steps[1][3].to;
+  EXPECT_FALSE(sim::HoldJoint(p, 0, q, f, task->co_contraction, {}).holds());
   fs::remove_all(dir);
 }
 

@@ -1,0 +1,117 @@
+#include "attach/holdable.h"
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+
+#include "attach/attach.h"
+#include "control/torque_allocation.h"
+#include "plugin/unit_model.h"
+
+namespace recruit::attach {
+namespace {
+
+struct Bundle {
+  int tendon = -1;
+  double gear = 1, units = 0, prestretch = 0, ref_length = 0;
+  std::unique_ptr<sma::UnitModel> unit;
+};
+
+// Whether the bundles hold joint `j` (index into `dofs`) at the pose in d (positions set).
+bool Holds(const mjModel* m, mjData* d, const std::vector<int>& dofs, std::size_t j,
+           const std::vector<Bundle>& bundles, double co_contraction) {
+  mjModel* mm = const_cast<mjModel*>(m);
+  const int saved = mm->opt.disableflags;
+  mm->opt.disableflags |= mjDSBL_CONSTRAINT;  // a limit or lock would take part of the load
+  mju_zero(d->qvel, m->nv);
+  mju_zero(d->qacc, m->nv);
+  mj_inverse(m, d);
+  mm->opt.disableflags = saved;
+  const int nj = static_cast<int>(dofs.size()), nb = static_cast<int>(bundles.size());
+  control::AllocationProblem p;
+  p.arms = Eigen::MatrixXd::Zero(nj, nb);
+  p.torque.resize(nj);
+  p.cap.resize(nb);
+  p.floor.resize(nb);
+  for (int k = 0; k < nj; ++k) p.torque[k] = d->qfrc_inverse[dofs[k]];
+  for (int i = 0; i < nb; ++i) {
+    const Bundle& b = bundles[i];
+    const int t = b.tendon;
+    for (int a = m->ten_J_rowadr[t]; a < m->ten_J_rowadr[t] + m->ten_J_rownnz[t]; ++a) {
+      for (int k = 0; k < nj; ++k) {
+        if (m->ten_J_colind[a] == dofs[k]) p.arms(k, i) = -d->ten_J[a];  // pulling shortens
+      }
+    }
+    const double s = b.prestretch + b.gear * (d->ten_length[t] - b.ref_length);
+    p.cap[i] = std::max(b.gear * b.units * b.unit->Tension(0.0, s), 1e-9);
+    p.floor[i] = co_contraction * p.cap[i];
+  }
+  const Eigen::VectorXd tensions = control::AllocateTensions(p);
+  const double span = p.arms.row(j).cwiseAbs().dot(p.cap);
+  return std::abs((p.arms * tensions)[j] - p.torque[j]) <= 1e-3 * span;
+}
+
+}  // namespace
+
+void FindHoldableRanges(const mjModel* m, const std::vector<BundleReport>& bundles,
+                        double co_contraction, std::vector<HoldableRange>& ranges) {
+  std::vector<Bundle> bs;
+  for (const BundleReport& r : bundles) {
+    auto unit = sma::UnitModel::Create(r.design.unit);
+    if (!unit.ok()) continue;  // sizing made it: cannot happen
+    Bundle b;
+    b.tendon = r.tendon_id;
+    b.gear = r.design.gear;
+    b.units = r.design.units;
+    b.prestretch = r.design.unit.prestretch;
+    b.ref_length = r.ref_length;
+    b.unit = std::make_unique<sma::UnitModel>(std::move(unit).value());
+    bs.push_back(std::move(b));
+  }
+  std::vector<int> dofs, qadr;
+  for (HoldableRange& h : ranges) {
+    const int j = mj_name2id(m, mjOBJ_JOINT, h.joint.c_str());
+    dofs.push_back(j >= 0 ? m->jnt_dofadr[j] : -1);
+    qadr.push_back(j >= 0 ? m->jnt_qposadr[j] : -1);
+    h.hold_lo = h.lo;
+    h.hold_hi = h.hi;
+  }
+  if (std::find(dofs.begin(), dofs.end(), -1) != dofs.end() || bs.empty()) return;
+  std::unique_ptr<mjData, void (*)(mjData*)> d(mj_makeData(m), mj_deleteData);
+  for (std::size_t j = 0; j < ranges.size(); ++j) {
+    std::vector<bool> held(kHoldSamples);
+    std::vector<double> q(kHoldSamples);
+    for (int s = 0; s < kHoldSamples; ++s) {
+      mju_copy(d->qpos, m->qpos0, m->nq);
+      for (std::size_t k = 0; k < ranges.size(); ++k) {
+        d->qpos[qadr[k]] = 0.5 * (ranges[k].lo + ranges[k].hi);
+      }
+      q[s] = ranges[j].lo + (ranges[j].hi - ranges[j].lo) * s / (kHoldSamples - 1);
+      d->qpos[qadr[j]] = q[s];
+      held[s] = Holds(m, d.get(), dofs, j, bs, co_contraction);
+    }
+    // The run of held samples around the middle, else the longest.
+    const int mid = kHoldSamples / 2;
+    int best_lo = -1, best_hi = -1;
+    for (int s = 0; s < kHoldSamples;) {
+      if (!held[s]) {
+        ++s;
+        continue;
+      }
+      int e = s;
+      while (e + 1 < kHoldSamples && held[e + 1]) ++e;
+      const bool has_mid = s <= mid && mid <= e;
+      const bool best_has_mid = best_lo <= mid && mid <= best_hi && best_lo >= 0;
+      if (best_lo < 0 || (has_mid && !best_has_mid) ||
+          (has_mid == best_has_mid && e - s > best_hi - best_lo)) {
+        best_lo = s, best_hi = e;
+      }
+      s = e + 1;
+    }
+    if (best_lo < 0) continue;  // none held: the whole range (the run names its poses)
+    ranges[j].hold_lo = q[best_lo];
+    ranges[j].hold_hi = q[best_hi];
+  }
+}
+
+}  // namespace recruit::attach
