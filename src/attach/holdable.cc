@@ -18,15 +18,14 @@ struct Bundle {
 };
 
 // Whether the bundles hold joint `j` (index into `dofs`) at the pose in d (positions set).
-bool Holds(const mjModel* m, mjData* d, const std::vector<int>& dofs, std::size_t j,
+bool Holds(mjModel* m, mjData* d, const std::vector<int>& dofs, std::size_t j,
            const std::vector<Bundle>& bundles, double co_contraction) {
-  mjModel* mm = const_cast<mjModel*>(m);
-  const int saved = mm->opt.disableflags;
-  mm->opt.disableflags |= mjDSBL_CONSTRAINT;  // a limit or lock would take part of the load
+  const int saved = m->opt.disableflags;
+  m->opt.disableflags |= mjDSBL_CONSTRAINT;  // a limit or lock would take part of the load
   mju_zero(d->qvel, m->nv);
   mju_zero(d->qacc, m->nv);
   mj_inverse(m, d);
-  mm->opt.disableflags = saved;
+  m->opt.disableflags = saved;
   const int nj = static_cast<int>(dofs.size()), nb = static_cast<int>(bundles.size());
   control::AllocationProblem p;
   p.arms = Eigen::MatrixXd::Zero(nj, nb);
@@ -53,8 +52,8 @@ bool Holds(const mjModel* m, mjData* d, const std::vector<int>& dofs, std::size_
 
 }  // namespace
 
-void FindHoldableRanges(const mjModel* m, const std::vector<BundleReport>& bundles,
-                        double co_contraction, std::vector<HoldableRange>& ranges) {
+void FindHoldableRanges(mjModel* m, const std::vector<BundleReport>& bundles, double co_contraction,
+                        std::vector<HoldableRange>& ranges) {
   std::vector<Bundle> bs;
   for (const BundleReport& r : bundles) {
     auto unit = sma::UnitModel::Create(r.design.unit);

@@ -26,9 +26,10 @@ struct HoldableRange {
 // other joints of `ranges` at their middles and the rest at qpos0, and sets hold_lo/hold_hi to
 // the run of held samples that contains the middle (the longest run when the middle is not held;
 // the whole range when none is). `m` is the written model (the bundles with their designs in
-// `bundles`, by actuator name); `co_contraction` the floor as a fraction of capacity.
-void FindHoldableRanges(const mjModel* m, const std::vector<BundleReport>& bundles,
-                        double co_contraction, std::vector<HoldableRange>& ranges);
+// `bundles`, by actuator name; its constraints are disabled for each inverse dynamics call and
+// the flag restored); `co_contraction` the floor as a fraction of capacity.
+void FindHoldableRanges(mjModel* m, const std::vector<BundleReport>& bundles, double co_contraction,
+                        std::vector<HoldableRange>& ranges);
 
 inline constexpr int kHoldSamples = 41;
 
