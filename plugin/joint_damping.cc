@@ -2,14 +2,15 @@
 
 #include <algorithm>
 
+#include "plugin/tendon_range.h"
+
 namespace recruit::sma {
 namespace {
 
-// The squared entry of column `dof` in row r of a MuJoCo sparse matrix (0 when absent).
-double SquaredEntry(const int* rownnz, const int* rowadr, const int* colind, const mjtNum* values,
-                    int r, int dof) {
-  for (int k = rowadr[r]; k < rowadr[r] + rownnz[r]; ++k) {
-    if (colind[k] == dof) return values[k] * values[k];
+// Row r's entry in column `dof` of the actuators' sparse moment matrix in d (0 when absent).
+double Moment(const mjData* d, int r, int dof) {
+  for (int k = d->moment_rowadr[r]; k < d->moment_rowadr[r] + d->moment_rownnz[r]; ++k) {
+    if (d->moment_colind[k] == dof) return d->actuator_moment[k];
   }
   return 0;
 }
@@ -20,16 +21,16 @@ double JointDamping(const mjModel* m, const mjData* d, int dof, const std::vecto
   double b = m->dof_damping[dof];
   for (int t = 0; t < m->ntendon; ++t) {
     if (m->tendon_damping[t] == 0) continue;
-    b += m->tendon_damping[t] *
-         SquaredEntry(m->ten_J_rownnz, m->ten_J_rowadr, m->ten_J_colind, d->ten_J, t, dof);
+    const double arm = TendonArm(m, d, t, dof);
+    b += m->tendon_damping[t] * arm * arm;
   }
   for (int a = 0; a < m->nu; ++a) {
     if (m->actuator_damping[a] == 0 || std::find(skip.begin(), skip.end(), a) != skip.end()) {
       continue;
     }
     for (int r = m->actuator_outadr[a]; r < m->actuator_outadr[a] + m->actuator_outnum[a]; ++r) {
-      b += m->actuator_damping[a] * SquaredEntry(d->moment_rownnz, d->moment_rowadr,
-                                                 d->moment_colind, d->actuator_moment, r, dof);
+      const double arm = Moment(d, r, dof);
+      b += m->actuator_damping[a] * arm * arm;
     }
   }
   return b;

@@ -245,4 +245,12 @@ std::string JumpText(const mjModel* m, const TendonJump& jump) {
          " mm)";
 }
 
+double TendonArm(const mjModel* m, const mjData* d, int t, int dof) {
+  const int adr = m->ten_J_rowadr[t];
+  for (int k = 0; k < m->ten_J_rownnz[t]; ++k) {
+    if (m->ten_J_colind[adr + k] == dof) return d->ten_J[adr + k];
+  }
+  return 0;
+}
+
 }  // namespace recruit::sma

@@ -51,4 +51,8 @@ std::string JointRangeText(const mjModel* m, const std::vector<int>& joints,
 // "elbow at 114 deg (376.0 -> 211.0 mm)".
 std::string JumpText(const mjModel* m, const TendonJump& jump);
 
+// Tendon t's moment arm about degree of freedom `dof`, d(length)/d(qvel[dof]), from MuJoCo's
+// sparse tendon Jacobian in d (mj_tendon done); 0 when the tendon does not cross it.
+double TendonArm(const mjModel* m, const mjData* d, int t, int dof);
+
 }  // namespace recruit::sma

@@ -107,11 +107,7 @@ void ProbeArms(const mjModel* m, mjData* d, const std::vector<std::string>& name
     for (JointUse& u : b.joints) {
       const int j = mj_name2id(m, mjOBJ_JOINT, u.joint.c_str());
       if (j < 0) continue;
-      const int dof = m->jnt_dofadr[j];
-      const int t = b.tendon_id;
-      for (int k = m->ten_J_rowadr[t]; k < m->ten_J_rowadr[t] + m->ten_J_rownnz[t]; ++k) {
-        if (m->ten_J_colind[k] == dof) u.arm = d->ten_J[k];
-      }
+      u.arm = sma::TendonArm(m, d, b.tendon_id, m->jnt_dofadr[j]);
       const bool seen = std::any_of(joints->begin(), joints->end(),
                                     [&](const DampedJoint& x) { return x.joint == u.joint; });
       const bool held = std::find(locked.begin(), locked.end(), u.joint) != locked.end();

@@ -23,7 +23,7 @@ double RestTension(const SizingInput& in, const SizingLimits& limits) {
 
 double RestStiffness(const BundleDesign& d, const SizingInput& in, double rest_tension) {
   const double l_mid = 0.5 * (in.length_min + in.length_max);
-  const double stretch = d.unit.prestretch + d.gear * (l_mid - in.ref_length);
+  const double stretch = d.Stretch(l_mid, in.ref_length);
   return stretch > 0 ? rest_tension * d.gear / stretch : 0;
 }
 

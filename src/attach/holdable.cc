@@ -6,15 +6,15 @@
 
 #include "attach/attach.h"
 #include "control/torque_allocation.h"
+#include "plugin/tendon_range.h"
 #include "plugin/unit_model.h"
 
 namespace recruit::attach {
 namespace {
 
 struct Bundle {
-  int tendon = -1;
-  double gear = 1, units = 0, prestretch = 0, ref_length = 0;
-  std::unique_ptr<sma::UnitModel> unit;
+  const BundleReport* report = nullptr;
+  std::unique_ptr<sma::UnitModel> unit;  // its design's
 };
 
 // Whether the bundles hold joint `j` (index into `dofs`) at the pose in d (positions set).
@@ -34,15 +34,11 @@ bool Holds(mjModel* m, mjData* d, const std::vector<int>& dofs, std::size_t j,
   p.floor.resize(nb);
   for (int k = 0; k < nj; ++k) p.torque[k] = d->qfrc_inverse[dofs[k]];
   for (int i = 0; i < nb; ++i) {
-    const Bundle& b = bundles[i];
-    const int t = b.tendon;
-    for (int a = m->ten_J_rowadr[t]; a < m->ten_J_rowadr[t] + m->ten_J_rownnz[t]; ++a) {
-      for (int k = 0; k < nj; ++k) {
-        if (m->ten_J_colind[a] == dofs[k]) p.arms(k, i) = -d->ten_J[a];  // pulling shortens
-      }
-    }
-    const double s = b.prestretch + b.gear * (d->ten_length[t] - b.ref_length);
-    p.cap[i] = std::max(b.gear * b.units * b.unit->Tension(0.0, s), 1e-9);
+    const BundleReport& b = *bundles[i].report;
+    const BundleDesign& design = b.design;
+    for (int k = 0; k < nj; ++k) p.arms(k, i) = -sma::TendonArm(m, d, b.tendon_id, dofs[k]);
+    const double s = design.Stretch(d->ten_length[b.tendon_id], b.ref_length);
+    p.cap[i] = std::max(design.gear * design.units * bundles[i].unit->Tension(0.0, s), 1e-9);
     p.floor[i] = co_contraction * p.cap[i];
   }
   const Eigen::VectorXd tensions = control::AllocateTensions(p);
@@ -58,14 +54,7 @@ void FindHoldableRanges(mjModel* m, const std::vector<BundleReport>& bundles, do
   for (const BundleReport& r : bundles) {
     auto unit = sma::UnitModel::Create(r.design.unit);
     if (!unit.ok()) continue;  // sizing made it: cannot happen
-    Bundle b;
-    b.tendon = r.tendon_id;
-    b.gear = r.design.gear;
-    b.units = r.design.units;
-    b.prestretch = r.design.unit.prestretch;
-    b.ref_length = r.ref_length;
-    b.unit = std::make_unique<sma::UnitModel>(std::move(unit).value());
-    bs.push_back(std::move(b));
+    bs.push_back({&r, std::make_unique<sma::UnitModel>(std::move(unit).value())});
   }
   std::vector<int> dofs, qadr;
   for (HoldableRange& h : ranges) {
@@ -89,23 +78,17 @@ void FindHoldableRanges(mjModel* m, const std::vector<BundleReport>& bundles, do
       d->qpos[qadr[j]] = q[s];
       held[s] = Holds(m, d.get(), dofs, j, bs, co_contraction);
     }
-    // The run of held samples around the middle, else the longest.
-    const int mid = kHoldSamples / 2;
+    // The run of held samples around the middle, else the longest (the first of equals).
     int best_lo = -1, best_hi = -1;
-    for (int s = 0; s < kHoldSamples;) {
-      if (!held[s]) {
-        ++s;
-        continue;
-      }
+    for (int s = 0; s < kHoldSamples; ++s) {
+      if (!held[s] || (s > 0 && held[s - 1])) continue;  // s starts a run
       int e = s;
       while (e + 1 < kHoldSamples && held[e + 1]) ++e;
-      const bool has_mid = s <= mid && mid <= e;
-      const bool best_has_mid = best_lo <= mid && mid <= best_hi && best_lo >= 0;
-      if (best_lo < 0 || (has_mid && !best_has_mid) ||
-          (has_mid == best_has_mid && e - s > best_hi - best_lo)) {
+      if (s <= kHoldSamples / 2 && kHoldSamples / 2 <= e) {
         best_lo = s, best_hi = e;
+        break;
       }
-      s = e + 1;
+      if (best_lo < 0 || e - s > best_hi - best_lo) best_lo = s, best_hi = e;
     }
     if (best_lo < 0) continue;  // none held: the whole range (the run names its poses)
     ranges[j].hold_lo = q[best_lo];

@@ -3,20 +3,9 @@
 #include <algorithm>
 #include <cmath>
 
+#include "plugin/tendon_range.h"
+
 namespace recruit::attach {
-namespace {
-
-// d(length)/d(qvel[dof]) from MuJoCo's sparse tendon Jacobian (its row of the tendon).
-double TendonArm(const mjModel* m, const mjData* d, int tendon, int dof) {
-  const int adr = m->ten_J_rowadr[tendon];
-  for (int k = 0; k < m->ten_J_rownnz[tendon]; ++k) {
-    if (m->ten_J_colind[adr + k] == dof) return d->ten_J[adr + k];
-  }
-  return 0;
-}
-
-}  // namespace
-
 HoldingLoad SampleHoldingLoad(const mjModel* m, mjData* d, int tendon,
                               const std::vector<int>& joints, const std::vector<double>& lo,
                               const std::vector<double>& hi) {
@@ -32,7 +21,7 @@ HoldingLoad SampleHoldingLoad(const mjModel* m, mjData* d, int tendon,
       mj_fwdPosition(m, d);
       mj_fwdVelocity(m, d);  // qfrc_bias (gravity at rest) and qfrc_passive (springs)
       load.torque = std::max(load.torque, std::abs(d->qfrc_bias[dof] - d->qfrc_passive[dof]));
-      load.arm = std::max(load.arm, std::abs(TendonArm(m, d, tendon, dof)));
+      load.arm = std::max(load.arm, std::abs(sma::TendonArm(m, d, tendon, dof)));
     }
     if (load.force() > best.force()) best = load;
   }

@@ -231,7 +231,7 @@ Result<BundleDesign> SizeBundle(const SizingInput& in, const SizingLimits& limit
   auto u = sma::UnitModel::Create(out.unit);
   if (!u.ok()) return Error{where + u.error(), u.code()};
   const sma::UnitLimits datasheet = sma::UnitLimits::ForWire(out.unit.wire_diameter);
-  auto stretch = [&](double l) { return out.unit.prestretch + out.gear * (l - in.ref_length); };
+  auto stretch = [&](double l) { return out.Stretch(l, in.ref_length); };
   const double n = out.units;
   const double l_mid = 0.5 * (in.length_min + in.length_max);
   out.force_mid = out.gear * n * u->Tension(0.0, stretch(l_mid));

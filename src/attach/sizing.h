@@ -85,6 +85,12 @@ struct BundleDesign {
   // sees gear^2 times it). Set by the limb's damper design (attach/damper.h), 0 when none.
   double damper = 0;
 
+  // The units' extension (m) at tendon length L when the tendon is ref_length at qpos0 (the
+  // plugin's ref_length): prestretch + gear (L - ref_length).
+  double Stretch(double L, double ref_length) const {
+    return unit.prestretch + gear * (L - ref_length);
+  }
+
   // The plugin's config keys for this design (value strings).
   std::vector<std::pair<std::string, std::string>> ConfigPairs() const;
 };

@@ -733,18 +733,26 @@ TEST(Attach, MyoSuiteElbowAndFingerLoadFromTheirNewFolder) {
 namespace recruit::attach {
 namespace {
 
-// The starter task of an attached two-joint arm runs through the several-joint loop: both
-// joints scored, each step named by its joint, the CSV with the second joint's columns.
-TEST(StarterTask, RunsThroughTheSeveralJointLoop) {
-  const fs::path dir = fs::temp_directory_path() / "recruit_attach_run";
+// Every muscle of `model` attached into an empty temporary folder `name` (model m.xml, starter
+// task task.json), the plugin registered.
+AttachOptions AllWithTask(const std::string& model, const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / name;
   fs::remove_all(dir);
   fs::create_directories(dir);
   AttachOptions o;
-  o.model = kSrc + "/models/arm2j_muscle.xml";
+  o.model = model;
   o.muscles = {"all"};
-  o.output = (dir / "arm2j.xml").string();
+  o.output = (dir / "m.xml").string();
   o.task = (dir / "task.json").string();
   sma::RegisterSmaPlugin();
+  return o;
+}
+
+// The starter task of an attached two-joint arm runs through the several-joint loop: both
+// joints scored, each step named by its joint, the CSV with the second joint's columns.
+TEST(StarterTask, RunsThroughTheSeveralJointLoop) {
+  const AttachOptions o = AllWithTask(kSrc + "/models/arm2j_muscle.xml", "recruit_attach_run");
+  const fs::path dir = fs::path(o.output).parent_path();
   sma::testing::WarningCapture quiet;  // the fit check may warn: not into MUJOCO_LOG.TXT
   auto r = Attach(o);
   ASSERT_TRUE(r.ok()) << r.error();
@@ -789,15 +797,9 @@ TEST(StarterTask, RunsThroughTheSeveralJointLoop) {
 TEST(StarterTask, StepsWhereTheBundlesHoldTheLimb) {
   const std::string myo = MyoSimDir();
   if (myo.empty()) GTEST_SKIP() << "myo_sim not installed (pip install myo-sim==0.2.3)";
-  const fs::path dir = fs::temp_directory_path() / "recruit_attach_holdable";
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  AttachOptions o;
-  o.model = myo + "/models/legacy/elbow/myoelbow_2dof6muscles.xml";
-  o.muscles = {"all"};
-  o.output = (dir / "m.xml").string();
-  o.task = (dir / "task.json").string();
-  sma::RegisterSmaPlugin();
+  const AttachOptions o = AllWithTask(myo + "/models/legacy/elbow/myoelbow_2dof6muscles.xml",
+                                      "recruit_attach_holdable");
+  const fs::path dir = fs::path(o.output).parent_path();
   sma::testing::WarningCapture quiet;
   auto r = Attach(o);
   ASSERT_TRUE(r.ok()) << r.error();
