@@ -2,7 +2,7 @@
 """Runs tasks over seeds and dT values and prints, per task and dT, what issue 24 item 5 asks:
 the fraction of steps that settle, the worst overshoot, each bundle's mean NEES range and
 the least fraction of control instants its count estimate is within 3 units (or 5 % of N),
-warnings; and how the steps' overshoot spreads (mean, 90th percentile, steps above 20 %: the
+how many bundle-runs have a mean NEES outside [0.3, 2], warnings; and how the steps' overshoot spreads (mean, 90th percentile, steps above 20 %: the
 worst alone moves a lot from one seed to the next). Usage:
   eval_tasks.py [--recruit BIN] [--seeds 101-110] [--dT 1,0.5] [--override-auto] TASK.json...
 """
@@ -60,9 +60,12 @@ def main():
                     o = sorted(overshoots)
                     print(f"   steps: overshoot mean {statistics.mean(o):.3f} "
                           f"p90 {o[int(0.9 * len(o))]:.3f}, above 20 % {sum(x > 0.2 for x in o)}")
+                outside = total = 0
                 for b in nees:
                     v=[x for x in nees[b] if x is not None]; w=[x for x in within[b] if x is not None]
+                    outside += sum(not 0.3 <= x <= 2 for x in v); total += len(v)
                     if v: print(f"   {b}: NEES {min(v):.2f}..{max(v):.2f}, within max(3, 5 % N) min {min(w):.3f}")
+                if total: print(f"   bundle-runs with mean NEES outside [0.3, 2]: {outside} of {total}")
                 if warns: print("   warnings:", sorted(warns)[:5])
                 print("   per seed (settled, max os):", " ".join(f"{s}:{f:.2f}/{o:.2f}" for s, f, o in rows))
 
