@@ -8,8 +8,7 @@
 namespace recruit::sim {
 
 SignalMetrics::SignalMetrics(std::vector<ReferenceStep> steps, double band,
-                             std::vector<DisturbanceWindow> disturbances)
-    : band_(band) {
+                             std::vector<DisturbanceWindow> disturbances) {
   for (const ReferenceStep& s : steps) {
     const double size = std::abs(s.to - s.from);
     steps_.push_back({s, s.to > s.from ? 1.0 : -1.0, band * size});

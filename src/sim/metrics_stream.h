@@ -43,7 +43,6 @@ class SignalMetrics {
   // The indices of those whose window holds from_ (indices, so that a copy is right).
   std::vector<int> open_steps_, open_disturbances_;
   double from_ = 0, until_ = 0;  // empty until the first sample
-  double band_ = 0;
   long n_ = 0;
   double sq_ = 0, iae_ = 0, tv_r_ = 0, tv_y_ = 0;
   double prev_t_ = 0, prev_r_ = 0, prev_y_ = 0, prev_abs_ = 0;
