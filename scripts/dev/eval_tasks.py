@@ -2,8 +2,9 @@
 """Runs tasks over seeds and dT values and prints, per task and dT, what issue 24 item 5 asks:
 the fraction of steps that settle, the worst overshoot, each bundle's mean NEES range and
 the least fraction of control instants its count estimate is within 3 units (or 5 % of N),
-how many bundle-runs have a mean NEES outside [0.3, 2], warnings; and how the steps' overshoot spreads (mean, 90th percentile, steps above 20 %: the
-worst alone moves a lot from one seed to the next). Usage:
+how many bundle-runs have a mean NEES outside [0.3, 2], warnings; and how the steps' overshoot
+spreads (mean, 90th percentile, steps above 20 %: the worst alone moves a lot from one seed to
+the next). Usage:
   eval_tasks.py [--recruit BIN] [--seeds 101-110] [--dT 1,0.5] [--override-auto] TASK.json...
 """
 import argparse, json, os, statistics, subprocess, sys, tempfile
