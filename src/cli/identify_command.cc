@@ -72,8 +72,9 @@ void PrintFit(const recruit::identification::IdentificationResult& fit) {
       "R^2 %.4f)\n",
       fit.holdout.samples, fit.holdout.rmse, fit.holdout.r2, fit.two_state_holdout.rmse,
       fit.two_state_holdout.r2);
-  std::printf("R = %.4g N^2 + %.4g N^2 per unit in transit (constant R: %.4g N^2)\n", fit.noise.r0,
-              fit.noise.r_transit, fit.force_noise_var);
+  std::printf(
+      "R = %.4g N^2 + n %.4g N^2 + n^2 %.4g N^2, n units in transit (constant R: %.4g N^2)\n",
+      fit.noise.r0, fit.noise.r_transit, fit.noise.r_transit2, fit.force_noise_var);
 }
 
 // --log: the chain fitted to a recorded switching log (plant unknown: no length model).
@@ -92,8 +93,8 @@ Result<nlohmann::json> IdentifyFromLog(const IdentifyArgs& a, const std::string&
   // the plant unknown, no force law carries H to other lengths (that needs --bench).
   TransientChain c = fit->chain;
   c.force = c.force.cwiseMax(0.0);
-  const estimation::FilterModel model =
-      ToFilterModel(c, log->num_units, log->dT, fit->noise.r0, fit->noise.r_transit);
+  const estimation::FilterModel model = ToFilterModel(c, log->num_units, log->dT, fit->noise.r0,
+                                                      fit->noise.r_transit, fit->noise.r_transit2);
   if (Status s = model.Validate("identified model"); !s) return Error{s.error(), s.code()};
   nlohmann::json j = model.ToJson();
   j["identification"] = {{"command", command_line},
@@ -105,6 +106,7 @@ Result<nlohmann::json> IdentifyFromLog(const IdentifyArgs& a, const std::string&
                          {"two_state_holdout", MetricsJson(fit->two_state_holdout)},
                          {"R_N2", fit->noise.r0},
                          {"R_transit_N2", fit->noise.r_transit},
+                         {"R_transit2_N2", fit->noise.r_transit2},
                          {"R_constant_N2", fit->force_noise_var}};
   std::printf("identified %d-state model, N = %d, dT = %g s, from %s\n", c.num_states(),
               log->num_units, log->dT, a.log_in.c_str());

@@ -260,6 +260,7 @@ Result<std::unique_ptr<OnCountEstimator>> MakeEstimator(const EstimatorSpec& spe
     if (spec.force_noise_std > 0) {  // the user's noise replaces the model's, all of it
       model.R = Eigen::MatrixXd::Constant(1, 1, spec.force_noise_std * spec.force_noise_std);
       model.R_transit.resize(0, 0);
+      model.R_transit2.resize(0, 0);
     }
     const nlohmann::json ident = IdentificationOf((*parsed)->json);
     if (geometry) {

@@ -260,15 +260,19 @@ double FailureKalmanFilter::working_variance() const {
 
 double FailureKalmanFilter::OutputNoise() const {
   if (transit_.size() == 0) return R_(0, 0);
-  if (!augmented_) return R_(0, 0) + inner_.TransitCount() * model_.R_transit(0, 0);
-  // Working, open and stuck units alike are in transit while their wires heat or cool.
   double n = 0;
-  for (int b = 0; b < 3; ++b) {
-    for (int j = 0; j < m_; ++j) {
-      if (transit_[j] != 0.0 && x_[b * m_ + j] > 0.0) n += x_[b * m_ + j];
+  if (!augmented_) {
+    n = inner_.TransitCount();
+  } else {
+    // Working, open and stuck units alike are in transit while their wires heat or cool.
+    for (int b = 0; b < 3; ++b) {
+      for (int j = 0; j < m_; ++j) {
+        if (transit_[j] != 0.0 && x_[b * m_ + j] > 0.0) n += x_[b * m_ + j];
+      }
     }
   }
-  return R_(0, 0) + n * model_.R_transit(0, 0);
+  auto first = [](const Eigen::MatrixXd& t) { return t.size() > 0 ? t(0, 0) : 0.0; };
+  return R_(0, 0) + (n * first(model_.R_transit) + (n * n) * first(model_.R_transit2));
 }
 
 void FailureKalmanFilter::SetOutput(const Eigen::MatrixXd& H, const Eigen::MatrixXd& R) {

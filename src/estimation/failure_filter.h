@@ -194,8 +194,8 @@ class FailureKalmanFilter {
   // The augmented output row [c H, H, H, dy/dc] for the working-state row H.
   Eigen::RowVectorXd OutputRow(const Eigen::MatrixXd& H) const;
   double Predicted(const Eigen::MatrixXd& H) const;
-  // The force's noise variance at the present estimate: R + the units in transit times the
-  // model's R_transit (as the inner filter's), in whichever filter runs now.
+  // The force's noise variance at the present estimate: R + n R_transit + n^2 R_transit2, n the
+  // units in transit (as the inner filter's), in whichever filter runs now.
   double OutputNoise() const;
   void UpdateCore(double y, const Eigen::MatrixXd& H, double R);
   // The augmented time update with the transition in A_.

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <nlohmann/json.hpp>
 #include <set>
+#include <utility>
 
 #include "common/atomic_file.h"
 #include "common/json_fields.h"
@@ -30,28 +31,33 @@ Eigen::VectorXd FilterModel::TransitMask() const {
 
 namespace {
 
-// R_transit: empty (none) or r x r, finite, symmetric PSD; only with a broadcast transition,
-// whose interior defines the states in transit.
+// R_transit and R_transit2: each empty (none) or r x r, finite, symmetric PSD; only with a
+// broadcast transition, whose interior defines the states in transit.
 Status ValidateTransitNoise(const FilterModel& f, const std::string& where) {
-  const Eigen::MatrixXd& T = f.R_transit;
-  if (T.size() == 0) return Status::Ok();
-  const int r = f.num_outputs();
-  if (T.rows() != r || T.cols() != r) {
-    return Error{where + ".R_transit: must be " + std::to_string(r) + " x " + std::to_string(r) +
-                 " (as R), got " + std::to_string(T.rows()) + " x " + std::to_string(T.cols())};
-  }
-  if (!T.allFinite()) return Error{where + ".R_transit: entries must be finite"};
-  const double scale = 1.0 + T.cwiseAbs().maxCoeff();
-  if ((T - T.transpose()).cwiseAbs().maxCoeff() > 1e-12 * scale) {
-    return Error{where + ".R_transit: must be symmetric"};
-  }
-  if (Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(T).eigenvalues().minCoeff() < -1e-12 * scale) {
-    return Error{where + ".R_transit: must be positive semi-definite (a variance per unit >= 0)"};
-  }
-  if (f.has_transit_noise() && f.transition != TransitionSource::kBroadcast) {
-    return Error{where +
-                 ".R_transit: needs a \"broadcast\" transition (its interior says which states "
-                 "are in transit)"};
+  for (const auto& [name, T] :
+       {std::pair<const char*, const Eigen::MatrixXd*>{"R_transit", &f.R_transit},
+        {"R_transit2", &f.R_transit2}}) {
+    if (T->size() == 0) continue;
+    const int r = f.num_outputs();
+    const std::string w = where + "." + name;
+    if (T->rows() != r || T->cols() != r) {
+      return Error{w + ": must be " + std::to_string(r) + " x " + std::to_string(r) +
+                   " (as R), got " + std::to_string(T->rows()) + " x " + std::to_string(T->cols())};
+    }
+    if (!T->allFinite()) return Error{w + ": entries must be finite"};
+    const double scale = 1.0 + T->cwiseAbs().maxCoeff();
+    if ((*T - T->transpose()).cwiseAbs().maxCoeff() > 1e-12 * scale) {
+      return Error{w + ": must be symmetric"};
+    }
+    if (Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(*T).eigenvalues().minCoeff() <
+        -1e-12 * scale) {
+      return Error{w + ": must be positive semi-definite (a variance >= 0)"};
+    }
+    if (FilterModel::NonZero(*T) && f.transition != TransitionSource::kBroadcast) {
+      return Error{w +
+                   ": needs a \"broadcast\" transition (its interior says which states are in "
+                   "transit)"};
+    }
   }
   return Status::Ok();
 }
@@ -219,8 +225,8 @@ Result<FilterModel> FilterModel::FromJsonValue(const nlohmann::json& j, const st
   using namespace json_fields;
   if (!j.is_object()) return Error{where + ": must be a JSON object"};
   RECRUIT_TRY(CheckKeys(j,
-                        {"format", "version", "states", "N", "H", "R", "R_transit", "G", "Qw",
-                         "transition", "initial", "identification"},
+                        {"format", "version", "states", "N", "H", "R", "R_transit", "R_transit2",
+                         "G", "Qw", "transition", "initial", "identification"},
                         where));
   std::string format;
   RECRUIT_TRY(OneOf(j, "format", where, &format, false, {"recruit.filter_model"}));
@@ -237,6 +243,8 @@ Result<FilterModel> FilterModel::FromJsonValue(const nlohmann::json& j, const st
   RECRUIT_TRY(Matrix(j, "R", where, &f.R, true, r, r));
   f.R_transit = Eigen::MatrixXd::Zero(r, r);
   RECRUIT_TRY(Matrix(j, "R_transit", where, &f.R_transit, false, r, r));
+  f.R_transit2 = Eigen::MatrixXd::Zero(r, r);
+  RECRUIT_TRY(Matrix(j, "R_transit2", where, &f.R_transit2, false, r, r));
   if (j.contains("G") != j.contains("Qw")) {
     return Error{where + ": missing field '" + (j.contains("G") ? "Qw" : "G") +
                  "' (G and Qw come together; neither: no process noise)"};
@@ -280,7 +288,8 @@ nlohmann::json FilterModel::ToJson() const {
   j["N"] = N;
   j["H"] = json_io::WriteMatrix(H);
   j["R"] = json_io::WriteMatrix(R);
-  if (has_transit_noise()) j["R_transit"] = json_io::WriteMatrix(R_transit);
+  if (NonZero(R_transit)) j["R_transit"] = json_io::WriteMatrix(R_transit);
+  if (NonZero(R_transit2)) j["R_transit2"] = json_io::WriteMatrix(R_transit2);
   if (G.cols() > 0) {
     j["G"] = json_io::WriteMatrix(G);
     j["Qw"] = json_io::WriteMatrix(Qw);
@@ -308,9 +317,9 @@ void WriteReadable(const nlohmann::json& v, int indent, std::string& out) {
   const std::string pad(indent, ' ');
   if (v.is_object()) {
     static const std::vector<std::string> order = {
-        "format",     "version", "states",     "N",       "H",     "R",        "R_transit",
-        "G",          "Qw",      "type",       "dt",      "is_on", "interior", "on_target",
-        "off_target", "A",       "transition", "initial", "x0",    "P0"};
+        "format",     "version",    "states", "N",          "H",       "R",     "R_transit",
+        "R_transit2", "G",          "Qw",     "type",       "dt",      "is_on", "interior",
+        "on_target",  "off_target", "A",      "transition", "initial", "x0",    "P0"};
     std::vector<std::string> keys;
     for (const auto& k : order) {
       if (v.contains(k)) keys.push_back(k);
@@ -354,6 +363,7 @@ FilterModel FilterModel::TwoState(int64_t N, double dt, double unit_force, doubl
   f.H << 0.0, unit_force;
   f.R = Eigen::MatrixXd::Constant(1, 1, noise_std * noise_std);
   f.R_transit = Eigen::MatrixXd::Zero(1, 1);
+  f.R_transit2 = Eigen::MatrixXd::Zero(1, 1);
   f.G = Eigen::MatrixXd::Zero(2, 0);
   f.Qw = Eigen::MatrixXd::Zero(0, 0);
   f.transition = TransitionSource::kBroadcast;

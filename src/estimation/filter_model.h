@@ -27,9 +27,12 @@ struct FilterModel {
   int64_t N = 0;                         // agents (units), >= 1
   Eigen::MatrixXd H;                     // r x m output matrix, y = H X + v (eq. 12)
   Eigen::MatrixXd R;                     // r x r measurement noise covariance, SPD
-  // r x r, symmetric PSD (default 0): the measurement noise each unit in transit adds, so that
-  // the covariance at a predicted state x is R + TransitCount(x) R_transit (kBroadcast only).
+  // r x r, symmetric PSD (default 0): the measurement noise the units in transit add, so that
+  // the covariance at a predicted state x is R + n R_transit + n^2 R_transit2, n = TransitCount(x)
+  // (kBroadcast only). R_transit: independent errors per unit; R_transit2: an error the units in
+  // transit share (units switched together follow one deterministic transient).
   Eigen::MatrixXd R_transit;
+  Eigen::MatrixXd R_transit2;
   Eigen::MatrixXd G;   // m x q process noise input (q may be 0)
   Eigen::MatrixXd Qw;  // q x q process noise covariance, PSD
   TransitionSource transition = TransitionSource::kBroadcast;
@@ -45,8 +48,8 @@ struct FilterModel {
   int num_outputs() const { return static_cast<int>(H.rows()); }
   // G Qw G^T (m x m); zero when q = 0.
   Eigen::MatrixXd ProcessNoise() const;
-  // True when R_transit is not all zero (the measurement noise depends on the state).
-  bool has_transit_noise() const { return R_transit.size() > 0 && (R_transit.array() != 0).any(); }
+  // True when R_transit or R_transit2 is not all zero (the measurement noise depends on the state).
+  bool has_transit_noise() const { return NonZero(R_transit) || NonZero(R_transit2); }
   // 1 for the states a unit leaves without being switched (interior(j, j) < 1 in the broadcast
   // model: the heating and cooling transients), 0 for the others (the settled states); all 0
   // for other transition sources.
@@ -55,6 +58,8 @@ struct FilterModel {
   // Checks every field and the relations between them; `where` (the file) prefixes messages.
   // G Qw G^T must have zero column sums: process noise cannot change the total N.
   Status Validate(const std::string& where = "filter model") const;
+
+  static bool NonZero(const Eigen::MatrixXd& m) { return m.size() > 0 && (m.array() != 0).any(); }
 
   // The same units and sensor for a population of N agents: x0 and P0 are rescaled by N'/N.
   FilterModel WithPopulation(int64_t N_new) const;

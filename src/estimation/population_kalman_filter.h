@@ -123,8 +123,8 @@ class PopulationKalmanFilterT {
   static constexpr int kAvxMinStates = 8;
   void set_avx_kernels(bool on) { avx_ = on && kf_detail::CpuHasAvx(); }
   // Measurement update with y(t) (eqs. 15, 17, 19, 20 in Joseph form). The measurement noise
-  // is R + TransitCount() R_transit (the model's R_transit; R alone when it has none), evaluated
-  // at the predicted estimate.
+  // is R + n R_transit + n^2 R_transit2, n = TransitCount() (the model's; R alone when it has
+  // neither), evaluated at the predicted estimate.
   void Update(const OutVec& y);
   // The expected number of units in transit at the current estimate: the sum of max(0, x_j)
   // over the states of FilterModel::TransitMask, in state order (0 without R_transit).
@@ -198,8 +198,9 @@ class PopulationKalmanFilterT {
   double N_ = 0.0;
   OutputMat H_;
   OutMat R_;
-  OutMat R_transit_;  // per unit in transit (has_transit_noise_ only)
-  Vec transit_mask_;  // FilterModel::TransitMask
+  OutMat R_transit_;   // per unit in transit (has_transit_noise_ only)
+  OutMat R_transit2_;  // per squared count of units in transit (has_transit_noise_ only)
+  Vec transit_mask_;   // FilterModel::TransitMask
   bool has_transit_noise_ = false;
   Mat GQG_;  // G Qw G^T, precomputed
   bool has_process_noise_ = false;
@@ -338,7 +339,11 @@ Result<PopulationKalmanFilterT<M, R>> PopulationKalmanFilterT<M, R>::Create(
   f.H_ = model.H;
   f.R_ = model.R;
   f.has_transit_noise_ = model.has_transit_noise();
-  f.R_transit_ = f.has_transit_noise_ ? OutMat(model.R_transit) : OutMat::Zero(r, r);
+  auto or_zero = [r](const Eigen::MatrixXd& t) {
+    return t.size() > 0 ? OutMat(t) : OutMat(OutMat::Zero(r, r));
+  };
+  f.R_transit_ = f.has_transit_noise_ ? or_zero(model.R_transit) : OutMat::Zero(r, r);
+  f.R_transit2_ = f.has_transit_noise_ ? or_zero(model.R_transit2) : OutMat::Zero(r, r);
   f.transit_mask_ = model.TransitMask();
   f.GQG_ = model.ProcessNoise();
   f.has_process_noise_ = model.G.cols() > 0;
@@ -577,7 +582,10 @@ void PopulationKalmanFilterT<M, R>::UpdateScalarWith(double y) {
   // matrix-vector kernel, whose set-up dominates at these sizes). H is 1 x m: h is contiguous.
   Kernels::template MatVec<M>(u.data(), P_.data(), m, iota_.data(), H_.data());
   double noise = R_(0, 0);
-  if (has_transit_noise_) noise += TransitCount() * R_transit_(0, 0);
+  if (has_transit_noise_) {
+    const double n = TransitCount();
+    noise += n * R_transit_(0, 0) + (n * n) * R_transit2_(0, 0);
+  }
   const double s = h.dot(u) + noise;
   S_(0, 0) = s;
   k = u / s;
@@ -601,7 +609,10 @@ void PopulationKalmanFilterT<M, R>::Update(const OutVec& y) {
   }
   U_.noalias() = P_ * H_.transpose();  // P H^T
   S_ = R_;
-  if (has_transit_noise_) S_ += TransitCount() * R_transit_;
+  if (has_transit_noise_) {
+    const double n = TransitCount();
+    S_ += n * R_transit_ + (n * n) * R_transit2_;
+  }
   S_.noalias() += H_ * U_;  // H P H^T + R
   llt_.compute(S_);
   Kt_ = U_.transpose();

@@ -24,9 +24,9 @@ struct BundleConstants {
   double N = 0, lambda = 0, unit_force = 0;
   bool length_aware = false;
   double prestretch = 0, ref_length = 0, on_k = 0, on_c = 0;
-  std::vector<int> ptr, col, target, is_on, transit;  // transit: empty when R_transit = 0
+  std::vector<int> ptr, col, target, is_on, transit;  // transit: empty without transit noise
   std::vector<double> base, k, c, h, x0, P0, gqg;     // P0, gqg packed; empty = none
-  double R = 0, relative_noise = 0, R_transit = 0;
+  double R = 0, relative_noise = 0, R_transit = 0, R_transit2 = 0;
 };
 
 // The unit's stiffness at fraction xi: sma::UnitModel's arithmetic (wire in series with the
@@ -120,7 +120,9 @@ Result<BundleConstants> Constants(const sim::BundleController& bc, const std::st
   out.R = model.R(0, 0);
   out.relative_noise = k->relative_noise();
   if (model.has_transit_noise()) {
-    out.R_transit = model.R_transit(0, 0);
+    auto first = [](const Eigen::MatrixXd& t) { return t.size() > 0 ? t(0, 0) : 0.0; };
+    out.R_transit = first(model.R_transit);
+    out.R_transit2 = first(model.R_transit2);
     const Eigen::VectorXd mask = model.TransitMask();
     for (int i = 0; i < out.m; ++i) out.transit.push_back(mask[i] != 0.0 ? 1 : 0);
   }
@@ -178,7 +180,8 @@ std::string BundleBlock(const BundleConstants& b, int i, const Writer& w) {
     s += field("h", n + "h") + field("R", w.Num(b.R)) +
          field("relative_noise", w.Num(b.relative_noise)) + field("x0", n + "x0");
     if (!b.transit.empty()) {
-      s += field("R_transit", w.Num(b.R_transit)) + field("transit", n + "transit");
+      s += field("R_transit", w.Num(b.R_transit)) + field("R_transit2", w.Num(b.R_transit2)) +
+           field("transit", n + "transit");
     }
     if (!b.P0.empty()) s += field("P0", n + "P0");
     if (!b.gqg.empty()) s += field("gqg", n + "gqg");

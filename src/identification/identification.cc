@@ -266,8 +266,7 @@ double NoiseNegLogLikelihood(const TransientChain& c, const SwitchingLog& log, i
   const Eigen::MatrixXd I = Eigen::MatrixXd::Identity(m, m);
   double nll = 0;
   for (int k = 0; k < rows; ++k) {
-    double R = noise.r0;
-    if (noise.r_transit != 0) R += noise.r_transit * mask.dot(x.cwiseMax(0.0));
+    const double R = noise.At(mask.dot(x.cwiseMax(0.0)));
     const Eigen::VectorXd ph = P * h;
     const double S = h.dot(ph) + R;
     const double nu = log.force[k] - h.dot(x);
@@ -397,13 +396,14 @@ NoiseModel SettledNoiseModel(const TransientChain& c, const SwitchingLog& log, i
   const double r0 = std::clamp(sd * sd, lo, hi);
   const double transit = (MeanTrajectory(c, log, rows) * TransitMask(c)).mean();
   if (!(transit > 1e-9)) return {r0, 0.0};
-  // r_transit from 1e-6 of the floor per unit (below that its term is nothing) to the whole
-  // force variance spread over the mean units in transit.
-  auto nll = [&](double log_rt) {
-    return NoiseNegLogLikelihood(c, log, rows, {r0, std::exp(log_rt)});
+  // r_transit2 from 1e-6 of the floor over the mean units in transit (below that its term is
+  // nothing) to the whole force variance over their square.
+  auto nll = [&](double log_rt2) {
+    return NoiseNegLogLikelihood(c, log, rows, {r0, 0.0, std::exp(log_rt2)});
   };
-  const double rt = std::exp(GoldenMinimum(nll, std::log(lo * 1e-6), std::log(hi / transit), 1e-3));
-  return {r0, rt};
+  const double rt2 = std::exp(
+      GoldenMinimum(nll, std::log(lo * 1e-6 / transit), std::log(hi / (transit * transit)), 1e-3));
+  return {r0, 0.0, rt2};
 }
 
 namespace {

@@ -49,12 +49,15 @@ struct FitMetrics {
   double r2 = 0;    // 1 - SS_res / SS_tot
 };
 
-// The measurement noise model R(x) = r0 + r_transit TransitCount(x), TransitCount(x) the sum of
-// max(0, x_j) over the states a unit leaves without being switched (TransitMask), x the
-// filter's predicted counts.
+// The measurement noise model R(x) = r0 + r_transit n + r_transit2 n^2, n = TransitCount(x) the
+// sum of max(0, x_j) over the states a unit leaves without being switched (TransitMask), x the
+// filter's predicted counts. r_transit: errors independent from unit to unit; r_transit2: an
+// error the units in transit share (docs/identification.md, "Noise in transit").
 struct NoiseModel {
-  double r0 = 0;         // N^2
-  double r_transit = 0;  // N^2 per unit in transit
+  double r0 = 0;          // N^2
+  double r_transit = 0;   // N^2 per unit in transit
+  double r_transit2 = 0;  // N^2 per squared count of units in transit
+  double At(double n) const { return r0 + (r_transit * n + r_transit2 * (n * n)); }
 };
 
 struct IdentificationResult {
@@ -86,7 +89,7 @@ Eigen::VectorXd TransitMask(const TransientChain& chain);
 
 // Negative log-likelihood (up to constants, sum of log S_k + nu_k^2 / S_k) of
 // log.force[0, rows) under the population Kalman filter on `chain` (extended covariance) with
-// R(x^-) = noise.r0 + noise.r_transit TransitCount(x^-).
+// R(x^-) = noise.At(TransitCount(x^-)).
 double NoiseNegLogLikelihood(const TransientChain& chain, const SwitchingLog& log, int rows,
                              const NoiseModel& noise);
 
@@ -105,12 +108,12 @@ std::vector<int> ForceSettledSamples(const TransientChain& chain, const Switchin
 
 // R(x) for a log with realized switching fractions (the bench's): r0 the square of a robust
 // scale (1.4826 MAD) of the mean prediction's residual over the force-settled samples (at least
-// `lo`), r_transit by
-// maximum likelihood with r0 fixed (golden section on log r_transit). A joint likelihood over
-// (r0, r_transit) puts the transit's error into r0 when units are almost always in transit
-// (a random excitation), and the filter then doubts its holds. Falls back to
-// MaxLikelihoodNoiseModel without realized fractions (the residual would hold the broadcasts'
-// binomial spread) or with fewer than 20 settled samples.
+// `lo`), r_transit2 by maximum likelihood with r0 fixed (golden section on log r_transit2;
+// r_transit 0: the transit's error is shared by the units that switch together). A joint likelihood
+// over (r0, r_transit) puts the transit's error into r0 when units are almost always in transit (a
+// random excitation), and the filter then doubts its holds. Falls back to MaxLikelihoodNoiseModel
+// without realized fractions (the residual would hold the broadcasts' binomial spread) or with
+// fewer than 20 settled samples.
 NoiseModel SettledNoiseModel(const TransientChain& chain, const SwitchingLog& log, int rows,
                              double constant, double lo, double hi);
 

@@ -3,7 +3,8 @@
 namespace recruit::identification {
 
 estimation::FilterModel ToFilterModel(const TransientChain& chain, std::int64_t num_units,
-                                      double dT, double force_noise_var, double transit_noise_var) {
+                                      double dT, double force_noise_var, double transit_noise_var,
+                                      double transit2_noise_var) {
   const int m = chain.num_states();
   estimation::FilterModel f;
   f.state_names = chain.StateNames();
@@ -11,6 +12,7 @@ estimation::FilterModel ToFilterModel(const TransientChain& chain, std::int64_t 
   f.H = chain.force.transpose();
   f.R = Eigen::MatrixXd::Constant(1, 1, force_noise_var);
   f.R_transit = Eigen::MatrixXd::Constant(1, 1, transit_noise_var);
+  f.R_transit2 = Eigen::MatrixXd::Constant(1, 1, transit2_noise_var);
   f.G = Eigen::MatrixXd::Zero(m, 0);
   f.Qw = Eigen::MatrixXd::Zero(0, 0);
   f.transition = estimation::TransitionSource::kBroadcast;

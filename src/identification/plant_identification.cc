@@ -215,8 +215,8 @@ Result<PlantIdentification> IdentifyOnPlant(const std::string& model_path,
     out.fit.noise = FitNoiseModel(exported, rec->log, train, fit->force_noise_var, fo);
   }
   const NoiseModel& noise = out.fit.noise;
-  const estimation::FilterModel model =
-      ToFilterModel(exported, rec->log.num_units, rec->log.dT, noise.r0, noise.r_transit);
+  const estimation::FilterModel model = ToFilterModel(exported, rec->log.num_units, rec->log.dT,
+                                                      noise.r0, noise.r_transit, noise.r_transit2);
   if (Status s = model.Validate("identified model"); !s) return Error{s.error(), s.code()};
   const Eigen::VectorXd& xi = map->fractions();
   nlohmann::json j = model.ToJson();
@@ -241,6 +241,7 @@ Result<PlantIdentification> IdentifyOnPlant(const std::string& model_path,
       {"length_checks", checks},
       {"R_N2", noise.r0},
       {"R_transit_N2", noise.r_transit},
+      {"R_transit2_N2", noise.r_transit2},
       {"R_constant_N2", fit->force_noise_var},
       {"plant", rec->plant}};
   out.model = std::move(j);

@@ -83,6 +83,16 @@ TEST(EstimationFilterModel, SaveAndLoadRoundTrip) {
   ASSERT_TRUE(t.ok()) << t.error();
   EXPECT_EQ(t->R_transit, f.R_transit);
   EXPECT_TRUE(t->has_transit_noise());
+  EXPECT_FALSE(t->ToJson().contains("R_transit2"));
+  // The shared term alone: written, read back, and transit noise all the same.
+  f.R_transit(0, 0) = 0;
+  f.R_transit2 = Eigen::MatrixXd::Constant(1, 1, 0.0625);
+  ASSERT_TRUE(f.Save(path).ok());
+  auto u = estimation::FilterModel::FromJson(path);
+  ASSERT_TRUE(u.ok()) << u.error();
+  EXPECT_EQ(u->R_transit2, f.R_transit2);
+  EXPECT_TRUE(u->has_transit_noise());
+  EXPECT_FALSE(u->ToJson().contains("R_transit"));
   std::remove(path.c_str());
 }
 
@@ -119,8 +129,8 @@ TEST(EstimationFilterModel, ClearErrorsForBadFields) {
   const std::vector<Case> cases = {
       // an unknown key, at the top and inside an object
       {"/Hx", 1,
-       "m.json: unknown field 'Hx'; allowed: G, H, N, Qw, R, R_transit, format, identification, "
-       "initial, states, transition, version"},
+       "m.json: unknown field 'Hx'; allowed: G, H, N, Qw, R, R_transit, R_transit2, format, "
+       "identification, initial, states, transition, version"},
       {"/transition/A", parse("[[1, 0], [0, 1]]"),
        "m.json.transition: unknown field 'A'; allowed: dt, interior, is_on, off_target, "
        "on_target, type"},
@@ -162,6 +172,9 @@ TEST(EstimationFilterModel, ClearErrorsForBadFields) {
       {"/R_transit", parse("[[1, 0]]"),
        "m.json.R_transit[0]: must be an array of 1 numbers (row 0 of a 1 x 1 matrix)"},
       {"/R_transit", "0.5", "m.json.R_transit: must be an array of rows"},
+      {"/R_transit2", parse("[[-0.5]]"), "m.json.R_transit2: must be positive semi-definite"},
+      {"/R_transit2", parse(R"([["x"]])"),
+       "m.json.R_transit2[0][0]: must be a finite number, got \"x\""},
       {"/initial", parse(R"({"x0": [50, 9]})"),
        "m.json.initial.x0: must sum to N = 60, sums to 59"},
       {"/states", parse(R"(["off", "off"])"), "m.json.states: duplicate name 'off'"},

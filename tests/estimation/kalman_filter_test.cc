@@ -198,13 +198,15 @@ TEST(EstimationKalman, RejectsBadInitialBeliefAndInputs) {
   EXPECT_EQ(kf->estimate(), Eigen::Vector2d(10, 0));  // untouched by the rejected inputs
 }
 
-// R growing with the units in transit, R(x^-) = R + TransitCount(x^-) R_transit, against a
+// R growing with the units in transit, R(x^-) = R + n R_transit + n^2 R_transit2 with
+// n = TransitCount(x^-), against a
 // textbook filter written out densely (explicit Qz, Joseph form with its own R_k) over a run of
 // broadcasts and measurements of the three-state unit, whose only state in transit is
 // "warming" (interior 0.4 on the diagonal). The dynamic and the fixed-size filters both.
 TEST(EstimationKalman, TransitNoiseMatchesTextbookFilterWithStateDependentR) {
   estimation::FilterModel f = testing_util::ThreeStateModel(40, 0.3);
   f.R_transit = Eigen::MatrixXd::Constant(1, 1, 0.05);
+  f.R_transit2 = Eigen::MatrixXd::Constant(1, 1, 0.004);
   EXPECT_EQ(f.TransitMask(), Eigen::Vector3d(0, 1, 0));
   auto d = estimation::PopulationKalmanFilter::Create(f, estimation::CovarianceMode::kExtended);
   auto s =
@@ -213,7 +215,7 @@ TEST(EstimationKalman, TransitNoiseMatchesTextbookFilterWithStateDependentR) {
   Eigen::Vector3d x = f.x0;
   Eigen::Matrix3d P = Eigen::Matrix3d::Zero();
   const Eigen::RowVector3d h = f.H;
-  const double r0 = f.R(0, 0), rt = f.R_transit(0, 0);
+  const double r0 = f.R(0, 0), rt = f.R_transit(0, 0), rt2 = f.R_transit2(0, 0);
   for (int t = 0; t < 60; ++t) {
     const double p_on = 0.05 + 0.1 * ((t / 7) % 3), p_off = 0.02 + 0.04 * ((t / 5) % 4);
     d->PredictBroadcast(p_on, p_off);
@@ -229,7 +231,8 @@ TEST(EstimationKalman, TransitNoiseMatchesTextbookFilterWithStateDependentR) {
     x = A * x;
     if (t % 4 == 3) continue;  // a lost sample: prediction only
     const double y = 0.2 * x(1) + 0.45 * x(2) + 0.7 * std::sin(0.9 * t);
-    const double R = r0 + rt * std::max(0.0, x(1));
+    const double n = std::max(0.0, x(1));
+    const double R = r0 + rt * n + rt2 * n * n;
     EXPECT_NEAR(d->TransitCount(), std::max(0.0, x(1)), 1e-9) << t;
     const double S = (h * P * h.transpose())(0, 0) + R;
     const Eigen::Vector3d K = P * h.transpose() / S;
@@ -247,19 +250,23 @@ TEST(EstimationKalman, TransitNoiseMatchesTextbookFilterWithStateDependentR) {
   EXPECT_LT((s->covariance() - P).cwiseAbs().maxCoeff(), 1e-9);
 }
 
-// A model whose R_transit is zero is the constant-R filter bit for bit (the path of every model
-// file written before R_transit existed); one with R_transit > 0 differs.
+// A model whose R_transit and R_transit2 are zero is the constant-R filter bit for bit (the path
+// of every model file written before they existed); one with either > 0 differs.
 TEST(EstimationKalman, ZeroTransitNoiseIsTheConstantFilterBitForBit) {
   const estimation::FilterModel plain = testing_util::ThreeStateModel(40, 0.3);
-  estimation::FilterModel zero = plain, some = plain;
+  estimation::FilterModel zero = plain, some = plain, shared = plain;
   zero.R_transit = Eigen::MatrixXd::Zero(1, 1);
+  zero.R_transit2 = Eigen::MatrixXd::Zero(1, 1);
   some.R_transit = Eigen::MatrixXd::Constant(1, 1, 0.05);
+  shared.R_transit2 = Eigen::MatrixXd::Constant(1, 1, 0.05);
   auto a = estimation::PopulationKalmanFilter::Create(plain, estimation::CovarianceMode::kExtended);
   auto b = estimation::PopulationKalmanFilter::Create(zero, estimation::CovarianceMode::kExtended);
   auto c = estimation::PopulationKalmanFilter::Create(some, estimation::CovarianceMode::kExtended);
-  ASSERT_TRUE(a.ok() && b.ok() && c.ok());
+  auto e =
+      estimation::PopulationKalmanFilter::Create(shared, estimation::CovarianceMode::kExtended);
+  ASSERT_TRUE(a.ok() && b.ok() && c.ok() && e.ok());
   for (int t = 0; t < 60; ++t) {
-    for (auto* k : {&*a, &*b, &*c}) {
+    for (auto* k : {&*a, &*b, &*c, &*e}) {
       k->PredictBroadcast(0.1, 0.05);
       k->Update(Eigen::VectorXd::Constant(1, 5.0 + std::sin(0.3 * t)));
     }
@@ -269,6 +276,8 @@ TEST(EstimationKalman, ZeroTransitNoiseIsTheConstantFilterBitForBit) {
   EXPECT_EQ(b->TransitCount(), 0.0);
   EXPECT_GT(c->TransitCount(), 1.0);
   EXPECT_GT((a->estimate() - c->estimate()).cwiseAbs().maxCoeff(), 1e-6);
+  EXPECT_GT(e->TransitCount(), 1.0);
+  EXPECT_GT((a->estimate() - e->estimate()).cwiseAbs().maxCoeff(), 1e-6);
 }
 
 }  // namespace file_kalman_filter_test

@@ -164,12 +164,14 @@ std::string UncertainStartModel() {
 }
 
 // The same with measurement noise growing with the units in transit (R_transit = 0.01 N^2 per
-// unit in transit, against R = 0.0027 N^2): the package evaluates R at the predicted counts.
+// unit in transit and R_transit2 = 0.001 N^2 per squared unit, against R = 0.0027 N^2): the
+// package evaluates R at the predicted counts.
 std::string TransitNoiseModel() {
   static const std::string path = [] {
     std::ifstream in(UncertainStartModel());
     nlohmann::json j = nlohmann::json::parse(in);
     j["R_transit"] = {{0.01}};
+    j["R_transit2"] = {{0.001}};
     const auto out = FreshDir("models_transit") / "bench_p0_transit.json";
     std::ofstream(out) << j.dump();
     return out.string();
@@ -177,7 +179,8 @@ std::string TransitNoiseModel() {
   return path;
 }
 
-// The elbow arm's shipped flexor and extensor models (dT = 1 s) with R_transit = their R and an
+// The elbow arm's shipped flexor and extensor models (dT = 1 s) with R_transit = their R,
+// R_transit2 = R / 10 and an
 // uncertain start (as UncertainStartModel): the length-aware filter with the transit term, as
 // "{bundle}" files (one per bundle).
 std::string ArmTransitModels() {
@@ -190,6 +193,7 @@ std::string ArmTransitModels() {
       std::ifstream in(shipped + file);
       nlohmann::json j = nlohmann::json::parse(in);
       j["R_transit"] = j["R"];
+      j["R_transit2"] = {{j["R"][0][0].get<double>() / 10}};
       auto& P0 = j["initial"]["P0"];
       for (size_t i = 0; i < P0.size(); ++i) P0[i][i] = 0.5;
       std::ofstream(dir / (bundle + ".json")) << j.dump();
@@ -244,6 +248,7 @@ TEST(ExportEquivalence, TransitNoiseReachesThePackage) {
     if (f.name == "recruit_controller.c") c_file = f.contents;
   }
   EXPECT_NE(c_file.find(".R_transit = 0.01"), std::string::npos);
+  EXPECT_NE(c_file.find(".R_transit2 = 0.001"), std::string::npos);
   // cold (0) and hot (10) settled, the heating and cooling states in transit.
   EXPECT_NE(c_file.find("b0_transit[20] = {\n    0, 1, 1, 1, 1, 1,\n    1, 1, 1, 1, 0, 1,"),
             std::string::npos);

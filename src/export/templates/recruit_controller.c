@@ -35,9 +35,9 @@ struct recruit_bundle_params {
   recruit_real R, relative_noise; /* R + (relative_noise H x)^2: the measurement variance */
   const recruit_real *x0, *P0;    /* initial belief (P0 packed; NULL = 0) */
   const recruit_real *gqg;        /* process noise G Qw G^T, packed; NULL = none */
-  /* The variance each unit in transit adds (FilterModel::R_transit), and which states are in
-   * transit (1; TransitMask); transit NULL: none. */
-  recruit_real R_transit;
+  /* The variance n units in transit add, n R_transit + n^2 R_transit2 (FilterModel), and which
+   * states are in transit (1; TransitMask); transit NULL: none. */
+  recruit_real R_transit, R_transit2;
   const uint8_t *transit;
 };
 
@@ -248,7 +248,7 @@ static void kalman_observe(recruit_bundle *b, recruit_work *w, recruit_real y,
     for (i = 0; i < m; ++i) {
       if (p->transit[i] && b->x[i] > RK(0)) n += b->x[i];
     }
-    R += n * p->R_transit;
+    R += n * p->R_transit + (n * n) * p->R_transit2;
   }
   kalman_update(b, w, h, R, y);
 }
