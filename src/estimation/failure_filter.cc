@@ -271,8 +271,8 @@ double FailureKalmanFilter::OutputNoise() const {
       }
     }
   }
-  auto first = [](const Eigen::MatrixXd& t) { return t.size() > 0 ? t(0, 0) : 0.0; };
-  return R_(0, 0) + (n * first(model_.R_transit) + (n * n) * first(model_.R_transit2));
+  const auto [rt, rt2] = model_.ScalarTransitNoise();
+  return R_(0, 0) + (n * rt + (n * n) * rt2);
 }
 
 void FailureKalmanFilter::SetOutput(const Eigen::MatrixXd& H, const Eigen::MatrixXd& R) {

@@ -8,6 +8,7 @@
 #include <limits>
 #include <nlohmann/json_fwd.hpp>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "common/result.h"
@@ -60,6 +61,12 @@ struct FilterModel {
   Status Validate(const std::string& where = "filter model") const;
 
   static bool NonZero(const Eigen::MatrixXd& m) { return m.size() > 0 && (m.array() != 0).any(); }
+  // A one-output model's transit coefficients, R_transit(0, 0) and R_transit2(0, 0), 0 for a
+  // missing matrix: its transit noise is n first + n^2 second.
+  std::pair<double, double> ScalarTransitNoise() const {
+    auto entry = [](const Eigen::MatrixXd& t) { return t.size() > 0 ? t(0, 0) : 0.0; };
+    return {entry(R_transit), entry(R_transit2)};
+  }
 
   // The same units and sensor for a population of N agents: x0 and P0 are rescaled by N'/N.
   FilterModel WithPopulation(int64_t N_new) const;

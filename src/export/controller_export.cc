@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "common/version.h"
@@ -120,9 +121,7 @@ Result<BundleConstants> Constants(const sim::BundleController& bc, const std::st
   out.R = model.R(0, 0);
   out.relative_noise = k->relative_noise();
   if (model.has_transit_noise()) {
-    auto first = [](const Eigen::MatrixXd& t) { return t.size() > 0 ? t(0, 0) : 0.0; };
-    out.R_transit = first(model.R_transit);
-    out.R_transit2 = first(model.R_transit2);
+    std::tie(out.R_transit, out.R_transit2) = model.ScalarTransitNoise();
     const Eigen::VectorXd mask = model.TransitMask();
     for (int i = 0; i < out.m; ++i) out.transit.push_back(mask[i] != 0.0 ? 1 : 0);
   }
