@@ -205,7 +205,7 @@ FailureKalmanFilter::FailureKalmanFilter(FilterModel model, CovarianceMode mode,
   N_ = static_cast<double>(model_.N);
   H_ = model_.H;
   R_ = model_.R;
-  if (model_.has_transit_noise()) transit_ = model_.TransitMask();
+  if (model_.has_transit_noise()) transit_ = model_.TransitWeights();
   A_ = Eigen::MatrixXd::Identity(3 * m_ + 1, 3 * m_ + 1);
 }
 
@@ -267,7 +267,7 @@ double FailureKalmanFilter::OutputNoise() const {
     // Working, open and stuck units alike are in transit while their wires heat or cool.
     for (int b = 0; b < 3; ++b) {
       for (int j = 0; j < m_; ++j) {
-        if (transit_[j] != 0.0 && x_[b * m_ + j] > 0.0) n += x_[b * m_ + j];
+        if (transit_[j] != 0.0 && x_[b * m_ + j] > 0.0) n += transit_[j] * x_[b * m_ + j];
       }
     }
   }

@@ -217,7 +217,7 @@ class FailureKalmanFilter {
   Eigen::VectorXd x_;  // 3m + 1: [x_w; x_open; x_stuck; c]
   Eigen::MatrixXd P_, A_;
   Eigen::MatrixXd H_, R_;    // the working states' output (1 x m), noise
-  Eigen::VectorXd transit_;  // 1 on the states of FilterModel::TransitMask (empty: no R_transit)
+  Eigen::VectorXd transit_;  // FilterModel::TransitWeights (empty: no transit noise)
   mutable Eigen::VectorXd view_x_;
   mutable Eigen::MatrixXd view_P_;
   FailureGlr glr_;

@@ -12,6 +12,7 @@
 #include "estimation/filter_model_cache.h"
 #include "estimation/json_matrix.h"
 #include "estimation/population_chain.h"
+#include "estimation/transit_weights.h"
 
 namespace recruit::estimation {
 
@@ -21,12 +22,12 @@ Eigen::MatrixXd FilterModel::ProcessNoise() const {
   return G * Qw * G.transpose();
 }
 
-Eigen::VectorXd FilterModel::TransitMask() const {
+Eigen::VectorXd FilterModel::TransitWeights() const {
   const int m = num_states();
-  Eigen::VectorXd mask = Eigen::VectorXd::Zero(m);
-  if (transition != TransitionSource::kBroadcast || broadcast.interior.rows() != m) return mask;
-  for (int j = 0; j < m; ++j) mask[j] = broadcast.interior(j, j) < 1.0 ? 1.0 : 0.0;
-  return mask;
+  if (transition != TransitionSource::kBroadcast || broadcast.interior.rows() != m) {
+    return Eigen::VectorXd::Zero(m);
+  }
+  return estimation::TransitWeights(broadcast.interior, H);
 }
 
 namespace {

@@ -51,10 +51,11 @@ struct FilterModel {
   Eigen::MatrixXd ProcessNoise() const;
   // True when R_transit or R_transit2 is not all zero (the measurement noise depends on the state).
   bool has_transit_noise() const { return NonZero(R_transit) || NonZero(R_transit2); }
-  // 1 for the states a unit leaves without being switched (interior(j, j) < 1 in the broadcast
-  // model: the heating and cooling transients), 0 for the others (the settled states); all 0
-  // for other transition sources.
-  Eigen::VectorXd TransitMask() const;
+  // How much each state counts as in transit (estimation/transit_weights.h): for the states a
+  // unit leaves without being switched (interior(j, j) < 1 in the broadcast model: the heating
+  // and cooling transients), the force step to the next state over H's range; 0 for the settled
+  // states and for other transition sources.
+  Eigen::VectorXd TransitWeights() const;
 
   // Checks every field and the relations between them; `where` (the file) prefixes messages.
   // G Qw G^T must have zero column sums: process noise cannot change the total N.

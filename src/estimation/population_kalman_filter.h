@@ -127,12 +127,12 @@ class PopulationKalmanFilterT {
   // neither), evaluated at the predicted estimate.
   void Update(const OutVec& y);
   // The expected number of units in transit at the current estimate: the sum of max(0, x_j)
-  // over the states of FilterModel::TransitMask, in state order (0 without R_transit).
+  // weighted by FilterModel::TransitWeights, in state order (0 without transit noise).
   double TransitCount() const {
     double n = 0.0;
     if (!has_transit_noise_) return n;
     for (Eigen::Index j = 0; j < x_.size(); ++j) {
-      if (transit_mask_[j] != 0.0 && x_[j] > 0.0) n += x_[j];
+      if (transit_weights_[j] != 0.0 && x_[j] > 0.0) n += transit_weights_[j] * x_[j];
     }
     return n;
   }
@@ -198,9 +198,9 @@ class PopulationKalmanFilterT {
   double N_ = 0.0;
   OutputMat H_;
   OutMat R_;
-  OutMat R_transit_;   // per unit in transit (has_transit_noise_ only)
-  OutMat R_transit2_;  // per squared count of units in transit (has_transit_noise_ only)
-  Vec transit_mask_;   // FilterModel::TransitMask
+  OutMat R_transit_;     // per unit in transit (has_transit_noise_ only)
+  OutMat R_transit2_;    // per squared count of units in transit (has_transit_noise_ only)
+  Vec transit_weights_;  // FilterModel::TransitWeights
   bool has_transit_noise_ = false;
   Mat GQG_;  // G Qw G^T, precomputed
   bool has_process_noise_ = false;
@@ -344,7 +344,7 @@ Result<PopulationKalmanFilterT<M, R>> PopulationKalmanFilterT<M, R>::Create(
   };
   f.R_transit_ = f.has_transit_noise_ ? or_zero(model.R_transit) : OutMat::Zero(r, r);
   f.R_transit2_ = f.has_transit_noise_ ? or_zero(model.R_transit2) : OutMat::Zero(r, r);
-  f.transit_mask_ = model.TransitMask();
+  f.transit_weights_ = model.TransitWeights();
   f.GQG_ = model.ProcessNoise();
   f.has_process_noise_ = model.G.cols() > 0;
   f.x_ = x0;

@@ -25,8 +25,9 @@ struct BundleConstants {
   double N = 0, lambda = 0, unit_force = 0;
   bool length_aware = false;
   double prestretch = 0, ref_length = 0, on_k = 0, on_c = 0;
-  std::vector<int> ptr, col, target, is_on, transit;  // transit: empty without transit noise
-  std::vector<double> base, k, c, h, x0, P0, gqg;     // P0, gqg packed; empty = none
+  std::vector<int> ptr, col, target, is_on;
+  std::vector<double> base, k, c, h, x0, P0, gqg;  // P0, gqg packed; empty = none
+  std::vector<double> transit;                     // FilterModel::TransitWeights; empty: none
   double R = 0, relative_noise = 0, R_transit = 0, R_transit2 = 0;
 };
 
@@ -122,8 +123,8 @@ Result<BundleConstants> Constants(const sim::BundleController& bc, const std::st
   out.relative_noise = k->relative_noise();
   if (model.has_transit_noise()) {
     std::tie(out.R_transit, out.R_transit2) = model.ScalarTransitNoise();
-    const Eigen::VectorXd mask = model.TransitMask();
-    for (int i = 0; i < out.m; ++i) out.transit.push_back(mask[i] != 0.0 ? 1 : 0);
+    const Eigen::VectorXd weights = model.TransitWeights();
+    out.transit.assign(weights.data(), weights.data() + out.m);
   }
   out.x0.assign(model.x0.data(), model.x0.data() + out.m);
   out.P0 = Packed(model.P0);
@@ -153,7 +154,6 @@ std::string BundleBlock(const BundleConstants& b, int i, const Writer& w) {
     s += w.Array("uint8_t", n + "col", b.col, false);
     s += w.Array("uint8_t", n + "target", b.target, false);
     s += w.Array("uint8_t", n + "is_on", b.is_on, false);
-    if (!b.transit.empty()) s += w.Array("uint8_t", n + "transit", b.transit, false);
     s += w.Array("recruit_real", n + "base", b.base, true);
     s += w.Array("recruit_real", n + "h", b.h, true);
     s += w.Array("recruit_real", n + "x0", b.x0, true);
@@ -161,6 +161,7 @@ std::string BundleBlock(const BundleConstants& b, int i, const Writer& w) {
     if (!b.c.empty()) s += w.Array("recruit_real", n + "c", b.c, true);
     if (!b.P0.empty()) s += w.Array("recruit_real", n + "P0", b.P0, true);
     if (!b.gqg.empty()) s += w.Array("recruit_real", n + "gqg", b.gqg, true);
+    if (!b.transit.empty()) s += w.Array("recruit_real", n + "transit", b.transit, true);
   }
   const bool kf = b.m > 0;
   auto field = [](const std::string& name, const std::string& value) {

@@ -7,6 +7,7 @@
 #include <limits>
 #include <utility>
 
+#include "estimation/transit_weights.h"
 #include "identification/nelder_mead.h"
 #include "identification/nonnegative_qp.h"
 
@@ -246,11 +247,8 @@ bool RefineTargets(Problem& p, const Eigen::VectorXd& a) {
 
 }  // namespace
 
-Eigen::VectorXd TransitMask(const TransientChain& c) {
-  const Eigen::MatrixXd interior = c.Interior();
-  Eigen::VectorXd mask = Eigen::VectorXd::Zero(c.num_states());
-  for (int j = 0; j < c.num_states(); ++j) mask[j] = interior(j, j) < 1.0 ? 1.0 : 0.0;
-  return mask;
+Eigen::VectorXd TransitWeights(const TransientChain& c) {
+  return estimation::TransitWeights(c.Interior(), c.force.transpose());
 }
 
 // The population Kalman filter of eqs. 15-27 (extended covariance), dense and written out here:
@@ -258,7 +256,7 @@ Eigen::VectorXd TransitMask(const TransientChain& c) {
 double NoiseNegLogLikelihood(const TransientChain& c, const SwitchingLog& log, int rows,
                              const NoiseModel& noise) {
   const int m = c.num_states();
-  const Eigen::VectorXd mask = TransitMask(c);
+  const Eigen::VectorXd mask = TransitWeights(c);
   Eigen::VectorXd x = Eigen::VectorXd::Zero(m);
   x[c.cold()] = log.num_units;
   Eigen::MatrixXd P = Eigen::MatrixXd::Zero(m, m);
@@ -326,7 +324,7 @@ NoiseModel MaxLikelihoodNoiseModel(const TransientChain& c, const SwitchingLog& 
                                    double constant, double lo, double hi) {
   const NoiseModel flat{constant, 0.0};
   // The mean units in transit along the mean trajectory: the scale of r_transit's start.
-  const Eigen::VectorXd mask = TransitMask(c);
+  const Eigen::VectorXd mask = TransitWeights(c);
   const double transit = (MeanTrajectory(c, log, rows) * mask).mean();
   if (!(transit > 1e-9)) return flat;
   const double log_lo = std::log(lo), log_hi = std::log(hi);
@@ -394,7 +392,7 @@ NoiseModel SettledNoiseModel(const TransientChain& c, const SwitchingLog& log, i
   for (int k : settled) residual.push_back(log.force[k] - predicted[k]);
   const double sd = 1.4826 * MedianAbsoluteDeviation(residual);
   const double r0 = std::clamp(sd * sd, lo, hi);
-  const double transit = (MeanTrajectory(c, log, rows) * TransitMask(c)).mean();
+  const double transit = (MeanTrajectory(c, log, rows) * TransitWeights(c)).mean();
   if (!(transit > 1e-9)) return {r0, 0.0};
   // r_transit2 from 1e-6 of the floor over the mean units in transit (below that its term is
   // nothing) to the whole force variance over their square.

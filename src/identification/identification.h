@@ -50,8 +50,8 @@ struct FitMetrics {
 };
 
 // The measurement noise model R(x) = r0 + r_transit n + r_transit2 n^2, n = TransitCount(x) the
-// sum of max(0, x_j) over the states a unit leaves without being switched (TransitMask), x the
-// filter's predicted counts. r_transit: errors independent from unit to unit; r_transit2: an
+// sum of w_j max(0, x_j), w = TransitWeights (the states a unit leaves unswitched, by force step),
+// x the filter's predicted counts. r_transit: errors independent from unit to unit; r_transit2: an
 // error the units in transit share (docs/identification.md, "Noise in transit").
 struct NoiseModel {
   double r0 = 0;          // N^2
@@ -83,9 +83,10 @@ Eigen::VectorXd PredictMeanForce(const TransientChain& chain, const SwitchingLog
 double MaxLikelihoodNoise(const TransientChain& chain, const SwitchingLog& log, int rows, double lo,
                           double hi);
 
-// 1 for the chain's states a unit leaves without being switched (interior(j, j) < 1: the
-// heating and cooling states), 0 for cold and hot (FilterModel::TransitMask of its export).
-Eigen::VectorXd TransitMask(const TransientChain& chain);
+// For the chain's states a unit leaves without being switched (interior(j, j) < 1: the heating
+// and cooling states), the force step to the next state over the force range; 0 for cold and
+// hot (estimation::TransitWeights; FilterModel::TransitWeights of its export).
+Eigen::VectorXd TransitWeights(const TransientChain& chain);
 
 // Negative log-likelihood (up to constants, sum of log S_k + nu_k^2 / S_k) of
 // log.force[0, rows) under the population Kalman filter on `chain` (extended covariance) with

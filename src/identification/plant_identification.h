@@ -25,7 +25,7 @@ namespace recruit::identification {
 // "identification.version": raise it whenever a change to the recording, the fit or the export
 // changes the model it makes, so that models cached by an older build are made again
 // (model_cache.h).
-constexpr int kIdentificationVersion = 8;
+constexpr int kIdentificationVersion = 9;
 
 struct PlantIdentificationOptions {
   double dT = control::kDefaultDT;  // s

@@ -98,16 +98,22 @@ TEST(EstimationFilterModel, SaveAndLoadRoundTrip) {
   std::remove(path.c_str());
 }
 
-// The states in transit are those a unit leaves without a broadcast: interior(j, j) < 1.
-TEST(EstimationFilterModel, TransitMaskIsTheStatesAUnitLeavesUnswitched) {
+// A state's transit weight is the force between it and the state its units move on to, as a
+// fraction of the force range; settled states (interior(j, j) = 1) weigh 0.
+TEST(EstimationFilterModel, TransitWeightsAreTheForceStepToTheNextState) {
   estimation::FilterModel f = estimation::FilterModel::TwoState(60, 0.5, 0.45, 0.3);
-  EXPECT_EQ(f.TransitMask(), Eigen::Vector2d::Zero());
+  EXPECT_EQ(f.TransitWeights(), Eigen::Vector2d::Zero());
   f.broadcast = estimation::BroadcastTransitionModel::HeatingChain(6, 0.5);
   f.state_names = f.broadcast.state_names;
-  // HeatingChain(6): 0 settled off, 1..3 on (3 settled), 4..5 cooling.
+  // HeatingChain(6): 0 settled off, 1 -> 2 -> 3 heating (3 settled on), 4 -> 5 -> 0 cooling.
+  f.H = Eigen::RowVectorXd(6);
+  f.H << 0, 0.1, 0.3, 0.4, 0.25, 0.05;  // range 0.4
   Eigen::VectorXd expected(6);
-  expected << 0, 1, 1, 0, 1, 1;
-  EXPECT_EQ(f.TransitMask(), expected);
+  expected << 0, 0.2 / 0.4, 0.1 / 0.4, 0, 0.2 / 0.4, 0.05 / 0.4;
+  EXPECT_LT((f.TransitWeights() - expected).cwiseAbs().maxCoeff(), 1e-15);
+  // A state whose force is already its successor's weighs nothing.
+  f.H(2) = 0.4;
+  EXPECT_EQ(f.TransitWeights()[2], 0.0);
 }
 
 nlohmann::json GoodJson() {

@@ -199,15 +199,16 @@ TEST(EstimationKalman, RejectsBadInitialBeliefAndInputs) {
 }
 
 // R growing with the units in transit, R(x^-) = R + n R_transit + n^2 R_transit2 with
-// n = TransitCount(x^-), against a
-// textbook filter written out densely (explicit Qz, Joseph form with its own R_k) over a run of
-// broadcasts and measurements of the three-state unit, whose only state in transit is
-// "warming" (interior 0.4 on the diagonal). The dynamic and the fixed-size filters both.
+// n = TransitCount(x^-), against a textbook filter written out densely (explicit Qz, Joseph form
+// with its own R_k) over a run of broadcasts and measurements of the three-state unit, whose
+// only state in transit is "warming" (interior 0.4 on the diagonal; weight (0.45 - 0.2) / 0.45,
+// its force step to "on" over the force range). The dynamic and the fixed-size filters both.
 TEST(EstimationKalman, TransitNoiseMatchesTextbookFilterWithStateDependentR) {
   estimation::FilterModel f = testing_util::ThreeStateModel(40, 0.3);
   f.R_transit = Eigen::MatrixXd::Constant(1, 1, 0.05);
   f.R_transit2 = Eigen::MatrixXd::Constant(1, 1, 0.004);
-  EXPECT_EQ(f.TransitMask(), Eigen::Vector3d(0, 1, 0));
+  const double w = (0.45 - 0.2) / 0.45;
+  EXPECT_LT((f.TransitWeights() - Eigen::Vector3d(0, w, 0)).cwiseAbs().maxCoeff(), 1e-15);
   auto d = estimation::PopulationKalmanFilter::Create(f, estimation::CovarianceMode::kExtended);
   auto s =
       estimation::PopulationKalmanFilterT<3, 1>::Create(f, estimation::CovarianceMode::kExtended);
@@ -231,9 +232,9 @@ TEST(EstimationKalman, TransitNoiseMatchesTextbookFilterWithStateDependentR) {
     x = A * x;
     if (t % 4 == 3) continue;  // a lost sample: prediction only
     const double y = 0.2 * x(1) + 0.45 * x(2) + 0.7 * std::sin(0.9 * t);
-    const double n = std::max(0.0, x(1));
+    const double n = w * std::max(0.0, x(1));
     const double R = r0 + rt * n + rt2 * n * n;
-    EXPECT_NEAR(d->TransitCount(), std::max(0.0, x(1)), 1e-9) << t;
+    EXPECT_NEAR(d->TransitCount(), n, 1e-9) << t;
     const double S = (h * P * h.transpose())(0, 0) + R;
     const Eigen::Vector3d K = P * h.transpose() / S;
     x += K * (y - h.dot(x));

@@ -249,9 +249,32 @@ TEST(ExportEquivalence, TransitNoiseReachesThePackage) {
   }
   EXPECT_NE(c_file.find(".R_transit = 0.01"), std::string::npos);
   EXPECT_NE(c_file.find(".R_transit2 = 0.001"), std::string::npos);
-  // cold (0) and hot (10) settled, the heating and cooling states in transit.
-  EXPECT_NE(c_file.find("b0_transit[20] = {\n    0, 1, 1, 1, 1, 1,\n    1, 1, 1, 1, 0, 1,"),
-            std::string::npos);
+  // Each state's transit weight, from the model file here: its force step to the state its
+  // units most likely move on to (interior column), over the force range; cold and hot 0.
+  std::ifstream in(TransitNoiseModel());
+  const nlohmann::json j = nlohmann::json::parse(in);
+  const auto h = j["H"][0].get<std::vector<double>>();
+  const auto interior = j["transition"]["interior"].get<std::vector<std::vector<double>>>();
+  const double range =
+      *std::max_element(h.begin(), h.end()) - *std::min_element(h.begin(), h.end());
+  const size_t head = c_file.find("b0_transit[20] = {");
+  ASSERT_NE(head, std::string::npos);
+  std::istringstream values(c_file.substr(c_file.find('{', head) + 1));
+  for (size_t col = 0; col < h.size(); ++col) {
+    size_t next = col;
+    for (size_t row = 0; row < h.size(); ++row) {
+      if (row != col && interior[row][col] > 0 &&
+          (next == col || interior[row][col] > interior[next][col])) {
+        next = row;
+      }
+    }
+    const double expected =
+        interior[col][col] < 1 && next != col ? std::abs(h[next] - h[col]) / range : 0.0;
+    double written = -1;
+    char comma = 0;
+    values >> written >> comma;
+    EXPECT_NEAR(written, expected, 1e-15) << "state " << col;
+  }
   const auto a = Record(plain, 7), b = Record(transit, 7);
   ASSERT_EQ(a.size(), b.size());
   double largest = 0;

@@ -35,10 +35,10 @@ struct recruit_bundle_params {
   recruit_real R, relative_noise; /* R + (relative_noise H x)^2: the measurement variance */
   const recruit_real *x0, *P0;    /* initial belief (P0 packed; NULL = 0) */
   const recruit_real *gqg;        /* process noise G Qw G^T, packed; NULL = none */
-  /* The variance n units in transit add, n R_transit + n^2 R_transit2 (FilterModel), and which
-   * states are in transit (1; TransitMask); transit NULL: none. */
+  /* The variance n units in transit add, n R_transit + n^2 R_transit2 (FilterModel), n the
+   * counts weighted by how much each state is in transit (TransitWeights); transit NULL: none. */
   recruit_real R_transit, R_transit2;
-  const uint8_t *transit;
+  const recruit_real *transit;
 };
 
 /* clang-format off */
@@ -246,7 +246,7 @@ static void kalman_observe(recruit_bundle *b, recruit_work *w, recruit_real y,
   if (p->transit != NULL) { /* PopulationKalmanFilter::TransitCount, in state order */
     recruit_real n = RK(0);
     for (i = 0; i < m; ++i) {
-      if (p->transit[i] && b->x[i] > RK(0)) n += b->x[i];
+      if (p->transit[i] != RK(0) && b->x[i] > RK(0)) n += p->transit[i] * b->x[i];
     }
     R += n * p->R_transit + (n * n) * p->R_transit2;
   }
