@@ -47,6 +47,13 @@ void PrintDesign(const sim::JointDesignRecord& r, bool response) {
   } else {
     std::printf("does not settle\n");
   }
+  std::printf("%-14s %8s  one more unit on moves it", "", "");
+  for (size_t i = 0; i < r.unit_angle.size(); ++i) {
+    std::printf("%s %s %.3g deg", i ? "," : "", r.unit_angle[i].first.c_str(),
+                r.unit_angle[i].second * 180 / M_PI);
+  }
+  std::printf("; the settling band of this step is +-%.3g deg\n",
+              r.target.band * r.step * 180 / M_PI);
   if (!response) return;
   std::printf("%-14s %8s  step response (fraction of the step) at t = 0, dT, ...:", "", "");
   for (double y : d.nominal.angle) std::printf(" %.3f", y);

@@ -181,6 +181,15 @@ Result<JointDesignRecord> JointLoops::Design(const Plant& plant, int j, const Ei
   // Each way of the demand through the bundles that move it that way (not a design input).
   rec.both_ways = BothWays(plant, j, r, step);
   rec.release_t63 = rec.both_ways.Released().TimeTo(0.63);
+  const Eigen::VectorXd lengths = plant.UnitLengthsAt(r);
+  const double holding = rec.dynamics.stiffness + rec.design.gains.kp;
+  for (int i = 0; i < plant.num_bundles(); ++i) {
+    if (std::abs(arms(j, i)) <= tiny) continue;
+    const double torque = std::abs(arms(j, i)) * on_unit_force_[i](lengths[i]);
+    rec.unit_angle.emplace_back(
+        plant.bundle_name(i),
+        holding > 0 ? torque / holding : std::numeric_limits<double>::infinity());
+  }
   return rec;
 }
 

@@ -12,6 +12,7 @@
 
 #include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "common/result.h"
@@ -45,6 +46,10 @@ struct JointDesignRecord {
   // as the bundles will move the demand each way (recruit tune-loop).
   control::ActuatorResponse both_ways;
   double release_t63 = 0;
+  // The joint's resolution: for each bundle that crosses it (name, rad), the angle one more unit
+  // on moves it against the stiffness and kp, |arm| x unit force at the reference / (stiffness +
+  // kp); the count estimate's error of a few units moves the held pose by as many times this.
+  std::vector<std::pair<std::string, double>> unit_angle;
 };
 
 class JointLoops {

@@ -479,6 +479,8 @@ JointSummary ScoreJoint(const std::string& joint, const SignalMetrics& sig, doub
 
 nlohmann::json DesignJson(const JointDesignRecord& r) {
   const control::LoopDesign& d = r.design;
+  nlohmann::json unit_angle = nlohmann::json::object();
+  for (const auto& [bundle, angle] : r.unit_angle) unit_angle[bundle] = angle * 180 / M_PI;
   return {{"joint", r.joint},
           {"reference", r.reference},
           {"inertia", r.dynamics.inertia},
@@ -494,7 +496,8 @@ nlohmann::json DesignJson(const JointDesignRecord& r) {
           {"robust_overshoot", d.robust.overshoot},
           {"robust_settled", d.robust.settled},
           {"meets", d.meets},
-          {"note", d.note}};
+          {"note", d.note},
+          {"unit_angle_deg", unit_angle}};
 }
 
 // Several driven joints: each scored on its own reference, and the run's metrics over all of

@@ -318,6 +318,14 @@ TEST(JointLoop, BothWaysTakesEachBundlesRiseOrReleaseByTheWayItMovesTheTorque) {
   EXPECT_EQ(rec->target.band, t->settle_band);
   EXPECT_EQ(rec->target.hold, std::min(60.0, ShortestHold(t->joints[0].reference, t->duration)));
   EXPECT_EQ(rec->dT, dT);
+  // One unit's angle: each bundle's |arm| x 0.5 N over the joint's stiffness plus kp.
+  ASSERT_EQ(rec->unit_angle.size(), 2u);
+  for (int i = 0; i < 2; ++i) {
+    EXPECT_EQ(rec->unit_angle[i].first, pl.bundle_name(i));
+    EXPECT_NEAR(rec->unit_angle[i].second,
+                std::abs(arms(0, i)) * 0.5 / (rec->dynamics.stiffness + rec->design.gains.kp),
+                1e-12);
+  }
 }
 
 // A bundle designed past the wire's long-life temperature: the warning loading printed is in
