@@ -267,7 +267,7 @@ double FailureKalmanFilter::OutputNoise() const {
     // Working, open and stuck units alike are in transit while their wires heat or cool.
     for (int b = 0; b < 3; ++b) {
       for (int j = 0; j < m_; ++j) {
-        if (transit_[j] != 0.0 && x_[b * m_ + j] > 0.0) n += transit_[j] * x_[b * m_ + j];
+        if (x_[b * m_ + j] > 0.0) n += transit_[j] * x_[b * m_ + j];
       }
     }
   }

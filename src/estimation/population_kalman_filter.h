@@ -132,7 +132,7 @@ class PopulationKalmanFilterT {
     double n = 0.0;
     if (!has_transit_noise_) return n;
     for (Eigen::Index j = 0; j < x_.size(); ++j) {
-      if (transit_weights_[j] != 0.0 && x_[j] > 0.0) n += transit_weights_[j] * x_[j];
+      if (x_[j] > 0.0) n += transit_weights_[j] * x_[j];
     }
     return n;
   }

@@ -256,7 +256,7 @@ Eigen::VectorXd TransitWeights(const TransientChain& c) {
 double NoiseNegLogLikelihood(const TransientChain& c, const SwitchingLog& log, int rows,
                              const NoiseModel& noise) {
   const int m = c.num_states();
-  const Eigen::VectorXd mask = TransitWeights(c);
+  const Eigen::VectorXd weights = TransitWeights(c);
   Eigen::VectorXd x = Eigen::VectorXd::Zero(m);
   x[c.cold()] = log.num_units;
   Eigen::MatrixXd P = Eigen::MatrixXd::Zero(m, m);
@@ -264,7 +264,7 @@ double NoiseNegLogLikelihood(const TransientChain& c, const SwitchingLog& log, i
   const Eigen::MatrixXd I = Eigen::MatrixXd::Identity(m, m);
   double nll = 0;
   for (int k = 0; k < rows; ++k) {
-    const double R = noise.At(mask.dot(x.cwiseMax(0.0)));
+    const double R = noise.At(weights.dot(x.cwiseMax(0.0)));
     const Eigen::VectorXd ph = P * h;
     const double S = h.dot(ph) + R;
     const double nu = log.force[k] - h.dot(x);
@@ -324,8 +324,7 @@ NoiseModel MaxLikelihoodNoiseModel(const TransientChain& c, const SwitchingLog& 
                                    double constant, double lo, double hi) {
   const NoiseModel flat{constant, 0.0};
   // The mean units in transit along the mean trajectory: the scale of r_transit's start.
-  const Eigen::VectorXd mask = TransitWeights(c);
-  const double transit = (MeanTrajectory(c, log, rows) * mask).mean();
+  const double transit = (MeanTrajectory(c, log, rows) * TransitWeights(c)).mean();
   if (!(transit > 1e-9)) return flat;
   const double log_lo = std::log(lo), log_hi = std::log(hi);
   // r_transit is searched down to 1e-6 of the floor per unit: below that its term is nothing.

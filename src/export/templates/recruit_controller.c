@@ -246,7 +246,7 @@ static void kalman_observe(recruit_bundle *b, recruit_work *w, recruit_real y,
   if (p->transit != NULL) { /* PopulationKalmanFilter::TransitCount, in state order */
     recruit_real n = RK(0);
     for (i = 0; i < m; ++i) {
-      if (p->transit[i] != RK(0) && b->x[i] > RK(0)) n += p->transit[i] * b->x[i];
+      if (b->x[i] > RK(0)) n += p->transit[i] * b->x[i];
     }
     R += n * p->R_transit + (n * n) * p->R_transit2;
   }
